@@ -1,0 +1,48 @@
+"""Isotropic linear-elastic material constants (SI units)."""
+from dataclasses import dataclass
+import math
+
+from .errors import MaterialError
+
+
+@dataclass(frozen=True)
+class Material:
+    """Young's modulus ``E`` [Pa], Poisson's ratio ``nu`` [-], density ``rho`` [kg/m^3]."""
+
+    E: float
+    nu: float
+    rho: float = 1000.0
+
+    def __post_init__(self):
+        for name in ("E", "nu", "rho"):
+            v = getattr(self, name)
+            if not isinstance(v, (int, float)) or not math.isfinite(v):
+                raise MaterialError(f"Material.{name} must be a finite number, got {v!r}")
+        if self.E <= 0:
+            raise MaterialError(f"Young's modulus E must be > 0 Pa, got {self.E}")
+        if not -1.0 < self.nu < 0.5:
+            raise MaterialError(
+                f"Poisson's ratio nu must satisfy -1 < nu < 0.5, got {self.nu} "
+                "(nu = 0.5 is incompressible: use e.g. 0.49)")
+        if self.rho <= 0:
+            raise MaterialError(f"density rho must be > 0 kg/m^3, got {self.rho}")
+
+    @property
+    def G(self):
+        """Shear modulus E / (2 (1 + nu))."""
+        return self.E / (2.0 * (1.0 + self.nu))
+
+    @property
+    def K(self):
+        """Bulk modulus E / (3 (1 - 2 nu))."""
+        return self.E / (3.0 * (1.0 - 2.0 * self.nu))
+
+    @property
+    def lam(self):
+        """First Lame parameter."""
+        return self.E * self.nu / ((1.0 + self.nu) * (1.0 - 2.0 * self.nu))
+
+    @property
+    def p_wave_speed(self):
+        """Dilatational wave speed sqrt((K + 4G/3) / rho)."""
+        return math.sqrt((self.K + 4.0 * self.G / 3.0) / self.rho)
