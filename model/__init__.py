@@ -1,0 +1,50 @@
+"""The particle-based continuum model of Nakagawa et al. and its mass-spring baseline.
+
+>>> from model import Material, build
+>>> from model.mesh import cube
+>>> pm = build("pbcm-variational", cube(3, 0.032, "five"), Material(E=10e3, nu=0.45))
+>>> float(abs(pm.forces(pm.mesh.points)).max())
+0.0
+"""
+from .material import Material
+from .errors import (PbcmError, MeshError, MaterialError, ModelError, DegenerateTetError,
+                     BlowUpError, ConvergenceError)
+from .system import ParticleModel
+
+__version__ = "0.1.0"
+
+# name -> list of (term, parameters); MODEL.md "Shear force" and "Mass-spring baseline"
+PRESETS = {
+    "pbcm-corner": [("shear", {"reading": "corner"}), ("volume", {})],
+    "pbcm-balanced": [("shear", {"reading": "balanced"}), ("volume", {})],
+    "pbcm-variational": [("shear", {"reading": "variational", "c": "auto"}), ("volume", {})],
+    "pbcm-variational+normal": [("shear", {"reading": "variational", "c": "auto"}),
+                                ("normal", {"c": "auto"}), ("volume", {})],
+    "msm": [("springs", {})],
+    "msm+volume": [("springs", {}), ("volume", {})],
+}
+
+
+def build(model, mesh, material, **term_params):
+    """A :class:`ParticleModel` from a preset name or a list of ``(term, params)``.
+
+    ``term_params`` override parameters per term name, e.g.
+    ``build("pbcm-variational", mesh, mat, shear={"scale": 0.5})``.
+    """
+    if isinstance(model, str):
+        if model not in PRESETS:
+            raise ModelError(f"unknown model {model!r}; presets: {', '.join(PRESETS)}")
+        name, terms = model, PRESETS[model]
+    else:
+        name, terms = "custom", list(model)
+    unknown = set(term_params) - {t for t, _ in terms}
+    if unknown:
+        raise ModelError(f"parameters given for term(s) {', '.join(sorted(unknown))} that "
+                         f"model {name!r} does not have ({', '.join(t for t, _ in terms)})")
+    terms = [(t, {**p, **term_params.get(t, {})}) for t, p in terms]
+    return ParticleModel(mesh, material, terms, name=name)
+
+
+__all__ = ["Material", "build", "PRESETS", "ParticleModel", "PbcmError", "MeshError",
+           "MaterialError", "ModelError", "DegenerateTetError", "BlowUpError",
+           "ConvergenceError"]

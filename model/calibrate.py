@@ -1,0 +1,60 @@
+"""Calibration of auto-scaled energy terms against the isotropic deviatoric energy.
+
+A term whose coefficient is ``"auto"`` offers ``unit_energy(x)`` (its energy with coefficient 1).
+Under a homogeneous strain eps = sum_k a_k D_k over the orthonormal deviatoric basis D_k, each
+such term's energy is a^T Q a; the coefficients c_i >= 0 are fitted jointly by non-negative
+least squares so that sum_i c_i Q_i is closest (Frobenius) to G V I, the energy G |dev eps|^2 V.
+"""
+import numpy as np
+from scipy.optimize import nnls
+
+from .errors import ModelError
+
+
+def deviatoric_basis():
+    """Five orthonormal (Frobenius) symmetric traceless 3x3 tensors."""
+    s2 = np.sqrt(2.0)
+    b = [np.diag([1.0, -1.0, 0.0]) / s2, np.diag([1.0, 1.0, -2.0]) / np.sqrt(6.0)]
+    for i, j in ((0, 1), (1, 2), (0, 2)):
+        d = np.zeros((3, 3))
+        d[i, j] = d[j, i] = 1.0 / s2
+        b.append(d)
+    return np.array(b)
+
+
+def quadratic_form(energy, points, basis, delta=1e-4):
+    """Q with energy(X + delta eps X) = delta^2 a^T Q a + O(delta^4) (symmetric differences)."""
+    centred = points - points.mean(axis=0)
+
+    def w(eps):
+        return 0.5 * (energy(points + centred @ eps.T) + energy(points - centred @ eps.T))
+
+    nb = len(basis)
+    Q = np.empty((nb, nb))
+    for k in range(nb):
+        Q[k, k] = w(delta * basis[k]) / delta**2
+    for k in range(nb):
+        for l in range(k + 1, nb):
+            Q[k, l] = Q[l, k] = 0.5 * (w(delta * (basis[k] + basis[l])) / delta**2
+                                       - Q[k, k] - Q[l, l])
+    return Q
+
+
+def calibrate(terms, mesh, G):
+    """Set ``coef`` of every term with ``calibrate`` true; return the fit's summary."""
+    auto = [t for t in terms if getattr(t, "calibrate", False)]
+    if not auto:
+        return {}
+    basis = deviatoric_basis()
+    Qs = [quadratic_form(t.unit_energy, mesh.points, basis) for t in auto]
+    target = G * mesh.volumes.sum() * np.eye(len(basis))
+    coefs, _ = nnls(np.stack([q.ravel() for q in Qs], axis=1), target.ravel())
+    for t, c in zip(auto, coefs):
+        if not c > 0:
+            raise ModelError(f"calibration of {t.describe()} gave c = {c}: the term adds nothing "
+                             "to the deviatoric fit on this mesh; pass a number for c")
+        t.coef = float(c)
+    fitted = sum(c * q for c, q in zip(coefs, Qs)) / target[0, 0]
+    eig = np.linalg.eigvalsh(fitted)
+    # eigenvalues of the fitted deviatoric stiffness over G: all 1 for an isotropic model
+    return {"deviatoric_eig_min": float(eig.min()), "deviatoric_eig_max": float(eig.max())}

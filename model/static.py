@@ -1,0 +1,133 @@
+"""Quasi-static equilibrium: Newton on the free components with a coloured finite-difference
+Jacobian, so it needs no energy and serves the non-conservative readings too."""
+from dataclasses import dataclass
+
+import numpy as np
+import scipy.sparse as sp
+from scipy.sparse.linalg import spsolve
+
+from .bc import bc_arrays
+from .errors import ConvergenceError, DegenerateTetError, ModelError
+
+
+def node_adjacency(mesh):
+    """Sparse boolean node-node adjacency through shared tetrahedra (self included)."""
+    rows = np.repeat(mesh.tets, 4, axis=1).ravel()
+    cols = np.tile(mesh.tets, (1, 4)).ravel()
+    return sp.csr_matrix((np.ones(len(rows), dtype=bool), (rows, cols)),
+                         shape=(mesh.n_nodes,) * 2)
+
+
+def colour_nodes(adjacency):
+    """Greedy colouring in which two nodes of one colour share no neighbour, so perturbing all
+    of a colour at once leaves every force row touched by at most one of them."""
+    dist2 = (adjacency.astype(np.int32) @ adjacency.astype(np.int32)).tocsr()
+    colour = np.full(adjacency.shape[0], -1)
+    for i in range(adjacency.shape[0]):
+        taken = colour[dist2.indices[dist2.indptr[i]:dist2.indptr[i + 1]]]
+        c = 0
+        while c in taken:
+            c += 1
+        colour[i] = c
+    return colour
+
+
+def jacobian(forces, mesh, x, rel_step=1e-6):
+    """Sparse d forces / d x (3n x 3n) by central differences over node colours."""
+    adj = node_adjacency(mesh)
+    colour = colour_nodes(adj)
+    h = rel_step * np.linalg.norm(mesh.points[mesh.edges[:, 1]] - mesh.points[mesh.edges[:, 0]],
+                                  axis=1).mean()
+    rows, cols, vals = [], [], []
+    for c in range(colour.max() + 1):
+        nodes = np.flatnonzero(colour == c)
+        for k in range(3):
+            xp, xm = x.copy(), x.copy()
+            xp[nodes, k] += h
+            xm[nodes, k] -= h
+            df = (forces(xp) - forces(xm)) / (2 * h)
+            for q in nodes:
+                nb = adj.indices[adj.indptr[q]:adj.indptr[q + 1]]
+                rows.append((3 * nb[:, None] + np.arange(3)).ravel())
+                cols.append(np.full(3 * len(nb), 3 * q + k))
+                vals.append(df[nb].ravel())
+    n = 3 * mesh.n_nodes
+    return sp.csr_matrix((np.concatenate(vals), (np.concatenate(rows), np.concatenate(cols))),
+                         shape=(n, n))
+
+
+@dataclass
+class StaticResult:
+    """``x`` positions, ``u`` displacements, ``reaction`` (n, 3) support forces on the prescribed
+    components (zero elsewhere), ``residual`` max free-node force norm [N] reached, ``tol`` the
+    stated tolerance [N], ``iterations`` Newton iterations over all load steps."""
+
+    x: np.ndarray
+    u: np.ndarray
+    reaction: np.ndarray
+    residual: float
+    tol: float
+    iterations: int
+
+
+def force_scale(model):
+    """E h^2 with h the mean edge length: the size of a nodal force at unit strain [N]."""
+    m = model.mesh
+    h = np.linalg.norm(m.points[m.edges[:, 1]] - m.points[m.edges[:, 0]], axis=1).mean()
+    return model.material.E * h * h
+
+
+def solve(model, bc, f_ext=None, rtol=1e-9, max_iter=50, load_steps=1):
+    """Solve f_int(x) + f_ext = 0 on the free components, prescribed ones set from ``bc``.
+
+    Newton with a backtracking line search on the residual norm, in ``load_steps`` equal
+    increments of the prescribed displacement and of ``f_ext``; converged when the largest
+    free-node residual is below ``rtol * E h^2``. Raises ConvergenceError otherwise.
+    """
+    mesh = model.mesh
+    mask, vals = bc_arrays(bc, mesh.n_nodes)
+    if not mask.any():
+        raise ModelError("no prescribed component: the static problem is singular "
+                         "(rigid motions are free); fix or prescribe some nodes")
+    f_ext = np.zeros_like(mesh.points) if f_ext is None else np.asarray(f_ext, dtype=float)
+    free = ~mask.ravel()
+    tol = rtol * force_scale(model)
+    x = mesh.points.copy()
+    iters = 0
+
+    def residual(x, s):
+        return (model.forces(x) + s * f_ext).ravel()
+
+    for step in range(1, load_steps + 1):
+        s = step / load_steps
+        x[mask] = mesh.points[mask] + s * vals[mask]
+        r = residual(x, s)
+        for _ in range(max_iter):
+            rn = np.abs(r[free]).max(initial=0.0)
+            if rn <= tol:
+                break
+            J = model.jacobian(x).tocsc()[free][:, free]
+            du = spsolve(J, -r[free])
+            alpha = 1.0
+            while True:
+                xt = x.copy()
+                xt.ravel()[free] += alpha * du
+                try:
+                    rt = residual(xt, s)
+                    if np.abs(rt[free]).max() < rn or alpha < 1e-3:
+                        break
+                except DegenerateTetError:
+                    if alpha < 1e-3:
+                        raise
+                alpha *= 0.5
+            x, r = xt, rt
+            iters += 1
+        else:
+            raise ConvergenceError(
+                f"static solve did not converge in {max_iter} Newton iterations at load step "
+                f"{step}/{load_steps}: residual {rn:.3e} N > tol {tol:.3e} N; increase "
+                "load_steps or max_iter")
+    reaction = np.where(mask, -r.reshape(-1, 3), 0.0)
+    return StaticResult(x=x, u=x - mesh.points, reaction=reaction,
+                        residual=float(np.abs(r[free]).max(initial=0.0)), tol=tol,
+                        iterations=iters)

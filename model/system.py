@@ -1,0 +1,90 @@
+"""A particle model: a mesh, a material and a list of force terms, with its lumped masses."""
+import numpy as np
+
+from .calibrate import calibrate
+from .errors import ModelError
+from .terms import make_term
+from .terms.shear import Shear
+from .terms._kernels import volume_gradient_numpy
+from . import integrate, static
+
+
+class ParticleModel:
+    """Forces, energy, per-tetrahedron stresses, static equilibrium and RK4 dynamics.
+
+    Build one with :func:`model.build`. ``info`` holds what a report must state: the terms,
+    their parameters and calibration constants (``shear_c``, ``normal_c``).
+    """
+
+    def __init__(self, mesh, material, terms, name="custom"):
+        self.mesh, self.material, self.name = mesh, material, name
+        self.terms = [make_term(t, mesh, material, **p) for t, p in terms]
+        if not self.terms:
+            raise ModelError("a model needs at least one force term")
+        fit = calibrate(self.terms, mesh, material.G)
+        self.mass = np.zeros(mesh.n_nodes)
+        np.add.at(self.mass, mesh.tets, np.repeat(material.rho * mesh.volumes[:, None] / 4, 4, 1))
+        self._strain_probe = Shear(mesh, material, reading="corner")
+        self.info = {"model": name, "terms": [{"term": t.describe(), **t.info()}
+                                              for t in self.terms], **fit}
+        for t in self.terms:
+            if getattr(t, "coef", None) is not None:
+                self.info[f"{t.name}_c"] = t.coef
+
+    @property
+    def conservative(self):
+        return all(t.conservative for t in self.terms)
+
+    def forces(self, x):
+        """Internal forces (n, 3) [N] at positions x (n, 3) [m]."""
+        x = np.ascontiguousarray(x, dtype=np.float64)
+        if x.shape != self.mesh.points.shape:
+            raise ModelError(f"positions must have shape {self.mesh.points.shape}, got {x.shape}")
+        out = np.zeros_like(x)
+        for t in self.terms:
+            t.forces(x, out)
+        return out
+
+    def energy(self, x):
+        """Total stored energy [J]; an error for a model with a non-conservative term."""
+        return sum(t.energy(x) for t in self.terms)
+
+    def tet_stress(self, x):
+        """Per-tetrahedron ``max_tau`` = G max |gamma| over the 24 shear strains (the paper's
+        Figure 1 measure) and ``pressure`` p = -K (V - V0) / V [Pa], whatever the terms."""
+        V, _ = volume_gradient_numpy(np.asarray(x, dtype=np.float64), self.mesh.tets)
+        V0 = self.mesh.volumes
+        return {"max_tau": self._strain_probe.max_tau(x),
+                "pressure": -self.material.K * (V - V0) / V}
+
+    def net_force_torque(self, x):
+        """Net force and torque (about the centroid) of the internal forces at x, absolute and
+        relative to sum |f_i| and sum |x_i - c| |f_i|. Zero for a momentum-conserving model."""
+        f = self.forces(x)
+        r = x - x.mean(axis=0)
+        F, T = f.sum(axis=0), np.cross(r, f).sum(axis=0)
+        fs = np.linalg.norm(f, axis=1)
+        return {"force": F, "torque": T,
+                "force_rel": float(np.linalg.norm(F) / max(fs.sum(), 1e-300)),
+                "torque_rel": float(np.linalg.norm(T)
+                                    / max((np.linalg.norm(r, axis=1) * fs).sum(), 1e-300))}
+
+    def stable_dt(self, safety=0.5):
+        """safety * min_T h_T / c_p, with h_T the smallest height and c_p the P-wave speed."""
+        from .geometry import smallest_heights
+        return safety * float(smallest_heights(self.mesh.points, self.mesh.tets).min()) \
+            / self.material.p_wave_speed
+
+    def jacobian(self, x):
+        """Sparse d f / d x (3n x 3n) by coloured central differences (any reading)."""
+        return static.jacobian(self.forces, self.mesh, x)
+
+    def solve_static(self, bc, f_ext=None, rtol=1e-9, max_iter=50, load_steps=1):
+        """Equilibrium f_int(x) + f_ext = 0 on the free components (see model.static.solve)."""
+        return static.solve(self, bc, f_ext=f_ext, rtol=rtol, max_iter=max_iter,
+                            load_steps=load_steps)
+
+    def simulate(self, bc_of_t, t_end, dt=None, damping=0.0, f_ext=None, frames=101, safety=0.5):
+        """Classical RK4 dynamics (see model.integrate.simulate)."""
+        return integrate.simulate(self, bc_of_t, t_end, dt=dt, damping=damping, f_ext=f_ext,
+                                  frames=frames, safety=safety)

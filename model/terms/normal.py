@@ -1,0 +1,99 @@
+"""Deviatoric normal-stress extension (MODEL.md "Normal-stress extensions").
+
+The shear strains see no stretch along an edge. Per corner a, the three edge strains
+eps_j = (|d_j| - |D_j|) / |D_j| (d_j = x_j - x_a, D_j at rest) and their mean eps_a give
+
+    W = c_n G sum_T V0_T sum_a sum_j (eps_j - eps_a)^2,
+
+zero under uniform scaling (purely deviatoric, the volume term keeps the pressure).
+"""
+import numpy as np
+from numba import njit
+
+from . import Term, register
+from ..errors import ModelError
+
+# the three edges at each corner: (corner, other end)
+CORNER_EDGES = np.array([[(a, j) for j in range(4) if j != a] for a in range(4)], dtype=np.int64)
+
+
+@njit(cache=True)
+def _forces(x, tets, vol0, rest_len, coef_G, out):
+    d = np.empty((3, 3))
+    ln = np.empty(3)
+    eps = np.empty(3)
+    for t in range(tets.shape[0]):
+        for a in range(4):
+            na = tets[t, a]
+            for r in range(3):
+                nj = tets[t, CORNER_EDGES[a, r, 1]]
+                for k in range(3):
+                    d[r, k] = x[nj, k] - x[na, k]
+                ln[r] = np.sqrt(d[r, 0] ** 2 + d[r, 1] ** 2 + d[r, 2] ** 2)
+                if ln[r] <= 0.0:
+                    return t
+                eps[r] = ln[r] / rest_len[t, a, r] - 1.0
+            mean = (eps[0] + eps[1] + eps[2]) / 3.0
+            for r in range(3):
+                # dW/deps_r = 2 c_n G V0 (eps_r - mean); the mean's own derivative sums to zero
+                s = 2.0 * coef_G * vol0[t] * (eps[r] - mean) / (rest_len[t, a, r] * ln[r])
+                nj = tets[t, CORNER_EDGES[a, r, 1]]
+                for k in range(3):
+                    out[nj, k] -= s * d[r, k]
+                    out[na, k] += s * d[r, k]
+    return -1
+
+
+def edge_vectors(x, tets):
+    """d (m, 4, 3, 3): the three edge vectors at each corner."""
+    return x[tets[:, CORNER_EDGES[..., 1]]] - x[tets[:, CORNER_EDGES[..., 0]]]
+
+
+@register
+class Normal(Term):
+    """Deviatoric edge-strain term at each corner; ``c`` is ``"auto"`` or a positive number."""
+
+    name = "normal"
+    conservative = True
+    params = {"c": "auto"}
+
+    def __init__(self, mesh, material, scale=1.0, **params):
+        super().__init__(mesh, material, scale, **params)
+        c = self.p["c"]
+        if c != "auto" and not (isinstance(c, (int, float)) and np.isfinite(c) and c > 0):
+            raise ModelError(f"normal c must be 'auto' or a positive number, got {c!r}")
+        self.coef = None if c == "auto" else float(c)
+        self.calibrate = c == "auto"
+        self.G = self.scale * material.G
+        self.vol0 = mesh.volumes
+        self.rest_len = np.linalg.norm(edge_vectors(mesh.points, mesh.tets), axis=-1)
+
+    def info(self):
+        return {**super().info(), "c": self.coef}
+
+    def _kernel_forces(self, x, out):
+        if self.coef is None:
+            raise ModelError("normal term with c='auto' is not calibrated yet: build the model "
+                             "with model.build, or pass a number for c")
+        return _forces(x, self.mesh.tets, self.vol0, self.rest_len, self.coef * self.G, out)
+
+    def _dev_strain(self, x):
+        eps = np.linalg.norm(edge_vectors(x, self.mesh.tets), axis=-1) / self.rest_len - 1.0
+        return eps - eps.mean(axis=2, keepdims=True)
+
+    def unit_energy(self, x):
+        return float(self.G * np.sum(self.vol0[:, None, None] * self._dev_strain(x) ** 2))
+
+    def energy(self, x):
+        return self.coef * self.unit_energy(x)
+
+    def forces_numpy(self, x):
+        d = edge_vectors(x, self.mesh.tets)
+        ln = np.linalg.norm(d, axis=-1)
+        s = 2 * self.coef * self.G * self.vol0[:, None, None] * self._dev_strain(x) \
+            / (self.rest_len * ln)
+        fj = -s[..., None] * d
+        out = np.zeros_like(x)
+        np.add.at(out, self.mesh.tets[:, CORNER_EDGES[..., 1]], fj)
+        np.add.at(out, self.mesh.tets[:, CORNER_EDGES[..., 0]], -fj)
+        return out
