@@ -11,20 +11,30 @@ def bc_arrays(bc, n_nodes):
                          f"got {type(bc).__name__}")
     mask = np.zeros((n_nodes, 3), dtype=bool)
     vals = np.zeros((n_nodes, 3))
-    for node, comp in bc.items():
-        if int(node) != node or not 0 <= node < n_nodes:
-            raise ModelError(f"boundary condition on node {node!r}: nodes are 0..{n_nodes - 1}")
-        if len(comp) != 3:
-            raise ModelError(f"boundary condition on node {node}: give (ux, uy, uz) with None "
-                             f"for a free component, got {comp!r}")
-        for k, v in enumerate(comp):
-            if v is None:
-                continue
-            if not np.isfinite(v):
-                raise ModelError(f"boundary condition on node {node}, component {'xyz'[k]}: "
-                                 f"value {v!r} is not finite")
-            mask[node, k] = True
-            vals[node, k] = v
+    if not bc:
+        return mask, vals
+    nodes = np.array(list(bc.keys()))
+    comps = np.empty((len(bc), 3), dtype=object)
+    try:
+        comps[:] = list(bc.values())
+    except ValueError:
+        bad = next(k for k, v in bc.items() if not hasattr(v, "__len__") or len(v) != 3)
+        raise ModelError(f"boundary condition on node {bad}: give (ux, uy, uz) with None for a "
+                         f"free component, got {bc[bad]!r}") from None
+    if not np.issubdtype(nodes.dtype, np.integer) or nodes.min() < 0 or nodes.max() >= n_nodes:
+        bad = next(k for k in bc if not (isinstance(k, (int, np.integer)) and 0 <= k < n_nodes))
+        raise ModelError(f"boundary condition on node {bad!r}: nodes are 0..{n_nodes - 1}")
+    given = comps != None  # noqa: E711 (elementwise on an object array)
+    try:
+        v = np.where(given, comps, 0.0).astype(np.float64)
+    except (TypeError, ValueError):
+        raise ModelError("boundary condition values must be numbers or None") from None
+    if not np.isfinite(v).all():
+        i, k = np.argwhere(~np.isfinite(v))[0]
+        raise ModelError(f"boundary condition on node {nodes[i]}, component {'xyz'[k]}: "
+                         f"value {v[i, k]!r} is not finite")
+    mask[nodes] = given
+    vals[nodes] = v
     return mask, vals
 
 

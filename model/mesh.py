@@ -191,6 +191,8 @@ def box(nx, ny, nz, lx, ly, lz, scheme="five", seed=0):
         pts, tets = _perturbed_delaunay(pts, (nx, ny, nz), (lx, ly, lz), seed)
     else:
         raise MeshError(f"unknown mesh scheme {scheme!r}; choose one of {', '.join(SCHEMES)}")
+    neg = geometry.signed_volumes(pts, tets) < 0  # generate right-handed tetrahedra directly
+    tets[neg] = tets[neg][:, [0, 2, 1, 3]]
     return TetMesh(pts, tets)
 
 

@@ -33,15 +33,16 @@ _PARITY = np.array([round(np.linalg.det(np.eye(4)[[a, m, l, j]])) for a, j, m, l
 READINGS = {"corner": 0, "balanced": 1, "variational": 2}
 
 
-@njit(cache=True)
+@njit(cache=True, fastmath=True)
 def _shear(x, tets, vol0, gamma0, G, coef, reading, out, gamma_out):
     """Strains of every tetrahedron into gamma_out (m, 24); forces of ``reading`` into out
     unless reading < 0. Returns the first flattened tetrahedron, or -1."""
     xt, ee, dV = np.empty((4, 3)), np.empty((3, 3)), np.empty((4, 3))
     vec = np.empty((8, 3))
     u, w, d, c, ch, e, wc, cu = vec[0], vec[1], vec[2], vec[3], vec[4], vec[5], vec[6], vec[7]
-    gr = np.empty((4, 3))
+    gr, ft = np.empty((4, 3)), np.empty((4, 3))
     for t in range(tets.shape[0]):
+        ft[:] = 0.0
         gather(x, tets, t, xt)
         V = volume_gradient(xt, ee, dV)
         if V <= FLAT * vol0[t]:
@@ -67,14 +68,14 @@ def _shear(x, tets, vol0, gamma0, G, coef, reading, out, gamma_out):
             tau_area = G * gamma * 0.5 * cn  # tau S_F
             if reading == 0:      # corner: on a alone, paper factor 1/4
                 for k in range(3):
-                    out[tets[t, a], k] += 0.25 * tau_area * e[k]
+                    ft[a, k] += 0.25 * tau_area * e[k]
             elif reading == 1:    # balanced: on the tip, reaction over the base
                 for k in range(3):
                     f = tau_area * e[k]
-                    out[tets[t, j], k] -= f
-                    out[tets[t, a], k] += f / 3.0
-                    out[tets[t, m], k] += f / 3.0
-                    out[tets[t, l], k] += f / 3.0
+                    ft[j, k] -= f
+                    ft[a, k] += f / 3.0
+                    ft[m, k] += f / 3.0
+                    ft[l, k] += f / 3.0
             else:                 # variational: -dW/dx, W = (c/2) G V0 gamma^2
                 cross(w, ch, wc)
                 cross(ch, u, cu)
@@ -87,7 +88,11 @@ def _shear(x, tets, vol0, gamma0, G, coef, reading, out, gamma_out):
                 s_w = coef * G * vol0[t] * gamma
                 for i in range(4):
                     for k in range(3):
-                        out[tets[t, i], k] -= s_w * gr[i, k]
+                        ft[i, k] -= s_w * gr[i, k]
+        if reading >= 0:
+            for i in range(4):
+                for k in range(3):
+                    out[tets[t, i], k] += ft[i, k]
     return -1
 
 

@@ -1,0 +1,1 @@
+"""Experiments, metrics and the ``pbcm`` command."""

@@ -1,0 +1,1 @@
+"""FEM references (scikit-fem) and closed forms the particle model is measured against."""

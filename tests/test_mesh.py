@@ -1,0 +1,117 @@
+import meshio
+import numpy as np
+import pytest
+
+from model.errors import MeshError
+from model.mesh import SCHEMES, TetMesh, box, cube, read, write
+
+L = 0.032
+
+
+def boundary_faces(mesh):
+    f = np.sort(mesh.tets[:, [[1, 2, 3], [0, 2, 3], [0, 1, 3], [0, 1, 2]]].reshape(-1, 3), axis=1)
+    uniq, counts = np.unique(f, axis=0, return_counts=True)
+    assert counts.max() <= 2, "a face is shared by more than two tetrahedra"
+    return uniq[counts == 1]
+
+
+@pytest.mark.parametrize("scheme,nodes,tets", [("five", 125, 320), ("six", 125, 384),
+                                               ("bcc", 189, 768)])
+def test_cube_counts(scheme, nodes, tets):
+    m = cube(5, L, scheme)
+    assert (m.n_nodes, m.n_tets) == (nodes, tets)
+
+
+@pytest.mark.parametrize("scheme", SCHEMES)
+def test_cube_is_a_conforming_cube(scheme):
+    m = cube(5, L, scheme)
+    assert m.volumes.min() > 0
+    assert m.volumes.sum() == pytest.approx(L**3, rel=1e-12)
+    # a conforming mesh of the cube has only faces on the cube's surface as boundary faces,
+    # and their area adds up to 6 L^2
+    bf = boundary_faces(m)
+    p = m.points[bf]
+    on_surface = ((np.isclose(p, 0.0, atol=1e-12) | np.isclose(p, L, atol=1e-12))
+                  .all(axis=1)).any(axis=1)
+    assert on_surface.all()
+    area = 0.5 * np.linalg.norm(np.cross(p[:, 1] - p[:, 0], p[:, 2] - p[:, 0]), axis=1).sum()
+    assert area == pytest.approx(6 * L**2, rel=1e-12)
+
+
+def test_unstructured_has_no_slivers_and_planar_layers():
+    m = cube(5, L, "unstructured")
+    q = m.quality()
+    assert q["radius_ratio_min"] >= 0.1
+    assert np.allclose(np.unique(m.points[:, 1].round(12)), np.linspace(0, L, 5))
+    assert np.array_equal(m.points, cube(5, L, "unstructured").points)  # deterministic
+
+
+def test_box_and_node_sets():
+    m = box(6, 3, 2, 0.1, 0.02, 0.01, "six")
+    assert m.n_nodes == 36
+    assert len(m.nodes_on_plane("x", 0.0)) == 6
+    assert len(m.nodes_on_plane(1, 0.02)) == 12
+    assert len(m.nodes_where(lambda p: p[:, 0] > 0.05)) == 18
+    with pytest.raises(MeshError, match="axis"):
+        m.nodes_on_plane("w", 0.0)
+
+
+def test_reorients_negative_tetrahedra():
+    pts = np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0], [0, 0, 1.0]])
+    m = TetMesh(pts, np.array([[0, 2, 1, 3]]))
+    assert m.reoriented == 1 and m.volumes[0] == pytest.approx(1 / 6)
+
+
+@pytest.mark.parametrize("points,tets,match", [
+    ([[0, 0, 0], [1, 0, 0], [0, 1, 0], [0, 0, np.nan]], [[0, 1, 2, 3]], "non-finite"),
+    ([[0, 0, 0], [1, 0, 0], [0, 1, 0], [0, 0, 1]], [[0, 1, 2, 4]], "outside"),
+    ([[0, 0, 0], [1, 0, 0], [0, 1, 0], [1, 1, 0]], [[0, 1, 2, 3]], "zero volume"),
+    ([[0, 0, 0], [1, 0, 0], [0, 1, 0], [0, 0, 1]], [[0, 1, 2, 2]], "repeat"),
+    ([[0, 0, 0], [1, 0, 0], [0, 1, 0], [0, 0, 1], [5, 5, 5]], [[0, 1, 2, 3]], "no tetrahedron"),
+    ([[0, 0, 0], [1, 0, 0], [0, 1, 0], [0, 0, 1], [0, 0, 1]], [[0, 1, 2, 3], [0, 1, 2, 4]],
+     "duplicate nodes"),
+    ([[0, 0], [1, 0]], [[0, 1, 0, 1]], "shape"),
+])
+def test_bad_meshes_are_named(points, tets, match):
+    with pytest.raises(MeshError, match=match):
+        TetMesh(np.array(points, dtype=float), np.array(tets))
+
+
+def test_generator_arguments_are_checked():
+    with pytest.raises(MeshError, match="unknown mesh scheme"):
+        cube(3, L, "seven")
+    with pytest.raises(MeshError, match="integer >= 2"):
+        cube(1, L)
+    with pytest.raises(MeshError, match="positive length"):
+        cube(3, -1.0)
+
+
+def test_gmsh_file_with_mixed_blocks(tmp_path):
+    m = cube(3, L, "six")
+    tri = np.sort(m.tets[:, [0, 1, 2]], axis=1)[:5]
+    extra = np.vstack([m.points, [[1.0, 1.0, 1.0]]])  # a geometry point no tetrahedron uses
+    mio = meshio.Mesh(extra, [("vertex", np.array([[0], [len(extra) - 1]])),
+                              ("line", m.tets[:4, :2]), ("triangle", tri),
+                              ("tetra", m.tets[:20]), ("tetra", m.tets[20:])])
+    path = tmp_path / "mixed.msh"
+    meshio.write(path, mio, file_format="gmsh22", binary=False)
+    back = read(path)
+    assert (back.n_nodes, back.n_tets) == (m.n_nodes, m.n_tets)
+    assert np.allclose(back.volumes.sum(), L**3)
+
+
+def test_file_without_tetrahedra(tmp_path):
+    path = tmp_path / "surface.msh"
+    meshio.write(path, meshio.Mesh(np.eye(3), [("triangle", np.array([[0, 1, 2]]))]),
+                 file_format="gmsh22", binary=False)
+    with pytest.raises(MeshError, match="no tetrahedra"):
+        read(path)
+
+
+def test_write_roundtrip_with_data(tmp_path):
+    m = cube(3, L, "five")
+    path = tmp_path / "m.vtu"
+    write(path, m, point_data={"u": m.points * 0.1}, cell_data={"p": m.volumes})
+    back = meshio.read(path)
+    assert np.allclose(back.point_data["u"], m.points * 0.1)
+    assert np.allclose(back.cell_data["p"][0], m.volumes)
