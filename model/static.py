@@ -101,7 +101,13 @@ def solve(model, bc, f_ext=None, rtol=1e-9, max_iter=50, load_steps=1):
     for step in range(1, load_steps + 1):
         s = step / load_steps
         x[mask] = mesh.points[mask] + s * vals[mask]
-        r = residual(x, s)
+        try:
+            r = residual(x, s)
+        except DegenerateTetError as exc:
+            raise ConvergenceError(
+                f"load step {step}/{load_steps} starts from an inverted or flattened "
+                f"tetrahedron {exc.tets[0]}: the prescribed increment is too large for the "
+                "mesh; increase load_steps") from exc
         for _ in range(max_iter):
             rn = np.abs(r[free]).max(initial=0.0)
             if rn <= tol:

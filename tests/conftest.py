@@ -1,0 +1,38 @@
+import numpy as np
+import pytest
+
+from model import Material
+from model.mesh import TetMesh, cube
+
+MAT = Material(E=10e3, nu=0.45, rho=1000.0)
+
+
+@pytest.fixture
+def mat():
+    return MAT
+
+
+@pytest.fixture
+def small_mesh():
+    return cube(3, 0.032, "six")
+
+
+@pytest.fixture
+def one_tet():
+    pts = np.array([[0.0, 0.0, 0.0], [0.01, 0.001, 0.0], [0.002, 0.012, 0.001],
+                    [0.001, 0.002, 0.009]])
+    return TetMesh(pts, np.array([[0, 1, 2, 3]]))
+
+
+def perturbed(mesh, amplitude=1e-3, seed=0):
+    """Mesh positions with a random displacement of ``amplitude`` times the mean edge."""
+    e = mesh.edges
+    h = np.linalg.norm(mesh.points[e[:, 1]] - mesh.points[e[:, 0]], axis=1).mean()
+    return mesh.points + amplitude * h * np.random.default_rng(seed).standard_normal(
+        mesh.points.shape)
+
+
+def rotation(axis, angle):
+    axis = np.asarray(axis, float) / np.linalg.norm(axis)
+    K = np.array([[0, -axis[2], axis[1]], [axis[2], 0, -axis[0]], [-axis[1], axis[0], 0]])
+    return np.eye(3) + np.sin(angle) * K + (1 - np.cos(angle)) * K @ K

@@ -1,0 +1,220 @@
+"""Force terms: rest state, invariance, conservation, gradients, kernels, stiffness."""
+import numpy as np
+import pytest
+
+from model import PRESETS, build
+from model.errors import DegenerateTetError, ModelError
+from model.terms import make_term
+from model.terms.shear import Shear
+from model.mesh import cube
+
+from conftest import perturbed, rotation
+
+# every term with its parameters; ``c`` fixed so the terms stand alone
+TERMS = {
+    "volume": ("volume", {}),
+    "corner": ("shear", {"reading": "corner"}),
+    "balanced": ("shear", {"reading": "balanced"}),
+    "variational": ("shear", {"reading": "variational", "c": 0.3}),
+    "normal": ("normal", {"c": 0.7}),
+    "springs": ("springs", {}),
+}
+CONSERVATIVE = ["volume", "variational", "normal", "springs"]
+
+
+def term(key, mesh, mat):
+    name, params = TERMS[key]
+    return make_term(name, mesh, mat, **params)
+
+
+@pytest.mark.parametrize("key", TERMS)
+def test_zero_force_at_rest(key, small_mesh, mat):
+    f = term(key, small_mesh, mat).forces(small_mesh.points)
+    assert np.abs(f).max() < 1e-12
+
+
+@pytest.mark.parametrize("preset", PRESETS)
+def test_presets_at_rest(preset, small_mesh, mat):
+    pm = build(preset, small_mesh, mat)
+    assert np.abs(pm.forces(small_mesh.points)).max() < 1e-12
+
+
+def test_shear_strains_invariant_to_translation_rotation_and_scale(small_mesh, mat):
+    sh = Shear(small_mesh, mat, reading="corner")
+    x = perturbed(small_mesh, 0.05)
+    g = sh.strains(x)
+    assert np.abs(g).max() > 1e-3
+    R = rotation([1, 2, 3], 0.7)
+    for moved in (x + [0.3, -1.0, 2.0], x @ R.T, 1.7 * x @ R.T - 0.2):
+        assert np.allclose(sh.strains(moved), g, rtol=0, atol=1e-12)
+
+
+@pytest.mark.parametrize("key", TERMS)
+def test_forces_invariant_under_rigid_motion(key, small_mesh, mat):
+    t = term(key, small_mesh, mat)
+    x = perturbed(small_mesh, 0.05, seed=3)
+    R = rotation([0.2, -1, 0.5], 1.1)
+    f = t.forces(x)
+    assert np.allclose(t.forces(x @ R.T + 0.05), f @ R.T, atol=1e-12 * np.abs(f).max())
+
+
+@pytest.mark.parametrize("key", ["balanced", "variational", "volume", "springs", "normal"])
+def test_zero_net_force(key, small_mesh, mat):
+    f = term(key, small_mesh, mat).forces(perturbed(small_mesh, 0.05))
+    assert np.linalg.norm(f.sum(axis=0)) <= 1e-10 * np.abs(f).sum()
+
+
+@pytest.mark.parametrize("key", ["variational", "volume", "springs", "normal"])
+def test_zero_net_torque(key, small_mesh, mat):
+    x = perturbed(small_mesh, 0.05)
+    f = term(key, small_mesh, mat).forces(x)
+    r = x - x.mean(axis=0)
+    torque = np.cross(r, f).sum(axis=0)
+    assert np.linalg.norm(torque) <= 1e-10 * (np.linalg.norm(r, axis=1)
+                                              * np.linalg.norm(f, axis=1)).sum()
+
+
+@pytest.mark.parametrize("key", ["corner", "balanced"])
+def test_residual_momentum_of_the_literal_readings_is_measured(key, small_mesh, mat, capsys):
+    pm = build([TERMS[key]], small_mesh, mat)
+    nt = pm.net_force_torque(perturbed(small_mesh, 0.05))
+    with capsys.disabled():
+        print(f"\n  {key}: net force {nt['force_rel']:.3e}, net torque {nt['torque_rel']:.3e} "
+              "(relative to sum |f|)")
+    assert np.isfinite(nt["force_rel"]) and np.isfinite(nt["torque_rel"])
+    if key == "balanced":  # momentum is conserved by construction, angular momentum is not
+        assert nt["force_rel"] < 1e-12 and nt["torque_rel"] > 1e-6
+
+
+def fd_gradient(energy, x, h):
+    g = np.zeros_like(x)
+    for i in range(x.shape[0]):
+        for k in range(3):
+            xp, xm = x.copy(), x.copy()
+            xp[i, k] += h
+            xm[i, k] -= h
+            g[i, k] = (energy(xp) - energy(xm)) / (2 * h)
+    return g
+
+
+@pytest.mark.parametrize("key", CONSERVATIVE)
+def test_forces_are_minus_energy_gradient(key, small_mesh, mat):
+    t = term(key, small_mesh, mat)
+    x = perturbed(small_mesh, 0.05, seed=1)
+    f = t.forces(x)
+    g = fd_gradient(t.energy, x, 1e-7)
+    assert np.abs(f + g).max() <= 1e-6 * np.abs(f).max()
+
+
+def test_volume_energy_closed_form(one_tet, mat):
+    t = make_term("volume", one_tet, mat)
+    V0 = one_tet.volumes[0]
+    x = one_tet.points.copy()
+    x[3] *= 1.1  # stretch the apex: V = 1.1 V0
+    V = one_tet.volumes[0] * 1.1
+    assert t.energy(x) == pytest.approx(mat.K * ((V - V0) - V0 * np.log(V / V0)), rel=1e-12)
+    # f_i = (p / 3) sum of outward S_f n_f over the three faces at i, checked at node 0
+    p = -mat.K * (V - V0) / V
+    faces = [(0, 1, 2), (0, 1, 3), (0, 2, 3)]
+    centroid = x.mean(axis=0)
+    s = np.zeros(3)
+    for f in faces:
+        n = 0.5 * np.cross(x[f[1]] - x[f[0]], x[f[2]] - x[f[0]])
+        s += n if np.dot(n, x[f[0]] - centroid) > 0 else -n
+    assert np.allclose(t.forces(x)[0], p / 3 * s, rtol=1e-12)
+
+
+def test_shear_strain_closed_form(mat):
+    """Simple shear x += g y of a right-corner tetrahedron: gamma(0, 2, 1) = g exactly."""
+    from model.mesh import TetMesh
+    from model.terms.shear import COMBOS
+    pts = np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0], [0, 0, 1.0]]) * 0.01
+    sh = Shear(TetMesh(pts, np.array([[0, 1, 2, 3]])), mat, reading="corner")
+    g = 0.03
+    x = pts.copy()
+    x[:, 0] += g * x[:, 1]
+    s = [i for i, c in enumerate(COMBOS) if tuple(c[:3]) == (0, 2, 1)][0]
+    assert sh.strains(x)[0, s] == pytest.approx(g, rel=1e-12)
+
+
+@pytest.mark.parametrize("key", TERMS)
+def test_numba_kernel_equals_numpy(key, small_mesh, mat):
+    t = term(key, small_mesh, mat)
+    x = perturbed(small_mesh, 0.05, seed=2)
+    f = t.forces(x)
+    assert np.allclose(f, t.forces_numpy(x), rtol=0, atol=1e-12 * np.abs(f).max())
+
+
+def test_corner_sign_restores(small_mesh, mat):
+    """Moving one node alone must meet a force against the motion: the diagonal of
+    d f_a / d x_a is negative for every node and direction."""
+    pm = build([TERMS["corner"]], small_mesh, mat)
+    J = pm.jacobian(small_mesh.points)
+    assert J.diagonal().max() < 0
+
+
+def test_one_tetrahedron_has_six_zero_stiffness_modes(one_tet, mat):
+    pm = build("pbcm-variational", one_tet, mat)
+    J = pm.jacobian(one_tet.points).toarray()
+    assert np.allclose(J, J.T, atol=1e-6 * np.abs(J).max())  # an energy's Hessian
+    eig = np.sort(np.linalg.eigvalsh(-(J + J.T) / 2))
+    scale = eig[-1]
+    assert np.all(np.abs(eig[:6]) < 1e-7 * scale)
+    assert np.all(eig[6:] > 1e-3 * scale)
+
+
+def test_variational_calibration(mat):
+    """c = auto: the deviatoric energy of a homogeneous strain is G |dev eps|^2 V on average;
+    with the normal term the fit is closer still."""
+    m = cube(4, 0.032, "five")
+    pm = build("pbcm-variational", m, mat)
+    assert pm.info["shear_c"] > 0
+    assert 0.8 < pm.info["deviatoric_eig_min"] <= 1.0 <= pm.info["deviatoric_eig_max"] < 1.2
+    both = build("pbcm-variational+normal", m, mat)
+    spread = both.info["deviatoric_eig_max"] - both.info["deviatoric_eig_min"]
+    assert spread <= pm.info["deviatoric_eig_max"] - pm.info["deviatoric_eig_min"]
+    # the energy of a pure shear eps_xy = e matches 2 G e^2 V to the fitted accuracy
+    e = 1e-4
+    F = np.eye(3) + e * np.array([[0, 1, 0], [1, 0, 0], [0, 0, 0]])
+    x = m.points @ F.T
+    W = both.energy(x)
+    assert W == pytest.approx(2 * mat.G * e**2 * m.volumes.sum(), rel=0.05)
+
+
+def test_flattened_tetrahedron_is_reported(one_tet, mat):
+    pm = build("pbcm-variational", one_tet, mat)
+    x = one_tet.points.copy()
+    x[3] = x[0] + 0.5 * (x[1] - x[0]) + 0.2 * (x[2] - x[0])  # apex into the base plane
+    with pytest.raises(DegenerateTetError, match="tetrahedron 0"):
+        pm.forces(x)
+
+
+def test_bad_model_specifications(small_mesh, mat):
+    with pytest.raises(ModelError, match="presets"):
+        build("pbcm-nonsense", small_mesh, mat)
+    with pytest.raises(ModelError, match="registered"):
+        build([("gravity-ish", {})], small_mesh, mat)
+    with pytest.raises(ModelError, match="reading"):
+        build([("shear", {"reading": "sideways"})], small_mesh, mat)
+    with pytest.raises(ModelError, match="no parameter"):
+        build([("volume", {"stiff": 2})], small_mesh, mat)
+    with pytest.raises(ModelError, match="positive number"):
+        build([("shear", {"c": -1.0})], small_mesh, mat)
+    with pytest.raises(ModelError, match="does not have"):
+        build("msm", small_mesh, mat, shear={"scale": 0.5})
+
+
+def test_scale_knob_scales_forces(small_mesh, mat):
+    x = perturbed(small_mesh, 0.05)
+    full = build("pbcm-balanced", small_mesh, mat)
+    half = build("pbcm-balanced", small_mesh, mat, shear={"scale": 0.5}, volume={"scale": 0.5})
+    assert np.allclose(half.forces(x), 0.5 * full.forces(x), atol=1e-15)
+
+
+def test_tet_stress_outputs(small_mesh, mat):
+    pm = build("msm", small_mesh, mat)
+    x = small_mesh.points * (1 - 1e-3)  # uniform compression: no shear, p = -K (V-V0)/V
+    s = pm.tet_stress(x)
+    V_ratio = (1 - 1e-3) ** 3
+    assert np.allclose(s["pressure"], -mat.K * (V_ratio - 1) / V_ratio, rtol=1e-9)
+    assert np.abs(s["max_tau"]).max() < 1e-9 * mat.G
