@@ -7,7 +7,7 @@ from skfem.helpers import dot, sym_grad
 from skfem.models.elasticity import linear_elasticity
 
 from model.errors import ModelError
-from .fem import (bc_arrays, cell_average, check_finite, dirichlet_dofs, element_basis, lame,
+from .fem import (INTORDER, bc_arrays, cell_average, check_finite, dirichlet_dofs, element_basis, lame,
                   linear_solve, parent_of, refine_with_data, skfem_mesh, stress_measures)
 
 
@@ -84,7 +84,7 @@ def solve(mesh, E, nu, dirichlet, body_force=None, traction=None, element="P1", 
     if body_force is not None:
         f += asm(body_load(body_force), basis)
     if traction is not None:
-        fb = FacetBasis(m, basis.elem, intorder=basis.intorder)
+        fb = FacetBasis(m, basis.elem, intorder=INTORDER[element])
         f += asm(traction_load(traction), fb)
     A, b, x, I = condense(K, f, x=x_D, D=D)
     xI, sinfo = linear_solve(A, b, basis.doflocs.T[I], dof_component(basis)[I], solver)
