@@ -4,11 +4,37 @@ import numpy as np
 from .errors import ModelError
 
 
+def merge(pairs):
+    """One mapping from an iterable of ``(node, (ux, uy, uz))`` pairs, as node sets give them
+    when they overlap (an edge in two faces): components combine, conflicting values are an
+    error."""
+    out = {}
+    try:
+        for node, comp in pairs:
+            old = out.get(node, (None, None, None))
+            if len(comp) != 3:
+                raise ModelError(f"boundary condition on node {node}: give (ux, uy, uz) with "
+                                 f"None for a free component, got {comp!r}")
+            new = []
+            for k, (a, b) in enumerate(zip(old, comp)):
+                if a is not None and b is not None and a != b:
+                    raise ModelError(f"conflicting values for node {node}, component "
+                                     f"{'xyz'[k]}: {a!r} and {b!r}; give each component once")
+                new.append(a if b is None else b)
+            out[node] = tuple(new)
+    except TypeError:
+        raise ModelError("boundary conditions must be a mapping node -> (ux, uy, uz) or "
+                         "(node, (ux, uy, uz)) pairs") from None
+    return out
+
+
 def bc_arrays(bc, n_nodes):
-    """Mask (n, 3) of prescribed components and their displacement values (n, 3) [m]."""
+    """Mask (n, 3) of prescribed components and their displacement values (n, 3) [m].
+
+    ``bc`` is a mapping node -> (ux, uy, uz), None for a free component, or an iterable of
+    such pairs (see :func:`merge`)."""
     if not hasattr(bc, "items"):
-        raise ModelError(f"boundary conditions must be a mapping node -> (ux, uy, uz), "
-                         f"got {type(bc).__name__}")
+        bc = merge(bc)
     mask = np.zeros((n_nodes, 3), dtype=bool)
     vals = np.zeros((n_nodes, 3))
     if not bc:

@@ -17,7 +17,8 @@ from .linear import body_load, dof_component, transfer_to_nodes
 
 
 def _kinematics(w):
-    F = grad(w["u"]) + eye(np.ones_like(w["u"].value[0]), 3)
+    H = grad(w["u"])
+    F = H + eye(np.ones_like(H[0, 0]), 3)
     J = det(F)
     if np.any(J <= 0):
         raise ConvergenceError("neo-Hookean: an element inverted (det F <= 0); use more load "
