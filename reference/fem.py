@@ -5,6 +5,7 @@ Physics lives in the modules that use it (linear.py, hyperelastic.py, modal.py);
 the boundary-condition format come from ``model``, nothing else does.
 """
 import numpy as np
+import scipy.sparse as sp
 from scipy.sparse.linalg import spsolve
 from skfem import Basis, ElementTetP1, ElementTetP2, ElementVector, MeshTet
 
@@ -31,7 +32,12 @@ def skfem_mesh(mesh):
 
 def refine_with_data(m, mask, vals, dirichlet_fn, levels):
     """Refine ``levels`` times; a new node at the midpoint of a boundary edge whose two ends
-    carry a value in a component gets ``dirichlet_fn(point)`` there, or the mean of the ends."""
+    carry a value in a component gets ``dirichlet_fn(point)`` there, or the mean of the ends.
+
+    Also returns W (sparse, fine nodes x input nodes): the input mesh's P1 hat functions at
+    every fine node, built as the mean of the two parents' rows (hats are linear on edges).
+    """
+    W = sp.identity(m.nvertices, format="csr")
     for _ in range(levels):
         e = m.edges[:, m.boundary_edges()]
         both = mask[e[0]] & mask[e[1]]                       # (k, 3)
@@ -43,10 +49,26 @@ def refine_with_data(m, mask, vals, dirichlet_fn, levels):
         nm, nv = np.zeros((m.edges.shape[1], 3), bool), np.zeros((m.edges.shape[1], 3))
         nm[m.boundary_edges()] = both
         nv[m.boundary_edges()] = np.where(both, new_vals, 0.0)
+        W = sp.vstack([W, 0.5 * (W[m.edges[0]] + W[m.edges[1]])], format="csr")
         m = m.refined()
         assert m.nvertices == n_old + len(nm)  # new vertices are the old edges' midpoints
         mask, vals = np.vstack([mask, nm]), np.vstack([vals, nv])
-    return m, mask, vals
+    return m, mask, vals, W
+
+
+def dof_hats(basis, W):
+    """Sparse (N dofs x input nodes): the input mesh's P1 hats at every dof's location
+    (vertex dofs take their node's row of W, P2 edge dofs the mean of their ends' rows)."""
+    H = W
+    dofs = [basis.nodal_dofs]
+    if basis.edge_dofs.size:
+        e = basis.mesh.edges
+        H = sp.vstack([W, 0.5 * (W[e[0]] + W[e[1]])], format="csr")
+        dofs.append(basis.edge_dofs)
+    dof_index = np.concatenate([np.concatenate([d[k] for d in dofs]) for k in range(3)])
+    place = sp.csr_matrix((np.ones(len(dof_index)), (dof_index, np.arange(len(dof_index)))),
+                          shape=(basis.N, len(dof_index)))
+    return place @ sp.vstack([H, H, H], format="csr")
 
 
 def element_basis(m, element, intorder=None):
@@ -117,12 +139,22 @@ def cell_average(basis, field):
     return np.einsum("...eq,eq->...e", field, basis.dx) / basis.dx.sum(axis=1)
 
 
-def parent_of(m_fine, m_coarse, levels):
-    """Index of the coarse tetrahedron containing each fine one (by centroid)."""
-    if levels == 0:
-        return np.arange(m_coarse.nelements)
-    c = m_fine.p[:, m_fine.t].mean(axis=1)
-    return m_coarse.element_finder()(*c)
+def parent_of(m_fine, W, coarse_tets):
+    """Index of the input tetrahedron containing each fine one: the input nodes whose hats do
+    not vanish on a fine tetrahedron are exactly its parent's four vertices."""
+    if m_fine.nelements == len(coarse_tets):
+        return np.arange(len(coarse_tets))
+    S = (W[m_fine.t[0]] + W[m_fine.t[1]] + W[m_fine.t[2]] + W[m_fine.t[3]]).tocsr()
+    S.sort_indices()
+    if not np.all(np.diff(S.indptr) == 4):
+        raise AssertionError("a refined tetrahedron straddles two input tetrahedra")
+    def key(t):  # one opaque, consistently ordered scalar per row of four node indices
+        return np.ascontiguousarray(t, dtype=np.int64).view(np.dtype((np.void, 32))).ravel()
+
+    fine_key = key(S.indices.reshape(-1, 4))
+    coarse_key = key(np.sort(coarse_tets, axis=1))
+    order = np.argsort(coarse_key)
+    return order[np.searchsorted(coarse_key[order], fine_key)]
 
 
 def stress_measures(sigma):

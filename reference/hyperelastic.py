@@ -78,7 +78,7 @@ def solve(mesh, E, nu, dirichlet, body_force=None, element="P1", refine=0, diric
     if refine:
         raise ModelError("the neo-Hookean reference solves on the input mesh (refine=0); "
                          "pass a refined mesh instead")
-    m, mask_f, vals_f = refine_with_data(coarse, mask, vals, dirichlet_fn, 0)
+    m, mask_f, vals_f, W = refine_with_data(coarse, mask, vals, dirichlet_fn, 0)
     basis = element_basis(m, element)
     D, x_D = dirichlet_dofs(basis, mask_f, vals_f, dirichlet_fn)
     internal, tangent, P = forms(lam, mu)
@@ -111,8 +111,7 @@ def solve(mesh, E, nu, dirichlet, body_force=None, element="P1", refine=0, diric
                                    f"iterations at load step {step}/{load_steps}: residual "
                                    f"{rn:.3e} N; increase load_steps")
     w = {"u": basis.interpolate(u)}
-    reaction = transfer_to_nodes(coarse, basis, D, (asm(internal, basis, **w) - f_body)[D],
-                                 mesh.n_nodes)
+    reaction = transfer_to_nodes(basis, W, D, (asm(internal, basis, **w) - f_body)[D])
     F, J, FinvT = _kinematics(w)
     cauchy = np.einsum("ij...,kj...->ik...", P(F, J, FinvT), F) / J
     stress = np.moveaxis(cell_average(basis, cauchy), -1, 0)

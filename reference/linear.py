@@ -7,7 +7,8 @@ from skfem.helpers import dot, sym_grad
 from skfem.models.elasticity import linear_elasticity
 
 from model.errors import ModelError
-from .fem import (INTORDER, bc_arrays, cell_average, check_finite, dirichlet_dofs, element_basis, lame,
+from .fem import (INTORDER, bc_arrays, cell_average, check_finite, dirichlet_dofs, dof_hats,
+                  element_basis, lame,
                   linear_solve, parent_of, refine_with_data, skfem_mesh, stress_measures)
 
 
@@ -76,7 +77,7 @@ def solve(mesh, E, nu, dirichlet, body_force=None, traction=None, element="P1", 
     if int(refine) != refine or refine < 0:
         raise ModelError(f"refine must be a non-negative integer, got {refine!r}")
     coarse = skfem_mesh(mesh)
-    m, mask_f, vals_f = refine_with_data(coarse, mask, vals, dirichlet_fn, refine)
+    m, mask_f, vals_f, W = refine_with_data(coarse, mask, vals, dirichlet_fn, refine)
     basis = element_basis(m, element)
     D, x_D = dirichlet_dofs(basis, mask_f, vals_f, dirichlet_fn)
     K = asm(linear_elasticity(lam, mu), basis)
@@ -91,7 +92,7 @@ def solve(mesh, E, nu, dirichlet, body_force=None, traction=None, element="P1", 
     x[I] = check_finite("displacement", xI)
     u_all = x
     # reactions: K u - f on the prescribed dofs, carried to the input nodes by the P1 hats
-    reaction = transfer_to_nodes(coarse, basis, D, (K @ u_all - f)[D], n)
+    reaction = transfer_to_nodes(basis, W, D, (K @ u_all - f)[D])
     u = u_all[basis.nodal_dofs[:, :n]].T
     # stress: volume average over each input tetrahedron of the solution's stress
     w = basis.interpolate(u_all)
@@ -100,7 +101,7 @@ def solve(mesh, E, nu, dirichlet, body_force=None, traction=None, element="P1", 
     sig = 2 * mu * eps + lam * tr[None, None] * np.eye(3)[:, :, None, None]
     sig_fine = np.moveaxis(cell_average(basis, sig), -1, 0)         # (m_fine, 3, 3)
     vol_fine = basis.dx.sum(axis=1)
-    parent = parent_of(m, coarse, refine)
+    parent = parent_of(m, W, mesh.tets)
     vol = np.bincount(parent, weights=vol_fine, minlength=mesh.n_tets)
     stress = np.stack([np.bincount(parent, weights=vol_fine * sig_fine[:, i, j],
                                    minlength=mesh.n_tets)
@@ -119,21 +120,12 @@ def solve(mesh, E, nu, dirichlet, body_force=None, traction=None, element="P1", 
                               **sinfo})
 
 
-def transfer_to_nodes(coarse, basis, dofs, values, n):
-    """Carry forces on ``dofs`` to the input mesh's n nodes with its P1 hat functions
-    (preserves their sum and first moments)."""
-    out = np.zeros((n, 3))
-    if len(dofs) == 0:
-        return out
+def transfer_to_nodes(basis, W, dofs, values):
+    """Carry forces on ``dofs`` to the input mesh's nodes with its P1 hat functions
+    (preserves their sum and first moments; the identity for P1 without refinement)."""
+    hats = dof_hats(basis, W)[dofs]
     comp = dof_component(basis)[dofs]
-    pts = basis.doflocs[:, dofs]
-    tet = coarse.element_finder()(*pts)
-    X = coarse.p[:, coarse.t[:, tet]]                       # (3, 4, k)
-    T = np.moveaxis(X[:, 1:] - X[:, :1], -1, 0)             # (k, 3, 3) columns x_i - x_0
-    lam = np.linalg.solve(T, (pts - X[:, 0]).T[:, :, None])[:, :, 0]
-    bary = np.column_stack([1 - lam.sum(axis=1), lam])      # (k, 4)
-    np.add.at(out, (coarse.t[:, tet].T, comp[:, None]), bary * values[:, None])
-    return out
+    return np.column_stack([hats[comp == k].T @ values[comp == k] for k in range(3)])
 
 
 def dof_component(basis):

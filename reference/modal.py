@@ -44,7 +44,7 @@ def frequencies(mesh, E, nu, rho, dirichlet, k=6, mass="consistent", element="P2
     if mass not in ("consistent", "lumped"):
         raise ModelError(f"mass must be 'consistent' or 'lumped', got {mass!r}")
     mask, vals = bc_arrays(dirichlet, mesh.n_nodes)
-    m, mask_f, vals_f = refine_with_data(skfem_mesh(mesh), mask, vals, None, refine)
+    m, mask_f, vals_f, _ = refine_with_data(skfem_mesh(mesh), mask, vals, None, refine)
     basis = element_basis(m, element)
     D, _ = dirichlet_dofs(basis, mask_f, vals_f, None)
     K = asm(linear_elasticity(lam, mu), basis)
