@@ -64,16 +64,45 @@ def bc_arrays(bc, n_nodes):
     return mask, vals
 
 
-def ramp(nodes, displacement, t_ramp, fixed=()):
-    """A ``bc_of_t`` that moves ``nodes`` linearly to ``displacement`` (ux, uy, uz) over
-    ``t_ramp`` seconds and then holds, with ``fixed`` nodes held at zero throughout."""
-    nodes, fixed = [int(i) for i in nodes], [int(i) for i in fixed]
-    disp = tuple(displacement)
+class Ramp:
+    """A ``bc_of_t``: ``nodes`` move linearly to ``displacement`` (ux, uy, uz; None for free)
+    over ``t_ramp`` seconds and then hold; ``fixed`` nodes stay at zero throughout.
 
-    def bc_of_t(t):
-        s = min(max(t / t_ramp, 0.0), 1.0)
-        out = {i: (0.0, 0.0, 0.0) for i in fixed}
-        out.update({i: tuple(None if d is None else s * d for d in disp) for i in nodes})
+    Callable like any ``bc_of_t`` (t -> mapping); ``arrays`` and ``velocity`` give the
+    integrator the prescribed state without rebuilding a mapping at every stage.
+    """
+
+    def __init__(self, nodes, displacement, t_ramp, fixed=()):
+        if not t_ramp > 0:
+            raise ModelError(f"t_ramp must be a positive time in seconds, got {t_ramp!r}")
+        self.nodes, self.fixed = [int(i) for i in nodes], [int(i) for i in fixed]
+        self.disp, self.t_ramp = tuple(displacement), float(t_ramp)
+        self._cache = None
+
+    def __call__(self, t):
+        s = min(max(t / self.t_ramp, 0.0), 1.0)
+        out = {i: (0.0, 0.0, 0.0) for i in self.fixed}
+        out.update({i: tuple(None if d is None else s * d for d in self.disp)
+                    for i in self.nodes})
         return out
 
-    return bc_of_t
+    def _full(self, n_nodes):
+        if self._cache is None or self._cache[0] != n_nodes:
+            mask, full = bc_arrays(self(self.t_ramp), n_nodes)
+            self._cache = (n_nodes, mask, full)
+        return self._cache[1:]
+
+    def arrays(self, t, n_nodes):
+        """(mask, displacement) at time t, as bc_arrays(self(t), n_nodes) gives them."""
+        mask, full = self._full(n_nodes)
+        return mask, min(max(t / self.t_ramp, 0.0), 1.0) * full
+
+    def velocity(self, t, n_nodes):
+        """Prescribed velocity at t (the ramp's slope before t_ramp, zero after)."""
+        _, full = self._full(n_nodes)
+        return full / self.t_ramp if 0.0 <= t < self.t_ramp else np.zeros_like(full)
+
+
+def ramp(nodes, displacement, t_ramp, fixed=()):
+    """Shorthand for :class:`Ramp`."""
+    return Ramp(nodes, displacement, t_ramp, fixed)

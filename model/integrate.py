@@ -1,7 +1,7 @@
 """Classical RK4 on (x, v), as in the paper: a = (f_int + f_ext - zeta m v) / m.
 
-Prescribed components follow their path exactly (position from ``bc_of_t``, velocity by a
-central difference of it, exact for the piecewise-linear ramps of the cases).
+Prescribed components follow their path exactly: position from ``bc_of_t``, velocity from its
+``velocity`` method when it has one (model.bc.Ramp), else by a central difference of it.
 """
 from dataclasses import dataclass
 import math
@@ -66,24 +66,28 @@ def simulate(model, bc_of_t, t_end, dt=None, damping=0.0, f_ext=None, frames=101
     f_ext = np.zeros_like(mesh.points) if f_ext is None else np.asarray(f_ext, dtype=float)
     h_fd = 1e-6 * dt
 
-    cache = {}
+    if hasattr(bc_of_t, "arrays"):   # e.g. model.bc.Ramp: no mapping rebuilt per stage
+        def prescribed(t):
+            return bc_of_t.arrays(t, mesh.n_nodes)[1]
+    else:
+        def prescribed(t):
+            m, u = bc_arrays(bc_of_t(t), mesh.n_nodes)
+            if not np.array_equal(m, mask):
+                raise ModelError(f"bc_of_t({t:g}) prescribes other components than at t = 0; "
+                                 "the set of prescribed components must stay the same")
+            return u
 
-    def prescribed(t):
-        if t in cache:
-            return cache[t]
-        if len(cache) > 16:
-            cache.clear()
-        m, u = bc_arrays(bc_of_t(t), mesh.n_nodes)
-        cache[t] = u
-        if not np.array_equal(m, mask):
-            raise ModelError(f"bc_of_t({t:g}) prescribes other components than at t = 0; "
-                             "the set of prescribed components must stay the same")
-        return u
+    if hasattr(bc_of_t, "velocity"):
+        def prescribed_velocity(t):
+            return bc_of_t.velocity(t, mesh.n_nodes)
+    else:
+        def prescribed_velocity(t):  # central difference, one-sided at t = 0
+            t0 = max(t - h_fd, 0.0)
+            return (prescribed(t + h_fd) - prescribed(t0)) / (t + h_fd - t0)
 
     def constrain(x, v, t):
         x[mask] = mesh.points[mask] + prescribed(t)[mask]
-        t0 = max(t - h_fd, 0.0)
-        v[mask] = ((prescribed(t + h_fd) - prescribed(t0)) / (t + h_fd - t0))[mask]
+        v[mask] = prescribed_velocity(t)[mask]
 
     def accel(x, v, t):
         a = (model.forces(x) + f_ext) / mass - damping * v

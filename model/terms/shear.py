@@ -17,7 +17,7 @@ Readings of the force (``reading``):
 * ``variational`` f = -dW/dx with W = (c/2) G V0 sum gamma^2, every derivative taken.
 """
 import numpy as np
-from numba import njit
+from numba import njit, prange
 
 from . import Term, register
 from ._kernels import cross, dot, gather, volume_gradient, volume_gradient_numpy
@@ -33,67 +33,95 @@ _PARITY = np.array([round(np.linalg.det(np.eye(4)[[a, m, l, j]])) for a, j, m, l
 READINGS = {"corner": 0, "balanced": 1, "variational": 2}
 
 
-@njit(cache=True, fastmath=True)
-def _shear(x, tets, vol0, gamma0, G, coef, reading, out, gamma_out):
-    """Strains of every tetrahedron into gamma_out (m, 24); forces of ``reading`` into out
-    unless reading < 0. Returns the first flattened tetrahedron, or -1."""
-    xt, ee, dV = np.empty((4, 3)), np.empty((3, 3)), np.empty((4, 3))
-    vec = np.empty((8, 3))
-    u, w, d, c, ch, e, wc, cu = vec[0], vec[1], vec[2], vec[3], vec[4], vec[5], vec[6], vec[7]
-    gr, ft = np.empty((4, 3)), np.empty((4, 3))
-    for t in range(tets.shape[0]):
+@njit(cache=True, fastmath=True, parallel=True)
+def _shear(x, tets, vol0, gamma0, G, coef, reading, fbuf, gamma_out):
+    """Strains of every tetrahedron into gamma_out (m, 24) and, unless reading < 0, the
+    forces of ``reading`` on its four nodes into fbuf (m, 4, 3). Returns the first flattened
+    tetrahedron, or -1. Loops run corner a, tip j, then the two in-plane edges m of the base
+    (a, m, l), so that edge vectors and the base normal are computed once."""
+    n_tets = tets.shape[0]
+    flat = np.full(n_tets, -1)
+    for t in prange(n_tets):
+        xt, ee, dV = np.empty((4, 3)), np.empty((3, 3)), np.empty((4, 3))
+        ed, en, eu = np.empty((4, 3)), np.empty(4), np.empty((4, 3))  # edges from corner a
+        c, ch, gc, gr = np.empty(3), np.empty(3), np.empty((4, 3)), np.empty((4, 3))
+        ft = fbuf[t]
         ft[:] = 0.0
         gather(x, tets, t, xt)
         V = volume_gradient(xt, ee, dV)
         if V <= FLAT * vol0[t]:
-            return t
-        for s in range(24):
-            a, j, m, l = COMBOS[s, 0], COMBOS[s, 1], COMBOS[s, 2], COMBOS[s, 3]
-            for k in range(3):
-                u[k] = xt[m, k] - xt[a, k]
-                w[k] = xt[l, k] - xt[a, k]
-                d[k] = xt[j, k] - xt[a, k]
-            cross(u, w, c)
-            cn = np.sqrt(dot(c, c))
-            un = np.sqrt(dot(u, u))
-            for k in range(3):
-                e[k] = u[k] / un
-                ch[k] = c[k] / cn
-            q = dot(d, e)
-            graw = q * cn / (6.0 * V)
-            gamma = graw - gamma0[t, s]
-            gamma_out[t, s] = gamma
-            if reading < 0:
-                continue
-            tau_area = G * gamma * 0.5 * cn  # tau S_F
-            if reading == 0:      # corner: on a alone, paper factor 1/4
+            flat[t] = t
+            continue
+        s = 0
+        for a in range(4):
+            for b in range(4):
                 for k in range(3):
-                    ft[a, k] += 0.25 * tau_area * e[k]
-            elif reading == 1:    # balanced: on the tip, reaction over the base
+                    ed[b, k] = xt[b, k] - xt[a, k]
+                en[b] = np.sqrt(dot(ed[b], ed[b])) if b != a else 1.0
                 for k in range(3):
-                    f = tau_area * e[k]
-                    ft[j, k] -= f
-                    ft[a, k] += f / 3.0
-                    ft[m, k] += f / 3.0
-                    ft[l, k] += f / 3.0
-            else:                 # variational: -dW/dx, W = (c/2) G V0 gamma^2
-                cross(w, ch, wc)
-                cross(ch, u, cu)
+                    eu[b, k] = ed[b, k] / en[b]
+            for j in range(4):
+                if j == a:
+                    continue
+                m0 = 0
+                while m0 == a or m0 == j:
+                    m0 += 1
+                l0 = 6 - a - j - m0
+                cross(ed[m0], ed[l0], c)
+                cn = np.sqrt(dot(c, c))
                 for k in range(3):
-                    gr[j, k] = cn * e[k] / (6.0 * V) - graw * dV[j, k] / V
-                    gr[m, k] = (cn * (d[k] - q * e[k]) / un + q * wc[k]) / (6.0 * V) \
-                        - graw * dV[m, k] / V
-                    gr[l, k] = q * cu[k] / (6.0 * V) - graw * dV[l, k] / V
-                    gr[a, k] = -(gr[j, k] + gr[m, k] + gr[l, k])
-                s_w = coef * G * vol0[t] * gamma
-                for i in range(4):
+                    ch[k] = c[k] / cn
+                if reading == 2:  # d|c|/dx, shared by both in-plane edges
+                    cross(ed[l0], ch, gc[m0])
+                    cross(ch, ed[m0], gc[l0])
                     for k in range(3):
-                        ft[i, k] -= s_w * gr[i, k]
-        if reading >= 0:
-            for i in range(4):
-                for k in range(3):
-                    out[tets[t, i], k] += ft[i, k]
+                        gc[j, k] = 0.0
+                        gc[a, k] = -(gc[m0, k] + gc[l0, k])
+                for mm in range(2):
+                    m = m0 if mm == 0 else l0
+                    l = l0 if mm == 0 else m0
+                    q = dot(ed[j], eu[m])
+                    graw = q * cn / (6.0 * V)
+                    gamma = graw - gamma0[t, s]
+                    gamma_out[t, s] = gamma
+                    s += 1
+                    if reading < 0:
+                        continue
+                    tau_area = G * gamma * 0.5 * cn  # tau S_F
+                    if reading == 0:      # corner: on a alone, paper factor 1/4
+                        for k in range(3):
+                            ft[a, k] += 0.25 * tau_area * eu[m, k]
+                    elif reading == 1:    # balanced: on the tip, reaction over the base
+                        for k in range(3):
+                            f = tau_area * eu[m, k]
+                            ft[j, k] -= f
+                            ft[a, k] += f / 3.0
+                            ft[m, k] += f / 3.0
+                            ft[l, k] += f / 3.0
+                    else:                 # variational: -dW/dx, W = (c/2) G V0 gamma^2
+                        for k in range(3):
+                            gr[j, k] = cn * eu[m, k] / (6.0 * V)
+                            gr[m, k] = (cn * (ed[j, k] - q * eu[m, k]) / en[m]
+                                        + q * gc[m, k]) / (6.0 * V)
+                            gr[l, k] = q * gc[l, k] / (6.0 * V)
+                            gr[a, k] = -(gr[j, k] + gr[m, k] + gr[l, k])
+                        s_w = coef * G * vol0[t] * gamma
+                        for i in range(4):
+                            for k in range(3):
+                                ft[i, k] -= s_w * (gr[i, k] - graw * dV[i, k] / V)
+    for t in range(n_tets):
+        if flat[t] >= 0:
+            return t
     return -1
+
+
+@njit(cache=True)
+def scatter(tets, fbuf, out):
+    """Add per-tetrahedron nodal forces (m, 4, 3) into out (n, 3), in a fixed order."""
+    for t in range(tets.shape[0]):
+        for i in range(4):
+            for k in range(3):
+                out[tets[t, i], k] += fbuf[t, i, k]
 
 
 def strains_numpy(x, tets, gamma0):
@@ -143,6 +171,8 @@ class Shear(Term):
         self.G = self.scale * material.G
         self.vol0 = mesh.volumes
         self.gamma0 = np.zeros((mesh.n_tets, 24))
+        # work arrays reused by every force evaluation
+        self._fbuf, self._gam = np.empty((mesh.n_tets, 4, 3)), np.empty((mesh.n_tets, 24))
         self.gamma0 = self.strains(mesh.points)
 
     def describe(self):
@@ -165,17 +195,20 @@ class Shear(Term):
         return self.material.G * np.abs(self.strains(x)).max(axis=1)
 
     def _run(self, x, reading, out, gam):
+        fbuf = self._fbuf
         bad = _shear(np.ascontiguousarray(x, dtype=np.float64), self.mesh.tets, self.vol0,
-                     self.gamma0, self.G, self.coef or 0.0, reading, out, gam)
+                     self.gamma0, self.G, self.coef or 0.0, reading, fbuf, gam)
         if bad >= 0 and reading < 0:
             raise DegenerateTetError(f"tetrahedron {bad} is inverted or flattened", [bad])
+        if bad < 0 and reading >= 0:
+            scatter(self.mesh.tets, fbuf, out)
         return bad
 
     def _kernel_forces(self, x, out):
         if self.reading == 2 and self.coef is None:
             raise ModelError("variational shear with c='auto' is not calibrated yet: "
                              "build the model with model.build, or pass a number for c")
-        return self._run(x, self.reading, out, np.empty((self.mesh.n_tets, 24)))
+        return self._run(x, self.reading, out, self._gam)
 
     def forces_numpy(self, x):
         tets = self.mesh.tets
