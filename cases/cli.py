@@ -30,6 +30,90 @@ def _mesh_command(args):
     return 0
 
 
+def _choose(kind, given, valid):
+    """The names asked for, or a one-line error listing the valid ones (exit status 2)."""
+    if given is None:
+        return tuple(valid)
+    bad = [g for g in given if g not in valid]
+    if bad:
+        raise UsageError(f"unknown {kind} {', '.join(bad)}; valid: {', '.join(valid)}")
+    return tuple(given)
+
+
+class UsageError(Exception):
+    pass
+
+
+def _case(name):
+    from .registry import CASES
+    if name not in CASES:
+        raise UsageError(f"unknown case {name}; valid: {', '.join(CASES)}")
+    return CASES[name]
+
+
+def _config(case, args):
+    kw = {"meshes": _choose("mesh", args.meshes, case.MESHES),
+          "bcs": _choose("boundary condition", args.bcs, case.BCS),
+          "models": _choose("model", args.models, case.MODELS)}
+    for k in ("E", "nu", "rho"):
+        if getattr(args, k) is not None:
+            kw[k] = getattr(args, k)
+    if args.quick:
+        if args.meshes is None:
+            kw.pop("meshes")
+        return case.Config.quick_config(**kw)
+    return case.Config(**kw)
+
+
+def _run_case(name, args, out):
+    from .report import write_case
+    case = _case(name)
+    cfg = _config(case, args)
+    runs, fields = case.run(cfg)
+    path = write_case(out, name, cfg, runs, fields)
+    print(f"{name}: {len(runs)} runs written to {path}")
+    return path
+
+
+def _list_command(args):
+    from .registry import CASES
+    for name, case in CASES.items():
+        print(f"{name}: {case.__doc__.strip().splitlines()[0]}")
+        print(f"  meshes: {', '.join(case.MESHES)}")
+        print(f"  bcs:    {', '.join(case.BCS)}")
+        print(f"  models: {', '.join(case.MODELS)}")
+    return 0
+
+
+def _run_command(args):
+    from pathlib import Path
+    _run_case(args.case, args, Path(args.out) if args.out else Path("reports") / args.case)
+    return 0
+
+
+def _report_command(args):
+    from pathlib import Path
+    from .registry import CASES
+    from .report import write_index
+    root = Path(args.out or "reports")
+    for name in CASES:
+        _run_case(name, args, root / name)
+    write_index(root, list(CASES))
+    print(f"index written to {root / 'index.md'} and {root / 'index.html'}")
+    return 0
+
+
+def _selection(p):
+    p.add_argument("--models", nargs="+", help="model presets (default: all)")
+    p.add_argument("--meshes", nargs="+", help="meshes (default: all; --quick: five six)")
+    p.add_argument("--bcs", nargs="+", help="boundary conditions (default: all)")
+    p.add_argument("--quick", action="store_true",
+                   help="five and six meshes, one P2 refinement, fewer timing repeats")
+    p.add_argument("--E", type=float, help="Young's modulus [Pa] (default 10e3)")
+    p.add_argument("--nu", type=float, help="Poisson's ratio (default 0.45)")
+    p.add_argument("--rho", type=float, help="density [kg/m^3] (default 1000)")
+
+
 def parser():
     p = argparse.ArgumentParser(prog="pbcm", description=__doc__.splitlines()[0])
     p.add_argument("--version", action="version", version=f"pbcm {model.__version__}")
@@ -43,6 +127,17 @@ def parser():
     m.add_argument("--scheme", choices=SCHEMES, default="five", help="cube tetrahedralisation")
     m.add_argument("--seed", type=int, default=0, help="seed of the 'unstructured' scheme")
     m.set_defaults(func=_mesh_command)
+    ls = sub.add_parser("list", help="list the cases with their meshes, conditions and models")
+    ls.set_defaults(func=_list_command)
+    r = sub.add_parser("run", help="run one case and write its report folder")
+    r.add_argument("case", help="a case name (see pbcm list)")
+    r.add_argument("--out", help="output folder (default reports/CASE)")
+    _selection(r)
+    r.set_defaults(func=_run_command)
+    rep = sub.add_parser("report", help="run every case and write reports/ with its index")
+    rep.add_argument("--out", help="output folder (default reports)")
+    _selection(rep)
+    rep.set_defaults(func=_report_command)
     return p
 
 
@@ -50,6 +145,9 @@ def main(argv=None):
     args = parser().parse_args(argv)
     try:
         return args.func(args)
+    except UsageError as exc:
+        print(f"pbcm: error: {exc}", file=sys.stderr)
+        return 2
     except PbcmError as exc:
         print(f"pbcm: error: {exc}", file=sys.stderr)
         return 2

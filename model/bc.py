@@ -66,43 +66,48 @@ def bc_arrays(bc, n_nodes):
 
 class Ramp:
     """A ``bc_of_t``: ``nodes`` move linearly to ``displacement`` (ux, uy, uz; None for free)
-    over ``t_ramp`` seconds and then hold; ``fixed`` nodes stay at zero throughout.
+    over ``t_ramp`` seconds and then hold; ``fixed`` nodes stay at zero and ``held`` (a bc
+    mapping) stays at its values throughout.
 
     Callable like any ``bc_of_t`` (t -> mapping); ``arrays`` and ``velocity`` give the
     integrator the prescribed state without rebuilding a mapping at every stage.
     """
 
-    def __init__(self, nodes, displacement, t_ramp, fixed=()):
+    def __init__(self, nodes, displacement, t_ramp, fixed=(), held=None):
         if not t_ramp > 0:
             raise ModelError(f"t_ramp must be a positive time in seconds, got {t_ramp!r}")
         self.nodes, self.fixed = [int(i) for i in nodes], [int(i) for i in fixed]
         self.disp, self.t_ramp = tuple(displacement), float(t_ramp)
+        self.held = dict(held or {})
         self._cache = None
 
-    def __call__(self, t):
-        s = min(max(t / self.t_ramp, 0.0), 1.0)
-        out = {i: (0.0, 0.0, 0.0) for i in self.fixed}
-        out.update({i: tuple(None if d is None else s * d for d in self.disp)
-                    for i in self.nodes})
-        return out
+    def _scale(self, t):
+        return min(max(t / self.t_ramp, 0.0), 1.0)
 
-    def _full(self, n_nodes):
+    def __call__(self, t):
+        s = self._scale(t)
+        out = [(i, (0.0, 0.0, 0.0)) for i in self.fixed] + list(self.held.items())
+        out += [(i, tuple(None if d is None else s * d for d in self.disp)) for i in self.nodes]
+        return merge(out)
+
+    def _parts(self, n_nodes):
         if self._cache is None or self._cache[0] != n_nodes:
-            mask, full = bc_arrays(self(self.t_ramp), n_nodes)
-            self._cache = (n_nodes, mask, full)
+            mask, end = bc_arrays(self(self.t_ramp), n_nodes)
+            _, start = bc_arrays(self(0.0), n_nodes)
+            self._cache = (n_nodes, mask, start, end - start)
         return self._cache[1:]
 
     def arrays(self, t, n_nodes):
         """(mask, displacement) at time t, as bc_arrays(self(t), n_nodes) gives them."""
-        mask, full = self._full(n_nodes)
-        return mask, min(max(t / self.t_ramp, 0.0), 1.0) * full
+        mask, start, moving = self._parts(n_nodes)
+        return mask, start + self._scale(t) * moving
 
     def velocity(self, t, n_nodes):
         """Prescribed velocity at t (the ramp's slope before t_ramp, zero after)."""
-        _, full = self._full(n_nodes)
-        return full / self.t_ramp if 0.0 <= t < self.t_ramp else np.zeros_like(full)
+        _, _, moving = self._parts(n_nodes)
+        return moving / self.t_ramp if 0.0 <= t < self.t_ramp else np.zeros_like(moving)
 
 
-def ramp(nodes, displacement, t_ramp, fixed=()):
+def ramp(nodes, displacement, t_ramp, fixed=(), held=None):
     """Shorthand for :class:`Ramp`."""
-    return Ramp(nodes, displacement, t_ramp, fixed)
+    return Ramp(nodes, displacement, t_ramp, fixed, held)

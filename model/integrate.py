@@ -17,13 +17,15 @@ from .geometry import min_signed_volume
 class Trajectory:
     """``t`` (k,) frame times, ``x`` (k, n, 3) positions, ``reaction`` (k, n, 3) support forces
     -(f_int + f_ext) on the prescribed components (inertia of the driven nodes excluded),
-    ``dt`` the step used, ``steps`` the number of steps."""
+    ``dt`` the step used, ``steps`` the number of steps, ``v`` the final velocities (to
+    continue from)."""
 
     t: np.ndarray
     x: np.ndarray
     reaction: np.ndarray
     dt: float
     steps: int
+    v: np.ndarray
 
 
 def rk4_step(accel, x, v, t, dt, constrain):
@@ -45,8 +47,10 @@ def rk4_step(accel, x, v, t, dt, constrain):
     return xn, vn
 
 
-def simulate(model, bc_of_t, t_end, dt=None, damping=0.0, f_ext=None, frames=101, safety=0.5):
-    """Integrate from rest to ``t_end`` [s] with RK4.
+def simulate(model, bc_of_t, t_end, dt=None, damping=0.0, f_ext=None, frames=101, safety=0.5,
+             x0=None, v0=None, t0=0.0):
+    """Integrate from ``t0`` (state ``x0``, ``v0``; the mesh at rest by default) to ``t_end``
+    [s] with RK4.
 
     ``bc_of_t(t)`` returns the boundary-condition mapping at time t; the set of prescribed
     components must not change. ``dt`` defaults to ``model.stable_dt(safety)`` and is shrunk
@@ -55,13 +59,13 @@ def simulate(model, bc_of_t, t_end, dt=None, damping=0.0, f_ext=None, frames=101
     faster than the P-wave speed.
     """
     mesh, mass = model.mesh, model.mass[:, None]
-    if not (t_end > 0 and math.isfinite(t_end)):
-        raise ModelError(f"t_end must be a positive time in seconds, got {t_end!r}")
+    if not (t_end > t0 and math.isfinite(t_end)):
+        raise ModelError(f"t_end must be a time in seconds after t0 = {t0}, got {t_end!r}")
     dt = model.stable_dt(safety) if dt is None else float(dt)
     if not (dt > 0 and math.isfinite(dt)):
         raise ModelError(f"dt must be a positive time in seconds, got {dt!r}")
-    steps = max(1, math.ceil(t_end / dt - 1e-9))
-    dt = t_end / steps
+    steps = max(1, math.ceil((t_end - t0) / dt - 1e-9))
+    dt = (t_end - t0) / steps
     mask, _ = bc_arrays(bc_of_t(0.0), mesh.n_nodes)
     f_ext = np.zeros_like(mesh.points) if f_ext is None else np.asarray(f_ext, dtype=float)
     h_fd = 1e-6 * dt
@@ -94,20 +98,21 @@ def simulate(model, bc_of_t, t_end, dt=None, damping=0.0, f_ext=None, frames=101
         a[mask] = 0.0
         return a
 
-    x, v = mesh.points.copy(), np.zeros_like(mesh.points)
-    constrain(x, v, 0.0)
+    x = mesh.points.copy() if x0 is None else np.array(x0, dtype=float)
+    v = np.zeros_like(mesh.points) if v0 is None else np.array(v0, dtype=float)
+    constrain(x, v, t0)
     frame_steps = np.unique(np.linspace(0, steps, max(int(frames), 2)).round().astype(int))
     ts, xs, rs = [], [], []
     vmax = model.material.p_wave_speed
 
     def record(k, x):
-        ts.append(k * dt)
+        ts.append(t0 + k * dt)
         xs.append(x.copy())
         rs.append(np.where(mask, -(model.forces(x) + f_ext), 0.0))
 
     record(0, x)
     for k in range(1, steps + 1):
-        t = (k - 1) * dt
+        t = t0 + (k - 1) * dt
         try:
             x, v = rk4_step(accel, x, v, t, dt, constrain)
         except DegenerateTetError as exc:
@@ -123,7 +128,8 @@ def simulate(model, bc_of_t, t_end, dt=None, damping=0.0, f_ext=None, frames=101
                            f"{vmax:.3g} m/s", k, t + dt, dt)
         if k in frame_steps:
             record(k, x)
-    return Trajectory(t=np.array(ts), x=np.array(xs), reaction=np.array(rs), dt=dt, steps=steps)
+    return Trajectory(t=np.array(ts), x=np.array(xs), reaction=np.array(rs), dt=dt, steps=steps,
+                      v=v)
 
 
 def _blow_up(what, step, t, dt):

@@ -84,7 +84,8 @@ class ParticleModel:
         return static.solve(self, bc, f_ext=f_ext, rtol=rtol, max_iter=max_iter,
                             load_steps=load_steps)
 
-    def simulate(self, bc_of_t, t_end, dt=None, damping=0.0, f_ext=None, frames=101, safety=0.5):
+    def simulate(self, bc_of_t, t_end, dt=None, damping=0.0, f_ext=None, frames=101, safety=0.5,
+                 x0=None, v0=None, t0=0.0):
         """Classical RK4 dynamics (see model.integrate.simulate)."""
         return integrate.simulate(self, bc_of_t, t_end, dt=dt, damping=damping, f_ext=f_ext,
-                                  frames=frames, safety=safety)
+                                  frames=frames, safety=safety, x0=x0, v0=v0, t0=t0)

@@ -1,0 +1,95 @@
+"""A report as a list of blocks, rendered to Markdown and to self-contained HTML."""
+import base64
+import html
+from pathlib import Path
+
+
+class Link:
+    """A table cell linking to ``md_href`` in Markdown and ``html_href`` in HTML."""
+
+    def __init__(self, text, md_href, html_href=None):
+        self.text, self.md_href, self.html_href = text, md_href, html_href or md_href
+
+    def markdown(self):
+        return f"[{self.text}]({self.md_href})"
+
+    def html(self):
+        return f"<a href='{html.escape(self.html_href)}'>{html.escape(self.text)}</a>"
+
+
+def _md(c):
+    return c.markdown() if isinstance(c, Link) else str(c)
+
+
+def _html(c):
+    return c.html() if isinstance(c, Link) else html.escape(str(c))
+
+
+class Document:
+    def __init__(self, title):
+        self.title, self.blocks = title, []
+
+    def h(self, level, text):
+        self.blocks.append(("h", level, text))
+
+    def p(self, text):
+        self.blocks.append(("p", text))
+
+    def ul(self, items):
+        self.blocks.append(("ul", list(items)))
+
+    def table(self, header, rows):
+        self.blocks.append(("table", list(header), [list(r) for r in rows]))
+
+    def img(self, filename, alt):
+        self.blocks.append(("img", filename, alt))
+
+    def markdown(self):
+        out = [f"# {self.title}", ""]
+        for b in self.blocks:
+            if b[0] == "h":
+                out += ["#" * b[1] + " " + b[2], ""]
+            elif b[0] == "p":
+                out += [b[1], ""]
+            elif b[0] == "ul":
+                out += [f"- {i}" for i in b[1]] + [""]
+            elif b[0] == "table":
+                out += ["| " + " | ".join(b[1]) + " |", "|" + "---|" * len(b[1])]
+                out += ["| " + " | ".join(map(_md, r)) + " |" for r in b[2]] + [""]
+            elif b[0] == "img":
+                out += [f"![{b[2]}]({b[1]})", ""]
+        return "\n".join(out)
+
+    def html(self, folder):
+        """HTML with every figure embedded as a data URI (one file to send around)."""
+        e = html.escape
+        out = ["<!DOCTYPE html>", "<html><head><meta charset='utf-8'>",
+               f"<title>{e(self.title)}</title>",
+               "<style>body{font-family:sans-serif;max-width:1100px;margin:auto}"
+               "table{border-collapse:collapse;font-size:12px}td,th{border:1px solid #bbb;"
+               "padding:2px 6px;text-align:right}img{max-width:100%}</style></head><body>",
+               f"<h1>{e(self.title)}</h1>"]
+        for b in self.blocks:
+            if b[0] == "h":
+                out.append(f"<h{b[1]}>{e(b[2])}</h{b[1]}>")
+            elif b[0] == "p":
+                out.append(f"<p>{e(b[1])}</p>")
+            elif b[0] == "ul":
+                out.append("<ul>" + "".join(f"<li>{e(i)}</li>" for i in b[1]) + "</ul>")
+            elif b[0] == "table":
+                out.append("<table><tr>" + "".join(f"<th>{e(h)}</th>" for h in b[1]) + "</tr>")
+                out += ["<tr>" + "".join(f"<td>{_html(c)}</td>" for c in r) + "</tr>"
+                        for r in b[2]]
+                out.append("</table>")
+            elif b[0] == "img":
+                data = base64.b64encode((Path(folder) / b[1]).read_bytes()).decode()
+                out.append(f"<figure><img alt='{e(b[2])}' data-src='{e(b[1])}' "
+                           f"src='data:image/png;base64,{data}'><figcaption>{e(b[2])}"
+                           "</figcaption></figure>")
+        out.append("</body></html>")
+        return "\n".join(out)
+
+    def write(self, folder, stem="report"):
+        folder = Path(folder)
+        (folder / f"{stem}.md").write_text(self.markdown() + "\n")
+        (folder / f"{stem}.html").write_text(self.html(folder) + "\n")

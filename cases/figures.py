@@ -1,0 +1,96 @@
+"""Matplotlib figures of a case (millimetres on every axis)."""
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+import numpy as np  # noqa: E402
+from mpl_toolkits.mplot3d.art3d import Poly3DCollection  # noqa: E402
+
+MM = 1e-3
+FACES = np.array([[1, 2, 3], [0, 2, 3], [0, 1, 3], [0, 1, 2]])
+
+
+def boundary_faces(tets):
+    """Boundary triangles (k, 3) and the tetrahedron each belongs to."""
+    f = tets[:, FACES].reshape(-1, 3)
+    key = np.sort(f, axis=1)
+    _, inv, counts = np.unique(key, axis=0, return_inverse=True, return_counts=True)
+    once = counts[inv.ravel()] == 1
+    return f[once], np.repeat(np.arange(len(tets)), 4)[once]
+
+
+def stress_panels(path, panels, title, magnify):
+    """The analogue of the paper's Figure 1: each panel (label, mesh, u, max_tau) drawn
+    deformed (displacement x ``magnify``), boundary faces coloured by max |tau| on one shared
+    scale: blue at or below 0.01 of it, red at or above 0.9."""
+    scale = max(float(np.max(p[3])) for p in panels)
+    norm = matplotlib.colors.Normalize(vmin=0.01 * scale, vmax=0.9 * scale, clip=True)
+    cmap = plt.get_cmap("jet")
+    cols = min(4, len(panels))
+    rows = int(np.ceil(len(panels) / cols))
+    fig = plt.figure(figsize=(3.2 * cols, 3.2 * rows + 0.6))
+    for k, (label, mesh, u, tau) in enumerate(panels):
+        ax = fig.add_subplot(rows, cols, k + 1, projection="3d")
+        tri, owner = boundary_faces(mesh.tets)
+        x = (mesh.points + magnify * u) / MM
+        ax.add_collection3d(Poly3DCollection(x[tri], facecolors=cmap(norm(tau[owner])),
+                                             edgecolors="k", linewidths=0.2))
+        ax.set_xlim(-2, 34), ax.set_ylim(-2, 34), ax.set_zlim(-2, 34)
+        ax.view_init(elev=20, azim=-60, vertical_axis="y")
+        ax.set_title(label, fontsize=9)
+        ax.set_axis_off()
+    sm = matplotlib.cm.ScalarMappable(norm=norm, cmap=cmap)
+    fig.colorbar(sm, ax=fig.axes, shrink=0.6, label=f"max |tau| [Pa] (scale {scale:.4g} Pa)")
+    fig.suptitle(f"{title} (displacement x{magnify:g})", fontsize=10)
+    fig.savefig(path, dpi=90)
+    plt.close(fig)
+
+
+def profiles(path, layers_mm, series, fem, title):
+    """Layer profiles: mean outward lateral displacement per y-layer, models against FEM."""
+    fig, ax = plt.subplots(figsize=(6, 4))
+    ax.plot(fem, layers_mm, "k-o", lw=2.5, label="FEM P2 (converged)")
+    for label, prof in series:
+        ax.plot(prof, layers_mm, "-s", ms=4, label=label)
+    ax.set_xlabel("mean outward lateral displacement [mm]")
+    ax.set_ylabel("layer y [mm]")
+    ax.set_title(title, fontsize=10)
+    ax.grid(alpha=0.3)
+    ax.legend(fontsize=7)
+    fig.tight_layout()
+    fig.savefig(path, dpi=90)
+    plt.close(fig)
+
+
+def grouped_bars(path, groups, labels, values, ylabel, title, log=False):
+    """values[g][l] for each group g and label l."""
+    fig, ax = plt.subplots(figsize=(max(6, 1.3 * len(groups)), 4))
+    w = 0.8 / len(labels)
+    for i, lab in enumerate(labels):
+        ax.bar(np.arange(len(groups)) + i * w, [values[g][i] for g in range(len(groups))], w,
+               label=lab)
+    ax.set_xticks(np.arange(len(groups)) + 0.4 - w / 2, groups, fontsize=8)
+    if log:
+        ax.set_yscale("log")
+    ax.set_ylabel(ylabel)
+    ax.set_title(title, fontsize=10)
+    ax.legend(fontsize=7)
+    ax.grid(alpha=0.3, axis="y")
+    fig.tight_layout()
+    fig.savefig(path, dpi=90)
+    plt.close(fig)
+
+
+def reaction_history(path, series, fem_level, title):
+    fig, ax = plt.subplots(figsize=(6, 4))
+    for label, t, r in series:
+        ax.plot(t, r, label=label)
+    ax.axhline(fem_level, color="k", ls="--", label="FEM P2 static at 1.7 mm")
+    ax.set_xlabel("time [s]")
+    ax.set_ylabel("reaction on the driven nodes [N]")
+    ax.set_title(title, fontsize=10)
+    ax.grid(alpha=0.3)
+    ax.legend(fontsize=7)
+    fig.tight_layout()
+    fig.savefig(path, dpi=90)
+    plt.close(fig)

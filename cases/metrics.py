@@ -1,0 +1,90 @@
+"""Metrics comparing a model's state with a reference (MODEL.md "What is compared").
+
+Every function returns plain floats or arrays and raises MetricError rather than return NaN.
+"""
+import numpy as np
+
+from model.errors import PbcmError
+
+
+class MetricError(PbcmError, ArithmeticError):
+    """A metric could not be computed (NaN, empty set, zero reference)."""
+
+
+def finite(name, value):
+    """``value`` if every entry is finite, else a MetricError naming the metric."""
+    a = np.asarray(value, dtype=float)
+    if not np.all(np.isfinite(a)):
+        raise MetricError(f"metric {name!r} is not finite ({value!r}): the run behind it failed")
+    return float(a) if a.ndim == 0 else a
+
+
+def _nonzero(name, ref):
+    if not ref > 0:
+        raise MetricError(f"metric {name!r}: the reference is zero, the relative error is "
+                          "undefined")
+    return ref
+
+
+def rel_l2(u, ref):
+    """||u - ref|| / ||ref|| over all nodal components."""
+    return finite("rel_l2", np.linalg.norm(u - ref) / _nonzero("rel_l2", np.linalg.norm(ref)))
+
+
+def max_rel(u, ref):
+    """max_i |u_i - ref_i| / max_i |ref_i| (nodal vector norms)."""
+    num = np.linalg.norm(u - ref, axis=1).max()
+    return finite("max_rel", num / _nonzero("max_rel", np.linalg.norm(ref, axis=1).max()))
+
+
+def correlation(a, b):
+    """Pearson correlation of two per-tetrahedron fields."""
+    a, b = np.asarray(a, float), np.asarray(b, float)
+    if a.std() == 0 or b.std() == 0:
+        raise MetricError("correlation of a constant field is undefined")
+    return finite("correlation", np.corrcoef(a, b)[0, 1])
+
+
+def layer_profile(points, u, layers, size, tol=None):
+    """Mean outward lateral displacement of the side-face nodes of each y-layer of a cube
+    [0, size]^3 (a node on an edge counts once per face it lies on)."""
+    tol = 1e-6 * size if tol is None else tol
+    out = []
+    for y in layers:
+        in_layer = np.abs(points[:, 1] - y) <= tol
+        vals = []
+        for axis in (0, 2):
+            for side, normal in ((0.0, -1.0), (size, 1.0)):
+                on = in_layer & (np.abs(points[:, axis] - side) <= tol)
+                vals.append(normal * u[on, axis])
+        vals = np.concatenate(vals)
+        if vals.size == 0:
+            raise MetricError(f"no side-face node in the layer y = {y}")
+        out.append(vals.mean())
+    return finite("layer_profile", np.array(out))
+
+
+def zigzag(profile):
+    """Zig-zag amplitude of a layer profile: the RMS residual of a least-squares quadratic in
+    the layer index, over the largest |profile|. Zero for any profile a quadratic fits (a
+    barrel, a uniform expansion), about 0.86 for pure alternation +a, -a, +a, -a, +a."""
+    b = np.asarray(profile, float)
+    if b.size < 4:
+        raise MetricError("zig-zag needs at least four layers")
+    scale = np.abs(b).max()
+    if scale == 0:
+        return 0.0
+    k = np.arange(b.size)
+    residual = b - np.polyval(np.polyfit(k, b, 2), k)
+    return finite("zigzag", np.sqrt((residual**2).mean()) / scale)
+
+
+def paper_pattern(profile):
+    """True when the middle layer and the ends bulge relative to their neighbours while the
+    quarter layers neck (the paper's section 5): positive second differences at the quarter
+    layers and a negative one at the middle, for a five-layer profile."""
+    b = np.asarray(profile, float)
+    if b.size != 5:
+        raise MetricError("the paper's pattern is defined on five layers")
+    d2 = b[:-2] - 2 * b[1:-1] + b[2:]
+    return bool(d2[0] > 0 and d2[1] < 0 and d2[2] > 0)
