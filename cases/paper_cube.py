@@ -10,7 +10,7 @@ import time
 
 import numpy as np
 
-from model import PRESETS, Material, build
+from model import PRESETS, BlowUpError, Material, build
 from model.bc import Ramp
 from model.mesh import cube
 from model.terms.shear import Shear
@@ -127,19 +127,55 @@ def dynamic_run(pm, mesh, bc, cfg):
     t_push = ramp.t_ramp
     dt = pm.stable_dt(cfg.safety)
     t0 = time.perf_counter()
-    traj = pm.simulate(ramp, t_push, dt=dt, damping=cfg.damping, frames=21)
-    ts, rs, x, v, t, steps = list(traj.t), list(traj.reaction), traj.x[-1], traj.v, t_push, traj.steps
     rest = cfg.rest_speed * SPEED_MM_S * MM
-    while t < t_push + cfg.hold_max - 1e-12 and np.abs(v).max() > rest:
-        chunk = pm.simulate(ramp, t + 0.1, dt=dt, damping=cfg.damping, frames=3, x0=x, v0=v, t0=t)
-        ts += list(chunk.t[1:])
-        rs += list(chunk.reaction[1:])
-        x, v, t, steps = chunk.x[-1], chunk.v, t + 0.1, steps + chunk.steps
+    try:
+        traj = pm.simulate(ramp, t_push, dt=dt, damping=cfg.damping, frames=21)
+        ts, rs, x, v, t = list(traj.t), list(traj.reaction), traj.x[-1], traj.v, t_push
+        steps = traj.steps
+        while t < t_push + cfg.hold_max - 1e-12 and np.abs(v).max() > rest:
+            chunk = pm.simulate(ramp, t + 0.1, dt=dt, damping=cfg.damping, frames=3, x0=x,
+                                v0=v, t0=t)
+            ts += list(chunk.t[1:])
+            rs += list(chunk.reaction[1:])
+            x, v, t, steps = chunk.x[-1], chunk.v, t + 0.1, steps + chunk.steps
+    except BlowUpError as exc:
+        # a finding about the model (see the stability metric), not a crash of the suite
+        return {"failed": str(exc), "wall": time.perf_counter() - t0, "dt": dt}
     wall = time.perf_counter() - t0
     top = ramp.nodes
-    return {"x": x, "t": np.array(ts), "reaction_y": -np.array(rs)[:, top, 1].sum(axis=1),
+    return {"failed": None, "x": x, "t": np.array(ts),
+            "reaction_y": -np.array(rs)[:, top, 1].sum(axis=1),
             "t_end": t, "at_rest": bool(np.abs(v).max() <= rest), "steps": steps,
-            "dt": traj.dt, "wall": wall, "max_speed": float(np.abs(v).max())}
+            "dt": dt, "wall": wall, "max_speed": float(np.abs(v).max())}
+
+
+def dynamic_metrics(dyn, mesh, st):
+    """The dynamic run's metrics; None throughout (and the reason) when it blew up."""
+    keys = ("dyn_vs_static_rel_l2", "dyn_at_rest", "dyn_t_end_s", "dyn_steps",
+            "dyn_reaction_t_s", "dyn_reaction_n")
+    out = {"dyn_failed": dyn["failed"], "dyn_dt_s": dyn["dt"], "dyn_wall_s": dyn["wall"]}
+    if dyn["failed"]:
+        return {**out, **{k: None for k in keys}}
+    return {**out,
+            "dyn_vs_static_rel_l2": M.rel_l2(dyn["x"] - mesh.points, st.u),
+            "dyn_at_rest": dyn["at_rest"], "dyn_t_end_s": dyn["t_end"],
+            "dyn_steps": dyn["steps"], "dyn_reaction_t_s": dyn["t"].tolist(),
+            "dyn_reaction_n": M.finite("dyn_reaction", dyn["reaction_y"]).tolist()}
+
+
+def growth_rate(pm, mesh, bc):
+    """Largest exponential growth rate [1/s] of the undamped model linearised at rest with the
+    case's constraints: max Re sqrt(lambda) over the eigenvalues lambda of M^-1 df/dx on the
+    free components. Zero (to rounding) for a conservative model; positive means flutter, which
+    mass damping zeta only suppresses when zeta / 2 exceeds it."""
+    from model.bc import bc_arrays
+    mask, _ = bc_arrays(static_bc(mesh, bc), mesh.n_nodes)
+    free = ~mask.ravel()
+    A = pm.jacobian(mesh.points).toarray()[free][:, free] / np.repeat(pm.mass, 3)[free][:, None]
+    lam = np.linalg.eigvals(A).astype(complex)
+    rate = float(np.sqrt(lam).real.max())
+    scale = float(np.sqrt(np.abs(lam).max()))
+    return rate if rate > 1e-7 * scale else 0.0
 
 
 def step_time(pm, mesh, bc, cfg):
@@ -215,12 +251,8 @@ def run(cfg, log=True):
                     "net_force_rel": M.finite("net_force", nft["force_rel"]),
                     "net_torque_rel": M.finite("net_torque", nft["torque_rel"]),
                     "static_residual_n": st.residual,
-                    "dyn_vs_static_rel_l2": M.rel_l2(dyn["x"] - mesh.points, st.u),
-                    "dyn_at_rest": dyn["at_rest"], "dyn_t_end_s": dyn["t_end"],
-                    "dyn_steps": dyn["steps"], "dyn_dt_s": dyn["dt"],
-                    "dyn_reaction_t_s": dyn["t"].tolist(),
-                    "dyn_reaction_n": M.finite("dyn_reaction", dyn["reaction_y"]).tolist(),
-                    "dyn_wall_s": dyn["wall"],
+                    "growth_rate_1_s": growth_rate(pm, mesh, bc),
+                    **dynamic_metrics(dyn, mesh, st),
                     "step_time_s": step_time(pm, mesh, bc, cfg),
                     "p2_error_estimate": conv.error_estimate,
                     "model_info": _jsonable(pm.info),

@@ -106,6 +106,10 @@ def build_report(case, cfg, runs, fields, out):
         "8 and 24 mm layers neck (second differences +, -, +), as the paper's section 5 reports.",
         "net F / net T: |sum f| / sum |f| and |sum x x f| / sum |x||f| of the model's internal "
         "forces at the FEM P2 deformed state (zero for a momentum-conserving model).",
+        "growth: the largest exponential growth rate of the undamped model linearised at rest "
+        "(max Re sqrt(eig(M^-1 df/dx))); above zero the force field flutters.",
+        "dyn vs static: relative L2 distance between the end of the dynamic run and the static "
+        "equilibrium.",
         "step time: median over repeats of the wall time of one RK4 step of the full "
         "integrator."])
     doc.h(2, "Findings")
@@ -121,12 +125,15 @@ def build_report(case, cfg, runs, fields, out):
                   f"{fmt(rs[0]['p2_error_estimate'], 2)}.")
             doc.table(["model", "disp L2 P1", "disp L2 P2", "disp max P2", "reaction ratio",
                        "stress corr", "stress err", "pressure corr", "zig-zag",
-                       "paper pattern", "net F", "net T", "step time [us]"],
+                       "paper pattern", "net F", "net T", "growth [1/s]", "dyn vs static",
+                       "step time [us]"],
                       [[r["model"], fmt(r["disp_rel_l2_p1"]), fmt(r["disp_rel_l2_p2"]),
                         fmt(r["disp_max_rel_p2"]), fmt(r["reaction_ratio"]),
                         fmt(r["stress_corr"]), fmt(r["stress_rel_err"]),
                         fmt(r["pressure_corr"]), fmt(r["zigzag"]), fmt(r["paper_pattern"]),
                         fmt(r["net_force_rel"], 2), fmt(r["net_torque_rel"], 2),
+                        fmt(r["growth_rate_1_s"]),
+                        "blew up" if r["dyn_failed"] else fmt(r["dyn_vs_static_rel_l2"], 2),
                         fmt(r["step_time_s"] * 1e6)] for r in rs])
             doc.table(["layer y [mm]", "FEM P2"] + [r["model"] for r in rs],
                       [[fmt(y), fmt(rs[0]["bulge_profile_fem_mm"][k], 4)]
@@ -160,7 +167,7 @@ def build_report(case, cfg, runs, fields, out):
     m0, b0 = keys[0]
     figures.reaction_history(out / "reaction_time.png",
                              [(r["model"], r["dyn_reaction_t_s"], r["dyn_reaction_n"])
-                              for r in _runs(runs, mesh=m0, bc=b0)],
+                              for r in _runs(runs, mesh=m0, bc=b0) if not r["dyn_failed"]],
                              _runs(runs, mesh=m0, bc=b0)[0]["reaction_fem_p2_n"],
                              f"dynamic run, mesh {m0}, {b0}")
     doc.img("reaction_time.png", f"Reaction force against time, mesh {m0}, {b0}")
@@ -213,6 +220,18 @@ def findings(runs, cfg):
                        f"{max(rr):.3g}; net force up to {max(r['net_force_rel'] for r in rs):.2g}"
                        f", net torque up to {max(r['net_torque_rel'] for r in rs):.2g} of the "
                        "force scale.")
+    failed = [r for r in runs if r["dyn_failed"]]
+    for r in failed:
+        out.append(f"Dynamic run of {r['model']} on {r['mesh']}/{r['bc']} blew up: "
+                   f"{r['dyn_failed']} Linearised at rest it grows at {r['growth_rate_1_s']:.3g}"
+                   f" 1/s (mass damping removes {cfg.damping / 2:g} 1/s): a non-conservative "
+                   "force field flutters; a smaller dt does not cure it.")
+    unstable = sorted({(r["model"], r["mesh"], r["bc"], r["growth_rate_1_s"]) for r in runs
+                       if r["growth_rate_1_s"] > 0})
+    if unstable:
+        out.append("Flutter (positive growth rate of the undamped linearised model): "
+                   + "; ".join(f"{m} on {me}/{b}: {g:.3g} 1/s" for m, me, b, g in unstable)
+                   + ". Conservative readings have none.")
     msm = [r["step_time_s"] for r in runs if r["model"] == "msm"]
     if msm:
         for model in cfg.models:
