@@ -13,6 +13,7 @@ from .paper_cube import LAYERS_MM, PUSH_MM, SIZE_MM
 from .document import Document, Link
 
 TIMING_KEYS = ("step_time_s", "dyn_wall_s")
+CLEAR_ZIGZAG = 0.01  # below this the alternation is under 1 % of the profile
 MM = 1e-3
 
 
@@ -184,12 +185,21 @@ def findings(runs, cfg):
     out = []
     pattern = [r for r in runs if r["paper_pattern"]]
     fem_pattern = {(r["mesh"], r["bc"]) for r in runs if r["paper_pattern_fem"]}
-    if pattern:
-        out.append("The paper's bulge at 0/16/32 mm and neck at 8/24 mm is reproduced by: "
-                   + "; ".join(f"{r['model']} on {r['mesh']}/{r['bc']} (profile "
-                               + ", ".join(f"{v:.4f}" for v in r["bulge_profile_mm"])
-                               + f" mm, zig-zag {r['zigzag']:.3g})" for r in pattern) + ".")
-    else:
+
+    def listing(rs):
+        return "; ".join(f"{r['model']} on {r['mesh']}/{r['bc']} (profile "
+                         + ", ".join(f"{v:.4f}" for v in r["bulge_profile_mm"])
+                         + f" mm, zig-zag {r['zigzag']:.3g})" for r in rs)
+
+    clear = [r for r in pattern if r["zigzag"] >= CLEAR_ZIGZAG]
+    faint = [r for r in pattern if r["zigzag"] < CLEAR_ZIGZAG]
+    if clear:
+        out.append("The paper's bulge at 0/16/32 mm and neck at 8/24 mm is reproduced clearly "
+                   f"(zig-zag >= {CLEAR_ZIGZAG:g}) by: {listing(clear)}.")
+    if faint:
+        out.append(f"The same sign pattern appears faintly (zig-zag < {CLEAR_ZIGZAG:g}) in: "
+                   f"{listing(faint)}.")
+    if not pattern:
         out.append("No model reproduces the paper's bulge at 0/16/32 mm and neck at 8/24 mm on "
                    "any mesh and boundary condition run here.")
     none = sorted({(r["model"]) for r in runs} - {r["model"] for r in pattern})
@@ -223,7 +233,7 @@ def findings(runs, cfg):
     failed = [r for r in runs if r["dyn_failed"]]
     for r in failed:
         out.append(f"Dynamic run of {r['model']} on {r['mesh']}/{r['bc']} blew up: "
-                   f"{r['dyn_failed']} Linearised at rest it grows at {r['growth_rate_1_s']:.3g}"
+                   f"{r['dyn_failed']}. Linearised at rest it grows at {r['growth_rate_1_s']:.3g}"
                    f" 1/s (mass damping removes {cfg.damping / 2:g} 1/s): a non-conservative "
                    "force field flutters; a smaller dt does not cure it.")
     unstable = sorted({(r["model"], r["mesh"], r["bc"], r["growth_rate_1_s"]) for r in runs
