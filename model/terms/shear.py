@@ -17,7 +17,7 @@ Readings of the force (``reading``):
 * ``variational`` f = -dW/dx with W = (c/2) G V0 sum gamma^2, every derivative taken.
 """
 import numpy as np
-from numba import njit, prange
+from numba import njit
 
 from . import Term, register
 from ._kernels import cross, dot, gather, volume_gradient, volume_gradient_numpy
@@ -33,25 +33,23 @@ _PARITY = np.array([round(np.linalg.det(np.eye(4)[[a, m, l, j]])) for a, j, m, l
 READINGS = {"corner": 0, "balanced": 1, "variational": 2}
 
 
-@njit(cache=True, fastmath=True, parallel=True)
-def _shear(x, tets, vol0, gamma0, G, coef, reading, fbuf, gamma_out):
+@njit(cache=True, fastmath=True)
+def _shear(x, tets, vol0, gamma0, G, coef, reading, out, gamma_out):
     """Strains of every tetrahedron into gamma_out (m, 24) and, unless reading < 0, the
-    forces of ``reading`` on its four nodes into fbuf (m, 4, 3). Returns the first flattened
-    tetrahedron, or -1. Loops run corner a, tip j, then the two in-plane edges m of the base
+    forces of ``reading`` added into out (n, 3). Returns the first flattened tetrahedron,
+    or -1. Loops run corner a, tip j, then the two in-plane edges m of the base
     (a, m, l), so that edge vectors and the base normal are computed once."""
     n_tets = tets.shape[0]
-    flat = np.full(n_tets, -1)
-    for t in prange(n_tets):
-        xt, ee, dV = np.empty((4, 3)), np.empty((3, 3)), np.empty((4, 3))
-        ed, en, eu = np.empty((4, 3)), np.empty(4), np.empty((4, 3))  # edges from corner a
-        c, ch, gc, gr = np.empty(3), np.empty(3), np.empty((4, 3)), np.empty((4, 3))
-        ft = fbuf[t]
+    xt, ee, dV = np.empty((4, 3)), np.empty((3, 3)), np.empty((4, 3))
+    ed, en, eu = np.empty((4, 3)), np.empty(4), np.empty((4, 3))  # edges from corner a
+    c, ch, gc, gr = np.empty(3), np.empty(3), np.empty((4, 3)), np.empty((4, 3))
+    ft = np.empty((4, 3))  # this tetrahedron's nodal forces, added to out once
+    for t in range(n_tets):
         ft[:] = 0.0
         gather(x, tets, t, xt)
         V = volume_gradient(xt, ee, dV)
         if V <= FLAT * vol0[t]:
-            flat[t] = t
-            continue
+            return t
         s = 0
         for a in range(4):
             for b in range(4):
@@ -109,19 +107,11 @@ def _shear(x, tets, vol0, gamma0, G, coef, reading, fbuf, gamma_out):
                         for i in range(4):
                             for k in range(3):
                                 ft[i, k] -= s_w * (gr[i, k] - graw * dV[i, k] / V)
-    for t in range(n_tets):
-        if flat[t] >= 0:
-            return t
+        if reading >= 0:
+            for i in range(4):
+                for k in range(3):
+                    out[tets[t, i], k] += ft[i, k]
     return -1
-
-
-@njit(cache=True)
-def scatter(tets, fbuf, out):
-    """Add per-tetrahedron nodal forces (m, 4, 3) into out (n, 3), in a fixed order."""
-    for t in range(tets.shape[0]):
-        for i in range(4):
-            for k in range(3):
-                out[tets[t, i], k] += fbuf[t, i, k]
 
 
 def strains_numpy(x, tets, gamma0):
@@ -171,8 +161,7 @@ class Shear(Term):
         self.G = self.scale * material.G
         self.vol0 = mesh.volumes
         self.gamma0 = np.zeros((mesh.n_tets, 24))
-        # work arrays reused by every force evaluation
-        self._fbuf, self._gam = np.empty((mesh.n_tets, 4, 3)), np.empty((mesh.n_tets, 24))
+        self._gam = np.empty((mesh.n_tets, 24))  # reused by every force evaluation
         self.gamma0 = self.strains(mesh.points)
 
     def describe(self):
@@ -187,7 +176,7 @@ class Shear(Term):
     def strains(self, x):
         """The 24 shear strains (m, 24) at positions x."""
         gam = np.empty((self.mesh.n_tets, 24))
-        self._run(x, -1, np.zeros((0, 3)), gam)
+        self._run(x, -1, np.zeros((1, 3)), gam)
         return gam
 
     def max_tau(self, x):
@@ -195,13 +184,10 @@ class Shear(Term):
         return self.material.G * np.abs(self.strains(x)).max(axis=1)
 
     def _run(self, x, reading, out, gam):
-        fbuf = self._fbuf
         bad = _shear(np.ascontiguousarray(x, dtype=np.float64), self.mesh.tets, self.vol0,
-                     self.gamma0, self.G, self.coef or 0.0, reading, fbuf, gam)
+                     self.gamma0, self.G, self.coef or 0.0, reading, out, gam)
         if bad >= 0 and reading < 0:
             raise DegenerateTetError(f"tetrahedron {bad} is inverted or flattened", [bad])
-        if bad < 0 and reading >= 0:
-            scatter(self.mesh.tets, fbuf, out)
         return bad
 
     def _kernel_forces(self, x, out):

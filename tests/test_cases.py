@@ -1,0 +1,139 @@
+"""The paper-cube case, its metrics and its report (issue 4)."""
+import json
+from html.parser import HTMLParser
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from cases import metrics as M
+from cases.cli import main
+from cases.paper_cube import LAYERS_MM, SIZE_MM, make_mesh, static_bc
+from cases.report import TIMING_KEYS
+from reference import linear
+
+FILES = ["metrics.json", "report.md", "report.html", "errors.png", "step_time.png",
+         "reaction_time.png"] + [f"{kind}_{mesh}_{bc}.png" for kind in ("fig1", "profile")
+                                 for mesh in ("five", "six") for bc in ("clamped", "sliding")]
+KEYS = ["mesh", "bc", "model", "disp_rel_l2_p1", "disp_rel_l2_p2", "disp_max_rel_p2",
+        "reaction_ratio", "stress_corr", "bulge_profile_mm", "bulge_profile_fem_mm", "zigzag",
+        "step_time_s"]
+
+
+@pytest.fixture(scope="module")
+def quick(tmp_path_factory):
+    out = tmp_path_factory.mktemp("quick") / "paper-cube"
+    assert main(["run", "paper-cube", "--quick", "--out", str(out)]) == 0
+    return out
+
+
+def numbers(x):
+    if isinstance(x, dict):
+        for v in x.values():
+            yield from numbers(v)
+    elif isinstance(x, list):
+        for v in x:
+            yield from numbers(v)
+    elif isinstance(x, float):
+        yield x
+
+
+def test_quick_run_writes_every_file_with_finite_metrics(quick):
+    for f in FILES:
+        assert (quick / f).is_file(), f
+    data = json.loads((quick / "metrics.json").read_text())
+    runs = data["runs"]
+    assert len(runs) == 2 * 2 * 6
+    assert {r["mesh"] for r in runs} == {"five", "six"}
+    for r in runs:
+        for k in KEYS:
+            assert k in r, k
+        assert all(np.isfinite(v) for v in numbers(r))
+        assert len(r["bulge_profile_mm"]) == len(LAYERS_MM)
+    env = data["environment"]
+    assert {"python", "numpy", "numba", "scikit-fem", "git_commit", "date"} <= set(env)
+    assert len(list((quick / "vtu").glob("*.vtu"))) == 2 * 2 * 7
+
+
+def test_html_parses_and_every_figure_exists(quick):
+    class Images(HTMLParser):
+        def __init__(self):
+            super().__init__()
+            self.images = []
+
+        def handle_starttag(self, tag, attrs):
+            if tag == "img":
+                self.images.append(dict(attrs))
+
+    parser = Images()
+    parser.feed((quick / "report.html").read_text())
+    parser.close()
+    assert len(parser.images) >= 11
+    for img in parser.images:
+        assert img["src"].startswith("data:image/png;base64,")
+        assert (quick / img["data-src"]).is_file()
+    md = (quick / "report.md").read_text()
+    for name in [line.split("](")[1].rstrip(")") for line in md.splitlines()
+                 if line.startswith("![")]:
+        assert (quick / name).is_file()
+    assert "## Findings" in md
+
+
+def test_same_command_gives_the_same_metrics(quick, tmp_path):
+    """A second, narrower run reproduces the first one's runs exactly (timings aside)."""
+    out = tmp_path / "again"
+    assert main(["run", "paper-cube", "--quick", "--meshes", "five", "--models",
+                 "pbcm-corner", "pbcm-variational", "msm", "--out", str(out)]) == 0
+    first = {(r["mesh"], r["bc"], r["model"]): r
+             for r in json.loads((quick / "metrics.json").read_text())["runs"]}
+    for r in json.loads((out / "metrics.json").read_text())["runs"]:
+        ref = first[(r["mesh"], r["bc"], r["model"])]
+        for k in r:
+            if k not in TIMING_KEYS:
+                assert r[k] == ref[k], k
+
+
+def test_fem_against_itself_has_zero_error_and_zigzag():
+    mesh = make_mesh("five")
+    L = SIZE_MM * 1e-3
+    layers = [y * 1e-3 for y in LAYERS_MM]
+    for bc in ("clamped", "sliding"):
+        u = linear.solve(mesh, 10e3, 0.45, static_bc(mesh, bc), element="P2").u
+        assert M.rel_l2(u, u) == 0 and M.max_rel(u, u) == 0
+        profile = M.layer_profile(mesh.points, u, layers, L)
+        if bc == "sliding":  # homogeneous: uniform lateral expansion nu * 1.7 / 32 * 16 mm
+            assert np.allclose(profile, 0.45 * 1.7e-3 / 2, rtol=1e-9)
+            assert M.zigzag(profile) < 1e-9
+
+
+def test_zigzag_separates_alternation_from_smooth_profiles():
+    alternating = np.array([1.0, 0.4, 1.0, 0.4, 1.0])
+    barrel = np.sin(np.pi * np.linspace(0, 1, 5)) + 0.2
+    assert M.zigzag(alternating) > 0.2 and M.paper_pattern(alternating)
+    assert M.zigzag(barrel) < 0.03 and not M.paper_pattern(barrel)
+    assert M.zigzag(np.full(5, 0.38)) < 1e-12
+
+
+def test_metrics_refuse_nan_and_zero_references():
+    with pytest.raises(M.MetricError, match="not finite"):
+        M.rel_l2(np.array([[np.nan, 0, 0]]), np.ones((1, 3)))
+    with pytest.raises(M.MetricError, match="reference is zero"):
+        M.rel_l2(np.ones((2, 3)), np.zeros((2, 3)))
+    with pytest.raises(M.MetricError, match="constant"):
+        M.correlation(np.ones(4), np.arange(4.0))
+
+
+@pytest.mark.parametrize("argv,word", [(["run", "no-case"], "case"),
+                                       (["run", "paper-cube", "--models", "fem9"], "model"),
+                                       (["run", "paper-cube", "--meshes", "hex"], "mesh"),
+                                       (["run", "paper-cube", "--bcs", "glued"], "condition")])
+def test_bad_names_exit_2_listing_valid_ones(argv, word, capsys):
+    assert main(argv) == 2
+    err = capsys.readouterr().err.strip()
+    assert len(err.splitlines()) == 1 and f"unknown {word}" in err and "valid:" in err
+
+
+def test_list(capsys):
+    assert main(["list"]) == 0
+    out = capsys.readouterr().out
+    assert "paper-cube" in out and "pbcm-variational+normal" in out and "unstructured" in out
