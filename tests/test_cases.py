@@ -126,7 +126,7 @@ def test_metrics_refuse_nan_and_zero_references():
 @pytest.mark.parametrize("argv,word", [(["run", "no-case"], "case"),
                                        (["run", "paper-cube", "--models", "fem9"], "model"),
                                        (["run", "paper-cube", "--meshes", "hex"], "mesh"),
-                                       (["run", "paper-cube", "--bcs", "glued"], "condition")])
+                                       (["run", "paper-cube", "--bcs", "glued"], "boundary condition")])
 def test_bad_names_exit_2_listing_valid_ones(argv, word, capsys):
     assert main(argv) == 2
     err = capsys.readouterr().err.strip()
