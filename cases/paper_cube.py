@@ -237,6 +237,8 @@ def run(cfg, log=True):
                     "reaction_fem_p2_n": fem_reaction,
                     "reaction_ratio": M.finite("reaction_ratio",
                                                -st.reaction[top, 1].sum() / fem_reaction),
+                    "reaction_rel_err": M.finite("reaction_rel_err", abs(
+                        -st.reaction[top, 1].sum() / fem_reaction - 1)),
                     "stress_corr": None if uniform_ref else M.correlation(s["max_tau"], fem_tau),
                     "stress_rel_err": M.rel_l2(s["max_tau"], fem_tau),
                     "pressure_corr": (None if uniform(p2.pressure)
