@@ -55,7 +55,7 @@ def _config(case, args):
     kw = {"meshes": _choose("mesh", args.meshes, case.MESHES),
           "bcs": _choose("boundary condition", args.bcs, case.BCS),
           "models": _choose("model", args.models, case.MODELS)}
-    for k in ("E", "nu", "rho"):
+    for k in ("E", "nu", "rho", "shear_scale"):
         if getattr(args, k) is not None:
             kw[k] = getattr(args, k)
     if args.quick:
@@ -103,6 +103,55 @@ def _report_command(args):
     return 0
 
 
+def _check_command(args):
+    from .thresholds import CheckError, check, load, measured
+    try:
+        rows, status = check(load(args.thresholds), measured(args.metrics))
+    except CheckError as exc:
+        print(f"pbcm check: error: {exc}", file=sys.stderr)
+        return 2
+    print(f"{'metric':<66} {'measured':>11} {'bound':>11} {'margin':>8}  result")
+    for b, v, ok in rows:
+        name = f"{b.case}/{b.mesh}/{b.bc}/{b.model}/{b.metric}"
+        sign = "<=" if b.direction == "max" else ">="
+        print(f"{name:<66} {v:>11.5g} {sign}{b.limit:>9.5g} {b.margin(v):>8.1%}  "
+              f"{'PASS' if ok else 'FAIL'}")
+    failed = [r for r in rows if not r[2]]
+    print(f"{len(rows) - len(failed)} passed, {len(failed)} failed")
+    for b, v, _ in failed:
+        print(f"FAIL {b.metric} of {b.case}/{b.mesh}/{b.bc}/{b.model}: {v:.6g} "
+              f"{'>' if b.direction == 'max' else '<'} {b.limit:.6g}")
+    return status
+
+
+def _bless_command(args):
+    import tempfile
+    from pathlib import Path
+    from .registry import CASES
+    from .thresholds import CheckError, bless, dumps, load, measured
+    path = Path(args.thresholds)
+    if args.metrics:
+        folder = Path(args.metrics)
+    else:  # a fresh run of every case, in the mode asked
+        folder = Path(tempfile.mkdtemp(prefix="pbcm-bless-"))
+        for name in CASES:
+            _run_case(name, args, folder / name)
+    try:
+        values = measured(folder)
+        old = load(path) if path.exists() else []
+    except CheckError as exc:
+        print(f"pbcm bless: error: {exc}", file=sys.stderr)
+        return 2
+    modes = {k[1] for k in values}
+    keep = [b for b in old if b.mode not in modes]
+    new, changes = bless(values, [b for b in old if b.mode in modes], rtol=args.margin)
+    path.write_text(dumps(sorted(keep + new, key=lambda b: b.key)) + "\n")
+    for line in changes or ["no change"]:
+        print(line)
+    print(f"{len(new)} bounds for mode {', '.join(sorted(modes))} written to {path}")
+    return 0
+
+
 def _selection(p):
     p.add_argument("--models", nargs="+", help="model presets (default: all)")
     p.add_argument("--meshes", nargs="+", help="meshes (default: all; --quick: five six)")
@@ -112,6 +161,8 @@ def _selection(p):
     p.add_argument("--E", type=float, help="Young's modulus [Pa] (default 10e3)")
     p.add_argument("--nu", type=float, help="Poisson's ratio (default 0.45)")
     p.add_argument("--rho", type=float, help="density [kg/m^3] (default 1000)")
+    # test-only: scale the shear term, to prove that the error gate catches a worse model
+    p.add_argument("--shear-scale", type=float, default=None, help=argparse.SUPPRESS)
 
 
 def parser():
@@ -138,6 +189,18 @@ def parser():
     rep.add_argument("--out", help="output folder (default reports)")
     _selection(rep)
     rep.set_defaults(func=_report_command)
+    c = sub.add_parser("check", help="compare the latest metrics with thresholds.toml "
+                       "(exit 0 pass, 1 fail, 2 missing or malformed)")
+    c.add_argument("--metrics", default="reports", help="a metrics.json or a folder of them "
+                   "(default reports)")
+    c.add_argument("--thresholds", default="thresholds.toml")
+    c.set_defaults(func=_check_command)
+    b = sub.add_parser("bless", help="rewrite the bounds from a fresh run and print what changed")
+    b.add_argument("--margin", type=float, default=0.1, help="relative tolerance (default 0.1)")
+    b.add_argument("--thresholds", default="thresholds.toml")
+    b.add_argument("--metrics", help="bless these metrics instead of a fresh run")
+    _selection(b)
+    b.set_defaults(func=_bless_command)
     return p
 
 

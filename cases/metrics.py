@@ -7,6 +7,9 @@ import numpy as np
 from model.errors import PbcmError
 
 
+PATTERN_TOL = 1e-6  # second differences below this fraction of the profile count as zero
+
+
 class MetricError(PbcmError, ArithmeticError):
     """A metric could not be computed (NaN, empty set, zero reference)."""
 
@@ -81,10 +84,11 @@ def zigzag(profile):
 
 def paper_pattern(profile):
     """True when the middle layer and the ends bulge relative to their neighbours while the
-    quarter layers neck (the paper's section 5): positive second differences at the quarter
-    layers and a negative one at the middle, for a five-layer profile."""
+    quarter layers neck (the paper's section 5): second differences above PATTERN_TOL of the
+    profile, positive at the quarter layers and negative at the middle (five layers)."""
     b = np.asarray(profile, float)
     if b.size != 5:
         raise MetricError("the paper's pattern is defined on five layers")
     d2 = b[:-2] - 2 * b[1:-1] + b[2:]
-    return bool(d2[0] > 0 and d2[1] < 0 and d2[2] > 0)
+    tol = PATTERN_TOL * np.abs(b).max()  # rounding noise on a uniform profile is no pattern
+    return bool(d2[0] > tol and d2[1] < -tol and d2[2] > tol)

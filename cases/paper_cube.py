@@ -49,6 +49,7 @@ class Config:
     timing_steps: int = 20        # RK4 steps per timing repeat
     timing_repeats: int = 7
     quick: bool = False
+    shear_scale: float = 1.0      # testing knob: scales every shear term (1 = the model)
     material: Material = field(init=False)
 
     def __post_init__(self):
@@ -67,7 +68,8 @@ class Config:
                 "p2_levels": self.p2_levels, "damping_1_s": self.damping,
                 "rk4_safety": self.safety, "hold_max_s": self.hold_max,
                 "rest_speed_fraction": self.rest_speed, "timing_steps": self.timing_steps,
-                "timing_repeats": self.timing_repeats, "quick": self.quick}
+                "timing_repeats": self.timing_repeats, "quick": self.quick,
+                "shear_scale": self.shear_scale}
 
 
 def make_mesh(name):
@@ -119,6 +121,12 @@ def progress(done, total, label, t0):
 
 def uniform(field):
     return np.ptp(field) <= 1e-9 * max(np.abs(field).max(), 1e-300)
+
+
+def build_model(name, mesh, mat, cfg):
+    has_shear = any(t == "shear" for t, _ in PRESETS[name])
+    extra = {"shear": {"scale": cfg.shear_scale}} if has_shear and cfg.shear_scale != 1 else {}
+    return build(name, mesh, mat, **extra)
 
 
 def dynamic_run(pm, mesh, bc, cfg):
@@ -219,7 +227,7 @@ def run(cfg, log=True):
             for model_name in cfg.models:
                 if log:
                     progress(done, total, f"{mesh_name}/{bc}/{model_name}", t_start)
-                pm = build(model_name, mesh, mat)
+                pm = build_model(model_name, mesh, mat, cfg)
                 st = pm.solve_static(sbc)
                 s = pm.tet_stress(st.x)
                 dyn = dynamic_run(pm, mesh, bc, cfg)

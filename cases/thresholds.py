@@ -108,9 +108,21 @@ def measured(metrics_dir):
 
 
 def check(bounds, values):
-    """Rows (bound, measured, passed) and the exit status: 0 all pass, 1 any fails, 2 a bound's
-    metric is missing or not finite."""
+    """Rows (bound, measured, passed) and the exit status: 0 all pass, 1 any fails. A bound
+    without a measured value, a value that is not finite, or a measured metric of a mode that
+    has bounds but none for it raises CheckError (exit 2): a missing reference never passes."""
     rows, status = [], 0
+    modes = {b.mode for b in bounds}
+    keys = {b.key for b in bounds}
+    checked = [k for k in values if k[1] in modes]
+    if not checked:
+        raise CheckError(f"the metrics are of mode(s) {', '.join(sorted({k[1] for k in values}))}"
+                         f" but the bounds cover {', '.join(sorted(modes))}; run in that mode "
+                         "or bless this one")
+    unbounded = [k for k in checked if k not in keys and values[k] is not None]
+    if unbounded:
+        raise CheckError(f"no bound for {len(unbounded)} measured metric(s), e.g. "
+                         f"{'/'.join(unbounded[0])}: run `pbcm bless` to set them")
     for b in bounds:
         if b.key not in values or values[b.key] is None:
             raise CheckError(f"metric {b.metric} of {b.case}/{b.mesh}/{b.bc}/{b.model} "

@@ -36,3 +36,12 @@ def rotation(axis, angle):
     axis = np.asarray(axis, float) / np.linalg.norm(axis)
     K = np.array([[0, -axis[2], axis[1]], [axis[2], 0, -axis[0]], [-axis[1], axis[0], 0]])
     return np.eye(3) + np.sin(angle) * K + (1 - np.cos(angle)) * K @ K
+
+
+@pytest.fixture(scope="session")
+def quick(tmp_path_factory):
+    """`pbcm run paper-cube --quick`, once per test session (the CI run of the case)."""
+    from cases.cli import main
+    out = tmp_path_factory.mktemp("quick") / "paper-cube"
+    assert main(["run", "paper-cube", "--quick", "--out", str(out)]) == 0
+    return out

@@ -218,3 +218,14 @@ def test_tet_stress_outputs(small_mesh, mat):
     V_ratio = (1 - 1e-3) ** 3
     assert np.allclose(s["pressure"], -mat.K * (V_ratio - 1) / V_ratio, rtol=1e-9)
     assert np.abs(s["max_tau"]).max() < 1e-9 * mat.G
+
+
+def test_scale_survives_calibration(small_mesh, mat):
+    """scale multiplies a calibrated term after the fit (else c = auto would undo it)."""
+    x = perturbed(small_mesh, 0.05)
+    full = build("pbcm-variational+normal", small_mesh, mat)
+    half = build("pbcm-variational+normal", small_mesh, mat, shear={"scale": 0.5},
+                 normal={"scale": 0.5}, volume={"scale": 0.5})
+    assert half.info["shear_c"] == full.info["shear_c"]
+    assert np.allclose(half.forces(x), 0.5 * full.forces(x), atol=1e-15)
+    assert half.energy(x) == pytest.approx(0.5 * full.energy(x), rel=1e-12)

@@ -64,7 +64,7 @@ class Normal(Term):
             raise ModelError(f"normal c must be 'auto' or a positive number, got {c!r}")
         self.coef = None if c == "auto" else float(c)
         self.calibrate = c == "auto"
-        self.G = self.scale * material.G
+        self.G = material.G  # scale multiplies forces and energy after calibration
         self.vol0 = mesh.volumes
         self.rest_len = np.linalg.norm(edge_vectors(mesh.points, mesh.tets), axis=-1)
 
@@ -75,7 +75,8 @@ class Normal(Term):
         if self.coef is None:
             raise ModelError("normal term with c='auto' is not calibrated yet: build the model "
                              "with model.build, or pass a number for c")
-        return _forces(x, self.mesh.tets, self.vol0, self.rest_len, self.coef * self.G, out)
+        return _forces(x, self.mesh.tets, self.vol0, self.rest_len,
+                       self.scale * self.coef * self.G, out)
 
     def _dev_strain(self, x):
         eps = np.linalg.norm(edge_vectors(x, self.mesh.tets), axis=-1) / self.rest_len - 1.0
@@ -85,12 +86,12 @@ class Normal(Term):
         return float(self.G * np.sum(self.vol0[:, None, None] * self._dev_strain(x) ** 2))
 
     def energy(self, x):
-        return self.coef * self.unit_energy(x)
+        return self.scale * self.coef * self.unit_energy(x)
 
     def forces_numpy(self, x):
         d = edge_vectors(x, self.mesh.tets)
         ln = np.linalg.norm(d, axis=-1)
-        s = 2 * self.coef * self.G * self.vol0[:, None, None] * self._dev_strain(x) \
+        s = 2 * self.scale * self.coef * self.G * self.vol0[:, None, None] * self._dev_strain(x) \
             / (self.rest_len * ln)
         fj = -s[..., None] * d
         out = np.zeros_like(x)

@@ -158,7 +158,7 @@ class Shear(Term):
             raise ModelError(f"shear c must be 'auto' or a positive number, got {c!r}")
         self.coef = None if c == "auto" else float(c)
         self.calibrate = self.conservative and c == "auto"
-        self.G = self.scale * material.G
+        self.G = material.G  # scale multiplies forces and energy after calibration
         self.vol0 = mesh.volumes
         self.gamma0 = np.zeros((mesh.n_tets, 24))
         self._gam = np.empty((mesh.n_tets, 24))  # reused by every force evaluation
@@ -185,7 +185,7 @@ class Shear(Term):
 
     def _run(self, x, reading, out, gam):
         bad = _shear(np.ascontiguousarray(x, dtype=np.float64), self.mesh.tets, self.vol0,
-                     self.gamma0, self.G, self.coef or 0.0, reading, out, gam)
+                     self.gamma0, self.scale * self.G, self.coef or 0.0, reading, out, gam)
         if bad >= 0 and reading < 0:
             raise DegenerateTetError(f"tetrahedron {bad} is inverted or flattened", [bad])
         return bad
@@ -199,7 +199,7 @@ class Shear(Term):
     def forces_numpy(self, x):
         tets = self.mesh.tets
         gam, area, e, V = strains_numpy(x, tets, self.gamma0)
-        tau_area = (self.G * gam * area)[..., None] * e  # (m, 24, 3)
+        tau_area = (self.scale * self.G * gam * area)[..., None] * e  # (m, 24, 3)
         out = np.zeros_like(x)
         a, j, m, l = COMBOS.T
         if self.reading == 0:
@@ -224,7 +224,7 @@ class Shear(Term):
                 dq[a] = -(dq[j] + dq[m])
                 dc = {m: np.cross(w, c / cn), l: np.cross(c / cn, u)}
                 dc[a] = -(dc[m] + dc[l])
-                coef = (self.coef * self.G * self.vol0 * gam[:, s])[:, None]
+                coef = (self.scale * self.coef * self.G * self.vol0 * gam[:, s])[:, None]
                 for i in (a, j, m, l):
                     grad = (cn * dq.get(i, 0.0) + q * dc.get(i, 0.0)) / (6 * V[:, None]) \
                         - graw * dV[:, i] / V[:, None]
@@ -232,10 +232,11 @@ class Shear(Term):
         return out
 
     def unit_energy(self, x):
-        """Energy of the variational reading with c = 1: (1/2) G V0 sum gamma^2."""
+        """Energy of the variational reading with c = 1 and scale 1: (1/2) G V0 sum gamma^2
+        (what calibration fits, so that ``scale`` survives it)."""
         return float(0.5 * self.G * np.sum(self.vol0[:, None] * self.strains(x) ** 2))
 
     def energy(self, x):
         if not self.conservative:
             return super().energy(x)
-        return self.coef * self.unit_energy(x)
+        return self.scale * self.coef * self.unit_energy(x)

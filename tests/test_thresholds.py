@@ -1,0 +1,93 @@
+"""The CI error gate: thresholds.toml, pbcm check and pbcm bless (issue 5)."""
+import json
+import re
+import shutil
+from pathlib import Path
+
+import pytest
+
+from cases.cli import main
+
+ROOT = Path(__file__).resolve().parents[1]
+SMALL = ["--quick", "--meshes", "five", "--models", "pbcm-variational", "msm"]
+
+
+def test_committed_bounds_hold_for_the_quick_run(quick, capsys):
+    """The gate CI runs: every bound in thresholds.toml against this run's metrics."""
+    status = main(["check", "--metrics", str(quick), "--thresholds",
+                   str(ROOT / "thresholds.toml")])
+    out = capsys.readouterr().out
+    assert status == 0, out
+    assert re.search(r"^\d+ passed, 0 failed$", out, re.M)
+
+
+@pytest.fixture(scope="module")
+def blessed(tmp_path_factory):
+    d = tmp_path_factory.mktemp("gate")
+    assert main(["run", "paper-cube", *SMALL, "--out", str(d / "good" / "paper-cube")]) == 0
+    assert main(["bless", "--metrics", str(d / "good"), "--thresholds", str(d / "t.toml")]) == 0
+    return d
+
+
+def check(metrics, thresholds):
+    return main(["check", "--metrics", str(metrics), "--thresholds", str(thresholds)])
+
+
+def test_bless_then_check_passes(blessed, capsys):
+    assert check(blessed / "good", blessed / "t.toml") == 0
+    text = (blessed / "t.toml").read_text()
+    assert "# measured" in text and 'direction = "min"' in text and 'direction = "max"' in text
+
+
+def test_worse_model_fails_and_names_the_metric(blessed, tmp_path, capsys):
+    worse = tmp_path / "worse" / "paper-cube"
+    assert main(["run", "paper-cube", *SMALL, "--shear-scale", "0.5", "--out", str(worse)]) == 0
+    capsys.readouterr()
+    assert check(worse.parent, blessed / "t.toml") == 1
+    out = capsys.readouterr().out
+    assert "FAIL disp_rel_l2_p2 of paper-cube/five/clamped/pbcm-variational" in out
+    assert "msm/" not in "".join(l for l in out.splitlines() if l.startswith("FAIL"))
+
+
+def test_hand_tightened_bound_fails(blessed, tmp_path, capsys):
+    text = (blessed / "t.toml").read_text()
+    blocks = text.split("[[bound]]")
+    i = next(k for k, b in enumerate(blocks) if 'metric = "disp_rel_l2_p2"' in b)
+    value = float(re.search(r"^value = (.*)$", blocks[i], re.M).group(1))
+    blocks[i] = blocks[i].replace(f"value = {value!r}", f"value = {value / 2!r}")
+    (tmp_path / "t.toml").write_text("[[bound]]".join(blocks))
+    assert check(blessed / "good", tmp_path / "t.toml") == 1
+    assert "FAIL disp_rel_l2_p2" in capsys.readouterr().out
+
+
+def test_missing_bound_exits_2(blessed, tmp_path, capsys):
+    blocks = (blessed / "t.toml").read_text().split("[[bound]]")
+    (tmp_path / "t.toml").write_text("[[bound]]".join(blocks[:-1]))
+    assert check(blessed / "good", tmp_path / "t.toml") == 2
+    assert "no bound for" in capsys.readouterr().err
+
+
+def test_missing_metrics_file_exits_2(blessed, tmp_path, capsys):
+    assert check(tmp_path / "empty", blessed / "t.toml") == 2
+    assert "no metrics.json" in capsys.readouterr().err
+
+
+def test_nan_metric_exits_2(blessed, tmp_path, capsys):
+    shutil.copytree(blessed / "good", tmp_path / "nan")
+    f = tmp_path / "nan" / "paper-cube" / "metrics.json"
+    data = json.loads(f.read_text())
+    data["runs"][0]["zigzag"] = float("nan")
+    f.write_text(json.dumps(data))
+    assert check(tmp_path / "nan", blessed / "t.toml") == 2
+    err = capsys.readouterr().err
+    assert "zigzag" in err and "not a finite number" in err
+
+
+@pytest.mark.parametrize("text,word", [("[[bound]\nvalue = ", "malformed"),
+                                       ("# nothing\n", "no [[bound]]"),
+                                       ('[[bound]]\ncase = "paper-cube"\n', "lacks")])
+def test_malformed_or_missing_thresholds_exit_2(blessed, tmp_path, text, word, capsys):
+    (tmp_path / "t.toml").write_text(text)
+    assert check(blessed / "good", tmp_path / "t.toml") == 2
+    assert word in capsys.readouterr().err
+    assert check(blessed / "good", tmp_path / "absent.toml") == 2
