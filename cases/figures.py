@@ -37,6 +37,7 @@ def stress_panels(path, panels, title, magnify):
                                              edgecolors="k", linewidths=0.2))
         ax.set_xlim(-2, 34), ax.set_ylim(-2, 34), ax.set_zlim(-2, 34)
         ax.view_init(elev=20, azim=-60, vertical_axis="y")
+        ax.set_box_aspect((1, 1, 1))
         ax.set_title(label, fontsize=9)
         ax.set_axis_off()
     sm = matplotlib.cm.ScalarMappable(norm=norm, cmap=cmap)

@@ -3,15 +3,15 @@
 
 Millimetres stop at this file's edge: everything below the constants is in SI units.
 """
-from dataclasses import dataclass, field, replace
+from dataclasses import dataclass, field
 import statistics
 import sys
 import time
 
 import numpy as np
 
-from model import PRESETS, BlowUpError, Material, build
-from model.bc import Ramp
+from model import PRESETS, BlowUpError, Material, ModelError, build
+from model.bc import Ramp, bc_arrays, merge
 from model.mesh import cube
 from model.terms.shear import Shear
 from reference import linear
@@ -86,13 +86,12 @@ def boundary_sets(mesh, bc):
     if bc == "clamped":
         return top, (0.0, None, 0.0), {int(i): (0.0, 0.0, 0.0) for i in bottom}
     if bc != "sliding":
-        raise ValueError(f"unknown boundary condition {bc!r}; choose from {', '.join(BCS)}")
+        raise ModelError(f"unknown boundary condition {bc!r}; choose from {', '.join(BCS)}")
     held = [(int(i), (None, 0.0, None)) for i in bottom]
     origin = mesh.nodes_where(lambda p: np.all(np.abs(p) < 1e-9, axis=1))[0]
     corner_x = mesh.nodes_where(lambda p: (np.abs(p[:, 0] - L) < 1e-9) & (np.abs(p[:, 1]) < 1e-9)
                                 & (np.abs(p[:, 2]) < 1e-9))[0]
     held += [(int(origin), (0.0, 0.0, 0.0)), (int(corner_x), (None, 0.0, 0.0))]
-    from model.bc import merge
     return top, (None, None, None), merge(held)
 
 
@@ -176,7 +175,6 @@ def growth_rate(pm, mesh, bc):
     case's constraints: max Re sqrt(lambda) over the eigenvalues lambda of M^-1 df/dx on the
     free components. Zero (to rounding) for a conservative model; positive means flutter, which
     mass damping zeta only suppresses when zeta / 2 exceeds it."""
-    from model.bc import bc_arrays
     mask, _ = bc_arrays(static_bc(mesh, bc), mesh.n_nodes)
     free = ~mask.ravel()
     A = pm.jacobian(mesh.points).toarray()[free][:, free] / np.repeat(pm.mass, 3)[free][:, None]
@@ -285,7 +283,3 @@ def _jsonable(d):
     if isinstance(d, (np.floating, np.integer)):
         return d.item()
     return d
-
-
-__all__ = ["Config", "run", "make_mesh", "static_bc", "dynamic_bc", "MESHES", "BCS", "MODELS",
-           "replace"]

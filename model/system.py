@@ -2,6 +2,7 @@
 import numpy as np
 
 from .calibrate import calibrate
+from .geometry import smallest_heights
 from .errors import ModelError
 from .terms import make_term
 from .terms.shear import Shear
@@ -71,7 +72,6 @@ class ParticleModel:
 
     def stable_dt(self, safety=0.5):
         """safety * min_T h_T / c_p, with h_T the smallest height and c_p the P-wave speed."""
-        from .geometry import smallest_heights
         return safety * float(smallest_heights(self.mesh.points, self.mesh.tets).min()) \
             / self.material.p_wave_speed
 

@@ -4,7 +4,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from skfem import FacetBasis, LinearForm, asm, condense
 from skfem.helpers import dot, sym_grad
-from skfem.models.elasticity import linear_elasticity
+from skfem.models.elasticity import linear_elasticity, linear_stress
 
 from model.errors import ModelError
 from .fem import (INTORDER, bc_arrays, cell_average, check_finite, dirichlet_dofs, dof_hats,
@@ -96,9 +96,7 @@ def solve(mesh, E, nu, dirichlet, body_force=None, traction=None, element="P1", 
     u = u_all[basis.nodal_dofs[:, :n]].T
     # stress: volume average over each input tetrahedron of the solution's stress
     w = basis.interpolate(u_all)
-    eps = sym_grad(w)
-    tr = np.einsum("iieq->eq", eps)
-    sig = 2 * mu * eps + lam * tr[None, None] * np.eye(3)[:, :, None, None]
+    sig = linear_stress(lam, mu)(sym_grad(w))
     sig_fine = np.moveaxis(cell_average(basis, sig), -1, 0)         # (m_fine, 3, 3)
     vol_fine = basis.dx.sum(axis=1)
     parent = parent_of(m, W, mesh.tets)
