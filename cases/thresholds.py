@@ -1,8 +1,8 @@
 """Error bounds for CI, declared as data (thresholds.toml) in the style of verification
 harnesses: a stored value with a relative tolerance and an absolute floor, and a direction.
 
-    max: measured <= value * (1 + rtol) + atol     (an error must stay below)
-    min: measured >= value * (1 - rtol) - atol     (a correlation must stay above)
+    max: measured <= value + rtol |value| + atol     (an error must stay below)
+    min: measured >= value - rtol |value| - atol     (a correlation must stay above)
 """
 from dataclasses import dataclass
 import datetime
@@ -43,9 +43,8 @@ class Bound:
 
     @property
     def limit(self):
-        if self.direction == "max":
-            return self.value * (1 + self.rtol) + self.atol
-        return self.value * (1 - self.rtol) - self.atol
+        slack = self.rtol * abs(self.value) + self.atol
+        return self.value + slack if self.direction == "max" else self.value - slack
 
     def passes(self, measured):
         return measured <= self.limit if self.direction == "max" else measured >= self.limit
@@ -166,7 +165,7 @@ def bless(values, old=None, rtol=RTOL, atol=ATOL, today=None):
 
 def dumps(bounds):
     lines = ["# pbcm error bounds, read by `pbcm check` and rewritten only by `pbcm bless`.",
-             "# max: measured <= value * (1 + rtol) + atol;  min: measured >= value * (1 - rtol)"
+             "# max: measured <= value + rtol |value| + atol;  min: measured >= value - rtol |value|"
              " - atol.", "# mode: the run mode the bound belongs to (quick runs in CI).", ""]
     for b in bounds:
         lines += ["[[bound]]", f"# measured {b.value:.6g} on {b.measured_on}"]

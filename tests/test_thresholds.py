@@ -91,3 +91,13 @@ def test_malformed_or_missing_thresholds_exit_2(blessed, tmp_path, text, word, c
     assert check(blessed / "good", tmp_path / "t.toml") == 2
     assert word in capsys.readouterr().err
     assert check(blessed / "good", tmp_path / "absent.toml") == 2
+
+
+def test_bounds_widen_away_from_the_stored_value_for_either_sign():
+    from cases.thresholds import Bound
+    for value in (-0.6, 0.6):
+        lo = Bound("c", "quick", "m", "b", "x", "stress_corr", value, 0.1, 0.0, "min")
+        hi = Bound("c", "quick", "m", "b", "x", "zigzag", value, 0.1, 0.0, "max")
+        assert lo.limit < value < hi.limit
+        assert lo.passes(value) and hi.passes(value)
+        assert not lo.passes(value - 0.2) and not hi.passes(value + 0.2)
