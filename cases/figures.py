@@ -47,20 +47,26 @@ def stress_panels(path, panels, title, magnify):
     plt.close(fig)
 
 
+def _finish(fig, ax, path, xlabel, ylabel, title, grid_axis="both"):
+    """Labels, grid, legend, and the PNG written and closed: the end of every chart here."""
+    if xlabel:
+        ax.set_xlabel(xlabel)
+    ax.set_ylabel(ylabel)
+    ax.set_title(title, fontsize=10)
+    ax.grid(alpha=0.3, axis=grid_axis)
+    ax.legend(fontsize=7)
+    fig.tight_layout()
+    fig.savefig(path, dpi=90)
+    plt.close(fig)
+
+
 def profiles(path, layers_mm, series, fem, title):
     """Layer profiles: mean outward lateral displacement per y-layer, models against FEM."""
     fig, ax = plt.subplots(figsize=(6, 4))
     ax.plot(fem, layers_mm, "k-o", lw=2.5, label="FEM P2 (converged)")
     for label, prof in series:
         ax.plot(prof, layers_mm, "-s", ms=4, label=label)
-    ax.set_xlabel("mean outward lateral displacement [mm]")
-    ax.set_ylabel("layer y [mm]")
-    ax.set_title(title, fontsize=10)
-    ax.grid(alpha=0.3)
-    ax.legend(fontsize=7)
-    fig.tight_layout()
-    fig.savefig(path, dpi=90)
-    plt.close(fig)
+    _finish(fig, ax, path, "mean outward lateral displacement [mm]", "layer y [mm]", title)
 
 
 def grouped_bars(path, groups, labels, values, ylabel, title, log=False):
@@ -73,13 +79,7 @@ def grouped_bars(path, groups, labels, values, ylabel, title, log=False):
     ax.set_xticks(np.arange(len(groups)) + 0.4 - w / 2, groups, fontsize=8)
     if log:
         ax.set_yscale("log")
-    ax.set_ylabel(ylabel)
-    ax.set_title(title, fontsize=10)
-    ax.legend(fontsize=7)
-    ax.grid(alpha=0.3, axis="y")
-    fig.tight_layout()
-    fig.savefig(path, dpi=90)
-    plt.close(fig)
+    _finish(fig, ax, path, None, ylabel, title, grid_axis="y")
 
 
 def reaction_history(path, series, fem_level, title):
@@ -87,11 +87,4 @@ def reaction_history(path, series, fem_level, title):
     for label, t, r in series:
         ax.plot(t, r, label=label)
     ax.axhline(fem_level, color="k", ls="--", label="FEM P2 static at 1.7 mm")
-    ax.set_xlabel("time [s]")
-    ax.set_ylabel("reaction on the driven nodes [N]")
-    ax.set_title(title, fontsize=10)
-    ax.grid(alpha=0.3)
-    ax.legend(fontsize=7)
-    fig.tight_layout()
-    fig.savefig(path, dpi=90)
-    plt.close(fig)
+    _finish(fig, ax, path, "time [s]", "reaction on the driven nodes [N]", title)

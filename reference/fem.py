@@ -9,7 +9,6 @@ import scipy.sparse as sp
 from scipy.sparse.linalg import spsolve
 from skfem import Basis, ElementTetP1, ElementTetP2, ElementVector, MeshTet
 
-from model.bc import bc_arrays
 from model.errors import ConvergenceError, MaterialError, ModelError
 
 ELEMENTS = {"P1": ElementTetP1, "P2": ElementTetP2}

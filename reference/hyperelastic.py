@@ -8,10 +8,11 @@ from dataclasses import dataclass
 
 import numpy as np
 from skfem import BilinearForm, LinearForm, asm, condense
-from skfem.helpers import ddot, det, dot, eye, grad, inv, mul, transpose
+from skfem.helpers import ddot, det, eye, grad, inv, mul, transpose
 
+from model.bc import bc_arrays
 from model.errors import ConvergenceError, ModelError
-from .fem import (bc_arrays, cell_average, dirichlet_dofs, element_basis, lame, linear_solve,
+from .fem import (cell_average, dirichlet_dofs, element_basis, lame, linear_solve,
                   refine_with_data, skfem_mesh, stress_measures)
 from .linear import body_load, dof_component, transfer_to_nodes
 

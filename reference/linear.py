@@ -6,8 +6,9 @@ from skfem import FacetBasis, LinearForm, asm, condense
 from skfem.helpers import dot, sym_grad
 from skfem.models.elasticity import linear_elasticity, linear_stress
 
+from model.bc import bc_arrays
 from model.errors import ModelError
-from .fem import (INTORDER, bc_arrays, cell_average, check_finite, dirichlet_dofs, dof_hats,
+from .fem import (INTORDER, cell_average, check_finite, dirichlet_dofs, dof_hats,
                   element_basis, lame,
                   linear_solve, parent_of, refine_with_data, skfem_mesh, stress_measures)
 

@@ -9,8 +9,9 @@ from skfem import BilinearForm, asm
 from skfem.helpers import dot
 from skfem.models.elasticity import linear_elasticity
 
+from model.bc import bc_arrays
 from model.errors import MaterialError, ModelError
-from .fem import (bc_arrays, dirichlet_dofs, element_basis, lame, refine_with_data,
+from .fem import (dirichlet_dofs, element_basis, lame, refine_with_data,
                   skfem_mesh)
 
 

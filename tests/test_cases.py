@@ -1,7 +1,6 @@
 """The paper-cube case, its metrics and its report (issue 4)."""
 import json
 from html.parser import HTMLParser
-from pathlib import Path
 
 import numpy as np
 import pytest
