@@ -107,18 +107,18 @@ def measured(metrics_dir):
 
 
 def check(bounds, values):
-    """Rows (bound, measured, passed) and the exit status: 0 all pass, 1 any fails. A bound
-    without a measured value, a value that is not finite, or a measured metric of a mode that
-    has bounds but none for it raises CheckError (exit 2): a missing reference never passes."""
+    """Rows (bound, measured, passed) and the exit status: 0 all pass, 1 any fails. Bounds of
+    a case and mode that were not run are set aside; among the others, a bound without a
+    measured value, a value that is not finite, or a measured metric without a bound raises
+    CheckError (exit 2): a missing reference never passes."""
     rows, status = [], 0
-    modes = {b.mode for b in bounds}
+    runs = {k[:2] for k in values}            # (case, mode) pairs that were measured
+    bounds = [b for b in bounds if b.key[:2] in runs]
+    if not bounds:
+        raise CheckError(f"no bound for the measured {', '.join('/'.join(r) for r in sorted(runs))}"
+                         "; run in a mode the thresholds cover, or bless this one")
     keys = {b.key for b in bounds}
-    checked = [k for k in values if k[1] in modes]
-    if not checked:
-        raise CheckError(f"the metrics are of mode(s) {', '.join(sorted({k[1] for k in values}))}"
-                         f" but the bounds cover {', '.join(sorted(modes))}; run in that mode "
-                         "or bless this one")
-    unbounded = [k for k in checked if k not in keys and values[k] is not None]
+    unbounded = [k for k in values if k not in keys and values[k] is not None]
     if unbounded:
         raise CheckError(f"no bound for {len(unbounded)} measured metric(s), e.g. "
                          f"{'/'.join(unbounded[0])}: run `pbcm bless` to set them")

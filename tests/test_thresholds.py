@@ -101,3 +101,10 @@ def test_bounds_widen_away_from_the_stored_value_for_either_sign():
         assert lo.limit < value < hi.limit
         assert lo.passes(value) and hi.passes(value)
         assert not lo.passes(value - 0.2) and not hi.passes(value + 0.2)
+
+
+def test_committed_full_mode_bounds_hold_for_the_committed_reports(capsys):
+    """`pbcm check` with its defaults on a clean checkout: the committed full-mode report."""
+    assert main(["check", "--metrics", str(ROOT / "reports"), "--thresholds",
+                 str(ROOT / "thresholds.toml")]) == 0
+    assert "0 failed" in capsys.readouterr().out
