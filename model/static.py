@@ -32,28 +32,42 @@ def colour_nodes(adjacency):
     return colour
 
 
-def jacobian(forces, mesh, x, rel_step=1e-6):
+class JacobianPattern:
+    """What the finite-difference Jacobian needs of the mesh alone, built once per model: the
+    node colours, the step, and for each (colour, component) the rows, columns and the
+    gather that places the force differences in the sparse matrix."""
+
+    def __init__(self, mesh, rel_step=1e-6):
+        adj = node_adjacency(mesh)
+        colour = colour_nodes(adj)
+        self.h = rel_step * np.linalg.norm(
+            mesh.points[mesh.edges[:, 1]] - mesh.points[mesh.edges[:, 0]], axis=1).mean()
+        self.n = 3 * mesh.n_nodes
+        self.groups = []
+        for c in range(colour.max() + 1):
+            nodes = np.flatnonzero(colour == c)
+            nbs = [adj.indices[adj.indptr[q]:adj.indptr[q + 1]] for q in nodes]
+            nb = np.concatenate(nbs)
+            owner = np.repeat(nodes, [len(b) for b in nbs])
+            rows = (3 * nb[:, None] + np.arange(3)).ravel()
+            for k in range(3):
+                self.groups.append((nodes, k, rows, np.repeat(3 * owner + k, 3), nb))
+
+
+def jacobian(forces, mesh, x, pattern=None):
     """Sparse d forces / d x (3n x 3n) by central differences over node colours."""
-    adj = node_adjacency(mesh)
-    colour = colour_nodes(adj)
-    h = rel_step * np.linalg.norm(mesh.points[mesh.edges[:, 1]] - mesh.points[mesh.edges[:, 0]],
-                                  axis=1).mean()
+    p = pattern or JacobianPattern(mesh)
     rows, cols, vals = [], [], []
-    for c in range(colour.max() + 1):
-        nodes = np.flatnonzero(colour == c)
-        for k in range(3):
-            xp, xm = x.copy(), x.copy()
-            xp[nodes, k] += h
-            xm[nodes, k] -= h
-            df = (forces(xp) - forces(xm)) / (2 * h)
-            for q in nodes:
-                nb = adj.indices[adj.indptr[q]:adj.indptr[q + 1]]
-                rows.append((3 * nb[:, None] + np.arange(3)).ravel())
-                cols.append(np.full(3 * len(nb), 3 * q + k))
-                vals.append(df[nb].ravel())
-    n = 3 * mesh.n_nodes
+    for nodes, k, r, c, nb in p.groups:
+        xp, xm = x.copy(), x.copy()
+        xp[nodes, k] += p.h
+        xm[nodes, k] -= p.h
+        df = (forces(xp) - forces(xm)) / (2 * p.h)
+        rows.append(r)
+        cols.append(c)
+        vals.append(df[nb].ravel())
     return sp.csr_matrix((np.concatenate(vals), (np.concatenate(rows), np.concatenate(cols))),
-                         shape=(n, n))
+                         shape=(p.n, p.n))
 
 
 @dataclass

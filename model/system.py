@@ -26,6 +26,7 @@ class ParticleModel:
         self.mass = np.zeros(mesh.n_nodes)
         np.add.at(self.mass, mesh.tets, np.repeat(material.rho * mesh.volumes[:, None] / 4, 4, 1))
         self._strain_probe = Shear(mesh, material, reading="corner")
+        self._jacobian_pattern = None
         self.info = {"model": name, "terms": [{"term": t.describe(), **t.info()}
                                               for t in self.terms], **fit}
         for t in self.terms:
@@ -77,7 +78,9 @@ class ParticleModel:
 
     def jacobian(self, x):
         """Sparse d f / d x (3n x 3n) by coloured central differences (any reading)."""
-        return static.jacobian(self.forces, self.mesh, x)
+        if self._jacobian_pattern is None:  # mesh-only work, once per model
+            self._jacobian_pattern = static.JacobianPattern(self.mesh)
+        return static.jacobian(self.forces, self.mesh, x, self._jacobian_pattern)
 
     def solve_static(self, bc, f_ext=None, rtol=1e-9, max_iter=50, load_steps=1):
         """Equilibrium f_int(x) + f_ext = 0 on the free components (see model.static.solve)."""
