@@ -1,13 +1,65 @@
-"""The ``pbcm`` command line."""
+"""The ``pbcm`` command line.
+
+Every argument is checked before any computing starts (names, numbers, output paths); errors
+are one line ``pbcm: error: ...`` with exit status 2, Ctrl-C is one line with exit status 130.
+"""
 import argparse
+import math
+import re
 import sys
+import textwrap
+from pathlib import Path
 
 import model
 from model.errors import PbcmError
 from model.mesh import SCHEMES, box, read
+from .output import StagedFolder, writable_folder, write_text_atomic
+
+DESCRIPTION = """\
+pbcm measures how far the particle soft-body model of Nakagawa et al. is from the continuum:
+it runs cases against FEM references, writes reports, and gates CI on error bounds."""
+
+
+class Parser(argparse.ArgumentParser):
+    """argparse with one-line errors: ``pbcm: error: ...`` and exit status 2."""
+
+    def error(self, message):
+        message = re.sub(r"^argument (\S+): (?=\1 )", "", message)  # the flag is said already
+        self.exit(2, f"pbcm: error: {message} (see `{self.prog} --help`)\n")
+
+
+def _number(flag, what, low=None, high=None, integer=False, open_low=True):
+    """An argparse type: a finite number in (low, high), in the user's units, or an error
+    naming the flag."""
+    def parse(text):
+        try:
+            v = int(text) if integer else float(text)
+        except ValueError:
+            raise argparse.ArgumentTypeError(f"{flag} takes {what}, got {text!r}") from None
+        ok = math.isfinite(v) and (low is None or (v > low if open_low else v >= low)) \
+            and (high is None or v < high)
+        if not ok:
+            raise argparse.ArgumentTypeError(f"{flag} takes {what}, got {text}")
+        return v
+    return parse
+
+
+def _poisson(text):
+    v = _number("--nu", "Poisson's ratio, a number between -1 and 0.5")(text)
+    if v >= 0.5:
+        raise argparse.ArgumentTypeError(
+            f"--nu must be below 0.5, got {text} (0.5 is incompressible, which the volume "
+            "term cannot represent: use 0.49 at most)")
+    if v <= -1:
+        raise argparse.ArgumentTypeError(f"--nu must be above -1, got {text} (at -1 the bulk "
+                                         "modulus vanishes)")
+    return v
 
 
 def _mesh_command(args):
+    if args.source != "cube" and not Path(args.source).is_file():
+        raise UsageError(f"mesh file {args.source} does not exist (or is not a file); give a "
+                         "mesh file or 'cube'")
     if args.source == "cube":
         # millimetres at the edge, metres inside
         mesh = box(args.n, args.n, args.n, *(3 * [args.size * 1e-3]), scheme=args.scheme,
@@ -65,20 +117,28 @@ def _config(case, args):
     return case.Config(**kw)
 
 
-def _run_case(name, args, out):
+def _run_into(name, cfg, folder):
+    """Run case ``name`` with ``cfg`` and write its files into the existing ``folder``."""
     from .report import write_case
-    case = _case(name)
-    cfg = _config(case, args)
-    runs, fields = case.run(cfg)
-    path = write_case(out, name, cfg, runs, fields)
-    print(f"{name}: {len(runs)} runs written to {path}")
-    return path
+    runs, fields = _case(name).run(cfg)
+    write_case(folder, name, cfg, runs, fields)
+    return runs
+
+
+def _configs(names, args):
+    """Every case's configuration, built (and so checked) before anything runs."""
+    return {name: _config(_case(name), args) for name in names}
+
+
+def _summary(case):
+    """The first paragraph of a case's docstring, as whole sentences on one line."""
+    return " ".join(case.__doc__.strip().split("\n\n")[0].split())
 
 
 def _list_command(args):
     from .registry import CASES
     for name, case in CASES.items():
-        print(f"{name}: {case.__doc__.strip().splitlines()[0]}")
+        print(textwrap.fill(f"{name}: {_summary(case)}", width=96, subsequent_indent="  "))
         print(f"  meshes: {', '.join(case.MESHES)}")
         print(f"  bcs:    {', '.join(case.BCS)}")
         print(f"  models: {', '.join(case.MODELS)}")
@@ -86,19 +146,28 @@ def _list_command(args):
 
 
 def _run_command(args):
-    from pathlib import Path
-    _run_case(args.case, args, Path(args.out) if args.out else Path("reports") / args.case)
+    cfg = _configs([args.case], args)[args.case]
+    with StagedFolder(Path(args.out) if args.out else Path("reports") / args.case) as out:
+        runs = _run_into(args.case, cfg, out.path)
+        path = out.commit()
+    print(f"{args.case}: {len(runs)} runs written to {path}")
     return 0
 
 
 def _report_command(args):
-    from pathlib import Path
+    from contextlib import ExitStack
     from .registry import CASES
-    from .report import write_index
-    root = Path(args.out or "reports")
-    for name in CASES:
-        _run_case(name, args, root / name)
-    write_index(root, list(CASES))
+    from .report import index_documents
+    cfgs = _configs(CASES, args)
+    root = writable_folder(args.out or "reports")
+    with ExitStack() as stack:   # every case folder checked and staged before any computing
+        staged = {name: stack.enter_context(StagedFolder(root / name)) for name in CASES}
+        for name, out in staged.items():
+            runs = _run_into(name, cfgs[name], out.path)
+            print(f"{name}: {len(runs)} runs written to {out.commit()}")
+    md, html = index_documents(root, list(CASES))
+    write_text_atomic(root / "index.md", md)
+    write_text_atomic(root / "index.html", html)
     print(f"index written to {root / 'index.md'} and {root / 'index.html'}")
     return 0
 
@@ -106,7 +175,7 @@ def _report_command(args):
 def _check_command(args):
     from .thresholds import CheckError, check, load, measured
     try:
-        rows, status = check(load(args.thresholds), measured(args.metrics))
+        rows, status = check(load(args.thresholds, hint="--thresholds"), measured(args.metrics))
     except CheckError as exc:
         print(f"pbcm check: error: {exc}", file=sys.stderr)
         return 2
@@ -125,30 +194,33 @@ def _check_command(args):
 
 
 def _bless_command(args):
+    """Bounds from a folder of metrics (``--metrics``) or from a fresh run of every case. What
+    it keeps: bounds of runs it did not see (other modes, meshes, models...) unless
+    ``--prune``; each existing bound's tolerances unless ``--margin`` is given."""
     import tempfile
-    from pathlib import Path
     from .registry import CASES
     from .thresholds import CheckError, bless, dumps, load, measured
     path = Path(args.thresholds)
-    if args.metrics:
-        folder = Path(args.metrics)
-    else:  # a fresh run of every case, in the mode asked
-        folder = Path(tempfile.mkdtemp(prefix="pbcm-bless-"))
-        for name in CASES:
-            _run_case(name, args, folder / name)
-    try:
-        values = measured(folder)
+    try:   # every check before the run: the old file must load and the new one be writable
+        writable_folder(path.parent if str(path.parent) else Path("."), flag="--thresholds")
         old = load(path) if path.exists() else []
+        if args.metrics:
+            values = measured(args.metrics)
+        else:
+            cfgs = _configs(CASES, args)
+            with tempfile.TemporaryDirectory(prefix="pbcm-bless-") as tmp:
+                for name in CASES:
+                    (Path(tmp) / name).mkdir()
+                    _run_into(name, cfgs[name], Path(tmp) / name)
+                values = measured(tmp)
+        new, changes = bless(values, old, rtol=args.margin, prune=args.prune)
     except CheckError as exc:
         print(f"pbcm bless: error: {exc}", file=sys.stderr)
         return 2
-    modes = {k[1] for k in values}
-    keep = [b for b in old if b.mode not in modes]
-    new, changes = bless(values, [b for b in old if b.mode in modes], rtol=args.margin)
-    path.write_text(dumps(sorted(keep + new, key=lambda b: b.key)) + "\n")
+    write_text_atomic(path, dumps(new))
     for line in changes or ["no change"]:
         print(line)
-    print(f"{len(new)} bounds for mode {', '.join(sorted(modes))} written to {path}")
+    print(f"{len(new.bounds)} bounds written to {path}")
     return 0
 
 
@@ -158,23 +230,29 @@ def _selection(p):
     p.add_argument("--bcs", nargs="+", help="boundary conditions (default: all)")
     p.add_argument("--quick", action="store_true",
                    help="five and six meshes, one P2 refinement, fewer timing repeats")
-    p.add_argument("--E", type=float, help="Young's modulus [Pa] (default 10e3)")
-    p.add_argument("--nu", type=float, help="Poisson's ratio (default 0.45)")
-    p.add_argument("--rho", type=float, help="density [kg/m^3] (default 1000)")
+    p.add_argument("--E", type=_number("--E", "Young's modulus in Pa, a number > 0", low=0),
+                   help="Young's modulus [Pa] (default 10e3)")
+    p.add_argument("--nu", type=_poisson, help="Poisson's ratio, -1 < nu < 0.5 (default 0.45)")
+    p.add_argument("--rho", type=_number("--rho", "a density in kg/m^3, a number > 0", low=0),
+                   help="density [kg/m^3] (default 1000)")
     # test-only: scale the shear term, to prove that the error gate catches a worse model
     p.add_argument("--shear-scale", type=float, default=None, help=argparse.SUPPRESS)
 
 
 def parser():
-    p = argparse.ArgumentParser(prog="pbcm", description=__doc__.splitlines()[0])
+    p = Parser(prog="pbcm", description=DESCRIPTION,
+               formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("--version", action="version", version=f"pbcm {model.__version__}")
-    sub = p.add_subparsers(dest="command", required=True)
+    sub = p.add_subparsers(dest="command", required=True, parser_class=Parser)
     m = sub.add_parser("mesh", help="print node/tetrahedron counts and quality of a mesh",
                        description="Mesh statistics: 'pbcm mesh FILE' for any meshio-readable "
                                    "file, or 'pbcm mesh cube [--n N --size MM --scheme S]'.")
     m.add_argument("source", help="a mesh file, or 'cube'")
-    m.add_argument("--n", type=int, default=5, help="nodes per side (cube), default 5")
-    m.add_argument("--size", type=float, default=32.0, help="side in mm (cube), default 32")
+    m.add_argument("--n", type=_number("--n", "an integer >= 2 (nodes per side)", low=2,
+                                       integer=True, open_low=False),
+                   default=5, help="nodes per side (cube), default 5")
+    m.add_argument("--size", type=_number("--size", "a side length in mm, a number > 0", low=0),
+                   default=32.0, help="side in mm (cube), default 32")
     m.add_argument("--scheme", choices=SCHEMES, default="five", help="cube tetrahedralisation")
     m.add_argument("--seed", type=int, default=0, help="seed of the 'unstructured' scheme")
     m.set_defaults(func=_mesh_command)
@@ -193,27 +271,44 @@ def parser():
                        "(exit 0 pass, 1 fail, 2 missing or malformed)")
     c.add_argument("--metrics", default="reports", help="a metrics.json or a folder of them "
                    "(default reports)")
-    c.add_argument("--thresholds", default="thresholds.toml")
+    c.add_argument("--thresholds", default="thresholds.toml",
+                   help="the bounds file (default thresholds.toml in the current folder: the "
+                        "repository's own when run from a checkout)")
     c.set_defaults(func=_check_command)
-    b = sub.add_parser("bless", help="rewrite the bounds from a fresh run and print what changed")
-    b.add_argument("--margin", type=float, default=0.1, help="relative tolerance (default 0.1)")
-    b.add_argument("--thresholds", default="thresholds.toml")
-    b.add_argument("--metrics", help="bless these metrics instead of a fresh run")
+    b = sub.add_parser(
+        "bless", help="rewrite the bounds from measured metrics and print what changed",
+        description="Set the bounds of thresholds.toml from measured metrics. Without --metrics "
+                    "it first runs every case: in full mode (about 14 minutes) unless --quick "
+                    "is given. It keeps the bounds of runs it did not see (other modes, meshes, "
+                    "models) unless --prune is given, and each existing bound's tolerances "
+                    "unless --margin is given; new bounds get --margin or 0.1. It prints every "
+                    "bound it adds, changes or removes.")
+    b.add_argument("--margin", type=_number("--margin", "a relative tolerance, a number > 0",
+                                            low=0), default=None,
+                   help="relative tolerance rtol of every bound written (default: keep each "
+                        "existing bound's, 0.1 for new ones)")
+    b.add_argument("--prune", action="store_true",
+                   help="remove (and list) bounds of runs or metrics not in the metrics blessed")
+    b.add_argument("--thresholds", default="thresholds.toml",
+                   help="the bounds file to rewrite (default thresholds.toml)")
+    b.add_argument("--metrics", help="bless the metrics.json files under this folder instead "
+                                     "of a fresh run")
     _selection(b)
     b.set_defaults(func=_bless_command)
     return p
 
 
 def main(argv=None):
-    args = parser().parse_args(argv)
     try:
+        args = parser().parse_args(argv)
         return args.func(args)
-    except UsageError as exc:
+    except (UsageError, PbcmError) as exc:
         print(f"pbcm: error: {exc}", file=sys.stderr)
         return 2
-    except PbcmError as exc:
-        print(f"pbcm: error: {exc}", file=sys.stderr)
-        return 2
+    except KeyboardInterrupt:
+        print("\npbcm: interrupted; output folders hold what they held before the unfinished "
+              "one", file=sys.stderr)
+        return 130
 
 
 if __name__ == "__main__":

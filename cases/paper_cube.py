@@ -10,7 +10,7 @@ import time
 
 import numpy as np
 
-from model import PRESETS, BlowUpError, Material, ModelError, build
+from model import PRESETS, BlowUpError, Material, ModelError, PbcmError, build
 from model.bc import Ramp, bc_arrays, merge
 from model.mesh import cube
 from model.terms.shear import Shear
@@ -60,16 +60,23 @@ class Config:
         return cls(**{"meshes": QUICK_MESHES, "p2_levels": 1, "timing_repeats": 3,
                       "hold_max": 1.0, "quick": True, **kw})
 
-    def describe(self):
+    def problem(self):
+        """The parameters that define the problem the metrics answer (what a bound was
+        measured at): material, geometry, loading, damping, step and reference resolution.
+        Selections (meshes, models) and timing repeats are not part of it."""
         return {"E_Pa": self.E, "nu": self.nu, "rho_kg_m3": self.rho, "size_mm": SIZE_MM,
                 "nodes_per_side": NODES_PER_SIDE, "push_mm": PUSH_MM,
                 "speed_mm_s": SPEED_MM_S, "layers_mm": list(LAYERS_MM),
-                "meshes": list(self.meshes), "bcs": list(self.bcs), "models": list(self.models),
                 "p2_levels": self.p2_levels, "damping_1_s": self.damping,
                 "rk4_safety": self.safety, "hold_max_s": self.hold_max,
-                "rest_speed_fraction": self.rest_speed, "timing_steps": self.timing_steps,
-                "timing_repeats": self.timing_repeats, "quick": self.quick,
-                "shear_scale": self.shear_scale}
+                "rest_speed_fraction": self.rest_speed}
+
+    def describe(self):
+        """Everything the run was given: the problem, the selection and the run settings."""
+        return {**self.problem(),
+                "meshes": list(self.meshes), "bcs": list(self.bcs), "models": list(self.models),
+                "timing_steps": self.timing_steps, "timing_repeats": self.timing_repeats,
+                "quick": self.quick, "shear_scale": self.shear_scale}
 
 
 def make_mesh(name):
@@ -157,14 +164,15 @@ def dynamic_run(pm, mesh, bc, cfg):
 
 
 def dynamic_metrics(dyn, mesh, st):
-    """The dynamic run's metrics; None throughout (and the reason) when it blew up."""
+    """The dynamic run's metrics; None throughout (and the reason) when it blew up. The
+    distance to the static equilibrium is None when the static solve failed."""
     keys = ("dyn_vs_static_rel_l2", "dyn_at_rest", "dyn_t_end_s", "dyn_steps",
             "dyn_reaction_t_s", "dyn_reaction_n")
     out = {"dyn_failed": dyn["failed"], "dyn_dt_s": dyn["dt"], "dyn_wall_s": dyn["wall"]}
     if dyn["failed"]:
         return {**out, **{k: None for k in keys}}
     return {**out,
-            "dyn_vs_static_rel_l2": M.rel_l2(dyn["x"] - mesh.points, st.u),
+            "dyn_vs_static_rel_l2": None if st is None else M.rel_l2(dyn["x"] - mesh.points, st.u),
             "dyn_at_rest": dyn["at_rest"], "dyn_t_end_s": dyn["t_end"],
             "dyn_steps": dyn["steps"], "dyn_reaction_t_s": dyn["t"].tolist(),
             "dyn_reaction_n": M.finite("dyn_reaction", dyn["reaction_y"]).tolist()}
@@ -185,90 +193,135 @@ def growth_rate(pm, mesh, bc):
 
 
 def step_time(pm, mesh, bc, cfg):
-    """Median over repeats of the wall time of one RK4 step (the full integrator's step)."""
-    ramp = dynamic_bc(mesh, bc)
+    """Median over repeats of the wall time of one RK4 step of the full integrator, and the
+    state it was timed in: the paper's push ("push"), or, when the push blows up within the
+    timed steps (a fluttering reading), the same steps with the boundary held at rest ("rest":
+    the model stays exactly at rest, and a step costs the same arithmetic)."""
+    ramp, state = dynamic_bc(mesh, bc), "push"
     dt = pm.stable_dt(cfg.safety)
     times = []
     for _ in range(cfg.timing_repeats):
         t0 = time.perf_counter()
-        pm.simulate(ramp, cfg.timing_steps * dt, dt=dt, damping=cfg.damping, frames=2)
+        try:
+            pm.simulate(ramp, cfg.timing_steps * dt, dt=dt, damping=cfg.damping, frames=2)
+        except BlowUpError:
+            return _rest_step_time(pm, mesh, bc, cfg, dt), "rest"
+        times.append((time.perf_counter() - t0) / cfg.timing_steps)
+    return statistics.median(times), state
+
+
+def _rest_step_time(pm, mesh, bc, cfg, dt):
+    top, _, held = boundary_sets(mesh, bc)
+    still = Ramp(top, (0.0, 0.0, 0.0), 1.0, held=held)
+    times = []
+    for _ in range(cfg.timing_repeats):
+        t0 = time.perf_counter()
+        pm.simulate(still, cfg.timing_steps * dt, dt=dt, damping=cfg.damping, frames=2)
         times.append((time.perf_counter() - t0) / cfg.timing_steps)
     return statistics.median(times)
 
 
+# the metrics of the static solution; None when the static solve failed
+STATIC_KEYS = ("disp_rel_l2_p1", "disp_max_rel_p1", "disp_rel_l2_p2", "disp_max_rel_p2",
+               "reaction_n", "reaction_ratio", "reaction_rel_err", "stress_corr",
+               "stress_rel_err", "pressure_corr", "pressure_rel_err", "bulge_profile_mm",
+               "zigzag", "paper_pattern", "static_residual_n")
+
+
+class Reference:
+    """The FEM side of one (mesh, bc): P1 on the mesh, converged P2, and what the metrics need."""
+
+    def __init__(self, mesh, bc, cfg, probe):
+        mat = cfg.material
+        self.layers, self.L = [y * MM for y in LAYERS_MM], SIZE_MM * MM
+        self.sbc = static_bc(mesh, bc)
+        self.p1 = linear.solve(mesh, mat.E, mat.nu, self.sbc, element="P1")
+        self.conv = linear.converged(mesh, mat.E, mat.nu, self.sbc, levels=cfg.p2_levels)
+        self.p2 = self.conv.result
+        self.top = boundary_sets(mesh, bc)[0]
+        self.tau = probe.max_tau(mesh.points + self.p2.u)
+        self.profile = M.layer_profile(mesh.points, self.p2.u, self.layers, self.L)
+        self.reaction = float(-self.p2.reaction[self.top, 1].sum())
+
+
+def static_metrics(pm, st, mesh, ref):
+    """The static solution against the references (MODEL.md "What is compared")."""
+    s = pm.tet_stress(st.x)
+    profile = M.layer_profile(mesh.points, st.u, ref.layers, ref.L)
+    reaction = M.finite("reaction", -st.reaction[ref.top, 1].sum())
+    return {
+        "disp_rel_l2_p1": M.rel_l2(st.u, ref.p1.u),
+        "disp_max_rel_p1": M.max_rel(st.u, ref.p1.u),
+        "disp_rel_l2_p2": M.rel_l2(st.u, ref.p2.u),
+        "disp_max_rel_p2": M.max_rel(st.u, ref.p2.u),
+        "reaction_n": reaction,
+        "reaction_ratio": M.finite("reaction_ratio", reaction / ref.reaction),
+        "reaction_rel_err": M.finite("reaction_rel_err", abs(reaction / ref.reaction - 1)),
+        "stress_corr": None if uniform(ref.tau) else M.correlation(s["max_tau"], ref.tau),
+        "stress_rel_err": M.rel_l2(s["max_tau"], ref.tau),
+        "pressure_corr": (None if uniform(ref.p2.pressure)
+                          else M.correlation(s["pressure"], ref.p2.pressure)),
+        "pressure_rel_err": M.rel_l2(s["pressure"], ref.p2.pressure),
+        "bulge_profile_mm": (profile / MM).tolist(),
+        "zigzag": M.zigzag(profile),
+        "paper_pattern": M.paper_pattern(profile),
+        "static_residual_n": st.residual,
+    }, s
+
+
+def model_run(mesh_name, mesh, bc, model_name, cfg, ref):
+    """One (mesh, bc, model): its metrics and its fields for the figures (None when the static
+    solve failed). A failure of a phase (static, dynamic, timing) is recorded in that phase's
+    ``*_failed`` entry, its metrics are None, and the other phases still run."""
+    r = {"mesh": mesh_name, "bc": bc, "model": model_name,
+         "nodes": mesh.n_nodes, "tets": mesh.n_tets,
+         "reaction_fem_p2_n": ref.reaction,
+         "bulge_profile_fem_mm": (ref.profile / MM).tolist(),
+         "zigzag_fem": M.zigzag(ref.profile), "paper_pattern_fem": M.paper_pattern(ref.profile),
+         "p2_error_estimate": ref.conv.error_estimate}
+    pm = build_model(model_name, mesh, cfg.material, cfg)
+    st, fields = None, None
+    try:
+        st = pm.solve_static(ref.sbc)
+        values, s = static_metrics(pm, st, mesh, ref)
+        r.update(values, static_failed=None)
+        fields = {"mesh": mesh, "u": st.u, "max_tau": s["max_tau"], "pressure": s["pressure"]}
+    except PbcmError as exc:   # no equilibrium found, or a metric undefined: a finding
+        r.update({k: None for k in STATIC_KEYS}, static_failed=str(exc))
+        st = None
+    nft = pm.net_force_torque(mesh.points + ref.p2.u)
+    r.update(net_force_rel=M.finite("net_force", nft["force_rel"]),
+             net_torque_rel=M.finite("net_torque", nft["torque_rel"]),
+             growth_rate_1_s=growth_rate(pm, mesh, bc))
+    r.update(dynamic_metrics(dynamic_run(pm, mesh, bc, cfg), mesh, st))
+    r["step_time_s"], r["step_time_state"] = step_time(pm, mesh, bc, cfg)
+    r["model_info"] = _jsonable(pm.info)
+    return r, fields
+
+
 def run(cfg, log=True):
     """Run every (mesh, bc, model); return the runs (metrics) and the fields for figures."""
-    mat = cfg.material
     total = len(cfg.meshes) * len(cfg.bcs) * (len(cfg.models) + 1)
     done, t_start = 0, time.perf_counter()
     runs, fields = [], {}
-    layers = [y * MM for y in LAYERS_MM]
-    L = SIZE_MM * MM
     for mesh_name in cfg.meshes:
         mesh = make_mesh(mesh_name)
-        probe = Shear(mesh, mat, reading="corner")  # the paper's max |tau| measure
+        probe = Shear(mesh, cfg.material, reading="corner")  # the paper's max |tau| measure
         for bc in cfg.bcs:
             if log:
                 progress(done, total, f"{mesh_name}/{bc}: FEM P1 and P2 references", t_start)
-            sbc = static_bc(mesh, bc)
-            p1 = linear.solve(mesh, mat.E, mat.nu, sbc, element="P1")
-            conv = linear.converged(mesh, mat.E, mat.nu, sbc, levels=cfg.p2_levels)
-            p2 = conv.result
-            top = boundary_sets(mesh, bc)[0]
-            fem_tau = probe.max_tau(mesh.points + p2.u)
-            fem_profile = M.layer_profile(mesh.points, p2.u, layers, L)
-            fields[(mesh_name, bc, "fem-p2")] = {"mesh": mesh, "u": p2.u, "max_tau": fem_tau,
-                                                 "pressure": p2.pressure,
-                                                 "von_mises": p2.von_mises}
-            fem_reaction = float(-p2.reaction[top, 1].sum())
+            ref = Reference(mesh, bc, cfg, probe)
+            fields[(mesh_name, bc, "fem-p2")] = {"mesh": mesh, "u": ref.p2.u, "max_tau": ref.tau,
+                                                 "pressure": ref.p2.pressure,
+                                                 "von_mises": ref.p2.von_mises}
             done += 1
             for model_name in cfg.models:
                 if log:
                     progress(done, total, f"{mesh_name}/{bc}/{model_name}", t_start)
-                pm = build_model(model_name, mesh, mat, cfg)
-                st = pm.solve_static(sbc)
-                s = pm.tet_stress(st.x)
-                dyn = dynamic_run(pm, mesh, bc, cfg)
-                profile = M.layer_profile(mesh.points, st.u, layers, L)
-                nft = pm.net_force_torque(mesh.points + p2.u)
-                uniform_ref = uniform(fem_tau)
-                r = {
-                    "mesh": mesh_name, "bc": bc, "model": model_name,
-                    "nodes": mesh.n_nodes, "tets": mesh.n_tets,
-                    "disp_rel_l2_p1": M.rel_l2(st.u, p1.u),
-                    "disp_max_rel_p1": M.max_rel(st.u, p1.u),
-                    "disp_rel_l2_p2": M.rel_l2(st.u, p2.u),
-                    "disp_max_rel_p2": M.max_rel(st.u, p2.u),
-                    "reaction_n": M.finite("reaction", -st.reaction[top, 1].sum()),
-                    "reaction_fem_p2_n": fem_reaction,
-                    "reaction_ratio": M.finite("reaction_ratio",
-                                               -st.reaction[top, 1].sum() / fem_reaction),
-                    "reaction_rel_err": M.finite("reaction_rel_err", abs(
-                        -st.reaction[top, 1].sum() / fem_reaction - 1)),
-                    "stress_corr": None if uniform_ref else M.correlation(s["max_tau"], fem_tau),
-                    "stress_rel_err": M.rel_l2(s["max_tau"], fem_tau),
-                    "pressure_corr": (None if uniform(p2.pressure)
-                                      else M.correlation(s["pressure"], p2.pressure)),
-                    "pressure_rel_err": M.rel_l2(s["pressure"], p2.pressure),
-                    "bulge_profile_mm": (profile / MM).tolist(),
-                    "bulge_profile_fem_mm": (fem_profile / MM).tolist(),
-                    "zigzag": M.zigzag(profile),
-                    "zigzag_fem": M.zigzag(fem_profile),
-                    "paper_pattern": M.paper_pattern(profile),
-                    "paper_pattern_fem": M.paper_pattern(fem_profile),
-                    "net_force_rel": M.finite("net_force", nft["force_rel"]),
-                    "net_torque_rel": M.finite("net_torque", nft["torque_rel"]),
-                    "static_residual_n": st.residual,
-                    "growth_rate_1_s": growth_rate(pm, mesh, bc),
-                    **dynamic_metrics(dyn, mesh, st),
-                    "step_time_s": step_time(pm, mesh, bc, cfg),
-                    "p2_error_estimate": conv.error_estimate,
-                    "model_info": _jsonable(pm.info),
-                }
+                r, f = model_run(mesh_name, mesh, bc, model_name, cfg, ref)
                 runs.append(r)
-                fields[(mesh_name, bc, model_name)] = {"mesh": mesh, "u": st.u,
-                                                       "max_tau": s["max_tau"],
-                                                       "pressure": s["pressure"]}
+                if f is not None:
+                    fields[(mesh_name, bc, model_name)] = f
                 done += 1
     if log:
         progress(total, total, "done", t_start)

@@ -56,17 +56,44 @@ class Bound:
 
 
 FIELDS = ("case", "mode", "mesh", "bc", "model", "metric", "value", "rtol", "atol", "direction")
+HEADER = """\
+# pbcm error bounds, read by `pbcm check` and rewritten only by `pbcm bless`.
+# max: measured <= value + rtol |value| + atol;  min: measured >= value - rtol |value| - atol.
+# mode: the run mode the bound belongs to (quick runs in CI). [[problem]]: the parameters of
+# each case and mode the bounds were measured at; `pbcm check` refuses metrics run at others.
+"""
 
 
-def load(path):
+@dataclass
+class Measurements:
+    """What a folder of metrics.json holds for the gate: ``values`` {(case, mode, mesh, bc,
+    model, metric): value or None} and ``problems`` {(case, mode): parameters of the problem}."""
+
+    values: dict
+    problems: dict
+
+
+@dataclass
+class Thresholds:
+    """A thresholds file: ``bounds`` (Bound list) and ``problems`` {(case, mode): parameters}."""
+
+    bounds: list
+    problems: dict
+
+
+def load(path, hint=None):
+    """The bounds and problem parameters of a thresholds file (a ``Thresholds``)."""
     path = Path(path)
     if not path.is_file():
-        raise CheckError(f"thresholds file {path} is missing; create it with `pbcm bless`")
+        where = (f"pass {hint} PATH (e.g. the thresholds.toml of a pbcm checkout)"
+                 if hint else "give its path")
+        raise CheckError(f"thresholds file {path} is missing: {where}, or create one from "
+                         "measured metrics with `pbcm bless --metrics DIR`")
     try:
         data = tomllib.loads(path.read_text())
-    except tomllib.TOMLDecodeError as exc:
+    except (tomllib.TOMLDecodeError, UnicodeDecodeError) as exc:
         raise CheckError(f"thresholds file {path} is malformed: {exc}") from None
-    bounds = []
+    bounds, seen = [], {}
     for i, b in enumerate(data.get("bound", [])):
         missing = [f for f in FIELDS if f not in b]
         if missing:
@@ -79,44 +106,83 @@ def load(path):
                 or b["rtol"] < 0 or b["atol"] < 0:
             raise CheckError(f"{path}: bound {i + 1} needs finite value and non-negative "
                              "rtol, atol")
-        bounds.append(Bound(**{f: b[f] for f in FIELDS}, measured_on=b.get("measured_on", "")))
+        bound = Bound(**{f: b[f] for f in FIELDS}, measured_on=b.get("measured_on", ""))
+        if bound.key in seen:
+            raise CheckError(f"{path}: bounds {seen[bound.key] + 1} and {i + 1} are both for "
+                             f"{'/'.join(bound.key)}; keep one")
+        seen[bound.key] = i
+        bounds.append(bound)
     if not bounds:
         raise CheckError(f"thresholds file {path} holds no [[bound]]; run `pbcm bless`")
-    return bounds
+    problems = {}
+    for i, p in enumerate(data.get("problem", [])):
+        if not {"case", "mode"} <= set(p):
+            raise CheckError(f"{path}: [[problem]] {i + 1} lacks case or mode")
+        key = (p["case"], p["mode"])
+        if key in problems:
+            raise CheckError(f"{path}: two [[problem]] tables for {'/'.join(key)}; keep one")
+        problems[key] = {k: v for k, v in p.items() if k not in ("case", "mode")}
+    return Thresholds(bounds, problems)
+
 
 
 def measured(metrics_dir):
-    """{(case, mode, mesh, bc, model, metric): value} from every metrics.json under a folder
-    (or one file)."""
+    """The Measurements of every metrics.json under a folder (or of one file)."""
     p = Path(metrics_dir)
+    if not p.exists():
+        raise CheckError(f"--metrics {p} does not exist; run `pbcm run CASE --out {p}/CASE` "
+                         "first, or give the folder that holds the metrics.json files")
     files = [p] if p.is_file() else sorted(p.glob("**/metrics.json"))
     if not files:
         raise CheckError(f"no metrics.json under {p}; run `pbcm run CASE` first")
-    out = {}
+    values, problems = {}, {}
     for f in files:
         try:
             data = json.loads(f.read_text())
             case, mode = data["case"], "quick" if data["parameters"]["quick"] else "full"
-            runs = data["runs"]
-        except (ValueError, KeyError) as exc:
-            raise CheckError(f"{f} is not a pbcm metrics file: {exc}") from None
+            runs, problem = data["runs"], data["problem"]
+        except (ValueError, KeyError, TypeError) as exc:
+            raise CheckError(f"{f} is not a pbcm metrics file of this version (lacks {exc}); "
+                             "rerun the case") from None
+        if (case, mode) in problems and problems[(case, mode)] != problem:
+            raise CheckError(f"two metrics files of {case} ({mode} mode) under {p} were run at "
+                             "different parameters; check them one at a time")
+        problems[(case, mode)] = problem
         for r in runs:
             for metric in GATED:
-                out[(case, mode, r["mesh"], r["bc"], r["model"], metric)] = r.get(metric)
-    return out
+                values[(case, mode, r["mesh"], r["bc"], r["model"], metric)] = r.get(metric)
+    return Measurements(values, problems)
 
 
-def check(bounds, values):
+def _same_problem(case, mode, recorded, ran):
+    """CheckError naming the first parameter in which a run differs from the bounds."""
+    for k in sorted(set(recorded) | set(ran)):
+        if recorded.get(k) != ran.get(k):
+            raise CheckError(
+                f"parameter {k} of {case} ({mode} mode) is {ran.get(k, 'absent')!r} in the "
+                f"metrics but the bounds were measured at {recorded.get(k, 'absent')!r}: run "
+                "the case with the bounds' parameters, or bless these metrics on purpose")
+
+
+def check(thresholds, measurements):
     """Rows (bound, measured, passed) and the exit status: 0 all pass, 1 any fails. Bounds of
-    a case and mode that were not run are set aside; among the others, a bound without a
-    measured value, a value that is not finite, or a measured metric without a bound raises
-    CheckError (exit 2): a missing reference never passes."""
+    a case and mode that were not run are set aside; metrics run at other problem parameters
+    than the bounds', a bound without a measured value, a value that is not finite, or a
+    measured metric without a bound raise CheckError (exit 2): a missing reference never
+    passes."""
+    values = measurements.values
     rows, status = [], 0
     runs = {k[:2] for k in values}            # (case, mode) pairs that were measured
-    bounds = [b for b in bounds if b.key[:2] in runs]
+    bounds = [b for b in thresholds.bounds if b.key[:2] in runs]
     if not bounds:
         raise CheckError(f"no bound for the measured {', '.join('/'.join(r) for r in sorted(runs))}"
                          "; run in a mode the thresholds cover, or bless this one")
+    for case, mode in sorted(runs):
+        if (case, mode) not in thresholds.problems:
+            raise CheckError(f"the thresholds do not record the parameters of {case} ({mode} "
+                             "mode) their bounds were measured at; bless them again")
+        _same_problem(case, mode, thresholds.problems[(case, mode)],
+                      measurements.problems[(case, mode)])
     keys = {b.key for b in bounds}
     unbounded = [k for k in values if k not in keys and values[k] is not None]
     if unbounded:
@@ -137,11 +203,21 @@ def check(bounds, values):
     return rows, status
 
 
-def bless(values, old=None, rtol=RTOL, atol=ATOL, today=None):
-    """Bounds for every gated metric measured (metrics that are None, e.g. an undefined
-    correlation, get none), keeping an old bound's tolerances; and what changed."""
+def bless(measurements, old=None, rtol=None, prune=False, today=None):
+    """New thresholds from ``measurements`` and the lines saying what changed.
+
+    Every gated metric measured gets a bound at its value (metrics that are None, e.g. an
+    undefined correlation, get none) with ``rtol`` when given, else the old bound's
+    tolerances, else RTOL and ATOL. Bounds that were not measured are kept, unless ``prune``
+    (then they are removed and listed); keeping them is refused when the problem parameters of
+    their case and mode changed, since they would then gate another problem.
+    """
+    if rtol is not None and not (math.isfinite(rtol) and rtol > 0):
+        raise CheckError(f"the margin must be a finite number > 0, got {rtol!r}")
     today = today or datetime.date.today().isoformat()
-    prev = {b.key: b for b in (old or [])}
+    old = old or Thresholds([], {})
+    values = measurements.values
+    prev = {b.key: b for b in old.bounds}
     bounds, changes = [], []
     for key in sorted(values):
         v = values[key]
@@ -149,28 +225,40 @@ def bless(values, old=None, rtol=RTOL, atol=ATOL, today=None):
             continue
         if not math.isfinite(v):
             raise CheckError(f"cannot bless {'/'.join(key)}: measured {v!r}")
-        case, mode, mesh, bc, model, metric = key
         o = prev.get(key)
-        b = Bound(case, mode, mesh, bc, model, metric, float(v), rtol, atol, GATED[metric],
-                  today)
+        tol = (rtol if rtol is not None else o.rtol if o else RTOL, o.atol if o else ATOL)
+        b = Bound(*key, float(v), *tol, GATED[key[-1]], today)
         if o is None:
             changes.append(f"new     {'/'.join(key)}: {v:.6g}")
-        elif o.value != b.value or (o.rtol, o.atol) != (rtol, atol):
-            changes.append(f"changed {'/'.join(key)}: {o.value:.6g} -> {v:.6g}")
+        elif o.value != b.value or (o.rtol, o.atol) != tol:
+            changes.append(f"changed {'/'.join(key)}: {o.value:.6g} -> {v:.6g}"
+                           + (f" (rtol {o.rtol:g} -> {tol[0]:g})" if o.rtol != tol[0] else ""))
         bounds.append(b)
-    for key in sorted(set(prev) - {b.key for b in bounds}):
-        changes.append(f"removed {'/'.join(key)}")
-    return bounds, changes
+    problems = {**old.problems, **measurements.problems}
+    unseen = sorted(set(prev) - {b.key for b in bounds})
+    if prune:
+        changes += [f"removed {'/'.join(key)} (not in the metrics blessed)" for key in unseen]
+        live = {b.key[:2] for b in bounds}
+        problems = {k: v for k, v in problems.items() if k in live}
+    else:
+        moved = sorted({k[:2] for k in unseen if k[:2] in measurements.problems
+                        and old.problems.get(k[:2]) != measurements.problems[k[:2]]})
+        if moved:
+            raise CheckError(f"the parameters of {', '.join('/'.join(k) for k in moved)} differ "
+                             "from those of bounds these metrics do not cover; bless a complete "
+                             "run, or pass --prune to drop the bounds not measured")
+        bounds += [prev[key] for key in unseen]
+        if unseen:
+            changes.append(f"kept    {len(unseen)} bounds of runs or metrics not in the metrics "
+                           "blessed (--prune removes them)")
+    return Thresholds(sorted(bounds, key=lambda b: b.key), problems), changes
 
 
-def dumps(bounds):
-    lines = ["# pbcm error bounds, read by `pbcm check` and rewritten only by `pbcm bless`.",
-             "# max: measured <= value + rtol |value| + atol;  min: measured >= value - rtol |value|"
-             " - atol.", "# mode: the run mode the bound belongs to (quick runs in CI).", ""]
-    for b in bounds:
-        lines += ["[[bound]]", f"# measured {b.value:.6g} on {b.measured_on}"]
-        for f in FIELDS:
-            v = getattr(b, f)
-            lines.append(f"{f} = {json.dumps(v) if isinstance(v, str) else repr(float(v))}")
-        lines += [f"measured_on = {json.dumps(b.measured_on)}", ""]
-    return "\n".join(lines)
+def dumps(thresholds):
+    """TOML text of ``thresholds`` (bounds sorted by key, then the problem parameters)."""
+    import tomli_w
+    data = {"bound": [{**{f: getattr(b, f) for f in FIELDS}, "measured_on": b.measured_on}
+                      for b in sorted(thresholds.bounds, key=lambda b: b.key)],
+            "problem": [{"case": c, "mode": m, **p}
+                        for (c, m), p in sorted(thresholds.problems.items())]}
+    return HEADER + "\n" + tomli_w.dumps(data)

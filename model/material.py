@@ -5,6 +5,13 @@ import math
 from .errors import MaterialError
 
 
+def poisson_message(nu):
+    """Why ``nu`` is not a Poisson's ratio the models and references accept."""
+    why = ("0.5 and above is incompressible, which the volume term cannot represent: use 0.49 "
+           "at most" if nu >= 0.5 else "-1 and below has no bulk stiffness")
+    return f"Poisson's ratio nu must satisfy -1 < nu < 0.5, got {nu} ({why})"
+
+
 @dataclass(frozen=True)
 class Material:
     """Young's modulus ``E`` [Pa], Poisson's ratio ``nu`` [-], density ``rho`` [kg/m^3]."""
@@ -21,9 +28,7 @@ class Material:
         if self.E <= 0:
             raise MaterialError(f"Young's modulus E must be > 0 Pa, got {self.E}")
         if not -1.0 < self.nu < 0.5:
-            raise MaterialError(
-                f"Poisson's ratio nu must satisfy -1 < nu < 0.5, got {self.nu} "
-                "(nu = 0.5 is incompressible: use e.g. 0.49)")
+            raise MaterialError(poisson_message(self.nu))
         if self.rho <= 0:
             raise MaterialError(f"density rho must be > 0 kg/m^3, got {self.rho}")
 

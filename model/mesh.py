@@ -150,12 +150,14 @@ _SIX = np.array([[0, 1 << p[0], (1 << p[0]) | (1 << p[1]), 7]
 
 
 def _lattice(nx, ny, nz, lx, ly, lz):
-    for name, v in (("nx", nx), ("ny", ny), ("nz", nz)):
-        if int(v) != v or v < 2:
-            raise MeshError(f"{name} must be an integer >= 2 (nodes per side), got {v!r}")
-    for name, v in (("lx", lx), ("ly", ly), ("lz", lz)):
-        if not np.isfinite(v) or v <= 0:
-            raise MeshError(f"{name} must be a positive length in metres, got {v!r}")
+    for axis, v in zip("xyz", (nx, ny, nz)):
+        if not isinstance(v, (int, np.integer, float)) or int(v) != v or v < 2:
+            raise MeshError(f"the number of nodes along {axis} (n{axis}) must be an integer "
+                            f">= 2, got {v!r}")
+    for axis, v in zip("xyz", (lx, ly, lz)):
+        if not isinstance(v, (int, np.integer, float)) or not np.isfinite(v) or v <= 0:
+            raise MeshError(f"the length along {axis} (l{axis}) must be a positive length in "
+                            f"metres, got {v!r}")
     g = np.meshgrid(np.linspace(0, lx, nx), np.linspace(0, ly, ny), np.linspace(0, lz, nz),
                     indexing="ij")
     pts = np.stack([a.ravel(order="F") for a in g], axis=1)  # index i + nx (j + ny k)
@@ -259,18 +261,46 @@ def _perturbed_delaunay(pts, n, length, seed, amplitude=0.35, min_radius_ratio=0
 
 # ---------------------------------------------------------------- file I/O
 
-def read(path):
+def read(path, file_format=None):
     """Read the tetrahedra of any meshio-readable file (Gmsh .msh, .vtu, ...).
 
     Other cell blocks (vertices, lines, triangles) are ignored and nodes that belong to no
-    tetrahedron are dropped. Coordinates are taken as metres.
+    tetrahedron are dropped. Coordinates are taken as metres. ``file_format`` (a meshio
+    format name, e.g. "gmsh") overrides the choice by extension.
+
+    Raises MeshError naming the file and the formats tried for every unreadable input
+    (missing, empty, garbage, truncated, unknown extension, no tetrahedra), never SystemExit.
     """
+    import contextlib
+    import io
+    from pathlib import Path
+
     import meshio
 
+    path = Path(path)
+    if not path.is_file():
+        raise MeshError(f"mesh file {path} does not exist" if not path.exists()
+                        else f"mesh file {path} is not a file")
+    if path.stat().st_size == 0:
+        raise MeshError(f"mesh file {path} is empty")
+    if file_format is None:
+        tried = meshio.extension_to_filetypes.get(path.suffix.lower())
+        if not tried:
+            raise MeshError(f"cannot read mesh file {path}: the extension {path.suffix!r} is not "
+                            "a mesh format meshio knows (e.g. .msh, .vtu, .vtk, .mesh, .inp); "
+                            "rename it or pass file_format")
+    else:
+        tried = [file_format]
+    said = io.StringIO()   # meshio prints to stdout and may call sys.exit on a bad file
     try:
-        m = meshio.read(path)
-    except Exception as exc:  # meshio raises several types; name the file in every case
-        raise MeshError(f"cannot read mesh file {path}: {exc}") from exc
+        with contextlib.redirect_stdout(said), contextlib.redirect_stderr(said):
+            m = meshio.read(path, file_format=file_format)
+    except (Exception, SystemExit) as exc:
+        reason = " ".join((str(exc) if not isinstance(exc, SystemExit) else "").split()) \
+            or " ".join(said.getvalue().split()) or type(exc).__name__
+        raise MeshError(f"cannot read mesh file {path} as {' or '.join(tried)} (formats tried "
+                        f"for {path.suffix or 'it'}): {reason[:300]}; is the file complete and "
+                        "in that format?") from None
     blocks = [c.data for c in m.cells if c.type == "tetra"]
     if not blocks:
         kinds = sorted({c.type for c in m.cells}) or ["none"]
@@ -278,12 +308,19 @@ def read(path):
                         "export a volume mesh with 4-node tetrahedra")
     tets = np.vstack(blocks)
     pts = np.asarray(m.points, dtype=np.float64)
-    if pts.shape[1] == 2:
-        raise MeshError(f"{path} is a 2-D mesh; a 3-D tetrahedral mesh is needed")
+    if pts.ndim != 2 or pts.shape[1] != 3:
+        raise MeshError(f"{path} is not a 3-D mesh (points of shape {pts.shape}); a 3-D "
+                        "tetrahedral mesh is needed")
+    if tets.size and (tets.min() < 0 or tets.max() >= len(pts)):
+        raise MeshError(f"{path}: tetrahedra reference nodes outside 0..{len(pts) - 1}; the "
+                        "file is truncated or inconsistent")
     used = np.unique(tets)
     remap = np.full(len(pts), -1)
     remap[used] = np.arange(len(used))
-    return TetMesh(pts[used], remap[tets])
+    try:
+        return TetMesh(pts[used], remap[tets])
+    except MeshError as exc:
+        raise MeshError(f"{path}: {exc}") from None
 
 
 def write(path, mesh, point_data=None, cell_data=None):

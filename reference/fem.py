@@ -4,24 +4,38 @@ carries Dirichlet data along, element choice, Dirichlet dofs, linear solvers, st
 Physics lives in the modules that use it (linear.py, hyperelastic.py, modal.py); the mesh and
 the boundary-condition format come from ``model``, nothing else does.
 """
+import contextlib
+
 import numpy as np
 import scipy.sparse as sp
 from scipy.sparse.linalg import spsolve
 from skfem import Basis, ElementTetP1, ElementTetP2, ElementVector, MeshTet
 
 from model.errors import ConvergenceError, MaterialError, ModelError
+from model.material import poisson_message
 
 ELEMENTS = {"P1": ElementTetP1, "P2": ElementTetP2}
 INTORDER = {"P1": 1, "P2": 2}  # exact for the stiffness, and for a constant body force
-DIRECT_MAX_DOFS = 60_000       # beyond this scipy's direct solver runs out of memory and time
+# "auto" uses scipy's direct solver up to this many unknowns and AMG-CG beyond: where the two
+# cost the same on the P1 and P2 cubes of `python -m cases.fem_scaling --solvers` (direct/AMG
+# time 0.9-1.3 at 2 200-4 000 unknowns, 1.6 at 6 600, 3 at 14 700, 12-16 at 47 000; README)
+DIRECT_MAX_DOFS = 4_000
+# peak memory of that direct solve of a P2 cube with 101 277 unknowns, measured: 5.8 GiB (245 s)
+DIRECT_BYTES_AT_1E5 = 5.8 * 2**30
+# tried in order: the default (cheap to set up), then one that converges on thin slabs
+AMG_SETTINGS = (("default aggregation", {}),
+                ("evolution strength, energy prolongation",
+                 {"strength": "evolution", "smooth": "energy"}))
 
 
 def lame(E, nu):
     """(lambda, mu) after checking E > 0 and -1 < nu < 0.5."""
     if not (np.isfinite(E) and E > 0):
         raise MaterialError(f"Young's modulus E must be a finite number > 0 Pa, got {E!r}")
-    if not (np.isfinite(nu) and -1.0 < nu < 0.5):
-        raise MaterialError(f"Poisson's ratio nu must satisfy -1 < nu < 0.5, got {nu!r}")
+    if not np.isfinite(nu):
+        raise MaterialError(f"Poisson's ratio nu must be a finite number, got {nu!r}")
+    if not -1.0 < nu < 0.5:
+        raise MaterialError(poisson_message(nu))
     return E * nu / ((1 + nu) * (1 - 2 * nu)), E / (2 * (1 + nu))
 
 
@@ -29,25 +43,46 @@ def skfem_mesh(mesh):
     return MeshTet(np.ascontiguousarray(mesh.points.T), np.ascontiguousarray(mesh.tets.T))
 
 
+def prescribed_edges(m, mask, vals, dirichlet_fn):
+    """Which edges' new points (refined vertices, P2 midpoints) are prescribed, and to what.
+
+    An edge is prescribed in component k when it lies on a boundary facet whose three vertices
+    are all prescribed in k: a free face stays free even where two of its vertices are held.
+    The value is ``dirichlet_fn(midpoint)`` when given (NaN there leaves the component free:
+    how a caller keeps free a face that lies between two prescribed surfaces, e.g. the sides
+    of a body one element thick), else the mean of the edge's two ends.
+    Returns (n_edges, 3) mask and values.
+    """
+    bf = m.boundary_facets()
+    full = mask[m.facets[:, bf]].all(axis=0)                 # (n boundary facets, 3)
+    edge_mask = np.zeros((m.edges.shape[1], 3), dtype=bool)
+    for k in range(3):
+        edge_mask[m.f2e[:, bf[full[:, k]]].ravel(), k] = True
+    e = m.edges
+    edge_vals = np.where(edge_mask, 0.5 * (vals[e[0]] + vals[e[1]]), 0.0)
+    cand = np.flatnonzero(edge_mask.any(axis=1))
+    if dirichlet_fn is not None and cand.size:
+        mid = 0.5 * (m.p[:, e[0, cand]] + m.p[:, e[1, cand]]).T
+        given = np.asarray(dirichlet_fn(mid), dtype=float)
+        if given.shape != (cand.size, 3):
+            raise ModelError(f"dirichlet_fn must return a ({cand.size}, 3) array for "
+                             f"({cand.size}, 3) points, got shape {given.shape}")
+        edge_mask[cand] &= ~np.isnan(given)
+        edge_vals[cand] = np.where(edge_mask[cand], given, 0.0)
+    return edge_mask, edge_vals
+
+
 def refine_with_data(m, mask, vals, dirichlet_fn, levels):
-    """Refine ``levels`` times; a new node at the midpoint of a boundary edge whose two ends
-    carry a value in a component gets ``dirichlet_fn(point)`` there, or the mean of the ends.
+    """Refine ``levels`` times, carrying the Dirichlet data to the new vertices (see
+    :func:`prescribed_edges`).
 
     Also returns W (sparse, fine nodes x input nodes): the input mesh's P1 hat functions at
     every fine node, built as the mean of the two parents' rows (hats are linear on edges).
     """
     W = sp.identity(m.nvertices, format="csr")
     for _ in range(levels):
-        e = m.edges[:, m.boundary_edges()]
-        both = mask[e[0]] & mask[e[1]]                       # (k, 3)
-        new_vals = 0.5 * (vals[e[0]] + vals[e[1]])
-        mid = 0.5 * (m.p[:, e[0]] + m.p[:, e[1]]).T
-        if dirichlet_fn is not None and len(mid):
-            new_vals = np.asarray(dirichlet_fn(mid), dtype=float).reshape(-1, 3)
+        nm, nv = prescribed_edges(m, mask, vals, dirichlet_fn)
         n_old = m.nvertices
-        nm, nv = np.zeros((m.edges.shape[1], 3), bool), np.zeros((m.edges.shape[1], 3))
-        nm[m.boundary_edges()] = both
-        nv[m.boundary_edges()] = np.where(both, new_vals, 0.0)
         W = sp.vstack([W, 0.5 * (W[m.edges[0]] + W[m.edges[1]])], format="csr")
         m = m.refined()
         assert m.nvertices == n_old + len(nm)  # new vertices are the old edges' midpoints
@@ -77,22 +112,16 @@ def element_basis(m, element, intorder=None):
 
 
 def dirichlet_dofs(basis, mask, vals, dirichlet_fn):
-    """Prescribed dof indices and the full vector of their values. For P2 the midpoint dof of a
-    boundary edge whose two ends are prescribed in a component is prescribed too."""
-    m = basis.mesh
+    """Prescribed dof indices and the full vector of their values. For P2 the midpoint dofs
+    follow :func:`prescribed_edges`."""
     D = [basis.nodal_dofs.T[mask]]
     x = np.zeros(basis.N)
     x[basis.nodal_dofs.T[mask]] = vals[mask]
     if basis.edge_dofs.size:
-        be = m.boundary_edges()
-        e = m.edges[:, be]
-        both = mask[e[0]] & mask[e[1]]
-        mid = 0.5 * (m.p[:, e[0]] + m.p[:, e[1]]).T
-        ev = (np.asarray(dirichlet_fn(mid), dtype=float).reshape(-1, 3)
-              if dirichlet_fn is not None and len(mid) else 0.5 * (vals[e[0]] + vals[e[1]]))
-        dofs = basis.edge_dofs.T[be]
-        D.append(dofs[both])
-        x[dofs[both]] = ev[both]
+        em, ev = prescribed_edges(basis.mesh, mask, vals, dirichlet_fn)
+        dofs = basis.edge_dofs.T
+        D.append(dofs[em])
+        x[dofs[em]] = ev[em]
     return np.concatenate(D), x
 
 
@@ -108,29 +137,96 @@ def rigid_modes(points, comp):
     return B
 
 
-def linear_solve(A, b, doflocs, comp, solver="auto", rtol=1e-10):
-    """Solve the SPD system A x = b: scipy's direct solver up to DIRECT_MAX_DOFS unknowns,
-    else CG preconditioned by pyamg smoothed aggregation with the rigid-body modes as
-    near-null space. ``doflocs`` (N, 3) and ``comp`` (N,) locate each unknown."""
+def linear_solve(A, b, doflocs, comp, solver="auto", rtol=1e-8):
+    """Solve the SPD system A x = b to a relative residual ||b - A x|| / ||b|| <= ``rtol``.
+
+    ``solver``: "direct" (scipy's sparse LU), "amg" (CG preconditioned by pyamg smoothed
+    aggregation with the rigid-body modes as near-null space) or "auto": direct up to
+    DIRECT_MAX_DOFS unknowns, AMG-CG beyond. CG runs until it converges or stagnates, with no
+    fixed iteration count; if it stagnates with the default aggregation it starts again with
+    evolution strength and energy-minimising prolongation (what thin, bending-dominated bodies
+    need); if that stagnates too, "auto" falls back to the direct solver when its estimated
+    memory fits in the memory available, and otherwise a ConvergenceError advises
+    ``solver="direct"``. ``doflocs`` (N, 3) and ``comp`` (N,) locate each unknown.
+    """
     n = A.shape[0]
-    if solver == "auto":
-        solver = "direct" if n <= DIRECT_MAX_DOFS else "amg"
-    if solver == "direct":
-        return spsolve(A.tocsc(), b), {"solver": "direct", "iterations": 0}
-    if solver != "amg":
+    if solver not in ("auto", "direct", "amg"):
         raise ModelError(f"solver must be 'auto', 'direct' or 'amg', got {solver!r}")
+    if solver == "direct" or (solver == "auto" and n <= DIRECT_MAX_DOFS):
+        return spsolve(A.tocsc(), b), {"solver": "direct", "iterations": 0}
     import pyamg
 
-    ml = pyamg.smoothed_aggregation_solver(A.tocsr(), B=rigid_modes(doflocs, comp),
-                                           symmetry="symmetric")
-    residuals = []
-    x = ml.solve(b, tol=rtol, accel="cg", maxiter=500, residuals=residuals)
-    rel = residuals[-1] / max(residuals[0], 1e-300)
-    if not rel <= 10 * rtol:
-        raise ConvergenceError(f"AMG-preconditioned CG stopped at relative residual {rel:.2e} "
-                               f"> {rtol:g} after {len(residuals) - 1} iterations; the system "
-                               "may be singular (enough Dirichlet conditions?)")
-    return x, {"solver": "amg-cg", "iterations": len(residuals) - 1}
+    A = A.tocsr()
+    B = rigid_modes(doflocs, comp)
+    tried, x, total = [], np.zeros_like(b), 0
+    for name, settings in AMG_SETTINGS:
+        with _seeded_numpy_random():
+            ml = pyamg.smoothed_aggregation_solver(A, B=B, symmetry="symmetric", **settings)
+            x, iterations, rel = _cg_until_stagnant(ml, A, b, x, rtol)
+        total += iterations
+        tried.append(f"{name}: relative residual {rel:.2e} after {iterations} iterations")
+        if rel <= rtol:
+            return x, {"solver": f"amg-cg ({name})", "iterations": total}
+    need, have = direct_memory_estimate(n), available_memory()
+    if solver == "auto" and need < 0.5 * have:
+        return spsolve(A.tocsc(), b), {"solver": "direct (AMG-CG stagnated)", "iterations": 0,
+                                       "amg": tried}
+    why = ("solver=\"amg\" was asked" if solver == "amg" else
+           f"the direct solver's estimated {need / 2**30:.1f} GiB is more than half the "
+           f"{have / 2**30:.1f} GiB available")
+    raise ConvergenceError(
+        f"AMG-preconditioned CG stagnated on {n} unknowns ({'; '.join(tried)}) and {why}; pass "
+        "solver=\"direct\" to try the direct solver, or check that enough Dirichlet conditions "
+        "hold the body")
+
+
+@contextlib.contextmanager
+def _seeded_numpy_random(seed=0):
+    """pyamg estimates spectral radii from numpy's global random generator: seed it for the
+    solve (same inputs, same outputs to the last bit) and give the caller's state back."""
+    state = np.random.get_state()
+    np.random.seed(seed)
+    try:
+        yield
+    finally:
+        np.random.set_state(state)
+
+
+def _cg_until_stagnant(ml, A, b, x, rtol, chunk=100, gain=10.0):
+    """AMG-preconditioned CG from ``x`` in chunks of ``chunk`` iterations, each continuing
+    from the last iterate, until the relative residual ||b - A x|| / ||b|| reaches ``rtol`` or
+    a chunk fails to divide it by ``gain`` (a preconditioner this weak is not worth more
+    iterations). Returns (x, iterations, relative residual)."""
+    bn = max(np.linalg.norm(b), 1e-300)
+    iterations, rel = 0, np.linalg.norm(b - A @ x) / bn
+    while True:
+        x_new = ml.solve(b, x0=x, tol=0.1 * rtol, accel="cg", maxiter=chunk)
+        iterations += chunk
+        rel_new = np.linalg.norm(b - A @ x_new) / bn
+        if rel_new <= rtol:
+            return x_new, iterations, rel_new
+        if not np.isfinite(rel_new) or rel_new > rel / gain:   # stagnating or diverging
+            return (x_new, iterations, rel_new) if rel_new < rel else (x, iterations, rel)
+        x, rel = x_new, rel_new
+
+
+def direct_memory_estimate(n):
+    """Bytes the direct solver may need for n unknowns: the peak measured on a P2 cube
+    (DIRECT_BYTES_AT_1E5) scaled as n^(5/3), the fill of a 3-D sparse LU; thin bodies need
+    less, so this errs on the safe side."""
+    return DIRECT_BYTES_AT_1E5 * (n / 1e5) ** (5 / 3)
+
+
+def available_memory():
+    """MemAvailable of /proc/meminfo in bytes (0 where unknown: no direct fallback)."""
+    try:
+        with open("/proc/meminfo") as f:
+            for line in f:
+                if line.startswith("MemAvailable:"):
+                    return int(line.split()[1]) * 1024
+    except OSError:
+        pass
+    return 0
 
 
 def cell_average(basis, field):

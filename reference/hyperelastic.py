@@ -83,7 +83,7 @@ def solve(mesh, E, nu, dirichlet, body_force=None, element="P1", refine=0, diric
     basis = element_basis(m, element)
     D, x_D = dirichlet_dofs(basis, mask_f, vals_f, dirichlet_fn)
     internal, tangent, P = forms(lam, mu)
-    f_body = asm(body_load(body_force), basis) if body_force is not None else np.zeros(basis.N)
+    f_body = body_load(basis, body_force) if body_force is not None else np.zeros(basis.N)
     comp = dof_component(basis)
     I = np.setdiff1d(np.arange(basis.N), D)
     h = np.linalg.norm(np.diff(m.p[:, m.edges], axis=1), axis=0).mean()

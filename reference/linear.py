@@ -35,21 +35,38 @@ class LinearResult:
     info: dict = field(default_factory=dict)
 
 
-def body_load(b):
-    @LinearForm
-    def form(v, w):
-        return dot(np.asarray(b, dtype=float)[:, None, None] * np.ones_like(v), v)
-    return form
+@LinearForm
+def _vector_load(v, w):
+    return dot(w.load, v)
 
 
-def traction_load(fn):
-    @LinearForm
-    def form(v, w):
-        x = np.moveaxis(w.x, 0, -1)                   # (..., 3) points
-        n = np.moveaxis(w.n, 0, -1)
-        t = np.moveaxis(np.asarray(fn(x, n), dtype=float), -1, 0)
-        return dot(t, v)
-    return form
+def _assemble_load(basis, value, name, normals=False):
+    """The load vector of a force density ``value`` on ``basis``: a constant (3,) or a
+    callable evaluated once at every quadrature point on plain ndarrays, ``value(points)``
+    (or ``value(points, normals)`` on facets), points and normals (..., 3), returning
+    (..., 3); writing into ``np.zeros_like(points)`` works."""
+    x = np.moveaxis(np.array(basis.global_coordinates().value), 0, -1)   # (nel, nqp, 3)
+    if callable(value):
+        args = (x, np.moveaxis(np.array(basis.normals), 0, -1)) if normals else (x,)
+        load = np.asarray(value(*args), dtype=float)
+    else:
+        load = np.broadcast_to(np.asarray(value, dtype=float), x.shape)
+    if load.shape != x.shape:
+        raise ModelError(f"{name} must give a (..., 3) force density for points of shape "
+                         f"(..., 3), got shape {load.shape} for {x.shape}")
+    if not np.isfinite(load).all():
+        raise ModelError(f"{name} is not finite at some quadrature points")
+    return asm(_vector_load, basis, load=np.moveaxis(load, -1, 0))
+
+
+def body_load(basis, b):
+    """Load vector of a body force density ``b`` [N/m^3]: (3,) or ``b(points) -> (..., 3)``."""
+    return _assemble_load(basis, b, "body_force")
+
+
+def traction_load(facet_basis, fn):
+    """Load vector of a traction [Pa] ``fn(points, normals) -> (..., 3)`` on boundary facets."""
+    return _assemble_load(facet_basis, fn, "traction", normals=True)
 
 
 def solve(mesh, E, nu, dirichlet, body_force=None, traction=None, element="P1", refine=0,
@@ -59,15 +76,19 @@ def solve(mesh, E, nu, dirichlet, body_force=None, traction=None, element="P1", 
     Parameters
     ----------
     dirichlet : mapping node -> (ux, uy, uz), None for a free component (as the model takes).
-    body_force : (3,) force per unit volume [N/m^3], e.g. rho * g.
+    body_force : (3,) force per unit volume [N/m^3], e.g. rho * g, or a callable
+        ``points (..., 3) -> (..., 3)`` (plain ndarrays, evaluated once per quadrature point).
     traction : callable ``(points (..., 3), normals (..., 3)) -> (..., 3)`` [Pa] on the boundary
-        facets (return zero where unloaded).
+        facets (return zero where unloaded); plain ndarrays, so ``t = np.zeros_like(points);
+        t[..., 1] = ...`` works.
     element : "P1" or "P2".
     refine : uniform refinements before solving; results come back on the input mesh.
     dirichlet_fn : ``points (k, 3) -> (k, 3)``, the prescribed displacement at new boundary
-        points (P2 midpoints, refined nodes) where both edge ends are prescribed; linear
-        interpolation when None.
-    solver : "auto" (direct up to 60 000 unknowns, else pyamg-preconditioned CG), "direct", "amg".
+        points (P2 midpoints, refined nodes) on boundary facets whose three vertices are
+        prescribed; NaN leaves a component free there (declare the prescribed surfaces this
+        way when a free face lies between two of them, e.g. a body one element thick); linear
+        interpolation when None (see ``reference.fem.prescribed_edges``).
+    solver : "auto", "direct" or "amg" (see ``reference.fem.linear_solve``).
     """
     lam, mu = lame(E, nu)
     n = mesh.n_nodes
@@ -84,10 +105,10 @@ def solve(mesh, E, nu, dirichlet, body_force=None, traction=None, element="P1", 
     K = asm(linear_elasticity(lam, mu), basis)
     f = np.zeros(basis.N)
     if body_force is not None:
-        f += asm(body_load(body_force), basis)
+        f += body_load(basis, body_force)
     if traction is not None:
         fb = FacetBasis(m, basis.elem, intorder=INTORDER[element])
-        f += asm(traction_load(traction), fb)
+        f += traction_load(fb, traction)
     A, b, x, I = condense(K, f, x=x_D, D=D)
     xI, sinfo = linear_solve(A, b, basis.doflocs.T[I], dof_component(basis)[I], solver)
     x[I] = check_finite("displacement", xI)
@@ -141,15 +162,28 @@ def dof_component(basis):
 class ConvergedResult:
     """The finest P2 solution (``result``) of a refinement sequence, evaluated on the input
     mesh, with the reference's own error estimate: ``levels`` the refinements solved,
-    ``increments`` relative nodal L2 change between successive levels, ``rate`` the observed
-    convergence order, ``error_estimate`` the Richardson estimate of the finest level's
-    relative nodal L2 error (the last increment when no rate can be observed)."""
+    ``increments`` relative nodal L2 change between successive levels and ``rate`` its observed
+    order; ``energy_increments`` and ``energy_rate`` the same for the strain energy;
+    ``error_estimate`` the larger of the two Richardson estimates of the finest level's relative
+    error (the last increment where no rate can be observed). The energy keeps the estimate
+    honest where every input node is prescribed and the nodal values cannot move."""
 
     result: LinearResult
     levels: list
     increments: list
     rate: float
     error_estimate: float
+    energy_increments: list = field(default_factory=list)
+    energy_rate: float = float("nan")
+
+
+def richardson(increments):
+    """(observed order, estimated error of the finest level) from the relative changes
+    between successive levels of a sequence halving h."""
+    inc = increments
+    rate = float(np.log2(inc[-2] / inc[-1])) if len(inc) > 1 and inc[-1] > 0 else float("nan")
+    est = inc[-1] / (2**rate - 1) if np.isfinite(rate) and rate > 0.5 else inc[-1]
+    return rate, float(est)
 
 
 def converged(mesh, E, nu, dirichlet, levels=2, **kw):
@@ -160,10 +194,10 @@ def converged(mesh, E, nu, dirichlet, levels=2, **kw):
             for k in range(levels + 1)]
     norm = max(np.linalg.norm(sols[-1].u), 1e-300)
     inc = [float(np.linalg.norm(b.u - a.u) / norm) for a, b in zip(sols, sols[1:])]
-    rate = float(np.log2(inc[-2] / inc[-1])) if len(inc) > 1 and inc[-1] > 0 else float("nan")
-    if np.isfinite(rate) and rate > 0.5:
-        est = inc[-1] / (2**rate - 1)
-    else:
-        est = inc[-1]
+    scale = max(abs(sols[-1].energy), 1e-300)
+    inc_e = [abs(b.energy - a.energy) / scale for a, b in zip(sols, sols[1:])]
+    rate, est = richardson(inc)
+    rate_e, est_e = richardson(inc_e)
     return ConvergedResult(result=sols[-1], levels=list(range(levels + 1)), increments=inc,
-                           rate=rate, error_estimate=float(est))
+                           rate=rate, error_estimate=max(est, est_e), energy_increments=inc_e,
+                           energy_rate=rate_e)

@@ -80,7 +80,7 @@ def test_bad_meshes_are_named(points, tets, match):
 def test_generator_arguments_are_checked():
     with pytest.raises(MeshError, match="unknown mesh scheme"):
         cube(3, L, "seven")
-    with pytest.raises(MeshError, match="integer >= 2"):
+    with pytest.raises(MeshError, match=r"nodes along x \(nx\) must be an integer >= 2"):
         cube(1, L)
     with pytest.raises(MeshError, match="positive length"):
         cube(3, -1.0)

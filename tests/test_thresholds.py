@@ -36,7 +36,7 @@ def check(metrics, thresholds):
 def test_bless_then_check_passes(blessed, capsys):
     assert check(blessed / "good", blessed / "t.toml") == 0
     text = (blessed / "t.toml").read_text()
-    assert "# measured" in text and 'direction = "min"' in text and 'direction = "max"' in text
+    assert "[[problem]]" in text and 'direction = "min"' in text and 'direction = "max"' in text
 
 
 def test_worse_model_fails_and_names_the_metric(blessed, tmp_path, capsys):

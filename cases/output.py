@@ -1,0 +1,152 @@
+"""Where results go: every output path is checked before any computing, and a case folder is
+replaced as a whole (built in a sibling temporary folder, then swapped in), so that after an
+interrupt it holds exactly the earlier complete set of files or the new one.
+"""
+import contextlib
+import ctypes
+import ctypes.util
+import errno
+import os
+import shutil
+import signal
+import tempfile
+import threading
+from pathlib import Path
+
+from model.errors import PbcmError
+
+# a folder the suite may replace: empty, or written by it before (it always holds this file)
+OWNED_MARK = "metrics.json"
+TMP_TAG = ".pbcm-tmp-"
+
+
+class OutputError(PbcmError, OSError):
+    """An output path cannot be written: it names the path and what to do."""
+
+
+@contextlib.contextmanager
+def no_interrupt():
+    """Hold Ctrl-C (SIGINT) back until the block is done: for the few system calls that must
+    not be separated (a swap of folders, a rename)."""
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    old = signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGINT})
+    try:
+        yield
+    finally:
+        signal.pthread_sigmask(signal.SIG_SETMASK, old)
+
+
+def writable_folder(path, flag="--out"):
+    """Create ``path`` (and its parents) if needed and prove it takes files; else OutputError
+    naming ``flag``."""
+    path = Path(path)
+    if path.exists() and not path.is_dir():
+        raise OutputError(f"{flag} {path} is a file, not a folder; give a folder")
+    try:
+        path.mkdir(parents=True, exist_ok=True)
+        with tempfile.TemporaryFile(dir=path):
+            pass
+    except OSError as exc:
+        raise OutputError(f"{flag} {path} cannot be written ({exc.strerror or exc}); "
+                          "give a folder you can write to") from None
+    return path
+
+
+def owned(path):
+    """True when the suite may replace ``path``: missing, empty, or a pbcm case folder."""
+    path = Path(path)
+    return not path.exists() or (path.is_dir() and (
+        (path / OWNED_MARK).is_file() or not any(path.iterdir())))
+
+
+class StagedFolder:
+    """A case folder written atomically.
+
+    ``StagedFolder(target)`` checks at once that ``target`` may be replaced and that its parent
+    takes files, and creates the staging folder ``path`` beside it; write everything there,
+    then ``commit()`` swaps it in and removes the earlier contents (files the run did not
+    produce do not survive). ``discard()`` (also on leaving a ``with`` block by an exception)
+    removes the staging folder and leaves ``target`` as it was.
+    """
+
+    def __init__(self, target, flag="--out"):
+        self.target = Path(target)
+        if self.target.exists() and not self.target.is_dir():
+            raise OutputError(f"{flag} {self.target} is a file, not a folder; give a folder")
+        if not owned(self.target):
+            raise OutputError(f"{flag} {self.target} holds files that pbcm did not write (no "
+                              f"{OWNED_MARK}); pbcm replaces the whole folder it writes, so "
+                              "give a new or empty folder")
+        parent = writable_folder(self.target.parent, flag=f"{flag} {self.target}: the folder")
+        self.path = Path(tempfile.mkdtemp(prefix=f".{self.target.name}{TMP_TAG}", dir=parent))
+        os.chmod(self.path, 0o777 & ~_umask())
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, kind, exc, tb):
+        if kind is not None:
+            self.discard()
+
+    def discard(self):
+        shutil.rmtree(self.path, ignore_errors=True)
+
+    def commit(self):
+        with no_interrupt():
+            if self.target.exists():
+                if not _exchange(self.path, self.target):   # no atomic swap on this system
+                    old = self.path.with_name(self.path.name + "-old")
+                    os.rename(self.target, old)
+                    os.rename(self.path, self.target)
+                    self.path = old
+            else:
+                os.rename(self.path, self.target)
+                self.path = None
+        if self.path is not None:   # now the earlier contents
+            shutil.rmtree(self.path, ignore_errors=True)
+        return self.target
+
+
+def write_text_atomic(path, text):
+    """Write ``text`` to ``path`` through a temporary file in the same folder and a rename."""
+    path = Path(path)
+    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}{TMP_TAG}", dir=path.parent)
+    try:
+        with os.fdopen(fd, "w") as f:
+            f.write(text)
+        os.chmod(tmp, 0o666 & ~_umask())
+        with no_interrupt():
+            os.replace(tmp, path)
+    except BaseException:
+        with contextlib.suppress(OSError):
+            os.unlink(tmp)
+        raise
+
+
+def _umask():
+    mask = os.umask(0)
+    os.umask(mask)
+    return mask
+
+
+_RENAME_EXCHANGE = 2
+_AT_FDCWD = -100
+
+
+def _exchange(a, b):
+    """Swap two paths in one system call (Linux renameat2); False where unsupported."""
+    try:
+        libc = ctypes.CDLL(ctypes.util.find_library("c"), use_errno=True)
+        fn = libc.renameat2
+    except (OSError, AttributeError, TypeError):
+        return False
+    fn.argtypes = [ctypes.c_int, ctypes.c_char_p, ctypes.c_int, ctypes.c_char_p,
+                   ctypes.c_uint]
+    if fn(_AT_FDCWD, os.fsencode(a), _AT_FDCWD, os.fsencode(b), _RENAME_EXCHANGE) == 0:
+        return True
+    err = ctypes.get_errno()
+    if err in (errno.ENOSYS, errno.EINVAL, errno.EOPNOTSUPP):  # e.g. a file system without it
+        return False
+    raise OSError(err, os.strerror(err), str(b))

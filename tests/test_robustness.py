@@ -1,0 +1,316 @@
+"""Every input a user can give ends in a result or a clear error, and nothing is lost (issue 8)."""
+import json
+import os
+import shutil
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import meshio
+import numpy as np
+import pytest
+
+from cases import paper_cube
+from cases.cli import main
+from cases.output import StagedFolder, OutputError
+from model.errors import ConvergenceError, MeshError
+from model.mesh import cube, read
+
+ROOT = Path(__file__).resolve().parents[1]
+
+
+# ------------------------------------------------------------ a failing phase is a finding
+
+def test_nu_03_blow_ups_are_findings_and_the_report_is_complete(tmp_path, capsys):
+    """The issue's reproducer (balanced on six/clamped at nu = 0.3 blows up within the timed
+    steps) and more: exit 0, every file written, the failures recorded per run."""
+    out = tmp_path / "paper-cube"
+    assert main(["run", "paper-cube", "--quick", "--nu", "0.3", "--models", "pbcm-balanced",
+                 "pbcm-corner", "msm", "--out", str(out)]) == 0
+    runs = json.loads((out / "metrics.json").read_text())["runs"]
+    assert len(runs) == 2 * 2 * 3
+    blown = [r for r in runs if r["dyn_failed"]]
+    assert {r["model"] for r in blown} == {"pbcm-balanced", "pbcm-corner"}
+    assert all("blew up" in r["dyn_failed"] and r["dyn_vs_static_rel_l2"] is None for r in blown)
+    at_rest = {(r["mesh"], r["bc"]) for r in runs if r["step_time_state"] == "rest"}
+    assert ("six", "clamped") in at_rest
+    assert all(r["step_time_s"] > 0 for r in runs)
+    md = (out / "report.md").read_text()
+    assert "Dynamic run of pbcm-balanced on six/clamped blew up" in md and "(at rest)" in md
+    for name in [line.split("](")[1].rstrip(")") for line in md.splitlines()
+                 if line.startswith("![")]:
+        assert (out / name).stat().st_size > 0
+
+
+def test_a_failed_static_solve_is_recorded_and_the_case_goes_on(tmp_path, monkeypatch):
+    from model.system import ParticleModel
+    real = ParticleModel.solve_static
+
+    def fails_for_msm(self, bc, **kw):
+        if self.name == "msm":
+            raise ConvergenceError("static solve did not converge (planted by the test)")
+        return real(self, bc, **kw)
+
+    monkeypatch.setattr(ParticleModel, "solve_static", fails_for_msm)
+    out = tmp_path / "paper-cube"
+    assert main(["run", "paper-cube", "--quick", "--meshes", "five", "--bcs", "clamped",
+                 "--models", "msm", "pbcm-variational", "--out", str(out)]) == 0
+    runs = {r["model"]: r for r in json.loads((out / "metrics.json").read_text())["runs"]}
+    assert "planted" in runs["msm"]["static_failed"]
+    assert runs["msm"]["disp_rel_l2_p2"] is None and runs["msm"]["zigzag"] is None
+    assert runs["msm"]["growth_rate_1_s"] is not None     # the other phases still ran
+    assert runs["pbcm-variational"]["static_failed"] is None
+    md = (out / "report.md").read_text()
+    assert "No static equilibrium for msm on five/clamped" in md and "n/a" in md
+
+
+# ------------------------------------------------------------ paths checked before computing
+
+@pytest.fixture
+def no_computing(monkeypatch):
+    """Any attempt to run a case fails the test: errors must come before computing."""
+    def refuse(cfg, log=True):
+        raise AssertionError("the case started computing")
+    monkeypatch.setattr(paper_cube, "run", refuse)
+
+
+def one_error_line(capsys):
+    err = capsys.readouterr().err.strip()
+    assert len(err.splitlines()) == 1, err
+    assert err.startswith("pbcm: error: ")
+    return err
+
+
+@pytest.mark.parametrize("where", ["file", "under-a-file", "foreign-folder"])
+def test_bad_out_fails_before_computing(where, tmp_path, capsys, no_computing):
+    precious = tmp_path / "mine"
+    precious.mkdir()
+    (precious / "thesis.tex").write_text("do not lose me")
+    (tmp_path / "afile").write_text("x")
+    out = {"file": tmp_path / "afile", "under-a-file": tmp_path / "afile" / "sub",
+           "foreign-folder": precious}[where]
+    for command in ("run", "report"):
+        argv = [command, "paper-cube"] if command == "run" else [command]
+        assert main([*argv, "--quick", "--out", str(out)]) == 2
+        err = one_error_line(capsys)
+        assert "--out" in err and str(out if where != "under-a-file" else out.parent) in err
+    assert (precious / "thesis.tex").read_text() == "do not lose me"
+
+
+def test_bad_numbers_and_names_fail_before_computing(capsys, no_computing):
+    for argv, words in [(["--nu", "0.7"], ["--nu", "incompressible"]),
+                        (["--nu", "-1"], ["--nu", "above -1"]),
+                        (["--E", "-3"], ["--E", "Pa"]), (["--rho", "nan"], ["--rho"])]:
+        assert main(["run", "paper-cube", "--quick", *argv]) == 2
+        err = one_error_line(capsys)
+        assert all(w in err for w in words), err
+    assert main(["run", "paper-cube", "--nu", "-1"]) == 2
+    assert "incompressible" not in capsys.readouterr().err
+    assert main(["mesh", "cube", "--n", "1"]) == 2
+    err = one_error_line(capsys)
+    assert "--n" in err and "nx" not in err
+    assert main(["mesh", "cube", "--size", "-3"]) == 2
+    assert "mm" in one_error_line(capsys)
+
+
+# ------------------------------------------------------------ atomic case folders
+
+def test_staged_folder_keeps_the_earlier_set_until_commit(tmp_path):
+    target = tmp_path / "case"
+    target.mkdir()
+    for name in ("metrics.json", "report.md", "old.png"):
+        (target / name).write_text("earlier")
+    with pytest.raises(RuntimeError):
+        with StagedFolder(target) as s:
+            (s.path / "metrics.json").write_text("new")
+            raise RuntimeError("interrupted while writing")
+    assert sorted(p.name for p in target.iterdir()) == ["metrics.json", "old.png", "report.md"]
+    assert (target / "metrics.json").read_text() == "earlier"
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["case"]   # no staging folder left
+    with StagedFolder(target) as s:
+        (s.path / "metrics.json").write_text("new")
+        (s.path / "report.md").write_text("new")
+        s.commit()
+    assert sorted(p.name for p in target.iterdir()) == ["metrics.json", "report.md"]
+    assert (target / "metrics.json").read_text() == "new"
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["case"]
+    (tmp_path / "foreign").mkdir()
+    (tmp_path / "foreign" / "x").write_text("x")
+    with pytest.raises(OutputError, match="did not write"):
+        StagedFolder(tmp_path / "foreign")
+
+
+def test_a_narrower_rerun_leaves_no_stale_files(quick, tmp_path):
+    out = tmp_path / "paper-cube"
+    shutil.copytree(quick, out)
+    assert (out / "fig1_six_sliding.png").is_file()
+    assert main(["run", "paper-cube", "--quick", "--meshes", "five", "--bcs", "clamped",
+                 "--models", "msm", "--out", str(out)]) == 0
+    files = {p.name for p in out.iterdir()}
+    assert "fig1_six_sliding.png" not in files and "fig1_five_clamped.png" in files
+    assert {p.name for p in (out / "vtu").iterdir()} == {"five_clamped_msm.vtu",
+                                                          "five_clamped_fem-p2.vtu"}
+
+
+def test_ctrl_c_prints_one_line_exits_130_and_keeps_the_earlier_set(tmp_path):
+    out = tmp_path / "paper-cube"
+    out.mkdir()
+    (out / "metrics.json").write_text("{}")
+    (out / "report.md").write_text("earlier complete run")
+    proc = subprocess.Popen([sys.executable, "-m", "cases.cli", "run", "paper-cube", "--quick",
+                             "--out", str(out)], stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                            text=True, cwd=tmp_path)
+    deadline = time.monotonic() + 120
+    while not any(p.name.startswith(".paper-cube") for p in tmp_path.iterdir()):
+        assert proc.poll() is None and time.monotonic() < deadline
+        time.sleep(0.05)
+    time.sleep(2.0)   # well into the computing
+    proc.send_signal(signal.SIGINT)
+    _, err = proc.communicate(timeout=120)
+    assert proc.returncode == 130
+    lines = [line for line in err.replace("\r", "\n").splitlines()
+             if line.strip() and not line.startswith("[")]   # the progress bar aside
+    assert len(lines) == 1 and "interrupted" in lines[0], err
+    assert sorted(p.name for p in out.iterdir()) == ["metrics.json", "report.md"]
+    assert (out / "report.md").read_text() == "earlier complete run"
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["paper-cube"]
+
+
+# ------------------------------------------------------------ unreadable meshes
+
+def _gmsh_text(tmp_path):
+    m = cube(3, 0.032, "six")
+    path = tmp_path / "ok.msh"
+    meshio.write(path, meshio.Mesh(m.points, [("tetra", m.tets)]), file_format="gmsh22",
+                 binary=False)
+    return path.read_text()
+
+
+@pytest.mark.parametrize("name,content,words", [
+    ("garbage.msh", b"\x00\x01 not a mesh at all", ["garbage.msh", "gmsh"]),
+    ("empty.msh", b"", ["empty.msh", "empty"]),
+    ("truncated.msh", None, ["truncated.msh", "gmsh"]),
+    ("mesh.xyz", b"1 2 3\n", ["mesh.xyz", "extension '.xyz'"]),
+    ("missing.msh", False, ["missing.msh", "does not exist"]),
+])
+def test_unreadable_mesh_files_raise_mesh_error(name, content, words, tmp_path):
+    path = tmp_path / name
+    if content is None:
+        text = _gmsh_text(tmp_path)
+        path.write_text(text[: len(text) // 2])
+    elif content is not False:
+        path.write_bytes(content)
+    with pytest.raises(MeshError) as info:   # never SystemExit (meshio calls sys.exit)
+        read(path)
+    assert all(w in str(info.value) for w in words), str(info.value)
+
+
+def test_pbcm_mesh_on_garbage_exits_2_with_one_line(tmp_path, capsys):
+    path = tmp_path / "garbage.msh"
+    path.write_bytes(b"\x00\x01 not a mesh")
+    assert main(["mesh", str(path)]) == 2
+    assert "garbage.msh" in one_error_line(capsys)
+
+
+# ------------------------------------------------------------ bless and check
+
+SMALL = ["--quick", "--meshes", "five", "--bcs", "clamped", "--models", "msm"]
+
+
+@pytest.fixture(scope="module")
+def small_run(tmp_path_factory):
+    d = tmp_path_factory.mktemp("small")
+    assert main(["run", "paper-cube", *SMALL, "--out", str(d / "paper-cube")]) == 0
+    return d
+
+
+@pytest.mark.parametrize("margin", ["-1", "0", "nan", "inf"])
+def test_bless_refuses_a_bad_margin(margin, small_run, tmp_path, capsys):
+    assert main(["bless", "--metrics", str(small_run), "--margin", margin,
+                 "--thresholds", str(tmp_path / "t.toml")]) == 2
+    assert "--margin" in one_error_line(capsys)
+    assert not (tmp_path / "t.toml").exists()
+
+
+def test_bless_keeps_unseen_bounds_and_tolerances_unless_told(small_run, tmp_path, capsys,
+                                                             monkeypatch):
+    import tempfile
+    from cases.thresholds import load
+    monkeypatch.setattr(tempfile, "tempdir", str(tmp_path / "tmp"))
+    (tmp_path / "tmp").mkdir()
+    t = tmp_path / "t.toml"
+    shutil.copy(ROOT / "thresholds.toml", t)
+    before = load(t)
+    text = t.read_text().replace("rtol = 0.1", "rtol = 0.25")
+    t.write_text(text)
+    assert main(["bless", "--metrics", str(small_run), "--thresholds", str(t)]) == 0
+    out = capsys.readouterr().out
+    after = load(t)
+    assert len(after.bounds) == len(before.bounds)          # nothing dropped
+    assert {b.rtol for b in after.bounds} == {0.25}          # tolerances kept
+    assert "kept" in out and "--prune" in out
+    assert main(["bless", "--metrics", str(small_run), "--thresholds", str(t), "--prune",
+                 "--margin", "0.2"]) == 0
+    out = capsys.readouterr().out
+    pruned = load(t)
+    assert {b.key[:5] for b in pruned.bounds} == {("paper-cube", "quick", "five", "clamped",
+                                                    "msm")}
+    assert {b.rtol for b in pruned.bounds} == {0.2}
+    assert out.count("removed ") == len(before.bounds) - len(pruned.bounds)
+    assert list((tmp_path / "tmp").iterdir()) == []          # no temporary files left
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["t.toml", "tmp"]
+
+
+def test_check_refuses_metrics_run_at_other_parameters(small_run, tmp_path, capsys):
+    t = tmp_path / "t.toml"
+    assert main(["bless", "--metrics", str(small_run), "--thresholds", str(t)]) == 0
+    assert main(["check", "--metrics", str(small_run), "--thresholds", str(t)]) == 0
+    capsys.readouterr()
+    for key, value in (("E_Pa", 20e3), ("nu", 0.3), ("push_mm", 2.0)):
+        other = tmp_path / key / "paper-cube"
+        shutil.copytree(small_run / "paper-cube", other)
+        data = json.loads((other / "metrics.json").read_text())
+        data["problem"][key] = value
+        (other / "metrics.json").write_text(json.dumps(data))
+        assert main(["check", "--metrics", str(other.parent), "--thresholds", str(t)]) == 2
+        err = capsys.readouterr().err
+        assert f"parameter {key}" in err and repr(value) in err
+
+
+def test_check_refuses_duplicate_bounds(small_run, tmp_path, capsys):
+    t = tmp_path / "t.toml"
+    assert main(["bless", "--metrics", str(small_run), "--thresholds", str(t)]) == 0
+    text = t.read_text()
+    first = "[[bound]]" + text.split("[[bound]]")[1]
+    t.write_text(text + "\n" + first)
+    assert main(["check", "--metrics", str(small_run), "--thresholds", str(t)]) == 2
+    assert "both for" in capsys.readouterr().err
+
+
+def test_check_outside_a_checkout_points_to_thresholds_flag(small_run, tmp_path, capsys,
+                                                            monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    assert main(["check", "--metrics", str(small_run)]) == 2
+    err = capsys.readouterr().err
+    assert "--thresholds" in err and "14" not in err
+
+
+# ------------------------------------------------------------ help speaks the user's terms
+
+def test_help_and_list(capsys):
+    with pytest.raises(SystemExit):
+        main(["--help"])
+    out = capsys.readouterr().out
+    desc = out.split("\n\n")[1].strip().splitlines()
+    assert len(desc) == 2 and "particle" in desc[0]
+    with pytest.raises(SystemExit):
+        main(["bless", "--help"])
+    assert "full mode" in " ".join(capsys.readouterr().out.split())
+    with pytest.raises(SystemExit):
+        main(["check", "--help"])
+    assert "thresholds.toml in the current folder" in " ".join(capsys.readouterr().out.split())
+    assert main(["list"]) == 0
+    first = capsys.readouterr().out.split("  meshes:")[0]
+    assert " ".join(first.split()).endswith("boundary condition and model.")
