@@ -299,8 +299,13 @@ def parser():
 
 
 def main(argv=None):
+    """Run the command line on ``argv``; return the exit status (also for --help and for
+    argument errors, which argparse would raise as SystemExit)."""
     try:
-        args = parser().parse_args(argv)
+        try:
+            args = parser().parse_args(argv)
+        except SystemExit as exc:
+            return exc.code if isinstance(exc.code, int) else 2
         return args.func(args)
     except (UsageError, PbcmError) as exc:
         print(f"pbcm: error: {exc}", file=sys.stderr)

@@ -264,9 +264,11 @@ def findings(runs, cfg):
     unstable = sorted({(r["model"], r["mesh"], r["bc"], r["growth_rate_1_s"]) for r in runs
                        if r["growth_rate_1_s"] > 0})
     if unstable:
+        steady = sorted({r["model"] for r in runs} - {u[0] for u in unstable})
         out.append("Flutter (positive growth rate of the undamped linearised model): "
                    + "; ".join(f"{m} on {me}/{b}: {g:.3g} 1/s" for m, me, b, g in unstable)
-                   + ". Conservative readings have none.")
+                   + (f". No flutter on any mesh and condition run: {', '.join(steady)}."
+                      if steady else "."))
     rest = [r for r in runs if r["step_time_state"] == "rest"]
     if rest:
         out.append("Step time taken at rest (the push blew up within the timed steps; a step "
