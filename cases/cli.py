@@ -6,7 +6,9 @@ are one line ``pbcm: error: ...`` with exit status 2, Ctrl-C is one line with ex
 import argparse
 import math
 import re
+import signal
 import sys
+import threading
 import textwrap
 from pathlib import Path
 
@@ -301,6 +303,17 @@ def parser():
 def main(argv=None):
     """Run the command line on ``argv``; return the exit status (also for --help and for
     argument errors, which argparse would raise as SystemExit)."""
+    main_thread = threading.current_thread() is threading.main_thread()
+    if main_thread:   # clean up staging folders on SIGTERM as on Ctrl-C
+        previous = signal.signal(signal.SIGTERM, _terminated)
+    try:
+        return _main(argv)
+    finally:
+        if main_thread:
+            signal.signal(signal.SIGTERM, previous)
+
+
+def _main(argv):
     try:
         try:
             args = parser().parse_args(argv)
@@ -314,6 +327,18 @@ def main(argv=None):
         print("\npbcm: interrupted; output folders hold what they held before the unfinished "
               "one", file=sys.stderr)
         return 130
+    except Terminated:
+        print("\npbcm: terminated; output folders hold what they held before the unfinished "
+              "one", file=sys.stderr)
+        return 143
+
+
+class Terminated(Exception):
+    """SIGTERM, raised where the program is so that staging folders are removed."""
+
+
+def _terminated(signum, frame):
+    raise Terminated()
 
 
 if __name__ == "__main__":

@@ -91,7 +91,10 @@ class StagedFolder:
             self.discard()
 
     def discard(self):
-        shutil.rmtree(self.path, ignore_errors=True)
+        """Remove the staging folder (nothing once committed)."""
+        if self.path is not None:
+            shutil.rmtree(self.path, ignore_errors=True)
+            self.path = None
 
     def commit(self):
         with no_interrupt():
@@ -104,8 +107,7 @@ class StagedFolder:
             else:
                 os.rename(self.path, self.target)
                 self.path = None
-        if self.path is not None:   # now the earlier contents
-            shutil.rmtree(self.path, ignore_errors=True)
+        self.discard()   # the staging path now holds the earlier contents, if any
         return self.target
 
 

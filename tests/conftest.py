@@ -1,5 +1,12 @@
 import numpy as np
 import pytest
+from hypothesis import HealthCheck, settings
+
+# derandomized and without a database: the same examples on every run and machine, no files
+settings.register_profile("pbcm", derandomize=True, deadline=None, database=None,
+                          max_examples=60,
+                          suppress_health_check=[HealthCheck.too_slow, HealthCheck.filter_too_much])
+settings.load_profile("pbcm")
 
 from model import Material
 from model.mesh import TetMesh, cube

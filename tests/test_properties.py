@@ -3,18 +3,13 @@ forces that conserve momentum for every conservative preset; any corrupted mesh 
 MeshError and nothing else (issue 8)."""
 import numpy as np
 import pytest
-from hypothesis import HealthCheck, assume, given, settings, strategies as st
+from hypothesis import assume, given, strategies as st
 
 from model import PRESETS, Material, build
 from model.errors import MeshError
 from model.geometry import signed_volumes
 from model.mesh import SCHEMES, TetMesh, box
 
-# derandomized and without a database: the same examples on every run and machine, no files
-settings.register_profile("pbcm", derandomize=True, deadline=None, database=None,
-                          max_examples=25,
-                          suppress_health_check=[HealthCheck.too_slow, HealthCheck.filter_too_much])
-settings.load_profile("pbcm")
 
 
 @st.composite

@@ -155,7 +155,10 @@ def test_a_narrower_rerun_leaves_no_stale_files(quick, tmp_path):
                                                           "five_clamped_fem-p2.vtu"}
 
 
-def test_ctrl_c_prints_one_line_exits_130_and_keeps_the_earlier_set(tmp_path):
+@pytest.mark.parametrize("sig,status,word", [(signal.SIGINT, 130, "interrupted"),
+                                             (signal.SIGTERM, 143, "terminated")])
+def test_ctrl_c_prints_one_line_exits_130_and_keeps_the_earlier_set(sig, status, word,
+                                                                     tmp_path):
     out = tmp_path / "paper-cube"
     out.mkdir()
     (out / "metrics.json").write_text("{}")
@@ -168,12 +171,12 @@ def test_ctrl_c_prints_one_line_exits_130_and_keeps_the_earlier_set(tmp_path):
         assert proc.poll() is None and time.monotonic() < deadline
         time.sleep(0.05)
     time.sleep(2.0)   # well into the computing
-    proc.send_signal(signal.SIGINT)
+    proc.send_signal(sig)
     _, err = proc.communicate(timeout=120)
-    assert proc.returncode == 130
+    assert proc.returncode == status
     lines = [line for line in err.replace("\r", "\n").splitlines()
              if line.strip() and not line.startswith("[")]   # the progress bar aside
-    assert len(lines) == 1 and "interrupted" in lines[0], err
+    assert len(lines) == 1 and word in lines[0], err
     assert sorted(p.name for p in out.iterdir()) == ["metrics.json", "report.md"]
     assert (out / "report.md").read_text() == "earlier complete run"
     assert sorted(p.name for p in tmp_path.iterdir()) == ["paper-cube"]
