@@ -270,7 +270,12 @@ def parser():
     _selection(rep)
     rep.set_defaults(func=_report_command)
     c = sub.add_parser("check", help="compare the latest metrics with thresholds.toml "
-                       "(exit 0 pass, 1 fail, 2 missing or malformed)")
+                       "(exit 0 pass, 1 fail, 2 missing or malformed)",
+                       description="Compare every metrics.json under --metrics with the bounds "
+                                   "of --thresholds. Exit status 0: every bound holds; 1: some "
+                                   "metric left its bound; 2: a bound without a metric, a metric "
+                                   "without a bound, a NaN, a malformed or missing file, or "
+                                   "metrics run at other problem parameters than the bounds'.")
     c.add_argument("--metrics", default="reports", help="a metrics.json or a folder of them "
                    "(default reports)")
     c.add_argument("--thresholds", default="thresholds.toml",
@@ -280,7 +285,7 @@ def parser():
     b = sub.add_parser(
         "bless", help="rewrite the bounds from measured metrics and print what changed",
         description="Set the bounds of thresholds.toml from measured metrics. Without --metrics "
-                    "it first runs every case: in full mode (about 14 minutes) unless --quick "
+                    "it first runs every case: in full mode (about 5 minutes) unless --quick "
                     "is given. It keeps the bounds of runs it did not see (other modes, meshes, "
                     "models) unless --prune is given, and each existing bound's tolerances "
                     "unless --margin is given; new bounds get --margin or 0.1. It prints every "

@@ -77,6 +77,8 @@ def _dynamic(r):
 
 
 def _step_time(r):
+    if r["step_time_s"] is None:
+        return "n/a (blew up)"
     return fmt(r["step_time_s"] * 1e6) + (" (at rest)" if r["step_time_state"] == "rest" else "")
 
 
@@ -274,12 +276,17 @@ def findings(runs, cfg):
         out.append("Step time taken at rest (the push blew up within the timed steps; a step "
                    "costs the same arithmetic at rest) for: " + ", ".join(
                        f"{r['model']} on {r['mesh']}/{r['bc']}" for r in rest) + ".")
-    msm = [r["step_time_s"] for r in runs if r["model"] == "msm"]
+    for r in runs:
+        if r["step_time_s"] is None:
+            out.append(f"No step time for {r['model']} on {r['mesh']}/{r['bc']}: every timed "
+                       f"run blew up ({r['step_time_state'][len('failed: '):]}).")
+    timed = [r for r in runs if r["step_time_s"] is not None]
+    msm = [r["step_time_s"] for r in timed if r["model"] == "msm"]
     if msm:
         for model in cfg.models:
-            if model.startswith("pbcm"):
-                ratio = np.median([r["step_time_s"] for r in runs if r["model"] == model]) \
-                    / np.median(msm)
+            own = [r["step_time_s"] for r in timed if r["model"] == model]
+            if model.startswith("pbcm") and own:
+                ratio = np.median(own) / np.median(msm)
                 out.append(f"Cost: one RK4 step of {model} takes {ratio:.1f}x the MSM step "
                            "(the paper reports more than 10x).")
     slide_msm = [r for r in solved if r["model"] == "msm" and r["bc"] == "sliding"]

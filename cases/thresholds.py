@@ -59,8 +59,8 @@ FIELDS = ("case", "mode", "mesh", "bc", "model", "metric", "value", "rtol", "ato
 HEADER = """\
 # pbcm error bounds, read by `pbcm check` and rewritten only by `pbcm bless`.
 # max: measured <= value + rtol |value| + atol;  min: measured >= value - rtol |value| - atol.
-# mode: the run mode the bound belongs to (quick runs in CI). [[problem]]: the parameters of
-# each case and mode the bounds were measured at; `pbcm check` refuses metrics run at others.
+# mode: the run mode the bound belongs to (quick runs in CI). The problem tables at the end
+# hold the parameters each case and mode was measured at; `pbcm check` refuses other ones.
 """
 
 

@@ -6,7 +6,7 @@ import pytest
 from hypothesis import assume, given, strategies as st
 
 from model import PRESETS, Material, build
-from model.errors import MeshError
+from model.errors import MeshError, ModelError
 from model.geometry import signed_volumes
 from model.mesh import SCHEMES, TetMesh, box
 
@@ -51,7 +51,11 @@ def test_the_conservative_presets_are_the_expected_ones():
        seed=st.integers(0, 2**32 - 1))
 def test_random_valid_meshes_give_finite_forces_that_conserve_momentum(mesh, nu, E, preset,
                                                                         strain, seed):
-    pm = build(preset, mesh, Material(E=E, nu=nu))
+    try:
+        pm = build(preset, mesh, Material(E=E, nu=nu))
+    except ModelError as exc:   # e.g. one cell: the normal term adds nothing to fit
+        assume("pass a number for c" not in str(exc))
+        raise
     assert pm.conservative
     rng = np.random.default_rng(seed)
     h = mesh.size / np.cbrt(mesh.n_nodes)

@@ -61,13 +61,17 @@ def test_hand_tightened_bound_fails(blessed, tmp_path, capsys):
 
 
 def test_missing_bound_exits_2(blessed, tmp_path, capsys):
-    blocks = (blessed / "t.toml").read_text().split("[[bound]]")
-    (tmp_path / "t.toml").write_text("[[bound]]".join(blocks[:-1]))
+    bounds, problems = (blessed / "t.toml").read_text().split("\n[[problem]]", 1)
+    blocks = bounds.split("[[bound]]")
+    (tmp_path / "t.toml").write_text("[[bound]]".join(blocks[:-1]) + "\n[[problem]]" + problems)
     assert check(blessed / "good", tmp_path / "t.toml") == 2
     assert "no bound for" in capsys.readouterr().err
 
 
 def test_missing_metrics_file_exits_2(blessed, tmp_path, capsys):
+    assert check(tmp_path / "absent", blessed / "t.toml") == 2
+    assert "absent does not exist" in capsys.readouterr().err
+    (tmp_path / "empty").mkdir()
     assert check(tmp_path / "empty", blessed / "t.toml") == 2
     assert "no metrics.json" in capsys.readouterr().err
 
