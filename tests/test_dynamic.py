@@ -1,0 +1,102 @@
+"""The dynamic FEM reference (reference/dynamic.py) against closed forms (issue 9)."""
+import numpy as np
+import pytest
+
+from model.bc import Ramp
+from model.errors import MaterialError, ModelError
+from model.mesh import box, cube
+from reference import dynamic, linear
+
+E, RHO, L, H = 10e3, 1000.0, 0.064, 0.008
+C = np.sqrt(E / RHO)          # bar wave speed at nu = 0
+T = 4 * L / C                 # fixed-free bar: the released end-loaded bar is periodic in 4 L / c
+
+
+@pytest.fixture(scope="module")
+def bar():
+    mesh = box(17, 3, 3, L, H, H, "six")
+    fixed = {int(i): (0.0, 0.0, 0.0) for i in mesh.nodes_on_plane("x", 0.0)}
+
+    def pull(x, n):
+        t = np.zeros_like(x)
+        t[..., 0] = np.where(np.isclose(x[..., 0], L), 50.0, 0.0)
+        return t
+
+    return mesh, fixed, pull
+
+
+def released(bar, element, damping=0.0, periods=2.2):
+    mesh, fixed, pull = bar
+    u0 = linear.solve(mesh, E, 0.0, fixed, traction=pull, element=element).u
+    r = dynamic.solve(mesh, E, 0.0, RHO, lambda t: fixed, periods * T, dt=T / 400,
+                      element=element, u0=u0, damping=damping)
+    tip = r.u[:, np.isclose(mesh.points[:, 0], L), 0].mean(axis=1)
+    return r, tip
+
+
+@pytest.mark.parametrize("element", ["P1", "P2"])
+def test_fixed_free_bar_period_is_4L_over_c(bar, element):
+    """Released from its static deflection under an end load, the tip moves as a triangle
+    wave of period 4 L / c: its zero crossings are T / 2 apart."""
+    r, tip = released(bar, element)
+    z = np.flatnonzero(np.diff(np.sign(tip)) != 0)
+    crossing = r.t[z] - tip[z] * (r.t[z + 1] - r.t[z]) / (tip[z + 1] - tip[z])
+    assert len(crossing) >= 4
+    assert abs(2 * np.mean(np.diff(crossing)) / T - 1) < 0.01
+    assert tip[0] > 0 and abs(tip.min() / tip[0] + 1) < 0.05      # swings to -u0
+
+
+def test_undamped_energy_is_constant(bar):
+    r, _ = released(bar, "P1")
+    e = r.kinetic + r.strain
+    assert r.kinetic[0] == 0 and r.kinetic.max() > 0.5 * e[0]    # energy is exchanged
+    assert np.ptp(e) / e[0] < 1e-6
+
+
+def test_mass_proportional_damping_decays_energy_at_its_rate(bar):
+    """Every mode decays as exp(-zeta t / 2): the energy as exp(-zeta t), checked at whole
+    periods where the oscillating part vanishes."""
+    zeta = 0.2 * 2 * np.pi / T
+    r, _ = released(bar, "P1", damping=zeta, periods=2.0)
+    e = r.kinetic + r.strain
+    for k in (1, 2):
+        i = np.argmin(abs(r.t - k * T))
+        assert abs(e[i] / e[0] / np.exp(-zeta * r.t[i]) - 1) < 0.01
+
+
+@pytest.mark.parametrize("element,mass", [("P1", "lumped"), ("P1", "consistent"),
+                                          ("P2", "consistent")])
+def test_slow_push_then_rest_gives_the_static_reaction(element, mass):
+    """A cube pushed 1 % over many periods and held with damping comes to the static FEM
+    state: displacement and reaction (sign and size) equal to linear.solve. (The default step
+    resolves the mesh's modes: at a step 2.5 times longer, the modes the kinks of the path
+    excite through a consistent mass ring on at 1e-6 to 1e-5 of the push: the trapezoidal
+    rule hardly damps modes it does not resolve.)"""
+    mesh = cube(4, 0.032, "six")
+    top, bottom = mesh.nodes_on_plane("y", 0.032), mesh.nodes_on_plane("y", 0.0)
+    held = {int(i): (0.0, 0.0, 0.0) for i in bottom}
+    ramp = Ramp(top, (0.0, -0.32e-3, 0.0), 0.2, held=held)
+    r = dynamic.solve(mesh, E, 0.3, RHO, ramp, 1.0, damping=60.0, element=element, mass=mass,
+                      frames=11)
+    static = linear.solve(mesh, E, 0.3, ramp(1.0), element=element)
+    assert np.abs(r.u[-1] - static.u).max() < 1e-6 * np.abs(static.u).max()
+    assert np.allclose(r.reaction[-1], static.reaction, atol=1e-4 * np.abs(static.reaction).max())
+    assert r.reaction[-1][top, 1].sum() < 0          # the supports push the top down
+    assert len(r.t) == 11 and r.t[-1] == pytest.approx(1.0)
+
+
+def test_bad_input():
+    mesh = cube(3, 0.032, "six")
+    held = {0: (0.0, 0.0, 0.0)}
+    for kw, word in [(dict(rho=-1.0), "rho"), (dict(t_end=0.0), "t_end"),
+                     (dict(dt=-1.0), "dt"), (dict(damping=-1.0), "damping"),
+                     (dict(mass="diagonal"), "mass"), (dict(u0=np.zeros((2, 3))), "u0")]:
+        args = dict(rho=RHO, t_end=0.01)
+        args.update(kw)
+        with pytest.raises((ModelError, MaterialError), match=word):
+            dynamic.solve(mesh, E, 0.3, args.pop("rho"), lambda t: held, args.pop("t_end"),
+                          **args)
+    moving = Ramp([1], (0.0, 1e-4, None), 0.01, held=held)
+    changing = (lambda t: held if t < 0.005 else moving(t))
+    with pytest.raises(ModelError, match="prescribed components"):
+        dynamic.solve(mesh, E, 0.3, RHO, changing, 0.01, dt=1e-3)
