@@ -181,17 +181,18 @@ def _check_command(args):
     except CheckError as exc:
         print(f"pbcm check: error: {exc}", file=sys.stderr)
         return 2
-    print(f"{'metric':<66} {'measured':>11} {'bound':>11} {'margin':>8}  result")
+    print(f"{'metric':<66} {'measured':>11} {'band':>23} {'margin':>8}  result")
     for b, v, ok in rows:
         name = f"{b.case}/{b.mesh}/{b.bc}/{b.model}/{b.metric}"
-        sign = "<=" if b.direction == "max" else ">="
-        print(f"{name:<66} {v:>11.5g} {sign}{b.limit:>9.5g} {b.margin(v):>8.1%}  "
+        low, high = b.band
+        print(f"{name:<66} {v:>11.5g} [{low:>10.5g},{high:>10.5g}] {b.margin(v):>8.1%}  "
               f"{'PASS' if ok else 'FAIL'}")
     failed = [r for r in rows if not r[2]]
     print(f"{len(rows) - len(failed)} passed, {len(failed)} failed")
     for b, v, _ in failed:
-        print(f"FAIL {b.metric} of {b.case}/{b.mesh}/{b.bc}/{b.model}: {v:.6g} "
-              f"{'>' if b.direction == 'max' else '<'} {b.limit:.6g}")
+        low, high = b.band
+        print(f"FAIL {b.metric} of {b.case}/{b.mesh}/{b.bc}/{b.model}: {v:.6g} outside "
+              f"[{low:.6g}, {high:.6g}] ({b.verdict(v)})")
     return status
 
 

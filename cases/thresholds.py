@@ -1,8 +1,11 @@
 """Error bounds for CI, declared as data (thresholds.toml) in the style of verification
-harnesses: a stored value with a relative tolerance and an absolute floor, and a direction.
+harnesses: a stored value with a relative tolerance and an absolute floor. The gate is
+two-sided: every change of result fails until it is blessed on purpose,
 
-    max: measured <= value + rtol |value| + atol     (an error must stay below)
-    min: measured >= value - rtol |value| - atol     (a correlation must stay above)
+    |measured - value| <= rtol |value| + atol,
+
+and ``direction`` only says which way is worse (max: an error, min: a correlation), so that a
+failure reads as a regression or as an improvement to bless.
 """
 from dataclasses import dataclass
 import datetime
@@ -42,23 +45,37 @@ class Bound:
         return (self.case, self.mode, self.mesh, self.bc, self.model, self.metric)
 
     @property
-    def limit(self):
-        slack = self.rtol * abs(self.value) + self.atol
-        return self.value + slack if self.direction == "max" else self.value - slack
+    def slack(self):
+        return self.rtol * abs(self.value) + self.atol
+
+    @property
+    def band(self):
+        """(low, high): a measured value must stay inside, in either direction."""
+        return self.value - self.slack, self.value + self.slack
 
     def passes(self, measured):
-        return measured <= self.limit if self.direction == "max" else measured >= self.limit
+        low, high = self.band
+        return low <= measured <= high
 
     def margin(self, measured):
-        """How far inside the bound, as a fraction of the limit (negative: outside)."""
-        gap = self.limit - measured if self.direction == "max" else measured - self.limit
-        return gap / max(abs(self.limit), self.atol)
+        """How far inside the band, as a fraction of its half-width (negative: outside)."""
+        return 1.0 - abs(measured - self.value) / max(self.slack, 1e-300)
+
+    def verdict(self, measured):
+        """'' inside the band; else whether the metric got worse or better (``direction``
+        says which way is worse: 'max' an error, 'min' a correlation)."""
+        if self.passes(measured):
+            return ""
+        higher = measured > self.value
+        worse = higher if self.direction == "max" else not higher
+        return ("worse: a regression" if worse else
+                "better: bless it on purpose if the change is meant")
 
 
 FIELDS = ("case", "mode", "mesh", "bc", "model", "metric", "value", "rtol", "atol", "direction")
 HEADER = """\
 # pbcm error bounds, read by `pbcm check` and rewritten only by `pbcm bless`.
-# max: measured <= value + rtol |value| + atol;  min: measured >= value - rtol |value| - atol.
+# Two-sided: |measured - value| <= rtol |value| + atol; direction says which way is worse.
 # mode: the run mode the bound belongs to (quick runs in CI). The problem tables at the end
 # hold the parameters each case and mode was measured at; `pbcm check` refuses other ones.
 """

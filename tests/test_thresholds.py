@@ -97,14 +97,32 @@ def test_malformed_or_missing_thresholds_exit_2(blessed, tmp_path, text, word, c
     assert check(blessed / "good", tmp_path / "absent.toml") == 2
 
 
-def test_bounds_widen_away_from_the_stored_value_for_either_sign():
+def test_the_band_is_two_sided_for_either_sign():
     from cases.thresholds import Bound
     for value in (-0.6, 0.6):
-        lo = Bound("c", "quick", "m", "b", "x", "stress_corr", value, 0.1, 0.0, "min")
-        hi = Bound("c", "quick", "m", "b", "x", "zigzag", value, 0.1, 0.0, "max")
-        assert lo.limit < value < hi.limit
-        assert lo.passes(value) and hi.passes(value)
-        assert not lo.passes(value - 0.2) and not hi.passes(value + 0.2)
+        for direction in ("min", "max"):
+            b = Bound("c", "quick", "m", "b", "x", "zigzag", value, 0.1, 0.0, direction)
+            low, high = b.band
+            assert low == pytest.approx(value - 0.06) and high == pytest.approx(value + 0.06)
+            assert b.passes(value) and b.margin(value) == 1.0
+            assert not b.passes(value - 0.07) and not b.passes(value + 0.07)
+    error = Bound("c", "quick", "m", "b", "x", "zigzag", 0.5, 0.1, 0.0, "max")
+    assert "worse" in error.verdict(0.6) and "better" in error.verdict(0.4)
+    corr = Bound("c", "quick", "m", "b", "x", "stress_corr", 0.5, 0.1, 0.0, "min")
+    assert "better" in corr.verdict(0.6) and "worse" in corr.verdict(0.4)
+
+
+def test_a_better_result_fails_until_blessed(blessed, tmp_path, capsys):
+    """A bound loosened by hand (its value doubled) sees the measured error as an improvement
+    outside the band: that fails too, until blessed."""
+    text = (blessed / "t.toml").read_text()
+    blocks = text.split("[[bound]]")
+    i = next(k for k, b in enumerate(blocks) if 'metric = "disp_rel_l2_p2"' in b)
+    value = float(re.search(r"^value = (.*)$", blocks[i], re.M).group(1))
+    blocks[i] = blocks[i].replace(f"value = {value!r}", f"value = {2 * value!r}")
+    (tmp_path / "t.toml").write_text("[[bound]]".join(blocks))
+    assert check(blessed / "good", tmp_path / "t.toml") == 1
+    assert "better: bless it on purpose" in capsys.readouterr().out
 
 
 def test_committed_full_mode_bounds_hold_for_the_committed_reports(capsys):
