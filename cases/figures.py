@@ -82,8 +82,12 @@ def grouped_bars(path, groups, labels, values, ylabel, title, log=False):
     _finish(fig, ax, path, None, ylabel, title, grid_axis="y")
 
 
-def reaction_history(path, series, fem_level, title):
+def reaction_history(path, series, fem_level, fem_transient, title):
+    """The top reaction against time: every model, the FEM transient (label, t, r) on the
+    same boundary motion, and the static FEM level."""
     fig, ax = plt.subplots(figsize=(6, 4))
+    label, t, r = fem_transient
+    ax.plot(t, r, "k-", lw=2.5, label=label)
     for label, t, r in series:
         ax.plot(t, r, label=label)
     ax.axhline(fem_level, color="k", ls="--", label="FEM P2 static at 1.7 mm")

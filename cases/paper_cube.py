@@ -16,6 +16,7 @@ from model.mesh import cube
 from model.terms.shear import Shear
 from reference import linear
 from . import metrics as M
+from . import transient
 
 SIZE_MM = 32.0
 NODES_PER_SIDE = 5
@@ -42,6 +43,7 @@ class Config:
     bcs: tuple = BCS
     models: tuple = MODELS
     p2_levels: int = 2            # refinements of the converged P2 reference
+    transient_element: str = "P2"  # element of the FEM transient (quick: P1, 10x cheaper)
     damping: float = 50.0         # mass damping zeta [1/s] (the paper gives none)
     safety: float = 0.8           # RK4 step = safety * min h / c_p
     hold_max: float = 2.0         # longest hold after the push [s]
@@ -58,6 +60,7 @@ class Config:
     @classmethod
     def quick_config(cls, **kw):
         return cls(**{"meshes": QUICK_MESHES, "p2_levels": 1, "timing_repeats": 3,
+                      "transient_element": "P1",
                       "hold_max": 1.0, "quick": True, **kw})
 
     def problem(self):
@@ -67,9 +70,9 @@ class Config:
         return {"E_Pa": self.E, "nu": self.nu, "rho_kg_m3": self.rho, "size_mm": SIZE_MM,
                 "nodes_per_side": NODES_PER_SIDE, "push_mm": PUSH_MM,
                 "speed_mm_s": SPEED_MM_S, "layers_mm": list(LAYERS_MM),
-                "p2_levels": self.p2_levels, "damping_1_s": self.damping,
-                "rk4_safety": self.safety, "hold_max_s": self.hold_max,
-                "rest_speed_fraction": self.rest_speed}
+                "p2_levels": self.p2_levels, "transient_element": self.transient_element,
+                "damping_1_s": self.damping, "rk4_safety": self.safety,
+                "hold_max_s": self.hold_max, "rest_speed_fraction": self.rest_speed}
 
     def describe(self):
         """Everything the run was given: the problem, the selection and the run settings."""
@@ -142,16 +145,18 @@ def build_model(name, mesh, mat, cfg):
     return build(name, mesh, mat, **extra)
 
 
-def dynamic_run(pm, mesh, bc, cfg):
-    """RK4 as in the paper: the push over 1 s, then held until at rest (or hold_max)."""
+def dynamic_run(pm, mesh, bc, cfg, dt_scale=1.0):
+    """RK4 as in the paper: the push over 1 s, then held until at rest (or hold_max), at the
+    case's step times ``dt_scale``."""
     ramp = dynamic_bc(mesh, bc)
     t_push = ramp.t_ramp
-    dt = pm.stable_dt(cfg.safety)
+    dt = pm.stable_dt(cfg.safety) * dt_scale
     t0 = time.perf_counter()
     rest = cfg.rest_speed * SPEED_MM_S * MM
     try:
         traj = pm.simulate(ramp, t_push, dt=dt, damping=cfg.damping, frames=21)
         ts, rs, x, v, t = list(traj.t), list(traj.reaction), traj.x[-1], traj.v, t_push
+        x_push = x
         steps = traj.steps
         while t < t_push + cfg.hold_max - 1e-12 and np.abs(v).max() > rest:
             chunk = pm.simulate(ramp, t + 0.1, dt=dt, damping=cfg.damping, frames=3, x0=x,
@@ -164,21 +169,23 @@ def dynamic_run(pm, mesh, bc, cfg):
         return {"failed": str(exc), "wall": time.perf_counter() - t0, "dt": dt}
     wall = time.perf_counter() - t0
     top = ramp.nodes
-    return {"failed": None, "x": x, "t": np.array(ts),
+    return {"failed": None, "x": x, "x_push": x_push, "t": np.array(ts),
             "reaction_y": -np.array(rs)[:, top, 1].sum(axis=1),
             "t_end": t, "at_rest": bool(np.abs(v).max() <= rest), "steps": steps,
             "dt": dt, "wall": wall, "max_speed": float(np.abs(v).max())}
 
 
-def dynamic_metrics(dyn, mesh, st):
-    """The dynamic run's metrics; None throughout (and the reason) when it blew up. The
-    distance to the static equilibrium is None when the static solve failed."""
+def dynamic_metrics(dyn, mesh, st, fem):
+    """The dynamic run's metrics, against the static solution and the FEM transient ``fem``;
+    None throughout (and the reason) when it blew up. The distance to the static equilibrium
+    is None when the static solve failed."""
     keys = ("dyn_vs_static_rel_l2", "dyn_at_rest", "dyn_t_end_s", "dyn_steps",
-            "dyn_reaction_t_s", "dyn_reaction_n")
+            "dyn_reaction_t_s", "dyn_reaction_n", "reaction_time_rel_l2",
+            "disp_end_push_rel_l2", "rest_time_s")
     out = {"dyn_failed": dyn["failed"], "dyn_dt_s": dyn["dt"], "dyn_wall_s": dyn["wall"]}
     if dyn["failed"]:
         return {**out, **{k: None for k in keys}}
-    return {**out,
+    return {**out, **transient.compare_transient(dyn, fem, mesh),
             "dyn_vs_static_rel_l2": None if st is None else M.rel_l2(dyn["x"] - mesh.points, st.u),
             "dyn_at_rest": dyn["at_rest"], "dyn_t_end_s": dyn["t_end"],
             "dyn_steps": dyn["steps"], "dyn_reaction_t_s": dyn["t"].tolist(),
@@ -247,6 +254,10 @@ class Reference:
         self.tau = probe.max_tau(mesh.points + self.p2.u)
         self.profile = M.layer_profile(mesh.points, self.p2.u, self.layers, self.L)
         self.reaction = float(-self.p2.reaction[self.top, 1].sum())
+        rest = cfg.rest_speed * SPEED_MM_S * MM
+        self.transient = transient.fem_transient(mesh, dynamic_bc(mesh, bc), self.top, cfg, rest,
+                                                 element=cfg.transient_element)
+        self.modes_free, self.modes_held = transient.fem_modes(mesh, self.sbc, cfg)
 
 
 def static_metrics(pm, st, mesh, ref):
@@ -283,7 +294,8 @@ def model_run(mesh_name, mesh, bc, model_name, cfg, ref):
          "reaction_fem_p2_n": ref.reaction,
          "bulge_profile_fem_mm": (ref.profile / MM).tolist(),
          "zigzag_fem": M.zigzag(ref.profile), "paper_pattern_fem": M.paper_pattern(ref.profile),
-         "p2_error_estimate": ref.conv.error_estimate}
+         "p2_error_estimate": ref.conv.error_estimate,
+         "rest_time_fem_s": ref.transient["rest_time_s"]}
     pm = build_model(model_name, mesh, cfg.material, cfg)
     st, fields = None, None
     try:
@@ -298,7 +310,10 @@ def model_run(mesh_name, mesh, bc, model_name, cfg, ref):
     r.update(net_force_rel=M.finite("net_force", nft["force_rel"]),
              net_torque_rel=M.finite("net_torque", nft["torque_rel"]),
              growth_rate_1_s=growth_rate(pm, mesh, bc))
-    r.update(dynamic_metrics(dynamic_run(pm, mesh, bc, cfg), mesh, st))
+    r.update(dynamic_metrics(dynamic_run(pm, mesh, bc, cfg), mesh, st, ref.transient))
+    r["dyn_failed_dt4"] = dynamic_run(pm, mesh, bc, cfg, dt_scale=0.25)["failed"]
+    r["verdict_changes_dt4"] = (r["dyn_failed"] is None) != (r["dyn_failed_dt4"] is None)
+    r.update(transient.modal_comparison(pm, mesh, ref.sbc, ref.modes_free, ref.modes_held))
     r["step_time_s"], r["step_time_state"] = step_time(pm, mesh, bc, cfg)
     r["model_info"] = _jsonable(pm.info)
     return r, fields
@@ -318,7 +333,8 @@ def run(cfg, log=True):
             ref = Reference(mesh, bc, cfg, probe)
             fields[(mesh_name, bc, "fem-p2")] = {"mesh": mesh, "u": ref.p2.u, "max_tau": ref.tau,
                                                  "pressure": ref.p2.pressure,
-                                                 "von_mises": ref.p2.von_mises}
+                                                 "von_mises": ref.p2.von_mises,
+                                                 "transient": ref.transient}
             done += 1
             for model_name in cfg.models:
                 if log:

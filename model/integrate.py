@@ -134,4 +134,6 @@ def simulate(model, bc_of_t, t_end, dt=None, damping=0.0, f_ext=None, frames=101
 
 def _blow_up(what, step, t, dt):
     return BlowUpError(f"time integration blew up at step {step} (t = {t:.6g} s, dt = {dt:.3g} s):"
-                       f" {what}; try dt = {dt / 4:.3g} s or more damping", step, t, dt / 4)
+                       f" {what}; try dt = {dt / 4:.3g} s, which cures an unstable step but not "
+                       "flutter (a non-conservative reading whose linearised growth rate exceeds "
+                       "half the damping: there, add damping)", step, t, dt / 4)

@@ -11,20 +11,22 @@ from dataclasses import dataclass
 import math
 
 import numpy as np
+import scipy.sparse as sp
 from scipy.sparse.linalg import splu
 from skfem import asm
 from skfem.models.elasticity import linear_elasticity
 
 from model.bc import bc_arrays
 from model.errors import MaterialError, ModelError
-from .fem import dirichlet_dofs, element_basis, lame, skfem_mesh
-from .linear import body_load, transfer_to_nodes
+from .fem import dirichlet_dofs, dof_hats, element_basis, lame, skfem_mesh
+from .linear import body_load, dof_component
 from .modal import lumped, mass_form
 
 
 @dataclass
 class DynamicResult:
-    """``t`` (k,) frame times [s]; ``u`` (k, n, 3) displacements at the input nodes [m];
+    """``t`` (k,) frame times [s]; ``u`` and ``v`` (k, n, 3) displacements [m] and velocities
+    [m/s] at the input nodes;
     ``reaction`` (k, n, 3) the force the supports exert on the body on the prescribed
     components [N] (elastic force plus the inertia and damping the free dofs couple into the
     prescribed ones; the prescribed dofs' own inertia excluded, as in the particle runs);
@@ -32,6 +34,7 @@ class DynamicResult:
 
     t: np.ndarray
     u: np.ndarray
+    v: np.ndarray
     reaction: np.ndarray
     kinetic: np.ndarray
     strain: np.ndarray
@@ -130,13 +133,15 @@ def solve(mesh, E, nu, rho, dirichlet_of_t, t_end, dt=None, damping=0.0, element
 
     keep = (np.arange(steps + 1) if frames is None else
             np.unique(np.linspace(0, steps, max(int(frames), 2)).round().astype(int)))
-    ts, us, rs, kin, pot = [], [], [], [], []
+    ts, us, vs, rs, kin, pot = [], [], [], [], [], []
+    K_D, M_DI, nodal = K[D], M[D][:, I], basis.nodal_dofs[:, :n]
+    to_nodes = _transfer(basis, D, n)
 
     def record(k):
         ts.append(k * dt)
-        us.append(u[basis.nodal_dofs[:, :n]].T.copy())
-        r = K[D] @ u - f[D] + M[D][:, I] @ (a[I] + damping * v[I])
-        rs.append(transfer_to_nodes(basis, _identity(n), D, r))
+        us.append(u[nodal].T.copy())
+        vs.append(v[nodal].T.copy())
+        rs.append(to_nodes(K_D @ u - f[D] + M_DI @ (a[I] + damping * v[I])))
         kin.append(0.5 * v @ (M @ v))
         pot.append(0.5 * u @ (K @ u))
 
@@ -154,12 +159,22 @@ def solve(mesh, E, nu, rho, dirichlet_of_t, t_end, dt=None, damping=0.0, element
         u[D], v[D], a[D] = uD, vD, aD
         if k in keep:
             record(k)
-    return DynamicResult(t=np.array(ts), u=np.array(us), reaction=np.array(rs),
+    return DynamicResult(t=np.array(ts), u=np.array(us), v=np.array(vs), reaction=np.array(rs),
                          kinetic=np.array(kin), strain=np.array(pot), dt=dt,
                          info={"element": element, "mass": mass, "dofs": int(basis.N),
                                "steps": steps, "damping": damping})
 
 
-def _identity(n):
-    import scipy.sparse as sp
-    return sp.identity(n, format="csr")
+def _transfer(basis, D, n):
+    """values on the prescribed dofs -> (n, 3) forces at the input nodes, by the input
+    mesh's P1 hats (reference.linear.transfer_to_nodes, its matrices built once)."""
+    hats = dof_hats(basis, sp.identity(n, format="csr"))[D]
+    comp = dof_component(basis)[D]
+    parts = [(k, comp == k, hats[comp == k].T.tocsr()) for k in range(3)]
+
+    def to_nodes(values):
+        out = np.zeros((n, 3))
+        for k, sel, H in parts:
+            out[:, k] = H @ values[sel]
+        return out
+    return to_nodes
