@@ -16,7 +16,9 @@ FILES = ["metrics.json", "report.md", "report.html", "errors.png", "step_time.pn
                                  for mesh in ("five", "six") for bc in ("clamped", "sliding")]
 KEYS = ["mesh", "bc", "model", "disp_rel_l2_p1", "disp_rel_l2_p2", "disp_max_rel_p2",
         "reaction_ratio", "stress_corr", "bulge_profile_mm", "bulge_profile_fem_mm", "zigzag",
-        "step_time_s"]
+        "step_time_s", "reaction_time_rel_l2", "disp_end_push_rel_l2", "rest_time_s",
+        "modal_rel_err", "modal_rel_err_free", "rigid_modes_free", "dyn_failed_dt4",
+        "verdict_changes_dt4"]
 
 
 def numbers(x):
@@ -42,6 +44,9 @@ def test_quick_run_writes_every_file_with_finite_metrics(quick):
             assert k in r, k
         assert all(np.isfinite(v) for v in numbers(r))
         assert len(r["bulge_profile_mm"]) == len(LAYERS_MM)
+        assert r["rigid_modes_free"] == 6 and r["modal_rel_err"] > 0
+        if not r["dyn_failed"]:   # rest is None where the run never came to rest
+            assert r["reaction_time_rel_l2"] > 0 and (r["rest_time_s"] or 2.0) > 1.0
     env = data["environment"]
     assert {"python", "numpy", "numba", "scikit-fem", "git_commit", "date"} <= set(env)
     assert len(list((quick / "vtu").glob("*.vtu"))) == 2 * 2 * 7

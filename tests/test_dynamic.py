@@ -100,3 +100,28 @@ def test_bad_input():
     changing = (lambda t: held if t < 0.005 else moving(t))
     with pytest.raises(ModelError, match="prescribed components"):
         dynamic.solve(mesh, E, 0.3, RHO, changing, 0.01, dt=1e-3)
+
+
+def test_model_frequencies_of_one_spring_node_by_hand():
+    """One tetrahedron of springs (van Gelder: k = E V / L^2), three nodes held: the free node
+    vibrates at sqrt(eig(sum k e e^T) / m) / 2 pi, m = rho V / 4; free-free, six springs on
+    four nodes leave exactly the six rigid modes."""
+    from model import Material, build
+    from model.mesh import TetMesh
+    from cases.transient import model_frequencies
+    X = 0.01 * np.array([[0.0, 0, 0], [1, 0, 0], [0, 1, 0], [0.2, 0.3, 1]])
+    mesh = TetMesh(X, np.array([[0, 1, 2, 3]]))
+    mat = Material(E=E, nu=0.25, rho=RHO)
+    pm = build("msm", mesh, mat)
+    V = abs(np.linalg.det(X[1:] - X[0])) / 6
+    Kn = np.zeros((3, 3))
+    for i in range(3):
+        d = X[3] - X[i]
+        Kn += E * V / (d @ d) * np.outer(d, d) / (d @ d)
+    expected = np.sort(np.sqrt(np.linalg.eigvalsh(Kn) / (RHO * V / 4))) / (2 * np.pi)
+    free = np.zeros(12, dtype=bool)
+    free[9:] = True
+    freq, rigid = model_frequencies(pm, free)
+    assert rigid == 0 and np.allclose(freq, expected, rtol=1e-5)
+    _, rigid = model_frequencies(pm, np.ones(12, dtype=bool))
+    assert rigid == 6
