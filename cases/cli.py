@@ -85,9 +85,10 @@ def _mesh_command(args):
 
 
 def _choose(kind, given, valid):
-    """The names asked for, or a one-line error listing the valid ones (exit status 2)."""
+    """The names asked for (None when not given: the case's default), or a one-line error
+    listing the valid ones (exit status 2)."""
     if given is None:
-        return tuple(valid)
+        return None
     bad = [g for g in given if g not in valid]
     if bad:
         raise UsageError(f"unknown {kind} {', '.join(bad)}; valid: {', '.join(valid)}")
@@ -106,24 +107,20 @@ def _case(name):
 
 
 def _config(case, args):
-    kw = {"meshes": _choose("mesh", args.meshes, case.MESHES),
-          "bcs": _choose("boundary condition", args.bcs, case.BCS),
-          "models": _choose("model", args.models, case.MODELS)}
-    for k in ("E", "nu", "rho", "shear_scale"):
-        if getattr(args, k) is not None:
-            kw[k] = getattr(args, k)
-    if args.quick:
-        if args.meshes is None:
-            kw.pop("meshes")
-        return case.Config.quick_config(**kw)
-    return case.Config(**kw)
+    return case.settings(quick=args.quick,
+                         meshes=_choose("mesh", args.meshes, case.meshes),
+                         bcs=_choose("boundary condition", args.bcs, case.bcs),
+                         models=_choose("model", args.models, case.models),
+                         E=args.E, nu=args.nu, rho=args.rho, shear_scale=args.shear_scale)
 
 
 def _run_into(name, cfg, folder):
     """Run case ``name`` with ``cfg`` and write its files into the existing ``folder``."""
     from .report import write_case
-    runs, fields = _case(name).run(cfg)
-    write_case(folder, name, cfg, runs, fields)
+    from .runner import run
+    case = _case(name)
+    runs, fields = run(case, cfg)
+    write_case(folder, case, cfg, runs, fields)
     return runs
 
 
@@ -132,18 +129,13 @@ def _configs(names, args):
     return {name: _config(_case(name), args) for name in names}
 
 
-def _summary(case):
-    """The first paragraph of a case's docstring, as whole sentences on one line."""
-    return " ".join(case.__doc__.strip().split("\n\n")[0].split())
-
-
 def _list_command(args):
     from .registry import CASES
     for name, case in CASES.items():
-        print(textwrap.fill(f"{name}: {_summary(case)}", width=96, subsequent_indent="  "))
-        print(f"  meshes: {', '.join(case.MESHES)}")
-        print(f"  bcs:    {', '.join(case.BCS)}")
-        print(f"  models: {', '.join(case.MODELS)}")
+        print(textwrap.fill(f"{name}: {case.title}", width=96, subsequent_indent="  "))
+        print(f"  meshes: {', '.join(case.meshes)} (quick: {', '.join(case.quick_meshes)})")
+        print(f"  bcs:    {', '.join(case.bcs)}")
+        print(f"  models: {', '.join(case.models)}")
     return 0
 
 
@@ -159,7 +151,7 @@ def _run_command(args):
 def _report_command(args):
     from contextlib import ExitStack
     from .registry import CASES
-    from .report import index_documents
+    from .index import index_documents
     cfgs = _configs(CASES, args)
     root = writable_folder(args.out or "reports")
     with ExitStack() as stack:   # every case folder checked and staged before any computing
@@ -232,7 +224,8 @@ def _selection(p):
     p.add_argument("--meshes", nargs="+", help="meshes (default: all; --quick: five six)")
     p.add_argument("--bcs", nargs="+", help="boundary conditions (default: all)")
     p.add_argument("--quick", action="store_true",
-                   help="five and six meshes, one P2 refinement, fewer timing repeats")
+                   help="each case's quick settings (fewer meshes, coarser references; "
+                        "what CI runs)")
     p.add_argument("--E", type=_number("--E", "Young's modulus in Pa, a number > 0", low=0),
                    help="Young's modulus [Pa] (default 10e3)")
     p.add_argument("--nu", type=_poisson, help="Poisson's ratio, -1 < nu < 0.5 (default 0.45)")

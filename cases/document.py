@@ -4,6 +4,31 @@ import html
 from pathlib import Path
 
 
+def fmt(v, digits=3):
+    """A number for a report cell: 'n/a' for None, yes/no for a bool, ``digits`` significant
+    figures for a float."""
+    if v is None:
+        return "n/a"
+    if isinstance(v, bool):
+        return "yes" if v else "no"
+    if isinstance(v, float):
+        return f"{v:.{digits}g}"
+    return str(v)
+
+
+class Cell:
+    """A table cell with a background colour in HTML (the scorecard's bands)."""
+
+    def __init__(self, text, colour):
+        self.text, self.colour = text, colour
+
+    def markdown(self):
+        return self.text
+
+    def html(self):
+        return f"<span style='display:block;background:{self.colour}'>{html.escape(self.text)}</span>"
+
+
 class Link:
     """A table cell linking to ``md_href`` in Markdown and ``html_href`` in HTML."""
 
@@ -18,11 +43,11 @@ class Link:
 
 
 def _md(c):
-    return c.markdown() if isinstance(c, Link) else str(c)
+    return c.markdown() if isinstance(c, (Link, Cell)) else str(c)
 
 
 def _html(c):
-    return c.html() if isinstance(c, Link) else html.escape(str(c))
+    return c.html() if isinstance(c, (Link, Cell)) else html.escape(str(c))
 
 
 class Document:

@@ -35,9 +35,12 @@ def stress_panels(path, panels, title, magnify):
         x = (mesh.points + magnify * u) / MM
         ax.add_collection3d(Poly3DCollection(x[tri], facecolors=cmap(norm(tau[owner])),
                                              edgecolors="k", linewidths=0.2))
-        ax.set_xlim(-2, 34), ax.set_ylim(-2, 34), ax.set_zlim(-2, 34)
+        lo, hi = mesh.points.min(axis=0) / MM, mesh.points.max(axis=0) / MM
+        pad = 0.06 * (hi - lo).max()
+        ax.set_xlim(lo[0] - pad, hi[0] + pad), ax.set_ylim(lo[1] - pad, hi[1] + pad)
+        ax.set_zlim(lo[2] - pad, hi[2] + pad)
         ax.view_init(elev=20, azim=-60, vertical_axis="y")
-        ax.set_box_aspect((1, 1, 1))
+        ax.set_box_aspect(tuple(hi - lo + 2 * pad))
         ax.set_title(label, fontsize=9)
         ax.set_axis_off()
     sm = matplotlib.cm.ScalarMappable(norm=norm, cmap=cmap)
@@ -82,7 +85,7 @@ def grouped_bars(path, groups, labels, values, ylabel, title, log=False):
     _finish(fig, ax, path, None, ylabel, title, grid_axis="y")
 
 
-def reaction_history(path, series, fem_level, fem_transient, title):
+def reaction_history(path, series, fem_level, fem_transient, title, level_label):
     """The top reaction against time: every model, the FEM transient (label, t, r) on the
     same boundary motion, and the static FEM level."""
     fig, ax = plt.subplots(figsize=(6, 4))
@@ -90,5 +93,5 @@ def reaction_history(path, series, fem_level, fem_transient, title):
     ax.plot(t, r, "k-", lw=2.5, label=label)
     for label, t, r in series:
         ax.plot(t, r, label=label)
-    ax.axhline(fem_level, color="k", ls="--", label="FEM P2 static at 1.7 mm")
+    ax.axhline(fem_level, color="k", ls="--", label=level_label)
     _finish(fig, ax, path, "time [s]", "reaction on the driven nodes [N]", title)

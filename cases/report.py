@@ -1,4 +1,7 @@
-"""Write a case's results: metrics.json, report.md/.html, PNG figures, .vtu states, index."""
+"""Write a case's results: metrics.json, report.md/.html, PNG figures and .vtu states. The
+layout is the same for every case (conclusion, what was run, definitions, grouped findings, one
+table per mesh and boundary condition, figures); what is particular to a case comes from its
+hooks (``cases.framework.Case``)."""
 import datetime
 import json
 import platform
@@ -9,14 +12,26 @@ import numpy as np
 
 from model.mesh import write as write_mesh
 from . import figures
-from .paper_cube import LAYERS_MM, PUSH_MM, SIZE_MM
-from .document import Document, Link
+from .document import Document, fmt
+from .framework import STANDARD_GATED
+from .runner import jsonable
 
 TIMING_KEYS = ("step_time_s", "dyn_wall_s")
-CLEAR_ZIGZAG = 0.01  # below this the alternation is under 1 % of the profile
-PAPER_TETS = 374     # the paper's mesh (section 4), unpublished
-CAUCHY_TOL = 0.02    # an apparent Poisson ratio this close to 1/4 does not show anisotropy
-MM = 1e-3
+
+STANDARD_DEFINITIONS = (
+    "disp L2 P1 / P2: ||u_model - u_ref|| / ||u_ref|| over all nodes and components, against "
+    "FEM P1 on the same mesh and the converged P2 reference; disp max P2: "
+    "max_i |u_model,i - u_ref,i| / max_i |u_ref,i|.",
+    "reaction ratio: the force on the driven nodes along the driven axis, model over FEM P2 "
+    "(n/a in a load-controlled case, where it is the load).",
+    "stress corr / err: the paper's Figure 1 measure, max |tau| = G max |gamma| over the 24 "
+    "corner shear strains of each tetrahedron, computed on the model's and on the FEM P2 "
+    "displacement; Pearson correlation and relative L2 error (n/a where the reference field is "
+    "uniform).",
+    "pressure corr / err: model p = -K (V - V0)/V against the FEM P2 pressure -tr(sigma)/3 "
+    "averaged over each tetrahedron.",
+    "net F / net T: |sum f| / sum |f| and |sum x x f| / sum |x||f| of the model's internal "
+    "forces at the FEM P2 deformed state (zero for a momentum-conserving model).")
 
 
 def environment():
@@ -35,349 +50,139 @@ def environment():
             "date": datetime.datetime.now(datetime.timezone.utc).isoformat(timespec="seconds")}
 
 
-def fmt(v, digits=3):
-    if v is None:
-        return "n/a"
-    if isinstance(v, bool):
-        return "yes" if v else "no"
-    if isinstance(v, float):
-        return f"{v:.{digits}g}"
-    return str(v)
+def metrics_document(case, s, runs, extra=None):
+    """The metrics.json content of a case run: the parameters, the problem the gate compares,
+    the gated metrics with their direction, the runs, and what the case adds (``extra``)."""
+    return jsonable({"case": case.name, "parameters": s.describe(), "problem": s.problem(),
+                     "params": case.params(s), "gated": {**STANDARD_GATED, **case.gated},
+                     "headline": case.headline.metric, **(extra or {}),
+                     "environment": environment(), "runs": runs})
 
 
-def write_case(out, case, cfg, runs, fields):
-    """Write everything for ``case`` into ``out`` (created)."""
+def reference_summary(case, s, runs):
+    """``reference`` (the FEM quantities of the first (mesh, bc) run, with its error estimate),
+    ``references`` (every (mesh, bc)) and ``closed_form`` (per bc) for metrics.json."""
+    refs = []
+    for r in runs:
+        key = {"mesh": r["mesh"], "bc": r["bc"]}
+        if r.get("failed") or key in [{"mesh": x["mesh"], "bc": x["bc"]} for x in refs]:
+            continue
+        fem = {k: v for k, v in r.items() if "_fem" in k}
+        refs.append({**key, **fem, "p2_error_estimate": r["p2_error_estimate"]})
+    closed = {bc: case.closed_form(s, bc) for bc in s.bcs}
+    first = dict(refs[0]) if refs else {}
+    reference = {k.replace("_fem", ""): v for k, v in first.items()}
+    return {"reference": reference, "references": refs,
+            "closed_form": {bc: v for bc, v in closed.items() if v}
+            if len(s.bcs) > 1 else closed.get(s.bcs[0], {})}
+
+
+def write_case(out, case, s, runs, fields):
+    """Write everything for ``case`` into the folder ``out`` (created)."""
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
     (out / "vtu").mkdir(exist_ok=True)
-    meta = {"case": case, "parameters": cfg.describe(), "problem": cfg.problem(),
-            "environment": environment()}
-    (out / "metrics.json").write_text(json.dumps({**meta, "runs": runs}, indent=1) + "\n")
+    data = metrics_document(case, s, runs, reference_summary(case, s, runs))
+    (out / "metrics.json").write_text(json.dumps(data, indent=1) + "\n")
     for (mesh, bc, model), f in fields.items():
-        pdata = {"displacement": f["u"]}
         cdata = {k: f[k] for k in ("max_tau", "pressure") if k in f}
-        write_mesh(out / "vtu" / f"{mesh}_{bc}_{model}.vtu", f["mesh"], point_data=pdata,
-                   cell_data=cdata)
-    doc = build_report(case, cfg, runs, fields, out)
-    doc.write(out)
+        write_mesh(out / "vtu" / f"{mesh}_{bc}_{model}.vtu", f["mesh"],
+                   point_data={"displacement": f["u"]}, cell_data=cdata)
+    build_report(case, s, runs, fields, out).write(out)
     return out
-
-
-def _bracket(counts, paper):
-    """Whether the tetrahedron counts run bracket the paper's, with their range."""
-    lo, hi = min(counts), max(counts)
-    return (f"{'bracket' if lo <= paper <= hi else 'do not bracket'} it ({lo} to {hi} "
-            "tetrahedra)")
 
 
 def _runs(runs, **kw):
-    return [r for r in runs if all(r[k] == v for k, v in kw.items())]
+    return [r for r in runs if all(r.get(k) == v for k, v in kw.items())]
 
 
-def _value(r, key, scale=1.0):
-    """A run's metric for a chart: NaN (nothing drawn) where the run could not give it."""
-    return float("nan") if r[key] is None else r[key] * scale
-
-
-def _dynamic(r):
-    if r["dyn_failed"]:
-        return "blew up"
-    return "n/a" if r["dyn_vs_static_rel_l2"] is None else fmt(r["dyn_vs_static_rel_l2"], 2)
-
-
-def _step_time(r):
-    if r["step_time_s"] is None:
-        return "n/a (blew up)"
-    return fmt(r["step_time_s"] * 1e6) + (" (at rest)" if r["step_time_state"] == "rest" else "")
-
-
-def build_report(case, cfg, runs, fields, out):
-    meshes, bcs, models = cfg.meshes, cfg.bcs, cfg.models
-    doc = Document(f"pbcm report: {case}")
+def build_report(case, s, runs, fields, out):
+    doc = Document(f"pbcm report: {case.name}")
+    for line in case.conclusion(s, runs):
+        doc.p(line)
     doc.p("Generated by `pbcm` from the runs recorded in metrics.json; every number below was "
           "computed by the run that wrote this file.")
     doc.h(2, "What was run")
-    doc.ul([
-        f"Cube of side {SIZE_MM:g} mm, 5 x 5 x 5 lattice nodes; meshes {', '.join(meshes)}. "
-        "The paper's own 374-tetrahedron mesh is not published, so it cannot be reproduced: "
-        f"the meshes here {_bracket([r['tets'] for r in runs], PAPER_TETS)}.",
-        f"Top nodes (y = {SIZE_MM:g} mm) pushed down {PUSH_MM:g} mm; boundary conditions "
-        f"{', '.join(bcs)} (clamped: bottom fixed, top fully prescribed; sliding: only y "
-        "prescribed at top and bottom, rigid motions pinned). The paper does not say which.",
-        f"Material E = {cfg.E:g} Pa, nu = {cfg.nu:g}, rho = {cfg.rho:g} kg/m^3: the paper gives "
-        "none, these are the suite's defaults (override with --E, --nu, --rho).",
-        f"Models: {', '.join(models)}. Static equilibrium at 1.7 mm (Newton, residual below "
-        "1e-9 E h^2) and the paper's dynamic run: classical RK4, 1.7 mm/s for 1 s, then held "
-        f"until at rest (mass damping {cfg.damping:g} 1/s, at most {cfg.hold_max:g} s).",
-        f"References: linear FEM P1 on the same mesh, and P2 on {cfg.p2_levels} uniform "
+    doc.ul([case.title + "."] + case.what_was_run(s, runs) + [
+        f"Meshes {', '.join(s.meshes)}; boundary conditions {', '.join(s.bcs)}; models "
+        f"{', '.join(s.models)}.",
+        f"Material E = {s.E:g} Pa, nu = {s.nu:g}, rho = {s.rho:g} kg/m^3 (override with --E, "
+        "--nu, --rho).",
+        f"References: linear FEM P1 on the same mesh, and P2 on {s.p2_levels} uniform "
         "refinement(s) (the converged reference, evaluated at the particle nodes) with its own "
         "error estimate.",
-        "Quick mode (fewer meshes, one P2 refinement, fewer timing repeats)." if cfg.quick
-        else "Full mode."])
+        "Quick mode." if s.quick else "Full mode."])
     doc.h(2, "Definitions")
-    doc.ul([
-        "disp L2 P1 / P2: ||u_model - u_ref|| / ||u_ref|| over all nodes and components; "
-        "disp max P2: max_i |u_model,i - u_ref,i| / max_i |u_ref,i|.",
-        "reaction ratio: total y reaction on the driven (top) nodes, model over FEM P2.",
-        "stress corr / err: the paper's Figure 1 measure, max |tau| = G max |gamma| over the 24 "
-        "corner shear strains of each tetrahedron, computed on the model's and on the FEM P2 "
-        "displacement; Pearson correlation and relative L2 error. n/a where the reference field "
-        "is uniform (sliding case: the exact solution is homogeneous).",
-        "pressure corr / err: model p = -K (V - V0)/V against the FEM P2 pressure -tr(sigma)/3 "
-        "averaged over each tetrahedron.",
-        "layer profile: for each y-layer (0, 8, 16, 24, 32 mm) the mean outward lateral "
-        "displacement of the side-face nodes.",
-        "zig-zag: RMS residual of a least-squares quadratic fit to the five-layer profile, over "
-        "its largest |value|: 0 for a barrel or uniform expansion, about 0.86 for pure "
-        "alternation.",
-        "paper pattern: the middle and end layers bulge relative to their neighbours while the "
-        "8 and 24 mm layers neck (second differences +, -, +), as the paper's section 5 reports.",
-        "net F / net T: |sum f| / sum |f| and |sum x x f| / sum |x||f| of the model's internal "
-        "forces at the FEM P2 deformed state (zero for a momentum-conserving model).",
-        "growth: the largest exponential growth rate of the undamped model linearised at rest "
-        "(max Re sqrt(eig(M^-1 df/dx))); above zero the force field flutters.",
-        "dt/4: the dynamic run repeated at a quarter of the step (does its verdict hold?).",
-        "reaction(t) err: relative L2 of the top reaction over push and hold against the FEM "
-        "transient on the same boundary motion (Newmark, consistent mass, the same mass "
-        "damping); disp end push err: relative L2 of the displacement at the end of the push "
-        "against it; rest: when every node is slower than the rest speed (checked every "
-        "0.1 s of hold).",
-        "modal err: the first 10 frequencies of the model linearised at rest, with the case's "
-        "constraints, against FEM P2 (largest relative error); modal err free: the same "
-        "free-free after the rigid modes; rigid modes: zero eigenvalues free-free (6 expected).",
-        "dyn vs static: relative L2 distance between the end of the dynamic run and the static "
-        "equilibrium.",
-        "step time: median over repeats of the wall time of one RK4 step of the full "
-        "integrator, during the push; marked (at rest) where the push blows up within the "
-        "timed steps and the same steps were timed with the boundary held still."])
+    doc.ul(list(STANDARD_DEFINITIONS) + list(case.definitions))
+    failed = [r for r in runs if r.get("failed")]
+    groups = dict(case.findings(s, [r for r in runs if not r.get("failed")]))
+    if failed:
+        groups["Runs that could not start"] = sorted({f"{r['mesh']}/{r['bc']}: {r['failed']}"
+                                                      for r in failed})
     doc.h(2, "Findings")
-    doc.ul(findings(runs, cfg))
-    for mesh in meshes:
-        for bc in bcs:
-            rs = _runs(runs, mesh=mesh, bc=bc)
-            if not rs:
-                continue
-            doc.h(2, f"Mesh {mesh}, {bc}")
-            doc.p(f"{rs[0]['nodes']} nodes, {rs[0]['tets']} tetrahedra; FEM P2 reaction "
-                  f"{fmt(rs[0]['reaction_fem_p2_n'], 4)} N; P2 reference error estimate "
-                  f"{fmt(rs[0]['p2_error_estimate'], 2)}; FEM {cfg.transient_element} "
-                  f"transient at rest after {fmt(rs[0]['rest_time_fem_s'], 2)} s.")
-            doc.table(["model", "disp L2 P1", "disp L2 P2", "disp max P2", "reaction ratio",
-                       "stress corr", "stress err", "pressure corr", "zig-zag",
-                       "paper pattern", "net F", "net T", "growth [1/s]", "dyn vs static",
-                       "dt/4", "reaction(t) err", "disp end push err", "rest [s]",
-                       "modal err", "modal err free", "rigid modes", "step time [us]"],
-                      [[r["model"], fmt(r["disp_rel_l2_p1"]), fmt(r["disp_rel_l2_p2"]),
-                        fmt(r["disp_max_rel_p2"]), fmt(r["reaction_ratio"]),
-                        fmt(r["stress_corr"]), fmt(r["stress_rel_err"]),
-                        fmt(r["pressure_corr"]), fmt(r["zigzag"]), fmt(r["paper_pattern"]),
-                        fmt(r["net_force_rel"], 2), fmt(r["net_torque_rel"], 2),
-                        fmt(r["growth_rate_1_s"]), _dynamic(r),
-                        "blew up" if r["dyn_failed_dt4"] else "ok",
-                        fmt(r["reaction_time_rel_l2"]), fmt(r["disp_end_push_rel_l2"]),
-                        fmt(r["rest_time_s"], 2), fmt(r["modal_rel_err"]),
-                        fmt(r["modal_rel_err_free"]), r["rigid_modes_free"], _step_time(r)]
-                       for r in rs])
-            failed = [r for r in rs if r["static_failed"]]
-            if failed:
-                doc.p("Static solve failed (its metrics are n/a): " + "; ".join(
-                    f"{r['model']}: {r['static_failed']}" for r in failed) + ".")
-            solved = [r for r in rs if not r["static_failed"]]
-            doc.table(["layer y [mm]", "FEM P2"] + [r["model"] for r in solved],
-                      [[fmt(y), fmt(rs[0]["bulge_profile_fem_mm"][k], 4)]
-                       + [fmt(r["bulge_profile_mm"][k], 4) for r in solved]
-                       for k, y in enumerate(LAYERS_MM)])
-            name = f"fig1_{mesh}_{bc}.png"
-            panels = [("FEM P2", *_field(fields, mesh, bc, "fem-p2"))]
-            panels += [(m, *_field(fields, mesh, bc, m)) for m in models
-                       if (mesh, bc, m) in fields]
-            figures.stress_panels(out / name, panels, f"max |tau|, mesh {mesh}, {bc}", 5.0)
-            doc.img(name, f"Figure 1 analogue: mesh {mesh}, {bc}")
-            name = f"profile_{mesh}_{bc}.png"
-            figures.profiles(out / name, LAYERS_MM,
-                             [(r["model"], r["bulge_profile_mm"]) for r in solved],
-                             rs[0]["bulge_profile_fem_mm"], f"layer profile, mesh {mesh}, {bc}")
-            doc.img(name, f"Layer profiles: mesh {mesh}, {bc}")
-    groups = [f"{r['mesh']}/{r['bc']}" for r in runs if r["model"] == models[0]]
-    keys = [(g.split("/")[0], g.split("/")[1]) for g in groups]
-    doc.h(2, "Errors and cost")
-    figures.grouped_bars(out / "errors.png", groups, models,
-                         [[_value(_runs(runs, mesh=m, bc=b, model=mo)[0], "disp_rel_l2_p2")
-                           for mo in models] for m, b in keys],
-                         "relative L2 displacement error vs FEM P2", "Displacement error",
-                         log=True)
-    doc.img("errors.png", "Relative L2 displacement error against the converged P2 reference")
-    figures.grouped_bars(out / "step_time.png", groups, models,
-                         [[_value(_runs(runs, mesh=m, bc=b, model=mo)[0], "step_time_s", 1e6)
-                           for mo in models] for m, b in keys],
-                         "wall time of one RK4 step [us]", "Step time (the paper's Figure 2)",
-                         log=True)
-    doc.img("step_time.png", "Time of one RK4 step per model (the analogue of Figure 2)")
-    m0, b0 = keys[0]
-    figures.reaction_history(out / "reaction_time.png",
-                             [(r["model"], r["dyn_reaction_t_s"], r["dyn_reaction_n"])
-                              for r in _runs(runs, mesh=m0, bc=b0) if not r["dyn_failed"]],
-                             _runs(runs, mesh=m0, bc=b0)[0]["reaction_fem_p2_n"],
-                             (f"FEM {cfg.transient_element} transient",
-                              fields[(m0, b0, "fem-p2")]["transient"]["t"],
-                              fields[(m0, b0, "fem-p2")]["transient"]["reaction_y"]),
-                             f"dynamic run, mesh {m0}, {b0}")
-    doc.img("reaction_time.png", f"Reaction force against time, mesh {m0}, {b0}")
+    for title, items in groups.items():
+        if items:
+            doc.h(3, title)
+            doc.ul(items)
+    _tables(doc, case, s, runs)
+    case.sections(doc, s, runs, fields, out)
+    _standard_figures(doc, case, s, runs, fields, out)
     return doc
 
 
-def _field(fields, mesh, bc, model):
-    f = fields[(mesh, bc, model)]
-    return f["mesh"], f["u"], f["max_tau"]
+def _tables(doc, case, s, runs):
+    extra = case.columns()
+    for mesh in s.meshes:
+        for bc in s.bcs:
+            rs = [r for r in _runs(runs, mesh=mesh, bc=bc) if not r.get("failed")]
+            if not rs:
+                continue
+            doc.h(2, f"Mesh {mesh}, {bc}")
+            line = f"{rs[0]['nodes']} nodes, {rs[0]['tets']} tetrahedra"
+            if rs[0].get("reaction_fem_p2_n") is not None:
+                line += f"; FEM P2 reaction {fmt(rs[0]['reaction_fem_p2_n'], 4)} N"
+            doc.p(line + f"; P2 reference error estimate {fmt(rs[0]['p2_error_estimate'], 2)}.")
+            doc.table(["model", "disp L2 P1", "disp L2 P2", "disp max P2", "reaction ratio",
+                       "stress corr", "stress err", "pressure corr", "net F", "net T"]
+                      + [h for h, _ in extra],
+                      [[r["model"], fmt(r["disp_rel_l2_p1"]), fmt(r["disp_rel_l2_p2"]),
+                        fmt(r["disp_max_rel_p2"]), fmt(r["reaction_ratio"]),
+                        fmt(r["stress_corr"]), fmt(r["stress_rel_err"]),
+                        fmt(r["pressure_corr"]), fmt(r["net_force_rel"], 2),
+                        fmt(r["net_torque_rel"], 2)] + [f(r) for _, f in extra] for r in rs])
+            bad = [r for r in rs if r["static_failed"]]
+            if bad:
+                doc.p("Static solve failed (its metrics are n/a): " + "; ".join(
+                    f"{r['model']}: {r['static_failed']}" for r in bad) + ".")
 
 
-def _stability(r, cfg):
-    """What the run at dt/4 and the linearised growth rate say of a blow-up: computed, never
-    assumed."""
-    at4 = "blows up at dt/4 too" if r["dyn_failed_dt4"] else "comes to rest at dt/4"
-    g, damp = r["growth_rate_1_s"], cfg.damping / 2
-    return (f"Repeated at dt/4 it {at4}. Linearised at rest it grows at {g:.3g} 1/s, "
-            + ("above" if g > damp else "below") + f" the {damp:g} 1/s mass damping removes"
-            + (": flutter that a smaller step does not cure." if g > damp and r["dyn_failed_dt4"]
-               else ": the step, not the model, was unstable." if not r["dyn_failed_dt4"]
-               else "."))
+def _standard_figures(doc, case, s, runs, fields, out):
+    """The headline error of every run as bars per (mesh, bc), and the max |tau| panels of
+    the first (mesh, bc) for cases that draw none of their own."""
+    keys = [(m, b) for m in s.meshes for b in s.bcs
+            if any(not r.get("failed") for r in _runs(runs, mesh=m, bc=b))]
+    if not keys:
+        return
+    metric = case.headline.metric
+    doc.h(2, "Headline error")
+    figures.grouped_bars(out / "errors.png", [f"{m}/{b}" for m, b in keys], s.models,
+                         [[_chart_value(runs, m, b, mo, metric) for mo in s.models]
+                          for m, b in keys], f"{metric}", case.headline.label, log=True)
+    doc.img("errors.png", f"{case.headline.label} ({metric}) per run")
+    if case.draws_stress:
+        return
+    for m, b in keys[:1]:
+        panels = [("FEM P2", fields[(m, b, "fem-p2")]["mesh"], fields[(m, b, "fem-p2")]["u"],
+                   fields[(m, b, "fem-p2")]["max_tau"])]
+        panels += [(mo, fields[(m, b, mo)]["mesh"], fields[(m, b, mo)]["u"],
+                    fields[(m, b, mo)]["max_tau"]) for mo in s.models if (m, b, mo) in fields]
+        name = f"stress_{m}_{b}.png"
+        figures.stress_panels(out / name, panels, f"max |tau|, mesh {m}, {b}",
+                              case.magnify)
+        doc.img(name, f"Deformed shape and max |tau|: mesh {m}, {b}")
 
 
-def findings(runs, cfg):
-    """Plain statements computed from the runs."""
-    out = []
-    pattern = [r for r in runs if r["paper_pattern"]]
-    solved = [r for r in runs if not r["static_failed"]]
-    fem_pattern = {(r["mesh"], r["bc"]) for r in runs if r["paper_pattern_fem"]}
-
-    def listing(rs):
-        return "; ".join(f"{r['model']} on {r['mesh']}/{r['bc']} (profile "
-                         + ", ".join(f"{v:.4f}" for v in r["bulge_profile_mm"])
-                         + f" mm, zig-zag {r['zigzag']:.3g})" for r in rs)
-
-    clear = [r for r in pattern if r["zigzag"] >= CLEAR_ZIGZAG]
-    faint = [r for r in pattern if r["zigzag"] < CLEAR_ZIGZAG]
-    if clear:
-        out.append("The paper's bulge at 0/16/32 mm and neck at 8/24 mm is reproduced clearly "
-                   f"(zig-zag >= {CLEAR_ZIGZAG:g}) by: {listing(clear)}.")
-    if faint:
-        out.append(f"The same sign pattern appears faintly (zig-zag < {CLEAR_ZIGZAG:g}) in: "
-                   f"{listing(faint)}.")
-    if not pattern:
-        out.append("No model reproduces the paper's bulge at 0/16/32 mm and neck at 8/24 mm on "
-                   "any mesh and boundary condition run here.")
-    none = sorted({(r["model"]) for r in runs} - {r["model"] for r in pattern})
-    if none:
-        out.append(f"Never showing the pattern: {', '.join(none)}.")
-    out.append("The converged FEM reference shows the pattern on "
-               + (", ".join(f"{m}/{b}" for m, b in sorted(fem_pattern)) if fem_pattern
-                  else "no mesh and boundary condition") + ": where a model shows it, it is an "
-               "artefact of the model, not of the continuum.")
-    clamped = [r for r in runs if r["bc"] == "clamped"]
-    if clamped:
-        out.append("Clamped bottom: the y = 0 layer cannot move laterally, so the paper's "
-                   "reported bulge at y = 0 is impossible under a clamped base; the paper's "
-                   "base was therefore probably not fully clamped, or the bulge is relative.")
-    for r in runs:
-        if r["static_failed"]:
-            out.append(f"No static equilibrium for {r['model']} on {r['mesh']}/{r['bc']}: "
-                       f"{r['static_failed']}.")
-    for bc in cfg.bcs:
-        rs = [r for r in solved if r["bc"] == bc]
-        if rs:
-            best = min(rs, key=lambda r: r["disp_rel_l2_p2"])
-            worst = max(rs, key=lambda r: r["disp_rel_l2_p2"])
-            out.append(f"{bc}: smallest displacement error against P2 {best['disp_rel_l2_p2']:.3g}"
-                       f" ({best['model']}, {best['mesh']}), largest {worst['disp_rel_l2_p2']:.3g}"
-                       f" ({worst['model']}, {worst['mesh']}).")
-    for model in cfg.models:
-        rs = [r for r in solved if r["model"] == model]
-        if rs:
-            rr = [r["reaction_ratio"] for r in rs]
-            out.append(f"{model}: stiffness (reaction ratio to FEM P2) {min(rr):.3g} to "
-                       f"{max(rr):.3g}; net force up to {max(r['net_force_rel'] for r in rs):.2g}"
-                       f", net torque up to {max(r['net_torque_rel'] for r in rs):.2g} of the "
-                       "force scale.")
-    failed = [r for r in runs if r["dyn_failed"]]
-    for r in failed:
-        out.append(f"Dynamic run of {r['model']} on {r['mesh']}/{r['bc']} blew up: "
-                   f"{r['dyn_failed']}. " + _stability(r, cfg))
-    for r in runs:
-        if not r["dyn_failed"] and r["dyn_failed_dt4"]:
-            out.append(f"Verdict changes with the step: {r['model']} on {r['mesh']}/{r['bc']} "
-                       f"comes to rest at dt but blows up at dt/4 ({r['dyn_failed_dt4']}). "
-                       + _stability(r, cfg))
-    odd = [r for r in runs if r["rigid_modes_free"] != 6]
-    if odd:
-        out.append("Rigid modes free-free other than 6 (zero-energy deformation modes, or "
-                   "rigid motions the forces resist): " + "; ".join(
-                       f"{r['model']} on {r['mesh']}: {r['rigid_modes_free']}" for r in odd) + ".")
-    else:
-        out.append("Every model has exactly 6 rigid modes free-free on every mesh run.")
-    for model in cfg.models:
-        rs = [r for r in runs if r["model"] == model and r["reaction_time_rel_l2"] is not None]
-        if rs:
-            out.append(f"{model} against the FEM {cfg.transient_element} transient: top reaction "
-                       f"over push and hold off by {min(r['reaction_time_rel_l2'] for r in rs):.3g}"
-                       f" to {max(r['reaction_time_rel_l2'] for r in rs):.3g} (relative L2); "
-                       "first 10 frequencies with the case's constraints off by up to "
-                       f"{max(r['modal_rel_err'] for r in runs if r['model'] == model):.3g}.")
-    unstable = sorted({(r["model"], r["mesh"], r["bc"], r["growth_rate_1_s"]) for r in runs
-                       if r["growth_rate_1_s"] > 0})
-    if unstable:
-        steady = sorted({r["model"] for r in runs} - {u[0] for u in unstable})
-        out.append("Flutter (positive growth rate of the undamped linearised model): "
-                   + "; ".join(f"{m} on {me}/{b}: {g:.3g} 1/s" for m, me, b, g in unstable)
-                   + (f". No flutter on any mesh and condition run: {', '.join(steady)}."
-                      if steady else "."))
-    rest = [r for r in runs if r["step_time_state"] == "rest"]
-    if rest:
-        out.append("Step time taken at rest (the push blew up within the timed steps; a step "
-                   "costs the same arithmetic at rest) for: " + ", ".join(
-                       f"{r['model']} on {r['mesh']}/{r['bc']}" for r in rest) + ".")
-    for r in runs:
-        if r["step_time_s"] is None:
-            out.append(f"No step time for {r['model']} on {r['mesh']}/{r['bc']}: every timed "
-                       f"run blew up ({r['step_time_state'][len('failed: '):]}).")
-    timed = [r for r in runs if r["step_time_s"] is not None]
-    msm = [r["step_time_s"] for r in timed if r["model"] == "msm"]
-    if msm:
-        for model in cfg.models:
-            own = [r["step_time_s"] for r in timed if r["model"] == model]
-            if model.startswith("pbcm") and own:
-                ratio = np.median(own) / np.median(msm)
-                out.append(f"Cost: one RK4 step of {model} takes {ratio:.1f}x the MSM step "
-                           "(the paper reports more than 10x).")
-    slide_msm = [r for r in solved if r["model"] == "msm" and r["bc"] == "sliding"]
-    for r in slide_msm:
-        lateral = np.mean(r["bulge_profile_mm"])
-        nu_eff = lateral / (PUSH_MM / SIZE_MM * SIZE_MM / 2)
-        # the Cauchy relations bind an isotropic central-force network to nu = 1/4: a measured
-        # ratio away from it shows the lattice's springs are not isotropic, one near it does not
-        why = ("these lattices are not isotropic" if abs(nu_eff - 0.25) > CAUCHY_TOL else
-               f"this one is within {CAUCHY_TOL:g} of it")
-        out.append(f"msm on {r['mesh']}/sliding: apparent Poisson ratio {nu_eff:.3f} from the "
-                   f"lateral expansion, for nu = {cfg.nu:g} asked (an isotropic spring network "
-                   f"is bound to 1/4 by the Cauchy relations; {why}).")
-    return out
-
-
-def index_documents(root, cases):
-    """The Markdown and HTML of reports/index: one row per case with its headline numbers."""
-    root = Path(root)
-    doc = Document("pbcm reports")
-    doc.p("Each case folder holds metrics.json, report.md, report.html and the figures; "
-          "regenerate with `pbcm report`.")
-    rows = []
-    for case in cases:
-        data = json.loads((root / case / "metrics.json").read_text())
-        runs = data["runs"]
-        solved = [r for r in runs if r["disp_rel_l2_p2"] is not None]
-        best = min(solved, key=lambda r: r["disp_rel_l2_p2"]) if solved else None
-        rows.append([Link(case, f"{case}/report.md", f"{case}/report.html"), len(runs),
-                     f"{best['model']} ({best['mesh']}/{best['bc']}): "
-                     f"{best['disp_rel_l2_p2']:.3g}" if best else "no static solution",
-                     sum(bool(r["paper_pattern"]) for r in runs), data["environment"]["git_commit"][:10]])
-    doc.table(["case", "runs", "smallest displacement error vs P2", "runs with the paper's "
-               "pattern", "commit"], rows)
-    return doc.markdown() + "\n", doc.html(root) + "\n"
+def _chart_value(runs, mesh, bc, model, metric):
+    """A run's metric for a chart: NaN (nothing drawn) where the run could not give it."""
+    rs = _runs(runs, mesh=mesh, bc=bc, model=model)
+    return float("nan") if not rs or rs[0].get(metric) is None else rs[0][metric]

@@ -90,6 +90,7 @@ class Measurements:
 
     values: dict
     problems: dict
+    directions: dict = None
 
 
 @dataclass
@@ -154,12 +155,13 @@ def measured(metrics_dir):
     files = [p] if p.is_file() else sorted(p.glob("**/metrics.json"))
     if not files:
         raise CheckError(f"no metrics.json under {p}; run `pbcm run CASE` first")
-    values, problems = {}, {}
+    values, problems, directions = {}, {}, {}
     for f in files:
         try:
             data = json.loads(f.read_text())
             case, mode = data["case"], "quick" if data["parameters"]["quick"] else "full"
             runs, problem = data["runs"], data["problem"]
+            gated = data.get("gated", GATED)
         except (ValueError, KeyError, TypeError) as exc:
             raise CheckError(f"{f} is not a pbcm metrics file of this version (lacks {exc}); "
                              "rerun the case") from None
@@ -167,10 +169,11 @@ def measured(metrics_dir):
             raise CheckError(f"two metrics files of {case} ({mode} mode) under {p} were run at "
                              "different parameters; check them one at a time")
         problems[(case, mode)] = problem
+        directions.update(gated)
         for r in runs:
-            for metric in GATED:
+            for metric in gated:
                 values[(case, mode, r["mesh"], r["bc"], r["model"], metric)] = r.get(metric)
-    return Measurements(values, problems)
+    return Measurements(values, problems, directions)
 
 
 def _same_problem(case, mode, recorded, ran):
@@ -246,7 +249,8 @@ def bless(measurements, old=None, rtol=None, prune=False, today=None):
             raise CheckError(f"cannot bless {'/'.join(key)}: measured {v!r}")
         o = prev.get(key)
         tol = (rtol if rtol is not None else o.rtol if o else RTOL, o.atol if o else ATOL)
-        b = Bound(*key, float(v), *tol, GATED[key[-1]], today)
+        direction = {**GATED, **(measurements.directions or {})}[key[-1]]
+        b = Bound(*key, float(v), *tol, direction, today)
         if o is None:
             changes.append(f"new     {'/'.join(key)}: {v:.6g}")
         elif o.value != b.value or (o.rtol, o.atol) != tol:

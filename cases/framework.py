@@ -1,0 +1,279 @@
+"""The case contract: what a case declares, and what the shared runner (``cases.runner``) does
+with it.
+
+A case is a module that declares one :class:`Case` subclass: its geometry and mesh family,
+boundary conditions and loads, quantities of interest, closed form, quick and full settings and
+any case-specific metric, finding or figure. It does not loop, solve the FEM references, compute
+the standard metrics, write files or gate: the runner, ``cases.report`` and ``cases.thresholds``
+do that for every case alike. Millimetres stop at the case module's edge: everything a case
+hands the runner is in SI units, except the quantities it names ``*_mm`` for its report.
+"""
+import abc
+from dataclasses import dataclass, field, fields
+from typing import ClassVar
+
+import numpy as np
+
+from model import PRESETS, Material, build
+from model.mesh import SCHEMES
+from model.loads import body_forces, traction_forces
+
+MM = 1e-3
+MESH_FAMILIES = SCHEMES          # five, six, bcc, unstructured
+STANDARD_GATED = {"disp_rel_l2_p1": "max", "disp_rel_l2_p2": "max", "disp_max_rel_p2": "max",
+                  "reaction_rel_err": "max", "stress_corr": "min", "stress_rel_err": "max",
+                  "pressure_rel_err": "max", "net_force_rel": "max"}
+
+
+@dataclass
+class Settings:
+    """What one run of a case does: the material (defaults E = 10 kPa, nu = 0.45,
+    rho = 1000 kg/m^3), the selection (meshes, boundary conditions, models) and the
+    resolution of the references. A case subclasses it to add its own fields (geometry, load,
+    steps) and names them in ``problem()``."""
+
+    E: float = 10e3
+    nu: float = 0.45
+    rho: float = 1000.0
+    meshes: tuple = ()
+    bcs: tuple = ()
+    models: tuple = ()
+    p2_levels: int = 1          # refinements of the converged P2 reference
+    quick: bool = False
+    shear_scale: float = 1.0    # testing knob: scales every shear term (1 = the model)
+    material: Material = field(init=False, repr=False, compare=False)
+
+    def __post_init__(self):
+        self.material = Material(E=self.E, nu=self.nu, rho=self.rho)
+
+    def problem(self):
+        """The parameters that define the problem the metrics answer (what a bound was
+        measured at). Subclasses add their geometry and loads."""
+        return {"E_Pa": self.E, "nu": self.nu, "rho_kg_m3": self.rho,
+                "p2_levels": self.p2_levels}
+
+    def describe(self):
+        """Everything the run was given: the problem, the selection and the switches."""
+        return {**self.problem(), "meshes": list(self.meshes), "bcs": list(self.bcs),
+                "models": list(self.models), "quick": self.quick,
+                "shear_scale": self.shear_scale}
+
+
+@dataclass(frozen=True)
+class Traction:
+    """A uniform traction ``value`` [Pa] (3,) on the boundary facets lying in the plane
+    x_axis = ``at`` [m]."""
+
+    axis: int
+    at: float
+    value: tuple
+
+
+@dataclass(frozen=True)
+class Loads:
+    """The loads of a case: tractions and a constant body force [N/m^3]. The FEM references
+    integrate them exactly; the particle model receives them as consistent nodal forces
+    (``nodal_forces``)."""
+
+    tractions: tuple = ()
+    body_force: tuple = None
+
+    def nodal_forces(self, mesh):
+        """Consistent nodal forces (n, 3) [N] of these loads on ``mesh`` (P1 shape functions),
+        or None when there is no load."""
+        if not self.tractions and self.body_force is None:
+            return None
+        f = np.zeros_like(mesh.points)
+        for t in self.tractions:
+            f += traction_forces(mesh, t.axis, t.at, t.value)
+        if self.body_force is not None:
+            f += body_forces(mesh, self.body_force)
+        return f
+
+    def fem_traction(self, tol):
+        """The tractions as the callable ``(points, normals) -> (..., 3)`` that
+        ``reference.linear.solve`` takes (None without tractions)."""
+        if not self.tractions:
+            return None
+        tractions = self.tractions
+
+        def traction(points, normals):
+            out = np.zeros_like(points)
+            for t in tractions:
+                on = np.abs(points[..., t.axis] - t.at) <= tol
+                out += np.where(on[..., None], np.asarray(t.value, float), 0.0)
+            return out
+        return traction
+
+
+@dataclass(frozen=True)
+class Headline:
+    """The metric that sums a case up in the scorecard: ``metric`` (an error, smaller is
+    better, per run) and how the index names it."""
+
+    metric: str
+    label: str
+
+
+@dataclass
+class Reference:
+    """The FEM side of one (mesh, bc), as the runner computes it by default: P1 on the mesh,
+    converged P2 (``conv``, its finest solution ``p2``), the paper's max |tau| of the P2
+    displacement (``tau``), the reaction on the driven nodes, the case's quantities of
+    interest of the P2 solution, and anything the case adds in ``extra``."""
+
+    dirichlet: dict
+    f_ext: np.ndarray
+    p1: object
+    conv: object
+    p2: object
+    tau: np.ndarray
+    reaction: float
+    quantities: dict
+    error_estimate: float
+    extra: dict = field(default_factory=dict)
+
+
+class Case(abc.ABC):
+    """A case, declared. Subclasses set the class attributes and implement ``mesh`` and
+    ``dirichlet``; every other hook has a default that fits a static linear problem.
+
+    Attributes
+    ----------
+    name : the name on the command line and the folder under reports/.
+    title : one line for the report and ``pbcm list``.
+    settings_class : the Settings subclass with the case's own fields.
+    meshes, quick_meshes : mesh families run in full and in quick mode.
+    bcs, quick_bcs : boundary-condition names (quick_bcs None: all of them in quick mode).
+    models : model presets (default every preset).
+    quick : settings that ``--quick`` changes (e.g. ``{"p2_levels": 1}``).
+    headline : the scorecard's metric.
+    gated : case metrics the CI gate bounds beside the standard ones, {metric: "max"/"min"}.
+    qoi_errors : scalar quantities of interest that get ``<name>_rel_err`` = |model / FEM - 1|.
+    definitions : report lines defining the case's own metrics.
+    draws_stress, magnify : whether the case draws its own stress panels; the magnification
+        of the standard ones.
+    """
+
+    name: ClassVar[str]
+    title: ClassVar[str]
+    settings_class: ClassVar[type] = Settings
+    meshes: ClassVar[tuple] = MESH_FAMILIES
+    quick_meshes: ClassVar[tuple] = ("five",)
+    bcs: ClassVar[tuple] = ("clamped",)
+    quick_bcs: ClassVar[tuple] = None
+    models: ClassVar[tuple] = tuple(PRESETS)
+    quick: ClassVar[dict] = {}
+    headline: ClassVar[Headline] = Headline("disp_rel_l2_p2", "displacement error vs FEM P2")
+    gated: ClassVar[dict] = {}
+    qoi_errors: ClassVar[tuple] = ()
+    definitions: ClassVar[tuple] = ()
+    draws_stress: ClassVar[bool] = False   # True: the case draws its own max |tau| panels
+    magnify: ClassVar[float] = 5.0         # displacement magnification of the panels
+
+    # ------------------------------------------------------------------ settings
+    def settings(self, quick=False, **kw):
+        """The case's Settings: full by default, with ``quick`` overrides, then ``kw``
+        (None values ignored: what the user did not give)."""
+        kw = {k: v for k, v in kw.items() if v is not None}
+        base = {"meshes": self.quick_meshes if quick else self.meshes,
+                "bcs": (self.quick_bcs or self.bcs) if quick else self.bcs,
+                "models": self.models, **(self.quick if quick else {}), "quick": quick}
+        names = {f.name for f in fields(self.settings_class) if f.init}
+        return self.settings_class(**{k: v for k, v in {**base, **kw}.items() if k in names})
+
+    # ------------------------------------------------------------------ declaration
+    @abc.abstractmethod
+    def mesh(self, family, s):
+        """The TetMesh of mesh family ``family`` (SI units)."""
+
+    @abc.abstractmethod
+    def dirichlet(self, mesh, bc, s):
+        """The prescribed displacements of boundary condition ``bc``: {node: (ux, uy, uz)}."""
+
+    def loads(self, mesh, bc, s):
+        """The case's loads (default none)."""
+        return Loads()
+
+    def driven(self, mesh, bc, s):
+        """(nodes, axis) whose summed reaction along ``axis`` is the case's force (the
+        ``reaction_*`` metrics), or None for a load-controlled case."""
+        return None
+
+    def quantities(self, mesh, u, reaction, s, bc):
+        """Quantities of interest of a displacement ``u`` (n, 3) and reaction (n, 3), computed
+        alike for the model and the FEM reference; names ending in _mm are in millimetres."""
+        return {}
+
+    def closed_form(self, s, bc):
+        """Closed-form values of quantities of interest (same names), where one exists."""
+        return {}
+
+    def params(self, s):
+        """The case's parameters for metrics.json ``params`` (default: the problem)."""
+        return s.problem()
+
+    # ------------------------------------------------------------------ phases
+    def build_model(self, name, mesh, s):
+        """The particle model ``name`` (a preset), with the test-only shear scale."""
+        has_shear = any(t == "shear" for t, _ in PRESETS[name])
+        extra = {"shear": {"scale": s.shear_scale}} if has_shear and s.shear_scale != 1 else {}
+        return build(name, mesh, s.material, **extra)
+
+    def reference_extra(self, mesh, bc, s, ref):
+        """Case-specific reference work (a transient, modes), stored in ``ref.extra``."""
+        return {}
+
+    def reference_entries(self, ref):
+        """Entries of the reference copied into every run of its (mesh, bc)."""
+        return {}
+
+    def solve_static(self, pm, mesh, bc, s, ref):
+        """The model's static solution (default one Newton solve with the loads)."""
+        return pm.solve_static(ref.dirichlet, f_ext=ref.f_ext)
+
+    def run_extra(self, pm, mesh, bc, s, ref, st):
+        """Case-specific metrics of one run; ``st`` is None when the static solve failed."""
+        return {}
+
+    # ------------------------------------------------------------------ report
+    def what_was_run(self, s, runs):
+        """Report lines saying what the case ran (geometry, loads, references)."""
+        return []
+
+    def conclusion(self, s, runs):
+        """Three lines that open the report, computed from the runs."""
+        return []
+
+    def findings(self, s, runs):
+        """{group title: [sentences]} computed from the runs."""
+        return {}
+
+    def columns(self):
+        """Extra columns of the per-(mesh, bc) table: [(header, run -> text)]."""
+        return []
+
+    def sections(self, doc, s, runs, fields, out):
+        """Case-specific sections and figures, written into ``out`` and added to ``doc``."""
+
+
+def ref_name(name):
+    """The run key of the FEM value of quantity ``name``: '_fem' before a unit suffix
+    (bulge_profile_mm -> bulge_profile_fem_mm, zigzag -> zigzag_fem)."""
+    for unit in ("_mm", "_n", "_nm", "_hz", "_s", "_pa"):
+        if name.endswith(unit):
+            return name[:-len(unit)] + "_fem" + unit
+    return name + "_fem"
+
+
+def err_name(name):
+    """The run key of the relative error of quantity ``name`` (tip_deflection_mm ->
+    tip_deflection_rel_err)."""
+    for unit in ("_mm", "_n", "_nm", "_hz", "_s", "_pa"):
+        if name.endswith(unit):
+            return name[:-len(unit)] + "_rel_err"
+    return name + "_rel_err"
+
+
+__all__ = ["Case", "Settings", "Loads", "Traction", "Headline", "Reference", "MM",
+           "MESH_FAMILIES", "STANDARD_GATED", "ref_name", "err_name"]

@@ -1,0 +1,193 @@
+"""The shared runner: for a declared Case, every (mesh, bc) gets its FEM references and every
+model its run with the standard metrics, the case's quantities of interest and its extra
+metrics. A failure (a mesh that cannot be built, a reference that does not converge, a model
+without equilibrium) is recorded in the runs it touches and the case goes on.
+"""
+import numpy as np
+from rich.console import Console
+from rich.progress import BarColumn, Progress, TextColumn, TimeElapsedColumn, TimeRemainingColumn
+
+from model import PbcmError
+from model.terms.shear import Shear
+from reference import linear
+from . import metrics as M
+from .framework import Reference, err_name, ref_name
+
+# a reference field that varies by less than this fraction of its size is uniform: its
+# variation is the iterative solver's (relative residual 1e-10 gives about 1e-9 here), and a
+# correlation with it would correlate with solver noise (the sliding cube's pressure)
+UNIFORM_TOL = 1e-6
+# the standard metrics of a static solution; None when the static solve failed
+STATIC_KEYS = ("disp_rel_l2_p1", "disp_max_rel_p1", "disp_rel_l2_p2", "disp_max_rel_p2",
+               "reaction_n", "reaction_ratio", "reaction_rel_err", "stress_corr",
+               "stress_rel_err", "pressure_corr", "pressure_rel_err", "static_residual_n")
+# what a run may fail with and still be a finding: the suite's own errors and numerical ones
+FINDINGS = (PbcmError, ArithmeticError, np.linalg.LinAlgError)
+
+
+def uniform(field):
+    """True when a reference field is constant to the solver's accuracy (UNIFORM_TOL)."""
+    return np.ptp(field) <= UNIFORM_TOL * max(np.abs(field).max(), 1e-300)
+
+
+def reaction_along(reaction, driven):
+    """The force along the driven axis the supports exert on the driven nodes [N]."""
+    nodes, axis = driven
+    return -reaction[nodes, axis].sum()
+
+
+def reference(case, mesh, bc, s, probe):
+    """The default references of one (mesh, bc): P1 on the mesh and converged P2, with the
+    case's loads, quantities and extra reference work."""
+    mat = s.material
+    dirichlet = case.dirichlet(mesh, bc, s)
+    loads = case.loads(mesh, bc, s)
+    kw = {"traction": loads.fem_traction(1e-9 * mesh.size),
+          "body_force": None if loads.body_force is None else np.asarray(loads.body_force)}
+    kw = {k: v for k, v in kw.items() if v is not None}
+    p1 = linear.solve(mesh, mat.E, mat.nu, dirichlet, element="P1", **kw)
+    conv = linear.converged(mesh, mat.E, mat.nu, dirichlet, levels=s.p2_levels, **kw)
+    p2 = conv.result
+    driven = case.driven(mesh, bc, s)
+    ref = Reference(dirichlet=dirichlet, f_ext=loads.nodal_forces(mesh), p1=p1, conv=conv,
+                    p2=p2, tau=probe.max_tau(mesh.points + p2.u),
+                    reaction=None if driven is None else float(reaction_along(p2.reaction,
+                                                                              driven)),
+                    quantities=case.quantities(mesh, p2.u, p2.reaction, s, bc),
+                    error_estimate=conv.error_estimate)
+    ref.extra = case.reference_extra(mesh, bc, s, ref)
+    return ref
+
+
+def static_metrics(case, pm, st, mesh, bc, s, ref):
+    """The standard metrics of a static solution against the references (MODEL.md "What is
+    compared"), then the case's quantities of interest and their errors."""
+    stress = pm.tet_stress(st.x)
+    out = {"disp_rel_l2_p1": M.rel_l2(st.u, ref.p1.u),
+           "disp_max_rel_p1": M.max_rel(st.u, ref.p1.u),
+           "disp_rel_l2_p2": M.rel_l2(st.u, ref.p2.u),
+           "disp_max_rel_p2": M.max_rel(st.u, ref.p2.u)}
+    driven = case.driven(mesh, bc, s)
+    if driven is None:
+        out.update(reaction_n=None, reaction_ratio=None, reaction_rel_err=None)
+    else:
+        reaction = M.finite("reaction", reaction_along(st.reaction, driven))
+        out.update(reaction_n=reaction,
+                   reaction_ratio=M.finite("reaction_ratio", reaction / ref.reaction),
+                   reaction_rel_err=M.finite("reaction_rel_err",
+                                             abs(reaction / ref.reaction - 1)))
+    out.update({
+        "stress_corr": None if uniform(ref.tau) else M.correlation(stress["max_tau"], ref.tau),
+        "stress_rel_err": M.rel_l2(stress["max_tau"], ref.tau),
+        "pressure_corr": (None if uniform(ref.p2.pressure)
+                          else M.correlation(stress["pressure"], ref.p2.pressure)),
+        "pressure_rel_err": M.rel_l2(stress["pressure"], ref.p2.pressure)})
+    q = case.quantities(mesh, st.u, st.reaction, s, bc)
+    out.update(q)
+    for name in case.qoi_errors:
+        out[err_name(name)] = M.finite(err_name(name),
+                                       abs(q[name] / _nonzero(name, ref.quantities[name]) - 1))
+    out["static_residual_n"] = st.residual
+    return out, stress
+
+
+def _nonzero(name, value):
+    if value == 0:
+        raise M.MetricError(f"quantity {name!r} of the FEM reference is zero: its relative "
+                            "error is undefined")
+    return value
+
+
+def model_run(case, mesh_name, mesh, bc, model_name, s, ref):
+    """One (mesh, bc, model): its metrics, and its fields for figures (None when the static
+    solve failed). A failure of a phase is recorded in that phase's ``*_failed`` entry, its
+    metrics are None, and the other phases still run."""
+    r = {"mesh": mesh_name, "bc": bc, "model": model_name, "nodes": mesh.n_nodes,
+         "tets": mesh.n_tets, "failed": None}
+    if ref.reaction is not None:
+        r["reaction_fem_p2_n"] = ref.reaction
+    r.update({ref_name(k): v for k, v in ref.quantities.items()})
+    r["p2_error_estimate"] = ref.error_estimate
+    r.update(case.reference_entries(ref))
+    pm = case.build_model(model_name, mesh, s)
+    st, fields = None, None
+    try:
+        st = case.solve_static(pm, mesh, bc, s, ref)
+        values, stress = static_metrics(case, pm, st, mesh, bc, s, ref)
+        r.update(values, static_failed=None)
+        fields = {"mesh": mesh, "u": st.u, "max_tau": stress["max_tau"],
+                  "pressure": stress["pressure"]}
+    except FINDINGS as exc:   # no equilibrium found, or a metric undefined: a finding
+        r.update({k: None for k in STATIC_KEYS + tuple(ref.quantities)
+                  + tuple(err_name(q) for q in case.qoi_errors)}, static_failed=str(exc))
+        st = None
+    nft = pm.net_force_torque(mesh.points + ref.p2.u)
+    r.update(net_force_rel=M.finite("net_force", nft["force_rel"]),
+             net_torque_rel=M.finite("net_torque", nft["torque_rel"]))
+    r.update(case.run_extra(pm, mesh, bc, s, ref, st))
+    r["model_info"] = jsonable(pm.info)
+    return r, fields
+
+
+def failed_runs(mesh_name, bc, models, phase, exc):
+    """The rows of runs that could not start: the reason in ``failed``, every metric absent."""
+    return [{"mesh": mesh_name, "bc": bc, "model": m, "failed": f"{phase}: {exc}"}
+            for m in models]
+
+
+def run(case, s, log=True):
+    """Run every (mesh, bc, model) of ``case`` with settings ``s``; return the runs (metrics)
+    and the fields for the figures ({(mesh, bc, model or 'fem-p2'): arrays})."""
+    total = len(s.meshes) * len(s.bcs) * (len(s.models) + 1)
+    runs, fields = [], {}
+    with Progress(TextColumn("{task.description:<56}"), BarColumn(),
+                  TextColumn("{task.completed}/{task.total}"), TimeElapsedColumn(),
+                  TextColumn("left"), TimeRemainingColumn(), console=Console(stderr=True),
+                  disable=not log) as bar:
+        task = bar.add_task(case.name, total=total)
+        for mesh_name in s.meshes:
+            try:
+                mesh = case.mesh(mesh_name, s)
+            except FINDINGS as exc:
+                for bc in s.bcs:
+                    runs += failed_runs(mesh_name, bc, s.models, "mesh", exc)
+                bar.advance(task, len(s.bcs) * (len(s.models) + 1))
+                continue
+            probe = Shear(mesh, s.material, reading="corner")  # the paper's max |tau| measure
+            for bc in s.bcs:
+                bar.update(task, description=f"{case.name} {mesh_name}/{bc}: FEM references")
+                try:
+                    ref = reference(case, mesh, bc, s, probe)
+                except FINDINGS as exc:
+                    runs += failed_runs(mesh_name, bc, s.models, "reference", exc)
+                    bar.advance(task, len(s.models) + 1)
+                    continue
+                fields[(mesh_name, bc, "fem-p2")] = {
+                    "mesh": mesh, "u": ref.p2.u, "max_tau": ref.tau,
+                    "pressure": ref.p2.pressure, "von_mises": ref.p2.von_mises, **ref.extra}
+                bar.advance(task)
+                for model_name in s.models:
+                    bar.update(task, description=f"{case.name} {mesh_name}/{bc}/{model_name}")
+                    r, f = model_run(case, mesh_name, mesh, bc, model_name, s, ref)
+                    runs.append(r)
+                    if f is not None:
+                        fields[(mesh_name, bc, model_name)] = f
+                    bar.advance(task)
+        bar.update(task, description=f"{case.name}: done")
+    return runs, fields
+
+
+def jsonable(d):
+    """Plain Python numbers and lists for json (numpy scalars and arrays converted)."""
+    if isinstance(d, dict):
+        return {k: jsonable(v) for k, v in d.items()}
+    if isinstance(d, (list, tuple)):
+        return [jsonable(v) for v in d]
+    if isinstance(d, np.ndarray):
+        return jsonable(d.tolist())
+    if isinstance(d, (np.floating, np.integer, np.bool_)):
+        return d.item()
+    return d
+
+
+__all__ = ["run", "reference", "model_run", "uniform", "jsonable", "STATIC_KEYS"]
