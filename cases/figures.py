@@ -95,3 +95,12 @@ def reaction_history(path, series, fem_level, fem_transient, title, level_label)
         ax.plot(t, r, label=label)
     ax.axhline(fem_level, color="k", ls="--", label=level_label)
     _finish(fig, ax, path, "time [s]", "reaction on the driven nodes [N]", title)
+
+
+def curves(path, x, fem, fem_label, series, xlabel, ylabel, title, markers="-s"):
+    """Model curves y(x) against the reference's, on one chart."""
+    fig, ax = plt.subplots(figsize=(6, 4))
+    ax.plot(x, fem, "k-o", lw=2.5, label=fem_label)
+    for label, y in series:
+        ax.plot(x, y, markers, ms=4, label=label)
+    _finish(fig, ax, path, xlabel, ylabel, title)

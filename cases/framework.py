@@ -151,6 +151,7 @@ class Case(abc.ABC):
     gated : case metrics the CI gate bounds beside the standard ones, {metric: "max"/"min"}.
     qoi_errors : scalar quantities of interest that get ``<name>_rel_err`` = |model / FEM - 1|.
     definitions : report lines defining the case's own metrics.
+    fem_solver : the linear FEM solver ("auto", "direct", "amg").
     draws_stress, magnify : whether the case draws its own stress panels; the magnification
         of the standard ones.
     """
@@ -168,6 +169,7 @@ class Case(abc.ABC):
     gated: ClassVar[dict] = {}
     qoi_errors: ClassVar[tuple] = ()
     definitions: ClassVar[tuple] = ()
+    fem_solver: ClassVar[str] = "auto"    # the linear FEM solver (reference.fem.linear_solve)
     draws_stress: ClassVar[bool] = False   # True: the case draws its own max |tau| panels
     magnify: ClassVar[float] = 5.0         # displacement magnification of the panels
 
@@ -190,6 +192,12 @@ class Case(abc.ABC):
     @abc.abstractmethod
     def dirichlet(self, mesh, bc, s):
         """The prescribed displacements of boundary condition ``bc``: {node: (ux, uy, uz)}."""
+
+    def dirichlet_fn(self, mesh, bc, s):
+        """The prescribed displacement at new boundary points of refined and P2 meshes,
+        ``points (k, 3) -> (k, 3)`` (see ``reference.linear.solve``); None: linear
+        interpolation of the nodal values."""
+        return None
 
     def loads(self, mesh, bc, s):
         """The case's loads (default none)."""
@@ -220,6 +228,12 @@ class Case(abc.ABC):
         extra = {"shear": {"scale": s.shear_scale}} if has_shear and s.shear_scale != 1 else {}
         return build(name, mesh, s.material, **extra)
 
+    def solve_reference(self, mesh, bc, s, probe):
+        """A Reference of the case's own making (e.g. neo-Hookean), or None for the default:
+        linear P1 on the mesh and converged P2 with the case's loads. ``probe`` is the
+        paper's max |tau| measure on this mesh (a corner-reading Shear term)."""
+        return None
+
     def reference_extra(self, mesh, bc, s, ref):
         """Case-specific reference work (a transient, modes), stored in ``ref.extra``."""
         return {}
@@ -229,7 +243,8 @@ class Case(abc.ABC):
         return {}
 
     def solve_static(self, pm, mesh, bc, s, ref):
-        """The model's static solution (default one Newton solve with the loads)."""
+        """The model's static solution (default one Newton solve with the loads); None for a
+        case without a static problem."""
         return pm.solve_static(ref.dirichlet, f_ext=ref.f_ext)
 
     def run_extra(self, pm, mesh, bc, s, ref, st):

@@ -4,6 +4,12 @@ import importlib
 
 MODULES = {
     "paper-cube": "cases.library.paper_cube",
+    "cantilever": "cases.library.cantilever",
+    "torsion": "cases.library.torsion",
+    "indentation": "cases.library.indentation",
+    "large-compression": "cases.library.large_compression",
+    "self-weight": "cases.library.self_weight",
+    "modes": "cases.library.modes",
 }
 
 CASES = {name: importlib.import_module(module).CASE for name, module in MODULES.items()}

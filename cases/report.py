@@ -169,9 +169,9 @@ def _standard_figures(doc, case, s, runs, fields, out):
                          [[_chart_value(runs, m, b, mo, metric) for mo in s.models]
                           for m, b in keys], f"{metric}", case.headline.label, log=True)
     doc.img("errors.png", f"{case.headline.label} ({metric}) per run")
-    if case.draws_stress:
-        return
-    for m, b in keys[:1]:
+    for m, b in [k for k in keys if (*k, "fem-p2") in fields][:1]:
+        if case.draws_stress:
+            break
         panels = [("FEM P2", fields[(m, b, "fem-p2")]["mesh"], fields[(m, b, "fem-p2")]["u"],
                    fields[(m, b, "fem-p2")]["max_tau"])]
         panels += [(mo, fields[(m, b, mo)]["mesh"], fields[(m, b, mo)]["u"],

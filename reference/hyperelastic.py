@@ -67,10 +67,12 @@ class HyperelasticResult:
 
 
 def solve(mesh, E, nu, dirichlet, body_force=None, element="P1", refine=0, dirichlet_fn=None,
-          load_steps=1, rtol=1e-10, max_iter=30):
+          load_steps=1, rtol=1e-10, max_iter=30, on_step=None):
     """Neo-Hookean equilibrium: Newton in ``load_steps`` equal increments of the prescribed
     displacement and body force, each converged to max |residual| <= rtol * E h^2 (h the mean
-    edge). Raises ConvergenceError otherwise."""
+    edge). Raises ConvergenceError otherwise. ``on_step(step, u, reaction)``, when given, is
+    called after every converged step with the nodal displacement (n, 3) and reaction (n, 3)
+    at that load (a force-displacement curve in one solve)."""
     lam, mu = lame(E, nu)
     mask, vals = bc_arrays(dirichlet, mesh.n_nodes)
     if not mask.any():
@@ -111,6 +113,10 @@ def solve(mesh, E, nu, dirichlet, body_force=None, element="P1", refine=0, diric
             raise ConvergenceError(f"neo-Hookean Newton did not converge in {max_iter} "
                                    f"iterations at load step {step}/{load_steps}: residual "
                                    f"{rn:.3e} N; increase load_steps")
+        if on_step is not None:
+            w = {"u": basis.interpolate(u)}
+            on_step(step, u[basis.nodal_dofs[:, :mesh.n_nodes]].T,
+                    transfer_to_nodes(basis, W, D, (asm(internal, basis, **w) - s * f_body)[D]))
     w = {"u": basis.interpolate(u)}
     reaction = transfer_to_nodes(basis, W, D, (asm(internal, basis, **w) - f_body)[D])
     F, J, FinvT = _kinematics(w)

@@ -1,0 +1,100 @@
+"""A cantilever: a 64 x 16 x 16 mm beam along x, the x = 0 face clamped, a total end load of
+1 mN in -y as a uniform traction on the x = L face. Closed form: Euler-Bernoulli bending plus
+Timoshenko shear deflection."""
+from dataclasses import dataclass
+
+import numpy as np
+
+from reference import analytic
+from ..document import fmt
+from ..framework import MM, Case, Headline, Loads, Settings, Traction
+from . import common
+
+LENGTH_MM, HEIGHT_MM, WIDTH_MM = 64.0, 16.0, 16.0
+LOAD_N = 1e-3
+
+
+@dataclass
+class CantileverSettings(Settings):
+    spacing_mm: float = 4.0
+    load_N: float = LOAD_N
+
+    def problem(self):
+        return {**super().problem(), "length_mm": LENGTH_MM, "height_mm": HEIGHT_MM,
+                "width_mm": WIDTH_MM, "spacing_mm": self.spacing_mm, "load_N": self.load_N}
+
+
+class Cantilever(Case):
+    name = "cantilever"
+    title = ("Cantilever 64 x 16 x 16 mm, clamped at x = 0, 1 mN end load in -y (bending; "
+             "closed form Euler-Bernoulli + Timoshenko)")
+    settings_class = CantileverSettings
+    bcs = ("clamped",)
+    fem_solver = "direct"   # AMG-CG stagnates on this slender beam: 16 s direct, 32 s AMG
+    headline = Headline("tip_deflection_rel_err", "tip deflection error vs FEM P2")
+    qoi_errors = ("tip_deflection_mm",)
+    gated = {"tip_deflection_rel_err": "max"}
+    magnify = 3.0
+    definitions = (
+        "tip deflection: the mean -u_y over the nodes of the loaded face x = L [mm]; its error "
+        "is |model / FEM P2 - 1|.",
+        "The load reaches the particle model as consistent nodal forces (a third of traction x "
+        "area of each face triangle to its vertices), FEM integrates the traction itself.")
+
+    def mesh(self, family, s):
+        return common.bar(family, LENGTH_MM, HEIGHT_MM, WIDTH_MM, s.spacing_mm)
+
+    def dirichlet(self, mesh, bc, s):
+        return {int(i): (0.0, 0.0, 0.0) for i in common.face(mesh, 0.0)}
+
+    def loads(self, mesh, bc, s):
+        area = HEIGHT_MM * WIDTH_MM * MM**2
+        return Loads(tractions=(Traction(0, LENGTH_MM * MM, (0.0, -s.load_N / area, 0.0)),))
+
+    def quantities(self, mesh, u, reaction, s, bc):
+        tip = common.face(mesh, LENGTH_MM * MM)
+        return {"tip_deflection_mm": float(-u[tip, 1].mean() / MM)}
+
+    def closed_form(self, s, bc):
+        d = analytic.cantilever_tip_deflection(s.load_N, LENGTH_MM * MM, WIDTH_MM * MM,
+                                               HEIGHT_MM * MM, s.E, s.nu)
+        return {"tip_deflection_mm": d / MM}
+
+    def params(self, s):
+        return {"length_mm": LENGTH_MM, "height_mm": HEIGHT_MM, "width_mm": WIDTH_MM,
+                "load_N": s.load_N, "E_Pa": s.E, "nu": s.nu, "spacing_mm": s.spacing_mm}
+
+    def what_was_run(self, s, runs):
+        return [f"Beam {LENGTH_MM:g} x {HEIGHT_MM:g} x {WIDTH_MM:g} mm, nodes every "
+                f"{s.spacing_mm:g} mm; x = 0 fully clamped; {s.load_N * 1e3:g} mN in -y as a "
+                "uniform traction on x = L."]
+
+    def conclusion(self, s, runs):
+        cf = self.closed_form(s, "clamped")["tip_deflection_mm"]
+        solved = [r for r in runs if r.get("tip_deflection_mm") is not None]
+        out = [common.best_and_worst(runs, "tip_deflection_rel_err", "Tip deflection")]
+        if solved:
+            fem = runs[0]["tip_deflection_fem_mm"]
+            out.append(f"FEM P2 deflects {fem:.4g} mm ({runs[0]['mesh']}), the closed form "
+                       f"{cf:.4g} mm: a fully clamped root is stiffer than beam theory's.")
+            soft = sorted({r["model"] for r in solved
+                           if r["tip_deflection_mm"] > r["tip_deflection_fem_mm"]})
+            out.append("Softer than FEM in bending: " + (", ".join(soft) or "none") + ". "
+                       + common.failures(runs))
+        return out
+
+    def findings(self, s, runs):
+        cf = self.closed_form(s, "clamped")["tip_deflection_mm"]
+        return {"Bending stiffness": common.ranking(runs, "tip_deflection_rel_err",
+                                                    "tip deflection error"),
+                "Reference against the closed form": common.vs_closed_form(
+                    "tip deflection", runs, "tip_deflection_fem_mm", cf, "mm"),
+                "Failures": [common.failures(runs)]}
+
+    def columns(self):
+        return [("tip defl. [mm]", lambda r: fmt(r["tip_deflection_mm"], 4)),
+                ("FEM P2 [mm]", lambda r: fmt(r["tip_deflection_fem_mm"], 4)),
+                ("tip err", lambda r: fmt(r["tip_deflection_rel_err"]))]
+
+
+CASE = Cantilever()

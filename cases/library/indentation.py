@@ -1,0 +1,156 @@
+"""Indentation: a 32 mm cube on a clamped base, a centred 8 x 8 mm patch of the top face pushed
+down 2 mm by a rigid flat punch (the patch nodes fully prescribed: the punch holds them, no
+friction model beyond that): punch force, the surface profile along the centre line, and the
+peak shear stress under the punch edge."""
+from dataclasses import dataclass
+
+import numpy as np
+
+from model.mesh import cube
+from model.terms.shear import Shear
+from .. import metrics as M
+from ..document import fmt
+from ..framework import MM, Case, Headline, Settings
+from . import common
+
+SIZE_MM, PATCH_MM, DEPTH_MM = 32.0, 8.0, 2.0
+
+
+@dataclass
+class IndentationSettings(Settings):
+    spacing_mm: float = 4.0
+
+    def problem(self):
+        return {**super().problem(), "size_mm": SIZE_MM, "patch_mm": PATCH_MM,
+                "depth_mm": DEPTH_MM, "spacing_mm": self.spacing_mm}
+
+
+def _top(mesh):
+    return mesh.nodes_on_plane("y", SIZE_MM * MM)
+
+
+def _patch(mesh, grow=0.0):
+    """Top nodes inside the centred patch (grown by ``grow`` m on each side)."""
+    top = _top(mesh)
+    half = PATCH_MM * MM / 2 + grow + 1e-9
+    c = SIZE_MM * MM / 2
+    p = mesh.points[top]
+    return top[(np.abs(p[:, 0] - c) <= half) & (np.abs(p[:, 2] - c) <= half)]
+
+
+def centre_line(mesh):
+    """Top nodes on the centre line z = L/2, ordered by x (for structured meshes; the
+    unstructured ones keep boundary nodes on their lattice lines within the face)."""
+    top = _top(mesh)
+    on = top[np.abs(mesh.points[top, 2] - SIZE_MM * MM / 2) <= 1e-9]
+    return on[np.argsort(mesh.points[on, 0])]
+
+
+def edge_tets(mesh):
+    """Tetrahedra touching a patch node on the punch's edge (a patch node with a top
+    neighbour outside the patch)."""
+    patch = set(_patch(mesh).tolist())
+    ring = set(_patch(mesh, grow=1.01 * mesh_spacing(mesh)).tolist()) - patch
+    edge_nodes = {int(i) for i in patch
+                  if any(int(j) in ring for t in mesh.tets[(mesh.tets == i).any(axis=1)]
+                         for j in t)}
+    return np.flatnonzero(np.isin(mesh.tets, list(edge_nodes)).any(axis=1))
+
+
+def mesh_spacing(mesh):
+    top = mesh.points[_top(mesh)]
+    xs = np.unique(np.round(top[:, 0], 9))
+    return float(np.diff(xs).min())
+
+
+class Indentation(Case):
+    name = "indentation"
+    title = ("Indentation of a 32 mm cube on a clamped base by a rigid 8 x 8 mm flat punch "
+             "pressed 2 mm (punch force, surface profile, shear under the punch edge)")
+    settings_class = IndentationSettings
+    bcs = ("clamped",)
+    headline = Headline("reaction_rel_err", "punch force error vs FEM P2")
+    qoi_errors = ("edge_shear_pa",)
+    gated = {"edge_shear_rel_err": "max", "profile_rel_err": "max"}
+    magnify = 2.0
+    definitions = (
+        "punch force: the reaction on the patch nodes along y (the standard reaction ratio).",
+        "surface profile: u_y of the top nodes on the centre line z = 16 mm, by x [mm]; "
+        "profile err: its relative L2 error against FEM P2.",
+        "edge shear: the peak of the paper's max |tau| over the tetrahedra touching the "
+        "punch's edge nodes [Pa], computed alike on the model's and FEM's displacement; its "
+        "error is |model / FEM - 1|. The corner of a rigid punch is singular in the continuum: "
+        "FEM's value grows under refinement, so this error is a mesh-level comparison.")
+
+    def mesh(self, family, s):
+        n = int(round(SIZE_MM / s.spacing_mm)) + 1
+        return cube(n, SIZE_MM * MM, family)
+
+    def dirichlet(self, mesh, bc, s):
+        out = {int(i): (0.0, 0.0, 0.0) for i in mesh.nodes_on_plane("y", 0.0)}
+        out.update({int(i): (0.0, -DEPTH_MM * MM, 0.0) for i in _patch(mesh)})
+        return out
+
+    def driven(self, mesh, bc, s):
+        return _patch(mesh), 1
+
+    def quantities(self, mesh, u, reaction, s, bc):
+        line = centre_line(mesh)
+        tau = Shear(mesh, s.material, reading="corner").max_tau(mesh.points + u)
+        return {"surface_profile_mm": (u[line, 1] / MM).tolist(),
+                "edge_shear_pa": float(tau[edge_tets(mesh)].max())}
+
+    def run_extra(self, pm, mesh, bc, s, ref, st):
+        if st is None:
+            return {"profile_rel_err": None}
+        line = centre_line(mesh)
+        return {"profile_rel_err": M.rel_l2(st.u[line, 1], ref.p2.u[line, 1])}
+
+    def what_was_run(self, s, runs):
+        return [f"Cube of side {SIZE_MM:g} mm, nodes every {s.spacing_mm:g} mm, base clamped; "
+                f"the top nodes within the centred {PATCH_MM:g} x {PATCH_MM:g} mm patch moved "
+                f"(0, -{DEPTH_MM:g}, 0) mm (a rigid punch that holds them)."]
+
+    def conclusion(self, s, runs):
+        return [common.best_and_worst(runs, "reaction_rel_err", "Punch force"),
+                common.best_and_worst(runs, "profile_rel_err", "Surface profile"),
+                common.best_and_worst(runs, "edge_shear_rel_err", "Shear under the punch edge")
+                + " " + common.failures(runs)]
+
+    def findings(self, s, runs):
+        stiff = sorted({r["model"] for r in runs if r.get("reaction_ratio") is not None
+                        and r["reaction_ratio"] > 1})
+        return {"Punch force": common.ranking(runs, "reaction_rel_err", "force error")
+                + [f"Stiffer than FEM under the punch: {', '.join(stiff) or 'none'}."],
+                "Surface profile": common.ranking(runs, "profile_rel_err", "profile error"),
+                "Shear under the punch edge": common.ranking(runs, "edge_shear_rel_err",
+                                                             "edge shear error"),
+                "Failures": [common.failures(runs)]}
+
+    def columns(self):
+        return [("punch force [mN]", lambda r: fmt(None if r["reaction_n"] is None
+                                                    else r["reaction_n"] * 1e3, 4)),
+                ("FEM [mN]", lambda r: fmt(r["reaction_fem_p2_n"] * 1e3, 4)),
+                ("profile err", lambda r: fmt(r["profile_rel_err"])),
+                ("edge shear [Pa]", lambda r: fmt(r["edge_shear_pa"], 4)),
+                ("FEM [Pa]", lambda r: fmt(r["edge_shear_fem_pa"], 4)),
+                ("edge shear err", lambda r: fmt(r["edge_shear_rel_err"]))]
+
+    def sections(self, doc, s, runs, fields, out):
+        from .. import figures
+        for mesh in s.meshes:
+            rs = [r for r in runs if r["mesh"] == mesh and not r.get("failed")]
+            if not rs:
+                continue
+            m = fields[(mesh, "clamped", "fem-p2")]["mesh"]
+            x = m.points[centre_line(m), 0] / MM
+            name = f"profile_{mesh}.png"
+            figures.curves(out / name, x, rs[0]["surface_profile_fem_mm"], "FEM P2",
+                           [(r["model"], r["surface_profile_mm"]) for r in rs
+                            if r["surface_profile_mm"] is not None],
+                           "x along the centre line [mm]", "u_y of the top surface [mm]",
+                           f"surface profile under the punch, mesh {mesh}")
+            doc.img(name, f"Surface profile along the centre line, mesh {mesh}")
+
+
+CASE = Indentation()

@@ -1,0 +1,122 @@
+"""Modes: the 32 mm cube (5 x 5 x 5 nodes, as the paper's) free-free and with its base
+clamped; the first 10 frequencies of every model linearised at rest against FEM P2."""
+from dataclasses import dataclass
+
+import numpy as np
+
+from model.mesh import cube
+from reference import modal
+from .. import metrics as M
+from .. import transient
+from ..document import fmt
+from ..framework import MM, Case, Headline, Reference, Settings
+from . import common
+
+SIZE_MM, NODES = 32.0, 5
+N_MODES = transient.N_MODES
+
+
+@dataclass
+class ModesSettings(Settings):
+    fem_refine: int = 1        # refinements of the FEM P2 modal reference
+
+    def problem(self):
+        return {**super().problem(), "size_mm": SIZE_MM, "nodes_per_side": NODES,
+                "modes": N_MODES, "fem_refine": self.fem_refine}
+
+
+class Modes(Case):
+    name = "modes"
+    title = ("The first 10 frequencies of the 32 mm cube, free-free and with a clamped base, "
+             "of every model linearised at rest, against FEM P2")
+    settings_class = ModesSettings
+    bcs = ("free", "clamped")
+    quick = {"fem_refine": 0}
+    headline = Headline("modal_rel_err", "largest error of the first 10 frequencies")
+    gated = {"modal_rel_err": "max", "modal_rel_err_median": "max", "rigid_modes": "max"}
+    definitions = (
+        "modal err: the largest relative error of the first 10 non-rigid frequencies (sorted "
+        "lists) against FEM P2 (consistent mass); median: their median. The model is "
+        "linearised at rest (coloured finite-difference Jacobian, lumped mass); a "
+        "non-conservative reading's frequency is |Re sqrt(lambda)| / 2 pi.",
+        "rigid modes: zero eigenvalues (below 1e-8 of the largest); 6 free-free, 0 clamped "
+        "expected.")
+
+    def mesh(self, family, s):
+        return cube(NODES, SIZE_MM * MM, family)
+
+    def dirichlet(self, mesh, bc, s):
+        if bc == "free":
+            return {}
+        return {int(i): (0.0, 0.0, 0.0) for i in mesh.nodes_on_plane("y", 0.0)}
+
+    def solve_reference(self, mesh, bc, s, probe):
+        dirichlet = self.dirichlet(mesh, bc, s)
+        skip = 6 if bc == "free" else 0
+        r = modal.frequencies(mesh, s.E, s.nu, s.rho, dirichlet, k=N_MODES + skip,
+                              refine=s.fem_refine)
+        return Reference(dirichlet=dirichlet, f_ext=None, p1=None, conv=None, p2=None,
+                         tau=None, reaction=None, quantities={}, error_estimate=None,
+                         extra={"frequencies_hz": r.frequencies[skip:]})
+
+    def solve_static(self, pm, mesh, bc, s, ref):
+        return None
+
+    def reference_entries(self, ref):
+        return {"frequencies_fem_hz": ref.extra["frequencies_hz"].tolist()}
+
+    def run_extra(self, pm, mesh, bc, s, ref, st):
+        mask = np.zeros((mesh.n_nodes, 3), dtype=bool)
+        for i in ref.dirichlet:
+            mask[i] = True
+        freq, rigid = transient.model_frequencies(pm, ~mask.ravel())
+        freq = freq[rigid:rigid + N_MODES]
+        err = np.abs(freq / ref.extra["frequencies_hz"] - 1)
+        return {"frequencies_hz": freq.tolist(), "rigid_modes": rigid,
+                "modal_rel_err": M.finite("modal_rel_err", err.max()),
+                "modal_rel_err_median": M.finite("modal_rel_err_median", np.median(err))}
+
+    def what_was_run(self, s, runs):
+        return [f"Cube of side {SIZE_MM:g} mm, {NODES} x {NODES} x {NODES} lattice nodes; "
+                "free-free and base clamped; FEM P2 with consistent mass on "
+                f"{s.fem_refine} refinement(s). No static problem: the standard displacement "
+                "and stress metrics are n/a."]
+
+    def conclusion(self, s, runs):
+        out = [common.best_and_worst([r for r in runs if r["bc"] == bc], "modal_rel_err",
+                                     f"{bc}: first 10 frequencies") for bc in s.bcs]
+        odd = [f"{r['model']} on {r['mesh']}/{r['bc']} ({r['rigid_modes']})" for r in runs
+               if r["rigid_modes"] != (6 if r["bc"] == "free" else 0)]
+        out.append("Zero modes other than the rigid ones: " + ", ".join(odd) + "." if odd else
+                   "Every model has exactly the rigid modes it should (6 free-free, 0 clamped).")
+        return out
+
+    def findings(self, s, runs):
+        return {f"{bc}": common.ranking([r for r in runs if r["bc"] == bc], "modal_rel_err",
+                                        "largest frequency error")
+                for bc in s.bcs}
+
+    def columns(self):
+        return [("f1 [Hz]", lambda r: fmt(r["frequencies_hz"][0], 4)),
+                ("FEM f1 [Hz]", lambda r: fmt(r["frequencies_fem_hz"][0], 4)),
+                ("modal err", lambda r: fmt(r["modal_rel_err"])),
+                ("median err", lambda r: fmt(r["modal_rel_err_median"])),
+                ("rigid modes", lambda r: r["rigid_modes"])]
+
+    def sections(self, doc, s, runs, fields, out):
+        from .. import figures
+        for bc in s.bcs:
+            rs = [r for r in runs if r["bc"] == bc and r["mesh"] == s.meshes[0]
+                  and not r.get("failed")]
+            if not rs:
+                continue
+            name = f"frequencies_{s.meshes[0]}_{bc}.png"
+            k = np.arange(1, N_MODES + 1)
+            figures.curves(out / name, k, rs[0]["frequencies_fem_hz"], "FEM P2",
+                           [(r["model"], r["frequencies_hz"]) for r in rs], "mode number",
+                           "frequency [Hz]", f"first {N_MODES} frequencies, mesh "
+                           f"{s.meshes[0]}, {bc}")
+            doc.img(name, f"First {N_MODES} frequencies, mesh {s.meshes[0]}, {bc}")
+
+
+CASE = Modes()
