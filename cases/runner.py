@@ -3,6 +3,8 @@ model its run with the standard metrics, the case's quantities of interest and i
 metrics. A failure (a mesh that cannot be built, a reference that does not converge, a model
 without equilibrium) is recorded in the runs it touches and the case goes on.
 """
+import sys
+
 import numpy as np
 from rich.console import Console
 from rich.progress import BarColumn, Progress, TextColumn, TimeElapsedColumn, TimeRemainingColumn
@@ -152,7 +154,7 @@ def run(case, s, log=True):
     with Progress(TextColumn("{task.description:<56}"), BarColumn(),
                   TextColumn("{task.completed}/{task.total}"), TimeElapsedColumn(),
                   TextColumn("left"), TimeRemainingColumn(), console=Console(stderr=True),
-                  disable=not log) as bar:
+                  disable=not (log and sys.stderr.isatty())) as bar:
         task = bar.add_task(case.name, total=total)
         for mesh_name in s.meshes:
             try:

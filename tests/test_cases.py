@@ -7,7 +7,7 @@ import pytest
 
 from cases import metrics as M
 from cases.cli import main
-from cases.paper_cube import LAYERS_MM, SIZE_MM, make_mesh, static_bc
+from cases.library.paper_cube import LAYERS_MM, SIZE_MM, make_mesh, static_bc
 from cases.report import TIMING_KEYS
 from reference import linear
 

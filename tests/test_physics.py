@@ -100,8 +100,8 @@ def test_paper_cube_dynamic_reaction_is_the_force_that_moves_the_top():
     """At the end of the damped hold the case's dynamic reaction on the driven nodes equals
     the static reaction: positive (the body pushes back up, the supports push down) and of
     the same size."""
-    from cases import paper_cube as P
-    cfg = P.Config.quick_config(models=("msm",), meshes=("five",), bcs=("clamped",))
+    from cases.library import paper_cube as P
+    cfg = P.CASE.settings(quick=True, models=("msm",), meshes=("five",), bcs=("clamped",))
     mesh = P.make_mesh("five")
     pm = build("msm", mesh, cfg.material)
     dyn = P.dynamic_run(pm, mesh, "clamped", cfg)

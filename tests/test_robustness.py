@@ -12,7 +12,7 @@ import meshio
 import numpy as np
 import pytest
 
-from cases import paper_cube
+from cases import runner
 from cases.cli import main
 from cases.output import StagedFolder, OutputError
 from model.errors import ConvergenceError, MeshError
@@ -75,9 +75,9 @@ def test_a_failed_static_solve_is_recorded_and_the_case_goes_on(tmp_path, monkey
 @pytest.fixture
 def no_computing(monkeypatch):
     """Any attempt to run a case fails the test: errors must come before computing."""
-    def refuse(cfg, log=True):
+    def refuse(case, cfg, log=True):
         raise AssertionError("the case started computing")
-    monkeypatch.setattr(paper_cube, "run", refuse)
+    monkeypatch.setattr(runner, "run", refuse)
 
 
 def one_error_line(capsys):

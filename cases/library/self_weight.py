@@ -61,10 +61,12 @@ class SelfWeight(Case):
         exact = self.exact(mesh.points[base], s)
         p = mesh.points[base]
         c = SIZE_MM * MM / 2
-        centre = base[np.argmin(np.hypot(p[:, 0] - c, p[:, 2] - c))]
-        on_axis = base[(np.abs(p[:, 2] - c) < 1e-9) & (np.abs(p[:, 0] - c) > 1e-9)]
+        # (at their closed-form values: on an unstructured base no node sits on the axis)
+        k = np.argmin(np.hypot(p[:, 0] - c, p[:, 2] - c))
+        j = np.argmin(np.hypot(p[:, 0] - 2 * c, p[:, 2] - c))
         return merge([(int(i), (None, float(uy), None)) for i, uy in zip(base, exact[:, 1])]
-                     + [(int(centre), (0.0, 0.0, 0.0)), (int(on_axis[0]), (None, None, 0.0))])
+                     + [(int(base[k]), tuple(map(float, exact[k]))),
+                        (int(base[j]), (None, None, float(exact[j, 2])))])
 
     def dirichlet_fn(self, mesh, bc, s):
         return None if bc == "clamped" else (lambda points: self.exact(points, s))
