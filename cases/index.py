@@ -18,13 +18,19 @@ def headline_table(root, cases):
     table, metric, data = {}, {}, {}
     for case in cases:
         d = json.loads((Path(root) / case / "metrics.json").read_text())
-        data[case], metric[case] = d, d["headline"]
+        # metrics written before the case framework lack "headline": the case declares it
+        data[case], metric[case] = d, d.get("headline") or _declared_headline(case)
         table[case] = {}
         for model in d["parameters"]["models"]:
-            vals = [r[d["headline"]] for r in d["runs"] if r["model"] == model
-                    and r.get(d["headline"]) is not None]
+            vals = [r[metric[case]] for r in d["runs"] if r["model"] == model
+                    and r.get(metric[case]) is not None]
             table[case][model] = float(np.median(vals)) if vals else None
     return table, metric, data
+
+
+def _declared_headline(case):
+    from .registry import CASES
+    return CASES[case].headline.metric
 
 
 def _band(v):
