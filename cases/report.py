@@ -108,9 +108,7 @@ def build_report(case, s, runs, fields, out):
         f"{', '.join(s.models)}.",
         f"Material E = {s.E:g} Pa, nu = {s.nu:g}, rho = {s.rho:g} kg/m^3 (override with --E, "
         "--nu, --rho).",
-        f"References: linear FEM P1 on the same mesh, and P2 on {s.p2_levels} uniform "
-        "refinement(s) (the converged reference, evaluated at the particle nodes) with its own "
-        "error estimate.",
+        case.references_line(s),
         "Quick mode." if s.quick else "Full mode."])
     doc.h(2, "Definitions")
     doc.ul(list(STANDARD_DEFINITIONS) + list(case.definitions))

@@ -76,6 +76,10 @@ class Modes(Case):
                 "modal_rel_err": M.finite("modal_rel_err", err.max()),
                 "modal_rel_err_median": M.finite("modal_rel_err_median", np.median(err))}
 
+    def references_line(self, s):
+        return (f"Reference: FEM P2 modes (consistent mass) on {s.fem_refine} refinement(s) of "
+                "the mesh; no static reference.")
+
     def what_was_run(self, s, runs):
         return [f"Cube of side {SIZE_MM:g} mm, {NODES} x {NODES} x {NODES} lattice nodes; "
                 "free-free and base clamped; FEM P2 with consistent mass on "
