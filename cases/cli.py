@@ -129,10 +129,17 @@ def _configs(names, args):
     return {name: _config(_case(name), args) for name in names}
 
 
+def _summary(case):
+    """The first paragraph of the docstring of the module declaring a case, as whole
+    sentences on one line."""
+    doc = sys.modules[type(case).__module__].__doc__ or case.title
+    return " ".join(doc.strip().split("\n\n")[0].split())
+
+
 def _list_command(args):
     from .registry import CASES
     for name, case in CASES.items():
-        print(textwrap.fill(f"{name}: {case.title}", width=96, subsequent_indent="  "))
+        print(textwrap.fill(f"{name}: {_summary(case)}", width=96, subsequent_indent="  "))
         print(f"  meshes: {', '.join(case.meshes)} (quick: {', '.join(case.quick_meshes)})")
         print(f"  bcs:    {', '.join(case.bcs)}")
         print(f"  models: {', '.join(case.models)}")
