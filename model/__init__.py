@@ -24,6 +24,10 @@ PRESETS = {
                                 ("normal", {"c": "auto"}), ("volume", {})],
     "msm": [("springs", {})],
     "msm+volume": [("springs", {}), ("volume", {})],
+    # MODEL.md "Explicit FEM baselines": what a user would pick instead of a particle model
+    "fem-linear": [("fem_linear", {})],
+    "fem-corotated": [("fem_corotated", {})],
+    "fem-neohookean": [("fem_neohookean", {})],
 }
 
 

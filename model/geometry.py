@@ -14,14 +14,14 @@ def min_signed_volume(x, tets):
     """Smallest signed volume and the tetrahedron holding it (a cheap inversion watch)."""
     vmin = np.inf
     imin = -1
-    for t in range(tets.shape[0]):
+    for t in range(tets.shape[0]):   # scalars only: no array per tetrahedron
         a, b, c, d = tets[t, 0], tets[t, 1], tets[t, 2], tets[t, 3]
-        e1 = x[b] - x[a]
-        e2 = x[c] - x[a]
-        e3 = x[d] - x[a]
-        v = (e1[0] * (e2[1] * e3[2] - e2[2] * e3[1])
-             - e1[1] * (e2[0] * e3[2] - e2[2] * e3[0])
-             + e1[2] * (e2[0] * e3[1] - e2[1] * e3[0])) / 6.0
+        e10, e11, e12 = x[b, 0] - x[a, 0], x[b, 1] - x[a, 1], x[b, 2] - x[a, 2]
+        e20, e21, e22 = x[c, 0] - x[a, 0], x[c, 1] - x[a, 1], x[c, 2] - x[a, 2]
+        e30, e31, e32 = x[d, 0] - x[a, 0], x[d, 1] - x[a, 1], x[d, 2] - x[a, 2]
+        v = (e10 * (e21 * e32 - e22 * e31)
+             - e11 * (e20 * e32 - e22 * e30)
+             + e12 * (e20 * e31 - e21 * e30)) / 6.0
         if v < vmin:
             vmin = v
             imin = t

@@ -8,7 +8,12 @@ import math
 
 import numpy as np
 
-from .bc import bc_arrays
+import warnings
+
+from numba import literal_unroll, njit
+from numba.core.errors import NumbaExperimentalFeatureWarning
+
+from .bc import Ramp, bc_arrays
 from .errors import BlowUpError, DegenerateTetError, ModelError
 from .geometry import min_signed_volume
 
@@ -45,6 +50,108 @@ def rk4_step(accel, x, v, t, dt, constrain):
     vn = v + dt / 6.0 * (k1v + 2 * k2v + 2 * k3v + k4v)
     constrain(xn, vn, t + dt)
     return xn, vn
+
+# the terms' kernels reach the compiled step as first-class functions in a tuple, a feature
+# numba still calls experimental; it is what lets any composition of terms run compiled
+warnings.filterwarnings("ignore", category=NumbaExperimentalFeatureWarning)
+
+
+@njit(cache=True)
+def total_forces(kernels, x, out):
+    """out = the sum of every term's forces at x; returns (term, element) of the first
+    degenerate element a kernel found, or (-1, -1)."""
+    out[:] = 0.0
+    term, bad, i = -1, -1, 0
+    for k in literal_unroll(kernels):
+        b = k[0](x, *k[1], out)
+        if b >= 0 and term < 0:
+            term, bad = i, b
+        i += 1
+    return term, bad
+
+
+@njit(cache=True)
+def _accel(kernels, x, v, f_ext, mass, damping, mask, a):
+    term, bad = total_forces(kernels, x, a)
+    for i in range(x.shape[0]):
+        for k in range(3):
+            a[i, k] = 0.0 if mask[i, k] else ((a[i, k] + f_ext[i, k]) / mass[i]
+                                              - damping * v[i, k])
+    return term, bad
+
+
+@njit(cache=True)
+def _constrain(x, v, t, X, mask, start, moving, t_ramp):
+    """The ramp's prescribed components at time t (model.bc.Ramp.arrays and .velocity)."""
+    s = min(max(t / t_ramp, 0.0), 1.0)
+    moving_now = 0.0 <= t < t_ramp
+    for i in range(x.shape[0]):
+        for k in range(3):
+            if mask[i, k]:
+                x[i, k] = X[i, k] + (start[i, k] + s * moving[i, k])
+                v[i, k] = moving[i, k] / t_ramp if moving_now else 0.0
+
+
+@njit(cache=True)
+def _stage(x, v, kx, kv, h, xs, vs):
+    for i in range(x.shape[0]):
+        for k in range(3):
+            xs[i, k] = x[i, k] + h * kx[i, k]
+            vs[i, k] = v[i, k] + h * kv[i, k]
+
+
+@njit(cache=True)
+def rk4_ramp(kernels, x, v, t0, dt, steps, X, mass, f_ext, damping, mask, start, moving,
+             t_ramp, tets, check_volumes, vmax, buf):
+    """``steps`` classical RK4 steps from (x, v) at t0, in place, under a ramp (the arithmetic
+    of :func:`rk4_step`, element by element). ``buf`` (10, n, 3) is scratch. Stops at the first
+    step that breaks; returns (status, step, a, b, value): status 0 done, 1 NaN or inf,
+    2 degenerate element b of term a, 3 tetrahedron b inverted, 4 a particle at speed value.
+    ``check_volumes`` is needed where no term checks its tetrahedra (springs alone)."""
+    k1v, k2v, k3v, k4v, x2, v2, x3, v3, x4, v4 = (buf[0], buf[1], buf[2], buf[3], buf[4],
+                                                  buf[5], buf[6], buf[7], buf[8], buf[9])
+    n = x.shape[0]
+    for step in range(1, steps + 1):
+        t = t0 + (step - 1) * dt
+        term, bad = _accel(kernels, x, v, f_ext, mass, damping, mask, k1v)
+        if term < 0:
+            _stage(x, v, v, k1v, 0.5 * dt, x2, v2)
+            _constrain(x2, v2, t + 0.5 * dt, X, mask, start, moving, t_ramp)
+            term, bad = _accel(kernels, x2, v2, f_ext, mass, damping, mask, k2v)
+        if term < 0:
+            _stage(x, v, v2, k2v, 0.5 * dt, x3, v3)
+            _constrain(x3, v3, t + 0.5 * dt, X, mask, start, moving, t_ramp)
+            term, bad = _accel(kernels, x3, v3, f_ext, mass, damping, mask, k3v)
+        if term < 0:
+            _stage(x, v, v3, k3v, dt, x4, v4)
+            _constrain(x4, v4, t + dt, X, mask, start, moving, t_ramp)
+            term, bad = _accel(kernels, x4, v4, f_ext, mass, damping, mask, k4v)
+        if term >= 0:
+            return 2, step, term, bad, 0.0
+        h = dt / 6.0
+        for i in range(n):
+            for k in range(3):
+                x[i, k] = x[i, k] + h * (((v[i, k] + 2 * v2[i, k]) + 2 * v3[i, k]) + v4[i, k])
+                v[i, k] = v[i, k] + h * (((k1v[i, k] + 2 * k2v[i, k]) + 2 * k3v[i, k])
+                                         + k4v[i, k])
+        _constrain(x, v, t + dt, X, mask, start, moving, t_ramp)
+        finite = True
+        top = 0.0
+        for i in range(n):
+            sp = 0.0
+            for k in range(3):
+                finite = finite and np.isfinite(x[i, k]) and np.isfinite(v[i, k])
+                sp += v[i, k] * v[i, k]
+            top = max(top, sp)
+        if not finite:
+            return 1, step, -1, -1, 0.0
+        if check_volumes:
+            vmin, tmin = min_signed_volume(x, tets)
+            if vmin <= 0.0:
+                return 3, step, -1, tmin, 0.0
+        if np.sqrt(top) > vmax:
+            return 4, step, -1, -1, np.sqrt(top)
+    return 0, steps, -1, -1, 0.0
 
 
 def simulate(model, bc_of_t, t_end, dt=None, damping=0.0, f_ext=None, frames=101, safety=0.5,
@@ -111,23 +218,49 @@ def simulate(model, bc_of_t, t_end, dt=None, damping=0.0, f_ext=None, frames=101
         rs.append(np.where(mask, -(model.forces(x) + f_ext), 0.0))
 
     record(0, x)
-    for k in range(1, steps + 1):
-        t = t0 + (k - 1) * dt
-        try:
-            x, v = rk4_step(accel, x, v, t, dt, constrain)
-        except DegenerateTetError as exc:
-            raise _blow_up(f"tetrahedron {exc.tets[0]} inverted", k, t + dt, dt) from exc
-        if not (np.isfinite(x).all() and np.isfinite(v).all()):
-            raise _blow_up("NaN or inf in the state", k, t + dt, dt)
-        vmin, tmin = min_signed_volume(x, mesh.tets)
-        if vmin <= 0.0:
-            raise _blow_up(f"tetrahedron {tmin} inverted", k, t + dt, dt)
-        speed = np.sqrt((v * v).sum(axis=1)).max()
-        if speed > vmax:
-            raise _blow_up(f"a particle moves at {speed:.3g} m/s, faster than the P-wave speed "
-                           f"{vmax:.3g} m/s", k, t + dt, dt)
-        if k in frame_steps:
-            record(k, x)
+    if isinstance(bc_of_t, Ramp):   # the whole step compiled, forces included
+        _, start, moving = bc_of_t._parts(mesh.n_nodes)
+        kernels = model.kernels()
+        check = not any(t.checks_inversion for t in model.terms)
+        buf = np.empty((10,) + x.shape)
+        done = 0
+        for k in frame_steps[1:]:
+            status, at, term, bad, speed = rk4_ramp(
+                kernels, x, v, t0 + done * dt, dt, int(k - done), mesh.points, model.mass,
+                f_ext, float(damping), mask, start, moving, bc_of_t.t_ramp, mesh.tets, check,
+                vmax, buf)
+            if status:
+                step = done + at
+                what = ("NaN or inf in the state" if status == 1 else
+                        f"tetrahedron {model.terms[term].degenerate_tets(bad)[0]} inverted"
+                        if status == 2 else f"tetrahedron {bad} inverted" if status == 3 else
+                        f"a particle moves at {speed:.3g} m/s, faster than the P-wave speed "
+                        f"{vmax:.3g} m/s")
+                raise _blow_up(what, step, t0 + step * dt, dt)
+            done = int(k)
+            record(done, x)
+        if not check:   # the kernels check every stage but the last
+            vmin, tmin = min_signed_volume(x, mesh.tets)
+            if vmin <= 0.0:
+                raise _blow_up(f"tetrahedron {tmin} inverted", steps, t_end, dt)
+    else:
+        for k in range(1, steps + 1):
+            t = t0 + (k - 1) * dt
+            try:
+                x, v = rk4_step(accel, x, v, t, dt, constrain)
+            except DegenerateTetError as exc:
+                raise _blow_up(f"tetrahedron {exc.tets[0]} inverted", k, t + dt, dt) from exc
+            if not (np.isfinite(x).all() and np.isfinite(v).all()):
+                raise _blow_up("NaN or inf in the state", k, t + dt, dt)
+            vmin, tmin = min_signed_volume(x, mesh.tets)
+            if vmin <= 0.0:
+                raise _blow_up(f"tetrahedron {tmin} inverted", k, t + dt, dt)
+            speed = np.sqrt((v * v).sum(axis=1)).max()
+            if speed > vmax:
+                raise _blow_up(f"a particle moves at {speed:.3g} m/s, faster than the P-wave "
+                               f"speed {vmax:.3g} m/s", k, t + dt, dt)
+            if k in frame_steps:
+                record(k, x)
     return Trajectory(t=np.array(ts), x=np.array(xs), reaction=np.array(rs), dt=dt, steps=steps,
                       v=v)
 

@@ -47,6 +47,10 @@ class ParticleModel:
             t.forces(x, out)
         return out
 
+    def kernels(self):
+        """The terms' kernels as a tuple of ``(fn, args)`` for the compiled integrator."""
+        return tuple(t.kernel() for t in self.terms)
+
     def energy(self, x):
         """Total stored energy [J]; an error for a model with a non-conservative term."""
         return sum(t.energy(x) for t in self.terms)

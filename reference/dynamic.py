@@ -87,8 +87,9 @@ def solve(mesh, E, nu, rho, dirichlet_of_t, t_end, dt=None, damping=0.0, element
     f = body_load(basis, body_force) if body_force is not None else np.zeros(basis.N)
     n = mesh.n_nodes
 
-    def prescribed(t):
-        mask, vals = bc_arrays(dirichlet_of_t(t), n)
+    def prescribed(t):   # a Ramp gives its arrays without building a mapping per step
+        mask, vals = (dirichlet_of_t.arrays(t, n) if hasattr(dirichlet_of_t, "arrays")
+                      else bc_arrays(dirichlet_of_t(t), n))
         D, x = dirichlet_dofs(basis, mask, vals, None)
         return mask, D, x
 

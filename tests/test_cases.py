@@ -9,6 +9,7 @@ from cases import metrics as M
 from cases.cli import main
 from cases.library.paper_cube import LAYERS_MM, SIZE_MM, make_mesh, static_bc
 from cases.report import TIMING_KEYS
+from model import PRESETS
 from reference import linear
 
 FILES = ["metrics.json", "report.md", "report.html", "errors.png", "step_time.png",
@@ -37,7 +38,7 @@ def test_quick_run_writes_every_file_with_finite_metrics(quick):
         assert (quick / f).is_file(), f
     data = json.loads((quick / "metrics.json").read_text())
     runs = data["runs"]
-    assert len(runs) == 2 * 2 * 6
+    assert len(runs) == 2 * 2 * len(PRESETS)     # meshes x conditions x every preset
     assert {r["mesh"] for r in runs} == {"five", "six"}
     for r in runs:
         for k in KEYS:
@@ -49,7 +50,7 @@ def test_quick_run_writes_every_file_with_finite_metrics(quick):
             assert r["reaction_time_rel_l2"] > 0 and (r["rest_time_s"] or 2.0) > 1.0
     env = data["environment"]
     assert {"python", "numpy", "numba", "scikit-fem", "git_commit", "date"} <= set(env)
-    assert len(list((quick / "vtu").glob("*.vtu"))) == 2 * 2 * 7
+    assert len(list((quick / "vtu").glob("*.vtu"))) == 2 * 2 * (len(PRESETS) + 1)   # + FEM
 
 
 def test_html_parses_and_every_figure_exists(quick):

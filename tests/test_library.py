@@ -77,37 +77,40 @@ def test_quick_library_passes_the_committed_bounds(library, capsys):
     assert status == 0, out[-3000:]
 
 
-def test_paper_cube_on_the_framework_is_bit_for_bit_the_landed_case(quick):
+def test_paper_cube_on_the_framework_matches_the_landed_case(quick):
     """Every non-timing metric of the quick paper cube equals the one the pre-framework code
-    wrote (stored in tests/data), bit for bit when the numerical libraries are the ones it was
-    measured with (else to 1e-9: another BLAS or numba may round differently)."""
-    import numba
-    import scipy
-    import skfem
+    wrote (stored in tests/data). The framework move was bit for bit (commit b783075); the
+    rewritten force kernels and the compiled RK4 step (issue 11) sum in another order, so
+    values now agree to 1e-7 relative (FD-Jacobian frequencies differ by 1e-8, statics by
+    1e-11), series to 1e-9 of their largest value, and the Newton residual only has to stay
+    converged (it is rounding noise, 1e-16 to 1e-9 N)."""
     before = json.loads(BASELINE.read_text())
-    env = before["environment"]
-    exact = (env["numpy"], env["scipy"], env["numba"], env["scikit-fem"]) == (
-        np.__version__, scipy.__version__, numba.__version__, skfem.__version__)
     now = {(r["mesh"], r["bc"], r["model"]): r
            for r in json.loads((quick / "metrics.json").read_text())["runs"]}
-    assert len(now) == len(before["runs"])
     for old in before["runs"]:
         new = now[(old["mesh"], old["bc"], old["model"])]
         for k, v in old.items():
             assert k not in TIMING_KEYS
-            if exact:
-                assert new[k] == v, k
+            if k == "static_residual_n":
+                assert (new[k] is None) == (v is None) and (v is None or new[k] < 1e-8), k
             else:
                 _close(new[k], v, k)
 
 
 def _close(a, b, key):
     if isinstance(b, float):
-        assert a == pytest.approx(b, rel=1e-9, abs=1e-15), key
+        assert a == pytest.approx(b, rel=1e-7, abs=1e-15), key
+    elif isinstance(b, list) and b and all(isinstance(y, float) for y in b):
+        scale = max(abs(y) for y in b)
+        assert len(a) == len(b) and np.allclose(a, b, rtol=0, atol=1e-9 * scale), key
     elif isinstance(b, list):
+        assert len(a) == len(b), key
         for x, y in zip(a, b):
             _close(x, y, key)
-    elif not isinstance(b, dict):
+    elif isinstance(b, dict):
+        for k in b:
+            _close(a[k], b[k], key)
+    else:
         assert a == b, key
 
 

@@ -38,14 +38,34 @@ def make_term(name, mesh, material, **params):
 class Term:
     """Base class of a force term.
 
-    Subclasses set ``name``, ``conservative`` (an energy exists and forces are its negative
-    gradient) and implement ``_kernel_forces(x, out)`` (numba, adds into ``out``, returns the
-    first degenerate tetrahedron or -1) and ``forces_numpy(x)`` (plain numpy, for the tests).
+    What a term provides:
+
+    ``name``, ``params``
+        its registry name and the parameters a user may pass, with their defaults;
+    ``conservative``
+        whether an energy exists whose negative gradient the forces are;
+    ``kernel()``
+        ``(fn, args)``: a numba function called as ``fn(x, *args, out)`` that adds the term's
+        forces at positions ``x`` (n, 3) into ``out`` (n, 3) and returns -1, or the index of
+        the first element it found flattened or inverted (``degenerate_tets`` turns that index
+        into tetrahedra). The compiled integrator calls it directly, with no Python between;
+    ``forces_numpy(x)``
+        the same forces in plain numpy, written from the formula, for the tests;
+    ``energy(x)``
+        for a conservative term;
+    ``calibrate``, ``coef``, ``unit_energy(x)`` and ``calibration_residuals(x, rows)``
+        for a term whose constant is fitted (``"auto"``): ``unit_energy`` is the energy with
+        ``coef`` = 1, written as ``sum_t w_t sum_k r_tk^2``, and ``calibration_residuals``
+        gives ``(r, w)`` for the tetrahedra ``rows``; ``model.calibrate`` sets ``coef``.
+
     ``scale`` multiplies the whole term (a testing and sensitivity knob, 1 by default).
     """
 
     name = ""
     conservative = False
+    # whether the kernel reports every tetrahedron flattened below FLAT V0 (else the
+    # integrator checks the volumes itself)
+    checks_inversion = False
     # parameters a user may pass, with defaults
     params = {}
 
@@ -60,12 +80,25 @@ class Term:
     def forces(self, x, out=None):
         """Internal forces (n, 3) at positions ``x``; added into ``out`` when given."""
         out = np.zeros_like(x) if out is None else out
-        bad = self._kernel_forces(np.ascontiguousarray(x, dtype=np.float64), out)
+        fn, args = self.kernel()
+        bad = fn(np.ascontiguousarray(x, dtype=np.float64), *args, out)
         if bad >= 0:
-            raise DegenerateTetError(
-                f"tetrahedron {bad} (nodes {self.mesh.tets[bad].tolist()}) is inverted or "
-                f"flattened in term {self.name!r}; reduce the load step or time step", [bad])
+            raise self.degenerate(bad)
         return out
+
+    def kernel(self):
+        raise NotImplementedError(f"term {self.name!r} provides no kernel")
+
+    def degenerate_tets(self, bad):
+        """The tetrahedra behind the index a kernel returned (its own element)."""
+        return [int(bad)]
+
+    def degenerate(self, bad):
+        """The error for a kernel that stopped at element ``bad``."""
+        tets = self.degenerate_tets(bad)
+        return DegenerateTetError(
+            f"tetrahedron {tets[0]} (nodes {self.mesh.tets[tets[0]].tolist()}) is inverted or "
+            f"flattened in term {self.name!r}; reduce the load step or time step", tets)
 
     def energy(self, x):
         raise ModelError(f"term {self.name!r} ({self.describe()}) has no energy: "

@@ -17,8 +17,8 @@ from ..errors import ModelError
 CORNER_EDGES = np.array([[(a, j) for j in range(4) if j != a] for a in range(4)], dtype=np.int64)
 
 
-@njit(cache=True)
-def _forces(x, tets, vol0, rest_len, coef_G, out):
+@njit(cache=True, fastmath=True)
+def normal_forces(x, tets, vol0, rest_len, coef_G, out):
     d = np.empty((3, 3))
     ln = np.empty(3)
     eps = np.empty(3)
@@ -42,6 +42,23 @@ def _forces(x, tets, vol0, rest_len, coef_G, out):
                     out[nj, k] -= s * d[r, k]
                     out[na, k] += s * d[r, k]
     return -1
+
+
+@njit(cache=True, fastmath=True)
+def normal_strains(x, tets, rest_len, out):
+    """eps_j - eps_a (m, 4, 3): each corner's edge strains less their mean."""
+    for t in range(tets.shape[0]):
+        for a in range(4):
+            na = tets[t, a]
+            mean = 0.0
+            for r in range(3):
+                nj = tets[t, CORNER_EDGES[a, r, 1]]
+                ln = np.sqrt((x[nj, 0] - x[na, 0]) ** 2 + (x[nj, 1] - x[na, 1]) ** 2
+                             + (x[nj, 2] - x[na, 2]) ** 2)
+                out[t, a, r] = ln / rest_len[t, a, r] - 1.0
+                mean += out[t, a, r]
+            for r in range(3):
+                out[t, a, r] -= mean / 3.0
 
 
 def edge_vectors(x, tets):
@@ -71,16 +88,23 @@ class Normal(Term):
     def info(self):
         return {**super().info(), "c": self.coef}
 
-    def _kernel_forces(self, x, out):
+    def kernel(self):
         if self.coef is None:
             raise ModelError("normal term with c='auto' is not calibrated yet: build the model "
                              "with model.build, or pass a number for c")
-        return _forces(x, self.mesh.tets, self.vol0, self.rest_len,
-                       self.scale * self.coef * self.G, out)
+        return normal_forces, (self.mesh.tets, self.vol0, self.rest_len,
+                               self.scale * self.coef * self.G)
 
-    def _dev_strain(self, x):
-        eps = np.linalg.norm(edge_vectors(x, self.mesh.tets), axis=-1) / self.rest_len - 1.0
-        return eps - eps.mean(axis=2, keepdims=True)
+    def _dev_strain(self, x, rows=slice(None)):
+        tets = self.mesh.tets[rows]
+        out = np.empty((len(tets), 4, 3))
+        normal_strains(np.ascontiguousarray(x, dtype=np.float64), tets, self.rest_len[rows], out)
+        return out
+
+    def calibration_residuals(self, x, rows):
+        """The deviatoric edge strains (r, 4, 3) of the tetrahedra ``rows`` and their weights
+        G V0: unit_energy = sum w (eps - mean)^2."""
+        return self._dev_strain(x, rows), self.G * self.vol0[rows]
 
     def unit_energy(self, x):
         return float(self.G * np.sum(self.vol0[:, None, None] * self._dev_strain(x) ** 2))
@@ -91,7 +115,9 @@ class Normal(Term):
     def forces_numpy(self, x):
         d = edge_vectors(x, self.mesh.tets)
         ln = np.linalg.norm(d, axis=-1)
-        s = 2 * self.scale * self.coef * self.G * self.vol0[:, None, None] * self._dev_strain(x) \
+        eps = ln / self.rest_len - 1.0
+        dev = eps - eps.mean(axis=2, keepdims=True)
+        s = 2 * self.scale * self.coef * self.G * self.vol0[:, None, None] * dev \
             / (self.rest_len * ln)
         fj = -s[..., None] * d
         out = np.zeros_like(x)

@@ -20,7 +20,8 @@ import numpy as np
 from numba import njit
 
 from . import Term, register
-from ._kernels import cross, dot, gather, volume_gradient, volume_gradient_numpy
+from ._kernels import (FACE, apply_laplacian, cross, dot, edges, face_vectors, inverse_lengths,
+                       scatter, volume_gradient_numpy)
 from .volume import FLAT
 from ..errors import ModelError, DegenerateTetError
 
@@ -33,85 +34,147 @@ _PARITY = np.array([round(np.linalg.det(np.eye(4)[[a, m, l, j]])) for a, j, m, l
 READINGS = {"corner": 0, "balanced": 1, "variational": 2}
 
 
+# Every kernel below works on one tetrahedron at a time: the edges d[a, b], 6V, the face
+# vectors c[j] (|c[j]| = 2 S_j) and the lengths L once, then the 24 strains
+#     gamma_s = q |c_j| / (6V) - gamma0_s,   q = d[a, j] . d[a, m] / L[a, m].
+# The forces of the corner and balanced readings and the q-part of the variational gradient
+# are sums of coefficients times edges x_b - x_a: they are gathered in a 4 x 4 matrix M and
+# applied once (apply_laplacian).
+
+
 @njit(cache=True, fastmath=True)
-def _shear(x, tets, vol0, gamma0, G, coef, reading, out, gamma_out):
-    """Strains of every tetrahedron into gamma_out (m, 24) and, unless reading < 0, the
-    forces of ``reading`` added into out (n, 3). Returns the first flattened tetrahedron,
-    or -1. Loops run corner a, tip j, then the two in-plane edges m of the base
-    (a, m, l), so that edge vectors and the base normal are computed once."""
-    n_tets = tets.shape[0]
-    xt, ee, dV = np.empty((4, 3)), np.empty((3, 3)), np.empty((4, 3))
-    ed, en, eu = np.empty((4, 3)), np.empty(4), np.empty((4, 3))  # edges from corner a
-    c, ch, gc, gr = np.empty(3), np.empty(3), np.empty((4, 3)), np.empty((4, 3))
-    ft = np.empty((4, 3))  # this tetrahedron's nodal forces, added to out once
-    for t in range(n_tets):
-        ft[:] = 0.0
-        gather(x, tets, t, xt)
-        V = volume_gradient(xt, ee, dV)
-        if V <= FLAT * vol0[t]:
+def shear_strains(x, tets, gamma0, gamma_out):
+    """The 24 strains of every tetrahedron into gamma_out (m, 24); returns the first
+    flattened tetrahedron (6V <= 0), or -1."""
+    d, c, cn, iL = np.empty((4, 4, 3)), np.empty((4, 3)), np.empty(4), np.empty((4, 4))
+    for t in range(tets.shape[0]):
+        V6 = edges(x, tets, t, d)
+        if V6 <= 0.0:
             return t
-        s = 0
-        for a in range(4):
-            for b in range(4):
-                for k in range(3):
-                    ed[b, k] = xt[b, k] - xt[a, k]
-                en[b] = np.sqrt(dot(ed[b], ed[b])) if b != a else 1.0
-                for k in range(3):
-                    eu[b, k] = ed[b, k] / en[b]
-            for j in range(4):
-                if j == a:
-                    continue
-                m0 = 0
-                while m0 == a or m0 == j:
-                    m0 += 1
-                l0 = 6 - a - j - m0
-                cross(ed[m0], ed[l0], c)
-                cn = np.sqrt(dot(c, c))
-                for k in range(3):
-                    ch[k] = c[k] / cn
-                if reading == 2:  # d|c|/dx, shared by both in-plane edges
-                    cross(ed[l0], ch, gc[m0])
-                    cross(ch, ed[m0], gc[l0])
-                    for k in range(3):
-                        gc[j, k] = 0.0
-                        gc[a, k] = -(gc[m0, k] + gc[l0, k])
-                for mm in range(2):
-                    m = m0 if mm == 0 else l0
-                    l = l0 if mm == 0 else m0
-                    q = dot(ed[j], eu[m])
-                    graw = q * cn / (6.0 * V)
-                    gamma = graw - gamma0[t, s]
-                    gamma_out[t, s] = gamma
-                    s += 1
-                    if reading < 0:
-                        continue
-                    tau_area = G * gamma * 0.5 * cn  # tau S_F
-                    if reading == 0:      # corner: on a alone, paper factor 1/4
-                        for k in range(3):
-                            ft[a, k] += 0.25 * tau_area * eu[m, k]
-                    elif reading == 1:    # balanced: on the tip, reaction over the base
-                        for k in range(3):
-                            f = tau_area * eu[m, k]
-                            ft[j, k] -= f
-                            ft[a, k] += f / 3.0
-                            ft[m, k] += f / 3.0
-                            ft[l, k] += f / 3.0
-                    else:                 # variational: -dW/dx, W = (c/2) G V0 gamma^2
-                        for k in range(3):
-                            gr[j, k] = cn * eu[m, k] / (6.0 * V)
-                            gr[m, k] = (cn * (ed[j, k] - q * eu[m, k]) / en[m]
-                                        + q * gc[m, k]) / (6.0 * V)
-                            gr[l, k] = q * gc[l, k] / (6.0 * V)
-                            gr[a, k] = -(gr[j, k] + gr[m, k] + gr[l, k])
-                        s_w = coef * G * vol0[t] * gamma
-                        for i in range(4):
-                            for k in range(3):
-                                ft[i, k] -= s_w * (gr[i, k] - graw * dV[i, k] / V)
-        if reading >= 0:
-            for i in range(4):
-                for k in range(3):
-                    out[tets[t, i], k] += ft[i, k]
+        face_vectors(d, c, cn)
+        inverse_lengths(d, iL)
+        for j in range(4):
+            cn[j] /= V6                  # 1 / height over the face opposite j
+        for s in range(24):
+            a, j, m = COMBOS[s, 0], COMBOS[s, 1], COMBOS[s, 2]
+            gamma_out[t, s] = dot(d[a, j], d[a, m]) * iL[a, m] * cn[j] - gamma0[t, s]
     return -1
+
+
+@njit(cache=True, fastmath=True)
+def shear_corner(x, tets, vol0, gamma0, G, out):
+    """Literal eq. 5: f_a += (1/4) tau S_F e, tau = G gamma, S_F = |c_j| / 2, e = d[a, m] / L."""
+    d, c, cn, iL = np.empty((4, 4, 3)), np.empty((4, 3)), np.empty(4), np.empty((4, 4))
+    M, ft = np.empty((4, 4)), np.empty((4, 3))
+    for t in range(tets.shape[0]):
+        V6 = edges(x, tets, t, d)
+        if V6 <= FLAT * 6.0 * vol0[t]:
+            return t
+        face_vectors(d, c, cn)
+        inverse_lengths(d, iL)
+        iV6 = 1.0 / V6
+        M[:] = 0.0
+        for s in range(24):
+            a, j, m = COMBOS[s, 0], COMBOS[s, 1], COMBOS[s, 2]
+            gamma = dot(d[a, j], d[a, m]) * iL[a, m] * cn[j] * iV6 - gamma0[t, s]
+            w = 0.125 * G * gamma * cn[j] * iL[a, m]   # (1/4) tau S_F / L on the edge a -> m
+            M[a, m] += w
+            M[a, a] -= w
+        ft[:] = 0.0
+        apply_laplacian(M, d, ft)
+        scatter(tets, t, ft, out)
+    return -1
+
+
+@njit(cache=True, fastmath=True)
+def shear_balanced(x, tets, vol0, gamma0, G, out):
+    """f_j -= tau S_F e on the tip, + tau S_F e / 3 on each base vertex a, m, l."""
+    d, c, cn, iL = np.empty((4, 4, 3)), np.empty((4, 3)), np.empty(4), np.empty((4, 4))
+    M, ft = np.empty((4, 4)), np.empty((4, 3))
+    for t in range(tets.shape[0]):
+        V6 = edges(x, tets, t, d)
+        if V6 <= FLAT * 6.0 * vol0[t]:
+            return t
+        face_vectors(d, c, cn)
+        inverse_lengths(d, iL)
+        iV6 = 1.0 / V6
+        M[:] = 0.0
+        for s in range(24):
+            a, j, m, l = COMBOS[s, 0], COMBOS[s, 1], COMBOS[s, 2], COMBOS[s, 3]
+            gamma = dot(d[a, j], d[a, m]) * iL[a, m] * cn[j] * iV6 - gamma0[t, s]
+            w = 0.5 * G * gamma * cn[j] * iL[a, m]     # tau S_F / L on the edge a -> m
+            for i in range(4):                         # f_i += coef_i (x_m - x_a)
+                coef = -w if i == j else w / 3.0
+                M[i, m] += coef
+                M[i, a] -= coef
+        ft[:] = 0.0
+        apply_laplacian(M, d, ft)
+        scatter(tets, t, ft, out)
+    return -1
+
+
+@njit(cache=True, fastmath=True)
+def shear_variational(x, tets, vol0, gamma0, cG, out):
+    """f = -dW/dx, W = (c/2) G V0 sum_s gamma_s^2 (cG = c G). With w_s = c G V0 gamma_s:
+
+        dW = sum_s w_s [ |c_j|/(6V) dq + q/(6V) d|c_j| - gamma_raw d(6V)/(6V) ],
+        dq = d(d_aj . d_am) / L_am - q dL_am / L_am.
+    """
+    d, c, cn, iL = np.empty((4, 4, 3)), np.empty((4, 3)), np.empty(4), np.empty((4, 4))
+    M, ft, B, ch, g = np.empty((4, 4)), np.empty((4, 3)), np.empty(4), np.empty(3), np.empty(3)
+    for t in range(tets.shape[0]):
+        V6 = edges(x, tets, t, d)
+        if V6 <= FLAT * 6.0 * vol0[t]:
+            return t
+        face_vectors(d, c, cn)
+        inverse_lengths(d, iL)
+        iV6, cGV0 = 1.0 / V6, cG * vol0[t]
+        M[:] = 0.0      # -dW from dq, as coefficients of edges
+        B[:] = 0.0      # dW / d|c_j|
+        A = 0.0         # dW / d(6V)
+        for s in range(24):
+            a, j, m = COMBOS[s, 0], COMBOS[s, 1], COMBOS[s, 2]
+            q = dot(d[a, j], d[a, m]) * iL[a, m]
+            raw = q * cn[j] * iV6
+            w = cGV0 * (raw - gamma0[t, s])
+            A -= w * raw * iV6
+            B[j] += w * q * iV6
+            k = w * cn[j] * iV6 * iL[a, m]              # dW/dD for D = d_aj . d_am
+            # -k dD: f_j -= k d_am, f_m -= k d_aj, f_a += k (d_am + d_aj)
+            M[j, m] -= k
+            M[j, a] += k
+            M[m, j] -= k
+            M[m, a] += k
+            M[a, m] += k
+            M[a, j] += k
+            M[a, a] -= 2.0 * k
+            # -dW/dL_am = k q: f_m += r d_am, f_a -= r d_am, r = k q / L
+            r = k * q * iL[a, m]
+            M[m, m] += r
+            M[m, a] -= r
+            M[a, m] -= r
+            M[a, a] += r
+        ft[:] = 0.0
+        apply_laplacian(M, d, ft)
+        for j in range(4):
+            # -A d(6V)/dx_j = -A c[j]; -B_j d|c_j|/dx over the face (a, m, l) of c_j
+            a, m, l = FACE[j, 0], FACE[j, 1], FACE[j, 2]
+            for k in range(3):
+                ft[j, k] -= A * c[j, k]
+                ch[k] = B[j] * c[j, k] / cn[j]   # B_j c_hat
+            cross(d[a, l], ch, g)      # d|c|/dx_m = d_al x c_hat
+            for k in range(3):
+                ft[m, k] -= g[k]
+                ft[a, k] += g[k]
+            cross(ch, d[a, m], g)      # d|c|/dx_l = c_hat x d_am
+            for k in range(3):
+                ft[l, k] -= g[k]
+                ft[a, k] += g[k]
+        scatter(tets, t, ft, out)
+    return -1
+
+
+KERNELS = {0: shear_corner, 1: shear_balanced, 2: shear_variational}
 
 
 def strains_numpy(x, tets, gamma0):
@@ -144,6 +207,7 @@ class Shear(Term):
     """
 
     name = "shear"
+    checks_inversion = True
     params = {"reading": "variational", "c": "auto"}
 
     def __init__(self, mesh, material, scale=1.0, **params):
@@ -161,7 +225,6 @@ class Shear(Term):
         self.G = material.G  # scale multiplies forces and energy after calibration
         self.vol0 = mesh.volumes
         self.gamma0 = np.zeros((mesh.n_tets, 24))
-        self._gam = np.empty((mesh.n_tets, 24))  # reused by every force evaluation
         self.gamma0 = self.strains(mesh.points)
 
     def describe(self):
@@ -176,25 +239,22 @@ class Shear(Term):
     def strains(self, x):
         """The 24 shear strains (m, 24) at positions x."""
         gam = np.empty((self.mesh.n_tets, 24))
-        self._run(x, -1, np.zeros((1, 3)), gam)
+        bad = shear_strains(np.ascontiguousarray(x, dtype=np.float64), self.mesh.tets,
+                            self.gamma0, gam)
+        if bad >= 0:
+            raise DegenerateTetError(f"tetrahedron {bad} is inverted or flattened", [bad])
         return gam
 
     def max_tau(self, x):
         """Maximum |tau| = G max |gamma| per tetrahedron (the paper's Figure 1), material G."""
         return self.material.G * np.abs(self.strains(x)).max(axis=1)
 
-    def _run(self, x, reading, out, gam):
-        bad = _shear(np.ascontiguousarray(x, dtype=np.float64), self.mesh.tets, self.vol0,
-                     self.gamma0, self.scale * self.G, self.coef or 0.0, reading, out, gam)
-        if bad >= 0 and reading < 0:
-            raise DegenerateTetError(f"tetrahedron {bad} is inverted or flattened", [bad])
-        return bad
-
-    def _kernel_forces(self, x, out):
+    def kernel(self):
         if self.reading == 2 and self.coef is None:
             raise ModelError("variational shear with c='auto' is not calibrated yet: "
                              "build the model with model.build, or pass a number for c")
-        return self._run(x, self.reading, out, self._gam)
+        k = self.scale * self.G * (self.coef if self.reading == 2 else 1.0)
+        return KERNELS[self.reading], (self.mesh.tets, self.vol0, self.gamma0, k)
 
     def forces_numpy(self, x):
         tets = self.mesh.tets
@@ -230,6 +290,16 @@ class Shear(Term):
                         - graw * dV[:, i] / V[:, None]
                     np.add.at(out, tets[:, i], -coef * grad)
         return out
+
+    def calibration_residuals(self, x, rows):
+        """The strains gamma (r, 24) of the tetrahedra ``rows`` and their weights G V0 / 2:
+        unit_energy = sum w gamma^2."""
+        tets, g0 = self.mesh.tets[rows], self.gamma0[rows]
+        gam = np.empty(g0.shape)
+        bad = shear_strains(np.ascontiguousarray(x, dtype=np.float64), tets, g0, gam)
+        if bad >= 0:
+            raise DegenerateTetError(f"tetrahedron {bad} is inverted or flattened", [bad])
+        return gam, 0.5 * self.G * self.vol0[rows]
 
     def unit_energy(self, x):
         """Energy of the variational reading with c = 1 and scale 1: (1/2) G V0 sum gamma^2

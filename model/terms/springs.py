@@ -16,8 +16,9 @@ from . import Term, register
 from ..geometry import edges
 
 
-@njit(cache=True)
-def _forces(x, edge, rest, k, out):
+@njit(cache=True, fastmath=True)
+def spring_forces(x, edge, rest, k, out):
+    """Linear springs f = k (l - l0) on every edge; returns the first collapsed edge, or -1."""
     for s in range(edge.shape[0]):
         i, j = edge[s, 0], edge[s, 1]
         d0, d1, d2 = x[j, 0] - x[i, 0], x[j, 1] - x[i, 1], x[j, 2] - x[i, 2]
@@ -57,13 +58,14 @@ class Springs(Term):
         self.edge, self.rest, k = van_gelder_stiffness(mesh)
         self.k = self.scale * material.E * k
 
-    def _kernel_forces(self, x, out):
-        bad = _forces(x, self.edge, self.rest, self.k, out)
-        # report the tetrahedron of a collapsed edge rather than the edge
-        if bad < 0:
-            return -1
-        return int(np.flatnonzero((self.mesh.tets == self.edge[bad, 0]).any(axis=1)
-                                  & (self.mesh.tets == self.edge[bad, 1]).any(axis=1))[0])
+    def kernel(self):
+        return spring_forces, (self.edge, self.rest, self.k)
+
+    def degenerate_tets(self, bad):
+        """The tetrahedra around the collapsed edge ``bad``."""
+        e = self.edge[bad]
+        return np.flatnonzero((self.mesh.tets == e[0]).any(axis=1)
+                              & (self.mesh.tets == e[1]).any(axis=1)).tolist()
 
     def forces_numpy(self, x):
         d = x[self.edge[:, 1]] - x[self.edge[:, 0]]

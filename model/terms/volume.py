@@ -7,24 +7,36 @@ import numpy as np
 from numba import njit
 
 from . import Term, register
-from ._kernels import gather, volume_gradient, volume_gradient_numpy
+from ._kernels import cross, dot, volume_gradient_numpy
 
 # V / V0 below this is a flattened tetrahedron (the energy's log barrier is meaningless there)
 FLAT = 1e-6
 
 
-@njit(cache=True)
-def _forces(x, tets, vol0, K, out):
-    xt, e, dV = np.empty((4, 3)), np.empty((3, 3)), np.empty((4, 3))
+@njit(cache=True, fastmath=True)
+def volume_forces(x, tets, vol0, K, out):
+    """f_i = p dV/dx_i, p = -K (V - V0) / V, for every tetrahedron; returns the first one
+    flattened below FLAT V0, or -1."""
+    e1, e2, e3, g = np.empty(3), np.empty(3), np.empty(3), np.empty((4, 3))
     for t in range(tets.shape[0]):
-        gather(x, tets, t, xt)
-        V = volume_gradient(xt, e, dV)
-        if V <= FLAT * vol0[t]:
+        n0, n1, n2, n3 = tets[t, 0], tets[t, 1], tets[t, 2], tets[t, 3]
+        for k in range(3):
+            e1[k] = x[n1, k] - x[n0, k]
+            e2[k] = x[n2, k] - x[n0, k]
+            e3[k] = x[n3, k] - x[n0, k]
+        cross(e2, e3, g[1])
+        cross(e3, e1, g[2])
+        cross(e1, e2, g[3])
+        V6 = dot(e1, g[1])
+        if V6 <= FLAT * 6.0 * vol0[t]:
             return t
-        p = -K * (V - vol0[t]) / V
+        p6 = -K * (V6 - 6.0 * vol0[t]) / (6.0 * V6)   # p / 6: g holds d(6V)/dx
+        for k in range(3):
+            g[0, k] = -(g[1, k] + g[2, k] + g[3, k])
         for i in range(4):
+            n = tets[t, i]
             for k in range(3):
-                out[tets[t, i], k] += p * dV[i, k]
+                out[n, k] += p6 * g[i, k]
     return -1
 
 
@@ -34,14 +46,15 @@ class Volume(Term):
 
     name = "volume"
     conservative = True
+    checks_inversion = True
 
     def __init__(self, mesh, material, scale=1.0, **params):
         super().__init__(mesh, material, scale, **params)
         self.K = self.scale * material.K
         self.vol0 = mesh.volumes
 
-    def _kernel_forces(self, x, out):
-        return _forces(x, self.mesh.tets, self.vol0, self.K, out)
+    def kernel(self):
+        return volume_forces, (self.mesh.tets, self.vol0, self.K)
 
     def forces_numpy(self, x):
         V, dV = volume_gradient_numpy(x, self.mesh.tets)

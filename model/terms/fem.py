@@ -1,0 +1,197 @@
+"""Explicit FEM baselines (MODEL.md "Explicit FEM baselines"): constant-strain tetrahedra with
+F = Ds Dm^-1 and nodal forces f = -V0 P(F) Dm^-T, driven by the same RK4 as the particle
+model. What a simulation engineer would pick instead, at the same cost budget.
+
+* ``fem_linear``: small strain, eps = sym(F) - I, P = sigma = lam tr(eps) I + 2 mu eps;
+  W = V0 (mu eps:eps + lam/2 tr(eps)^2). Linear in x: its statics are linear FEM P1.
+* ``fem_corotated``: the rotation R of F = R S (polar decomposition) removed,
+  W = V0 (mu |S - I|^2 + lam/2 tr(S - I)^2), P = R (2 mu (S - I) + lam tr(S - I) I). This is
+  the warped stiffness of M. Mueller and M. Gross, "Interactive virtual materials", Graphics
+  Interface 2004 (SOFA's TetrahedronFEMForceField, method "large", uses a polar or QR
+  rotation), which with the polar R is the exact gradient of W (A. McAdams et al.,
+  "Efficient elasticity for character skinning with contact and collisions", SIGGRAPH 2011).
+* ``fem_neohookean``: W = V0 (mu/2 (tr C - 3) - mu ln J + lam/2 (ln J)^2),
+  P = mu (F - F^-T) + lam ln J F^-T, the law of ``reference.hyperelastic``.
+
+All three are conservative, conserve momentum and need no calibration.
+"""
+import numpy as np
+from numba import njit
+
+from . import Term, register
+from ._kernels import (add_piola_forces, deformation_gradient, deformation_gradients_numpy,
+                       piola_forces_numpy, rest_shape_inverse)
+from .volume import FLAT
+
+
+@njit(cache=True, fastmath=True)
+def linear_forces(x, tets, Dinv, vol0, lam, mu, out):
+    """Small-strain constant-strain tetrahedra; returns the first flattened one, or -1."""
+    F, P = np.empty((3, 3)), np.empty((3, 3))
+    for t in range(tets.shape[0]):
+        if deformation_gradient(x, tets, t, Dinv, F) <= FLAT:
+            return t
+        tr = F[0, 0] + F[1, 1] + F[2, 2] - 3.0
+        for i in range(3):
+            for j in range(3):
+                P[i, j] = mu * (F[i, j] + F[j, i])            # 2 mu eps, off the diagonal
+            P[i, i] += lam * tr - 2.0 * mu
+        add_piola_forces(P, Dinv, vol0, tets, t, out)
+    return -1
+
+
+@njit(cache=True, inline="always")
+def polar_rotation(F, R, Rn):
+    """R of F = R S by Newton's iteration R <- (R + R^-T) / 2 from R = F (det F > 0):
+    quadratic convergence, stopped at 1e-14 or 30 iterations."""
+    R[:] = F
+    for _ in range(30):
+        det = (R[0, 0] * (R[1, 1] * R[2, 2] - R[1, 2] * R[2, 1])
+               - R[0, 1] * (R[1, 0] * R[2, 2] - R[1, 2] * R[2, 0])
+               + R[0, 2] * (R[1, 0] * R[2, 1] - R[1, 1] * R[2, 0]))
+        # R^-T = cofactor(R) / det
+        for i in range(3):
+            i1, i2 = (i + 1) % 3, (i + 2) % 3
+            for j in range(3):
+                j1, j2 = (j + 1) % 3, (j + 2) % 3
+                Rn[i, j] = 0.5 * (R[i, j] + (R[i1, j1] * R[i2, j2] - R[i1, j2] * R[i2, j1]) / det)
+        change = 0.0
+        for i in range(3):
+            for j in range(3):
+                change = max(change, abs(Rn[i, j] - R[i, j]))
+                R[i, j] = Rn[i, j]
+        if change < 1e-14:
+            break
+
+
+@njit(cache=True, fastmath=True)
+def corotated_forces(x, tets, Dinv, vol0, lam, mu, out):
+    """Co-rotated constant-strain tetrahedra; returns the first flattened one, or -1."""
+    F, R, Rn, S, P = (np.empty((3, 3)), np.empty((3, 3)), np.empty((3, 3)), np.empty((3, 3)),
+                      np.empty((3, 3)))
+    for t in range(tets.shape[0]):
+        if deformation_gradient(x, tets, t, Dinv, F) <= FLAT:
+            return t
+        polar_rotation(F, R, Rn)
+        for i in range(3):              # S = R^T F
+            for j in range(3):
+                S[i, j] = R[0, i] * F[0, j] + R[1, i] * F[1, j] + R[2, i] * F[2, j]
+        tr = S[0, 0] + S[1, 1] + S[2, 2] - 3.0
+        for i in range(3):              # P = 2 mu (F - R) + lam tr(S - I) R
+            for j in range(3):
+                P[i, j] = 2.0 * mu * (F[i, j] - R[i, j]) + lam * tr * R[i, j]
+        add_piola_forces(P, Dinv, vol0, tets, t, out)
+    return -1
+
+
+@njit(cache=True, fastmath=True)
+def neohookean_forces(x, tets, Dinv, vol0, lam, mu, out):
+    """Compressible neo-Hookean constant-strain tetrahedra; returns the first one with
+    det F <= FLAT, or -1."""
+    F, P = np.empty((3, 3)), np.empty((3, 3))
+    for t in range(tets.shape[0]):
+        J = deformation_gradient(x, tets, t, Dinv, F)
+        if J <= FLAT:
+            return t
+        a = (lam * np.log(J) - mu) / J   # P = mu F + (lam ln J - mu) F^-T, F^-T = cof(F) / J
+        for i in range(3):
+            i1, i2 = (i + 1) % 3, (i + 2) % 3
+            for j in range(3):
+                j1, j2 = (j + 1) % 3, (j + 2) % 3
+                P[i, j] = mu * F[i, j] + a * (F[i1, j1] * F[i2, j2] - F[i1, j2] * F[i2, j1])
+        add_piola_forces(P, Dinv, vol0, tets, t, out)
+    return -1
+
+
+class _ConstantStrain(Term):
+    """What the three baselines share: Dm^-1, V0 and the Lame constants."""
+
+    conservative = True
+    checks_inversion = True
+    _kernel = None
+
+    def __init__(self, mesh, material, scale=1.0, **params):
+        super().__init__(mesh, material, scale, **params)
+        self.Dinv = np.ascontiguousarray(rest_shape_inverse(mesh.points, mesh.tets))
+        self.vol0 = mesh.volumes
+        self.lam, self.mu = self.scale * material.lam, self.scale * material.G
+
+    def kernel(self):
+        return type(self)._kernel, (self.mesh.tets, self.Dinv, self.vol0, self.lam, self.mu)
+
+    def F(self, x):
+        return deformation_gradients_numpy(np.asarray(x, dtype=float), self.mesh.tets,
+                                           self.Dinv)
+
+    def forces_numpy(self, x):
+        return piola_forces_numpy(self.piola(self.F(x)), self.Dinv, self.vol0, self.mesh.tets,
+                                  self.mesh.n_nodes)
+
+    def energy(self, x):
+        return float(np.sum(self.vol0 * self.energy_density(self.F(x))))
+
+
+@register
+class FemLinear(_ConstantStrain):
+    """Small-strain linear elastic tetrahedra."""
+
+    name = "fem_linear"
+    _kernel = staticmethod(linear_forces)
+
+    def _eps(self, F):
+        return 0.5 * (F + np.transpose(F, (0, 2, 1))) - np.eye(3)
+
+    def piola(self, F):
+        eps = self._eps(F)
+        tr = np.trace(eps, axis1=1, axis2=2)[:, None, None]
+        return self.lam * tr * np.eye(3) + 2 * self.mu * eps
+
+    def energy_density(self, F):
+        eps = self._eps(F)
+        return self.mu * np.sum(eps**2, axis=(1, 2)) + 0.5 * self.lam * np.trace(
+            eps, axis1=1, axis2=2)**2
+
+
+def polar_numpy(F):
+    """R and S of F = R S for a stack of F, by the SVD."""
+    U, _, Vt = np.linalg.svd(F)
+    R = U @ Vt
+    return R, np.transpose(R, (0, 2, 1)) @ F
+
+
+@register
+class FemCorotated(_ConstantStrain):
+    """Co-rotated linear tetrahedra (polar rotation)."""
+
+    name = "fem_corotated"
+    _kernel = staticmethod(corotated_forces)
+
+    def piola(self, F):
+        R, S = polar_numpy(F)
+        tr = (np.trace(S, axis1=1, axis2=2) - 3)[:, None, None]
+        return 2 * self.mu * (F - R) + self.lam * tr * R
+
+    def energy_density(self, F):
+        _, S = polar_numpy(F)
+        E = S - np.eye(3)
+        return self.mu * np.sum(E**2, axis=(1, 2)) + 0.5 * self.lam * np.trace(
+            E, axis1=1, axis2=2)**2
+
+
+@register
+class FemNeoHookean(_ConstantStrain):
+    """Compressible neo-Hookean tetrahedra."""
+
+    name = "fem_neohookean"
+    _kernel = staticmethod(neohookean_forces)
+
+    def piola(self, F):
+        J = np.linalg.det(F)[:, None, None]
+        FinvT = np.transpose(np.linalg.inv(F), (0, 2, 1))
+        return self.mu * (F - FinvT) + self.lam * np.log(J) * FinvT
+
+    def energy_density(self, F):
+        J = np.linalg.det(F)
+        C = np.transpose(F, (0, 2, 1)) @ F
+        return (0.5 * self.mu * (np.trace(C, axis1=1, axis2=2) - 3) - self.mu * np.log(J)
+                + 0.5 * self.lam * np.log(J)**2)
