@@ -155,6 +155,18 @@ def _run_command(args):
     return 0
 
 
+def _bench_command(args):
+    from . import bench
+    models = _choose("model", args.models, list(model.PRESETS))
+    sizes = args.sizes or (bench.QUICK_SIZES if args.quick else bench.SIZES)
+    with StagedFolder(Path(args.out)) as out:   # checked before any timing starts
+        data = bench.run(sizes=sizes, models=models, rounds=3 if args.quick else args.rounds)
+        bench.write(data, out.path)
+        path = out.commit()
+    print(f"bench written to {path}")
+    return 0
+
+
 def _report_command(args):
     from contextlib import ExitStack
     from .registry import CASES
@@ -270,6 +282,23 @@ def parser():
     rep.add_argument("--out", help="output folder (default reports)")
     _selection(rep)
     rep.set_defaults(func=_report_command)
+    bn = sub.add_parser(
+        "bench", help="time every model: force evaluation, RK4 step, calibration, memory",
+        description="Time every preset on cubes of about 1e2 to 1e6 tetrahedra (--quick: 1e2 "
+                    "and 1e3): ns per tetrahedron per force evaluation, microseconds per RK4 "
+                    "step, calibration seconds, memory, and the step ratios to msm and "
+                    "fem-linear as medians of per-round ratios (models timed round-robin). "
+                    "Writes bench.json, bench.md and step_time.png (the paper's Figure 2).")
+    bn.add_argument("--out", default="reports/bench", help="output folder (default reports/bench)")
+    bn.add_argument("--quick", action="store_true", help="sizes 1e2 and 1e3, three rounds")
+    bn.add_argument("--sizes", nargs="+",
+                    type=_number("--sizes", "tetrahedron counts, numbers >= 5", low=4),
+                    help="approximate tetrahedron counts (default 1e2 1e3 1e4 1e5 1e6)")
+    bn.add_argument("--rounds", type=_number("--rounds", "an integer >= 1", low=0, integer=True),
+                    default=7, help="timing rounds (default 7)")
+    bn.add_argument("--models", nargs="+", help="model presets (default: all)")
+    bn.set_defaults(func=_bench_command)
+
     c = sub.add_parser("check", help="compare the latest metrics with thresholds.toml "
                        "(exit 0 pass, 1 fail, 2 missing or malformed)",
                        description="Compare every metrics.json under --metrics with the bounds "

@@ -104,3 +104,11 @@ def curves(path, x, fem, fem_label, series, xlabel, ylabel, title, markers="-s")
     for label, y in series:
         ax.plot(x, y, markers, ms=4, label=label)
     _finish(fig, ax, path, xlabel, ylabel, title)
+
+
+def loglog(path, series, xlabel, ylabel, title):
+    """Lines y(x) on log-log axes, one per (label, x, y)."""
+    fig, ax = plt.subplots(figsize=(6, 4.5))
+    for label, x, y in series:
+        ax.loglog(x, y, "-o", ms=3, label=label)
+    _finish(fig, ax, path, xlabel, ylabel, title)

@@ -25,7 +25,7 @@ class ParticleModel:
         fit = calibrate(self.terms, mesh, material.G)
         self.mass = np.zeros(mesh.n_nodes)
         np.add.at(self.mass, mesh.tets, np.repeat(material.rho * mesh.volumes[:, None] / 4, 4, 1))
-        self._strain_probe = Shear(mesh, material, reading="corner")
+        self._strain_probe = None   # built on the first tet_stress: 24 strains per tet
         self._jacobian_pattern = None
         self.info = {"model": name, "terms": [{"term": t.describe(), **t.info()}
                                               for t in self.terms], **fit}
@@ -60,6 +60,8 @@ class ParticleModel:
         Figure 1 measure) and ``pressure`` p = -K (V - V0) / V [Pa], whatever the terms."""
         V, _ = volume_gradient_numpy(np.asarray(x, dtype=np.float64), self.mesh.tets)
         V0 = self.mesh.volumes
+        if self._strain_probe is None:
+            self._strain_probe = Shear(self.mesh, self.material, reading="corner")
         return {"max_tau": self._strain_probe.max_tau(x),
                 "pressure": -self.material.K * (V - V0) / V}
 

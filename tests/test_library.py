@@ -79,11 +79,12 @@ def test_quick_library_passes_the_committed_bounds(library, capsys):
 
 def test_paper_cube_on_the_framework_matches_the_landed_case(quick):
     """Every non-timing metric of the quick paper cube equals the one the pre-framework code
-    wrote (stored in tests/data). The framework move was bit for bit (commit b783075); the
-    rewritten force kernels and the compiled RK4 step (issue 11) sum in another order, so
-    values now agree to 1e-7 relative (FD-Jacobian frequencies differ by 1e-8, statics by
-    1e-11), series to 1e-9 of their largest value, and the Newton residual only has to stay
-    converged (it is rounding noise, 1e-16 to 1e-9 N)."""
+    wrote (stored in tests/data). The framework move was bit for bit (commit b783075). Issue 11
+    rewrote the force kernels and compiled the RK4 step (sums in another order) and takes the
+    calibration from strain measures instead of whole energies (c moves by 1e-9), so values
+    now agree to 1e-7 relative with a floor of 1e-7 (an error that is a difference of two
+    numbers moves by the Newton tolerance), series to 1e-7 of their largest value, and the
+    Newton residual only has to stay converged (rounding noise, 1e-16 to 1e-9 N)."""
     before = json.loads(BASELINE.read_text())
     now = {(r["mesh"], r["bc"], r["model"]): r
            for r in json.loads((quick / "metrics.json").read_text())["runs"]}
@@ -91,6 +92,8 @@ def test_paper_cube_on_the_framework_matches_the_landed_case(quick):
         new = now[(old["mesh"], old["bc"], old["model"])]
         for k, v in old.items():
             assert k not in TIMING_KEYS
+            if k == "step_time_state":   # step timing left the case for `pbcm bench`
+                continue
             if k == "static_residual_n":
                 assert (new[k] is None) == (v is None) and (v is None or new[k] < 1e-8), k
             else:
@@ -99,10 +102,10 @@ def test_paper_cube_on_the_framework_matches_the_landed_case(quick):
 
 def _close(a, b, key):
     if isinstance(b, float):
-        assert a == pytest.approx(b, rel=1e-7, abs=1e-15), key
+        assert a == pytest.approx(b, rel=1e-7, abs=1e-7), key   # errors are differences
     elif isinstance(b, list) and b and all(isinstance(y, float) for y in b):
         scale = max(abs(y) for y in b)
-        assert len(a) == len(b) and np.allclose(a, b, rtol=0, atol=1e-9 * scale), key
+        assert len(a) == len(b) and np.allclose(a, b, rtol=0, atol=1e-7 * scale), key
     elif isinstance(b, list):
         assert len(a) == len(b), key
         for x, y in zip(a, b):

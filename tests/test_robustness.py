@@ -25,9 +25,9 @@ ROOT = Path(__file__).resolve().parents[1]
 
 @pytest.mark.parametrize("nu", [0.3, 0.0])
 def test_blow_ups_are_findings_and_the_report_is_complete(nu, tmp_path, capsys):
-    """The issue's reproducer (balanced on six/clamped at nu = 0.3 blows up within the timed
-    steps; at nu = 0 even its rest state does) and more: exit 0, every file written, the
-    failures recorded per run."""
+    """The issue's reproducer (balanced on six/clamped at nu = 0.3 blows up) and more: exit 0,
+    every file written, the failures recorded per run. (Step times left the case for
+    `pbcm bench` with issue 11.)"""
     out = tmp_path / "paper-cube"
     assert main(["run", "paper-cube", "--quick", "--nu", str(nu), "--models", "pbcm-balanced",
                  "pbcm-corner", "msm", "--out", str(out)]) == 0
@@ -36,13 +36,8 @@ def test_blow_ups_are_findings_and_the_report_is_complete(nu, tmp_path, capsys):
     blown = [r for r in runs if r["dyn_failed"]]
     assert {r["model"] for r in blown} == {"pbcm-balanced", "pbcm-corner"}
     assert all("blew up" in r["dyn_failed"] and r["dyn_vs_static_rel_l2"] is None for r in blown)
-    states = {(r["mesh"], r["bc"], r["model"]): r["step_time_state"] for r in runs}
-    balanced = states[("six", "clamped", "pbcm-balanced")]
-    assert balanced == "rest" if nu == 0.3 else balanced.startswith("failed: push: time")
-    assert all(r["step_time_s"] > 0 for r in runs if not r["step_time_state"].startswith("fail"))
     md = (out / "report.md").read_text()
     assert "Dynamic run of pbcm-balanced on six/clamped blew up" in md
-    assert "(at rest)" in md if nu == 0.3 else "No step time for pbcm-balanced on six" in md
     for name in [line.split("](")[1].rstrip(")") for line in md.splitlines()
                  if line.startswith("![")]:
         assert (out / name).stat().st_size > 0

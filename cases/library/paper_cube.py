@@ -4,7 +4,6 @@
 Millimetres stop at this file's edge: everything below the constants is in SI units.
 """
 from dataclasses import dataclass
-import statistics
 import time
 
 import numpy as np
@@ -38,25 +37,17 @@ class Config(Settings):
     safety: float = 0.8           # RK4 step = safety * min h / c_p
     hold_max: float = 2.0         # longest hold after the push [s]
     rest_speed: float = 1e-3      # at rest: every node slower than this fraction of the push speed
-    timing_steps: int = 20        # RK4 steps per timing repeat
-    timing_repeats: int = 7
 
     def problem(self):
         """The parameters that define the problem the metrics answer (what a bound was
         measured at): material, geometry, loading, damping, step and reference resolution.
-        Selections (meshes, models) and timing repeats are not part of it."""
+        Selections (meshes, models) are not part of it."""
         return {"E_Pa": self.E, "nu": self.nu, "rho_kg_m3": self.rho, "size_mm": SIZE_MM,
                 "nodes_per_side": NODES_PER_SIDE, "push_mm": PUSH_MM,
                 "speed_mm_s": SPEED_MM_S, "layers_mm": list(LAYERS_MM),
                 "p2_levels": self.p2_levels, "transient_element": self.transient_element,
                 "damping_1_s": self.damping, "rk4_safety": self.safety,
                 "hold_max_s": self.hold_max, "rest_speed_fraction": self.rest_speed}
-
-    def describe(self):
-        """Everything the run was given: the problem, the selection and the run settings."""
-        return {**super().describe(), "timing_steps": self.timing_steps,
-                "timing_repeats": self.timing_repeats}
-
 
 def make_mesh(name):
     return cube(NODES_PER_SIDE, SIZE_MM * MM, name)
@@ -154,35 +145,6 @@ def growth_rate(pm, mesh, bc):
     return rate if rate > 1e-7 * scale else 0.0
 
 
-def step_time(pm, mesh, bc, cfg):
-    """Median over repeats of the wall time of one RK4 step of the full integrator, and the
-    state it was timed in: the paper's push ("push"); where the push blows up within the
-    timed steps, the same steps with the boundary held at rest ("rest": a step costs the same
-    arithmetic whatever the state); where even that blows up (rounding at rest amplified by an
-    unstable reading), None and "failed: " with the reason."""
-    top, _, held = boundary_sets(mesh, bc)
-    dt = pm.stable_dt(cfg.safety)
-    failures = []
-    for state, motion in (("push", dynamic_bc(mesh, bc)),
-                          ("rest", Ramp(top, (0.0, 0.0, 0.0), 1.0, held=held))):
-        try:
-            return _median_step(pm, motion, dt, cfg), state
-        except BlowUpError as exc:
-            failures.append(f"{state}: {exc}")
-    return None, "failed: " + "; ".join(failures)
-
-
-def _median_step(pm, motion, dt, cfg):
-    times = []
-    for _ in range(cfg.timing_repeats):
-        t0 = time.perf_counter()
-        pm.simulate(motion, cfg.timing_steps * dt, dt=dt, damping=cfg.damping, frames=2)
-        times.append((time.perf_counter() - t0) / cfg.timing_steps)
-    return statistics.median(times)
-
-
-
-
 class PaperCube(Case):
     """The paper's experiment (section 4): a 32 mm cube, 5 x 5 x 5 nodes, the top pushed down
     1.7 mm at 1.7 mm/s, measured against FEM for every mesh, boundary condition and model,
@@ -194,7 +156,7 @@ class PaperCube(Case):
     meshes = MESH_FAMILIES
     quick_meshes = ("five", "six")
     bcs = BCS
-    quick = {"p2_levels": 1, "timing_repeats": 3, "transient_element": "P1", "hold_max": 1.0}
+    quick = {"p2_levels": 1, "transient_element": "P1", "hold_max": 1.0}
     headline = Headline("disp_rel_l2_p2", "displacement error vs FEM P2")
     gated = {"zigzag": "max", "reaction_time_rel_l2": "max", "disp_end_push_rel_l2": "max",
              "rest_time_s": "max", "modal_rel_err": "max", "modal_rel_err_free": "max",
@@ -234,7 +196,6 @@ class PaperCube(Case):
         r["verdict_changes_dt4"] = (r["dyn_failed"] is None) != (r["dyn_failed_dt4"] is None)
         r.update(transient.modal_comparison(pm, mesh, ref.dirichlet, ref.extra["modes_free"],
                                             ref.extra["modes_held"]))
-        r["step_time_s"], r["step_time_state"] = step_time(pm, mesh, bc, s)
         return r
 
     def what_was_run(self, s, runs):

@@ -33,22 +33,13 @@ DEFINITIONS = (
     "constraints, against FEM P2 (largest relative error); modal err free: the same "
     "free-free after the rigid modes; rigid modes: zero eigenvalues free-free (6 expected).",
     "dyn vs static: relative L2 distance between the end of the dynamic run and the static "
-    "equilibrium.",
-    "step time: median over repeats of the wall time of one RK4 step of the full "
-    "integrator, during the push; marked (at rest) where the push blows up within the "
-    "timed steps and the same steps were timed with the boundary held still.")
+    "equilibrium.")
 
 
 def _dynamic(r):
     if r["dyn_failed"]:
         return "blew up"
     return "n/a" if r["dyn_vs_static_rel_l2"] is None else fmt(r["dyn_vs_static_rel_l2"], 2)
-
-
-def _step_time(r):
-    if r["step_time_s"] is None:
-        return "n/a (blew up)"
-    return fmt(r["step_time_s"] * 1e6) + (" (at rest)" if r["step_time_state"] == "rest" else "")
 
 
 COLUMNS = [("zig-zag", lambda r: fmt(r["zigzag"])),
@@ -61,8 +52,7 @@ COLUMNS = [("zig-zag", lambda r: fmt(r["zigzag"])),
            ("rest [s]", lambda r: fmt(r["rest_time_s"], 2)),
            ("modal err", lambda r: fmt(r["modal_rel_err"])),
            ("modal err free", lambda r: fmt(r["modal_rel_err_free"])),
-           ("rigid modes", lambda r: r["rigid_modes_free"]),
-           ("step time [us]", _step_time)]
+           ("rigid modes", lambda r: r["rigid_modes_free"])]
 
 
 def _bracket(counts, paper):
@@ -143,7 +133,7 @@ def findings(runs, cfg):
     return {"The bulge/neck artefact": _artefact(runs, cfg),
             "Accuracy and stiffness": _accuracy(runs, cfg),
             "Dynamics and stability": _dynamics(runs, cfg),
-            "Cost": _cost(runs, cfg)}
+}
 
 
 def _artefact(runs, cfg):
@@ -253,30 +243,6 @@ def _dynamics(runs, cfg):
     return out
 
 
-def _cost(runs, cfg):
-    out = []
-    rest = [r for r in runs if r["step_time_state"] == "rest"]
-    if rest:
-        out.append("Step time taken at rest (the push blew up within the timed steps; a step "
-                   "costs the same arithmetic at rest) for: " + ", ".join(
-                       f"{r['model']} on {r['mesh']}/{r['bc']}" for r in rest) + ".")
-    for r in runs:
-        if r["step_time_s"] is None:
-            out.append(f"No step time for {r['model']} on {r['mesh']}/{r['bc']}: every timed "
-                       f"run blew up ({r['step_time_state'][len('failed: '):]}).")
-    timed = [r for r in runs if r["step_time_s"] is not None]
-    msm = [r["step_time_s"] for r in timed if r["model"] == "msm"]
-    if msm:
-        for model in cfg.models:
-            own = [r["step_time_s"] for r in timed if r["model"] == model]
-            if model.startswith("pbcm") and own:
-                ratio = np.median(own) / np.median(msm)
-                out.append(f"Cost: one RK4 step of {model} takes {ratio:.1f}x the MSM step "
-                           "(the paper reports more than 10x; a single timing on a shared "
-                           "machine, not a benchmark).")
-    return out
-
-
 def _field(fields, mesh, bc, model):
     f = fields[(mesh, bc, model)]
     return f["mesh"], f["u"], f["max_tau"]
@@ -312,13 +278,7 @@ def sections(doc, cfg, runs, fields, out):
             and not r.get("failed")]
     if not keys:
         return
-    doc.h(2, "Cost and dynamics")
-    figures.grouped_bars(out / "step_time.png", [f"{m}/{b}" for m, b in keys], cfg.models,
-                         [[_value(_runs(runs, mesh=m, bc=b, model=mo)[0], "step_time_s", 1e6)
-                           for mo in cfg.models] for m, b in keys],
-                         "wall time of one RK4 step [us]", "Step time (the paper's Figure 2)",
-                         log=True)
-    doc.img("step_time.png", "Time of one RK4 step per model (the analogue of Figure 2)")
+    doc.h(2, "Dynamics")
     m0, b0 = keys[0]
     fem = fields[(m0, b0, "fem-p2")]["transient"]
     figures.reaction_history(out / "reaction_time.png",

@@ -1,0 +1,208 @@
+"""`pbcm bench`: what each model costs, measured so that the ratios hold on a shared machine.
+
+For every preset on cubes of about 1e2 ... 1e6 tetrahedra: the force evaluation (ns per
+tetrahedron), the compiled RK4 step (microseconds), the calibration of fitted constants
+(seconds) and the peak of the numpy memory building the model takes. Times are thread CPU
+times, so another process on the machine slows a sample less than a wall clock would. The
+presets are timed round-robin, one sample of each per round, and a ratio (to msm, to
+fem-linear) is taken within each round, then the median over rounds: drift of the machine
+between rounds cancels. Every cost sentence of the reports comes from these ratios.
+"""
+import importlib.util
+import json
+import time
+import tracemalloc
+
+import numpy as np
+from numba import njit
+
+from model import Material, PRESETS, build
+from model.bc import Ramp
+from model.calibrate import calibrate
+from model.integrate import rk4_ramp, total_forces
+from model.mesh import cube
+
+from . import figures
+from .document import Document, fmt
+
+SIZES = (1e2, 1e3, 1e4, 1e5, 1e6)
+QUICK_SIZES = (1e2, 1e3)
+BASELINES = ("msm", "fem-linear")
+SAMPLE_S = 0.02          # each timing sample runs at least this long (many calls if need be)
+ENGINES = {"newton": "newton", "warp": "warp-lang"}   # optional engines, by module
+
+
+@njit   # not cached: it takes the kernels (see model.integrate)
+def _force_loop(kernels, x, out, reps):
+    for _ in range(reps):
+        total_forces(kernels, x, out)
+
+
+def bench_mesh(target):
+    """The 'five' cube of side 32 mm whose tetrahedron count is closest to ``target``."""
+    k = max(1, round((target / 5.0) ** (1.0 / 3.0)))
+    return cube(k + 1, 0.032, "five")
+
+
+class _Timed:
+    """One preset on one mesh, ready to be timed: its kernels, a state and the step's
+    buffers (a 1 % push of the top over 1 s, the base held)."""
+
+    def __init__(self, name, mesh, mat):
+        tracemalloc.start()
+        self.pm = build(name, mesh, mat)
+        self.memory = tracemalloc.get_traced_memory()[1]
+        tracemalloc.stop()
+        t0 = time.perf_counter()
+        calibrate(self.pm.terms, mesh, mat.G)
+        self.calibration = time.perf_counter() - t0 if any(
+            getattr(t, "calibrate", False) for t in self.pm.terms) else 0.0
+        self.kernels = self.pm.kernels()
+        top, bot = mesh.nodes_on_plane("y", 0.032), mesh.nodes_on_plane("y", 0.0)
+        ramp = Ramp(top, (0.0, -0.32e-3, 0.0), 1.0, fixed=bot)
+        mask, start, moving = ramp._parts(mesh.n_nodes)
+        self.x, self.v = mesh.points.copy(), np.zeros_like(mesh.points)
+        self.out = np.zeros_like(mesh.points)
+        self.step_args = (mesh.points, self.pm.mass, np.zeros_like(mesh.points), 50.0, mask,
+                          start, moving, 1.0, mesh.tets,
+                          not any(t.checks_inversion for t in self.pm.terms),
+                          self.pm.material.p_wave_speed, np.empty((10,) + mesh.points.shape))
+        self.dt = self.pm.stable_dt(0.5)
+        self.t = 0.0
+        _force_loop(self.kernels, self.x, self.out, 1)    # compile outside the timings
+        self._steps(1)
+        self.reps_force = self._reps(lambda n: _force_loop(self.kernels, self.x, self.out, n))
+        self.reps_step = self._reps(self._steps)
+
+    def _steps(self, n):
+        status = rk4_ramp(self.kernels, self.x, self.v, self.t, self.dt, n, *self.step_args)[0]
+        if status:
+            raise RuntimeError(f"the benchmark's push blew up for {self.pm.name}")
+        self.t += n * self.dt
+
+    @staticmethod
+    def _reps(call):
+        t0 = time.thread_time()
+        call(1)
+        one = max(time.thread_time() - t0, 1e-7)
+        return max(1, int(SAMPLE_S / one))
+
+    def sample(self):
+        """(seconds per force evaluation, seconds per RK4 step), thread CPU time."""
+        t0 = time.thread_time_ns()
+        _force_loop(self.kernels, self.x, self.out, self.reps_force)
+        t1 = time.thread_time_ns()
+        self._steps(self.reps_step)
+        t2 = time.thread_time_ns()
+        return (t1 - t0) * 1e-9 / self.reps_force, (t2 - t1) * 1e-9 / self.reps_step
+
+
+def run(sizes=SIZES, models=None, rounds=7, progress=print):
+    """Measure every model at every size; returns the bench document (plain data)."""
+    models = list(models or PRESETS)
+    timed_models = models + [b for b in BASELINES if b not in models]
+    mat = Material(10e3, 0.45, 1000.0)
+    rows = []
+    for target in sizes:
+        mesh = bench_mesh(target)
+        progress(f"bench: {mesh.n_tets} tetrahedra, {len(timed_models)} models")
+        timed = {name: _Timed(name, mesh, mat) for name in timed_models}
+        samples = {name: [] for name in timed}
+        for _ in range(rounds):       # round-robin: one sample of every model per round
+            for name, t in timed.items():
+                samples[name].append(t.sample())
+        for name in models:
+            own = np.array(samples[name])
+            row = {"model": name, "tets": mesh.n_tets, "nodes": mesh.n_nodes,
+                   "ns_per_tet": float(np.median(own[:, 0]) / mesh.n_tets * 1e9),
+                   "us_per_step": float(np.median(own[:, 1]) * 1e6),
+                   "step_over_4_forces": float(np.median(own[:, 1] / (4 * own[:, 0]))),
+                   "calibration_s": timed[name].calibration,
+                   "memory_mb": timed[name].memory / 1e6, "rounds": rounds}
+            for base in BASELINES:
+                ref = np.array(samples[base])
+                row[f"force_vs_{base}"] = float(np.median(own[:, 0] / ref[:, 0]))
+                row[f"step_vs_{base}"] = float(np.median(own[:, 1] / ref[:, 1]))
+            rows.append(row)
+        del timed
+    engines = {name: ("installed, not timed by this version" if importlib.util.find_spec(mod)
+                      else "not installed") for mod, name in ENGINES.items()}
+    return {"machine": _machine(), "sizes": [int(s) for s in sizes], "rows": rows,
+            "engines": engines}
+
+
+def _machine():
+    import os
+    import platform
+    cpu = platform.processor() or platform.machine()
+    try:
+        for line in open("/proc/cpuinfo"):
+            if line.startswith("model name"):
+                cpu = line.split(":", 1)[1].strip()
+                break
+    except OSError:
+        pass
+    return {"cpu": cpu, "cores": os.cpu_count(), "python": platform.python_version()}
+
+
+def write(data, out):
+    """bench.json, bench.md (+ html) and step_time.png into the folder ``out``."""
+    out.mkdir(parents=True, exist_ok=True)
+    (out / "bench.json").write_text(json.dumps(data, indent=1) + "\n")
+    rows = data["rows"]
+    models = list(dict.fromkeys(r["model"] for r in rows))
+    figures.loglog(out / "step_time.png",
+                   [(m, [r["tets"] for r in rows if r["model"] == m],
+                     [r["us_per_step"] for r in rows if r["model"] == m]) for m in models],
+                   "tetrahedra", "one RK4 step [us] (thread CPU time)",
+                   "Step time against mesh size (the paper's Figure 2)")
+    doc = Document("pbcm bench")
+    m = data["machine"]
+    doc.p(f"Measured on {m['cpu']} ({m['cores']} cores), Python {m['python']}, serial kernels. "
+          f"Times are medians over {rows[0]['rounds']} rounds of thread CPU time; ratios are "
+          "the medians of per-round ratios (models timed round-robin), so machine drift "
+          "cancels.")
+    for line in summary(data):
+        doc.p(line)
+    doc.table(["model", "tets", "ns/tet (force)", "us/step", "step / 4 forces",
+               "step vs msm", "step vs fem-linear", "calibration [s]", "memory [MB]"],
+              [[r["model"], r["tets"], fmt(r["ns_per_tet"]), fmt(r["us_per_step"]),
+                fmt(r["step_over_4_forces"]), fmt(r["step_vs_msm"]),
+                fmt(r["step_vs_fem-linear"]), fmt(r["calibration_s"], 2),
+                fmt(r["memory_mb"], 3)] for r in rows])
+    doc.ul([f"{name}: {state}" for name, state in data["engines"].items()])
+    doc.img("step_time.png", "RK4 step time against tetrahedra, every model")
+    doc.write(out, stem="bench")
+
+
+def summary(data):
+    """Sentences from the largest size measured: each model's step against the baselines."""
+    rows = data["rows"]
+    top = max(r["tets"] for r in rows)
+    at = [r for r in rows if r["tets"] == top]
+    return [f"At {top} tetrahedra: " + "; ".join(
+        f"{r['model']} {fmt(r['ns_per_tet'])} ns/tet, step {fmt(r['step_vs_msm'])}x msm and "
+        f"{fmt(r['step_vs_fem-linear'])}x fem-linear" for r in at) + "."]
+
+
+def load(path):
+    """The bench document at ``path``, or None when there is none."""
+    try:
+        return json.loads(path.read_text())
+    except (OSError, ValueError):
+        return None
+
+
+def cost_sentences(data, models, tets):
+    """The cost of each model's RK4 step against msm and fem-linear, from the bench size
+    closest to ``tets``: the sentences a case report states about cost."""
+    if not data:
+        return ["No benchmark found beside this report (reports/bench/bench.json): run "
+                "`pbcm bench` for the cost of each model."]
+    sizes = sorted({r["tets"] for r in data["rows"]}, key=lambda n: abs(np.log(n / tets)))
+    near = [r for r in data["rows"] if r["tets"] == sizes[0] and r["model"] in models]
+    return [f"Cost, from `pbcm bench` at {sizes[0]} tetrahedra (median of "
+            f"{near[0]['rounds']} interleaved rounds): one RK4 step of " + "; ".join(
+                f"{r['model']} takes {fmt(r['step_vs_msm'])}x the msm step and "
+                f"{fmt(r['step_vs_fem-linear'])}x the fem-linear step" for r in near)
+            + ". The paper reports more than 10x msm."] if near else []

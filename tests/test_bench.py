@@ -1,0 +1,61 @@
+"""`pbcm bench` (issue 11): what it measures and how its ratios are taken. No test here asserts
+a wall-clock time: timings are the benchmark's output, not a pass condition."""
+import json
+
+import numpy as np
+
+from cases import bench
+from cases.cli import main
+
+
+def test_bench_writes_table_figure_and_in_round_ratios(tmp_path):
+    out = tmp_path / "bench"
+    assert main(["bench", "--sizes", "100", "700", "--rounds", "3", "--models", "msm",
+                 "pbcm-variational", "fem-linear", "--out", str(out)]) == 0
+    for f in ("bench.json", "bench.md", "step_time.png"):
+        assert (out / f).stat().st_size > 0, f
+    data = json.loads((out / "bench.json").read_text())
+    rows = {(r["model"], r["tets"]): r for r in data["rows"]}
+    assert {t for _, t in rows} == {135, 625}          # the 'five' cubes closest to the sizes
+    for (model, _), r in rows.items():
+        for k in ("ns_per_tet", "us_per_step", "step_over_4_forces", "step_vs_msm",
+                  "force_vs_fem-linear", "memory_mb"):
+            assert np.isfinite(r[k]) and r[k] > 0, (model, k)
+        # a model against itself within one round is exactly 1: the ratios are in-round
+        if model in ("msm", "fem-linear"):
+            assert r[f"step_vs_{model}"] == 1.0 and r[f"force_vs_{model}"] == 1.0
+    assert rows[("pbcm-variational", 625)]["calibration_s"] > 0
+    assert rows[("msm", 625)]["calibration_s"] == 0
+    assert set(data["engines"]) == {"newton", "warp-lang"}
+    md = (out / "bench.md").read_text()
+    assert "not installed" in md or "installed" in md
+    assert "pbcm-variational" in md and "step vs msm" in md
+
+
+def test_cost_sentences_come_from_the_nearest_bench_size():
+    data = {"rows": [{"model": m, "tets": t, "rounds": 5, "step_vs_msm": r,
+                      "step_vs_fem-linear": r / 2}
+                     for t, r in ((135, 3.0), (1080, 7.0), (10985, 9.0)) for m in ("a", "msm")]}
+    line = bench.cost_sentences(data, ["a"], 500)[0]
+    assert "1080 tetrahedra" in line and "a takes 7x the msm step and 3.5x the fem-linear" in line
+    assert "run `pbcm bench`" in bench.cost_sentences(None, ["a"], 500)[0]
+
+
+def test_bench_mesh_is_the_closest_five_cube():
+    assert bench.bench_mesh(1e3).n_tets == 1080 and bench.bench_mesh(1e2).n_tets == 135
+
+
+def test_a_rerun_writes_the_same_committed_files(tmp_path):
+    """Running a case again with nothing changed rewrites metrics.json, report.md and every
+    figure byte for byte (commit, date and wall times go to run.json, which git ignores), so
+    the main job on a clean checkout leaves `git status` clean."""
+    argv = ["run", "paper-cube", "--quick", "--meshes", "five", "--bcs", "clamped", "--models",
+            "msm", "fem-linear"]
+    for name in ("a", "b"):
+        assert main(argv + ["--out", str(tmp_path / name / "paper-cube")]) == 0
+    a, b = tmp_path / "a" / "paper-cube", tmp_path / "b" / "paper-cube"
+    files = sorted(p.name for p in a.iterdir() if p.suffix in (".json", ".md", ".png")
+                   and p.name != "run.json")
+    assert "metrics.json" in files and "report.md" in files
+    for name in files:
+        assert (a / name).read_bytes() == (b / name).read_bytes(), name
