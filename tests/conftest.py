@@ -52,3 +52,15 @@ def quick(tmp_path_factory):
     out = tmp_path_factory.mktemp("quick") / "paper-cube"
     assert main(["run", "paper-cube", "--quick", "--out", str(out)]) == 0
     return out
+
+
+def floats_in(x):
+    """Every float inside nested dicts and lists (a metrics document)."""
+    if isinstance(x, dict):
+        for v in x.values():
+            yield from floats_in(v)
+    elif isinstance(x, list):
+        for v in x:
+            yield from floats_in(v)
+    elif isinstance(x, float):
+        yield x

@@ -5,6 +5,8 @@ from html.parser import HTMLParser
 import numpy as np
 import pytest
 
+from conftest import floats_in
+
 from cases import metrics as M
 from cases.cli import main
 from cases.library.paper_cube import LAYERS_MM, SIZE_MM, make_mesh, static_bc
@@ -22,17 +24,6 @@ KEYS = ["mesh", "bc", "model", "disp_rel_l2_p1", "disp_rel_l2_p2", "disp_max_rel
         "verdict_changes_dt4"]
 
 
-def numbers(x):
-    if isinstance(x, dict):
-        for v in x.values():
-            yield from numbers(v)
-    elif isinstance(x, list):
-        for v in x:
-            yield from numbers(v)
-    elif isinstance(x, float):
-        yield x
-
-
 def test_quick_run_writes_every_file_with_finite_metrics(quick):
     for f in FILES:
         assert (quick / f).is_file(), f
@@ -43,7 +34,7 @@ def test_quick_run_writes_every_file_with_finite_metrics(quick):
     for r in runs:
         for k in KEYS:
             assert k in r, k
-        assert all(np.isfinite(v) for v in numbers(r))
+        assert all(np.isfinite(v) for v in floats_in(r))
         assert len(r["bulge_profile_mm"]) == len(LAYERS_MM)
         assert r["rigid_modes_free"] == 6 and r["modal_rel_err"] > 0
         if not r["dyn_failed"]:   # rest is None where the run never came to rest

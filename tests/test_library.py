@@ -9,6 +9,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from conftest import floats_in
+
 from cases.cli import main
 from cases.framework import Case, Headline, Settings
 from cases.registry import CASES
@@ -58,7 +60,7 @@ def test_quick_case_writes_report_and_finite_metrics(library, name):
     for r in runs:
         for k in data["gated"]:
             assert k in r, k
-        for v in _numbers(r):
+        for v in floats_in(r):
             assert math.isfinite(v)
     md = (out / "report.md").read_text()
     # three lines of conclusion before anything else
@@ -115,17 +117,6 @@ def _close(a, b, key):
             _close(a[k], b[k], key)
     else:
         assert a == b, key
-
-
-def _numbers(x):
-    if isinstance(x, dict):
-        for v in x.values():
-            yield from _numbers(v)
-    elif isinstance(x, list):
-        for v in x:
-            yield from _numbers(v)
-    elif isinstance(x, float):
-        yield x
 
 
 def test_traction_becomes_consistent_nodal_forces():

@@ -79,11 +79,6 @@ def _runs(runs, **kw):
     return [r for r in runs if all(r.get(k) == v for k, v in kw.items())]
 
 
-def _value(r, key, scale=1.0):
-    """A run's metric for a chart: NaN (nothing drawn) where the run could not give it."""
-    return float("nan") if r.get(key) is None else r[key] * scale
-
-
 def conclusion(cfg, runs):
     """Three lines: the artefact, the accuracy, the dynamics, computed from the runs."""
     solved = [r for r in runs if r.get("disp_rel_l2_p2") is not None]

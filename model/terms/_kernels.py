@@ -25,16 +25,6 @@ def dot(a, b):
 
 
 @njit(cache=True, inline="always")
-def gather(x, tets, t, xt):
-    """Copy the four corner positions of tetrahedron t into xt (4, 3)."""
-    for i in range(4):
-        n = tets[t, i]
-        xt[i, 0] = x[n, 0]
-        xt[i, 1] = x[n, 1]
-        xt[i, 2] = x[n, 2]
-
-
-@njit(cache=True, inline="always")
 def edges(x, tets, t, d):
     """d[a, b] = x_b - x_a for the corners of tetrahedron t; returns 6V, the signed volume
     times six (positive for a right-handed tetrahedron)."""
@@ -69,6 +59,16 @@ def inverse_lengths(d, iL):
 
 
 @njit(cache=True, inline="always")
+def tet_frame(x, tets, t, d, c, cn, iL):
+    """Everything the shear kernels take of tetrahedron t once: edges d, face vectors c with
+    norms cn, reciprocal lengths iL; returns 6V."""
+    V6 = edges(x, tets, t, d)
+    face_vectors(d, c, cn)
+    inverse_lengths(d, iL)
+    return V6
+
+
+@njit(cache=True, inline="always")
 def apply_laplacian(M, d, ft):
     """ft[i] += sum_k M[i, k] x_k for a coefficient matrix whose rows sum to zero, computed
     from the edges d[0, k] so that no absolute position enters (no cancellation)."""
@@ -85,24 +85,6 @@ def scatter(tets, t, ft, out):
         out[n, 0] += ft[i, 0]
         out[n, 1] += ft[i, 1]
         out[n, 2] += ft[i, 2]
-
-
-@njit(cache=True, inline="always")
-def volume_gradient(xt, e, g):
-    """Signed volume of the tetrahedron xt (4, 3); dV/dx_i into g (4, 3). e is (3, 3) scratch."""
-    for k in range(3):
-        e[0, k] = xt[1, k] - xt[0, k]
-        e[1, k] = xt[2, k] - xt[0, k]
-        e[2, k] = xt[3, k] - xt[0, k]
-    cross(e[1], e[2], g[1])
-    cross(e[2], e[0], g[2])
-    cross(e[0], e[1], g[3])
-    for k in range(3):
-        g[1, k] /= 6.0
-        g[2, k] /= 6.0
-        g[3, k] /= 6.0
-        g[0, k] = -(g[1, k] + g[2, k] + g[3, k])
-    return dot(e[0], g[1])
 
 
 def volume_gradient_numpy(x, tets):

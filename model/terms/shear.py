@@ -20,8 +20,8 @@ import numpy as np
 from numba import njit
 
 from . import Term, register
-from ._kernels import (FACE, apply_laplacian, cross, dot, edges, face_vectors, inverse_lengths,
-                       scatter, volume_gradient_numpy)
+from ._kernels import (FACE, apply_laplacian, cross, dot, scatter, tet_frame,
+                       volume_gradient_numpy)
 from .volume import FLAT
 from ..errors import ModelError, DegenerateTetError
 
@@ -48,11 +48,9 @@ def shear_strains(x, tets, gamma0, gamma_out):
     flattened tetrahedron (6V <= 0), or -1."""
     d, c, cn, iL = np.empty((4, 4, 3)), np.empty((4, 3)), np.empty(4), np.empty((4, 4))
     for t in range(tets.shape[0]):
-        V6 = edges(x, tets, t, d)
+        V6 = tet_frame(x, tets, t, d, c, cn, iL)
         if V6 <= 0.0:
             return t
-        face_vectors(d, c, cn)
-        inverse_lengths(d, iL)
         for j in range(4):
             cn[j] /= V6                  # 1 / height over the face opposite j
         for s in range(24):
@@ -67,11 +65,9 @@ def shear_corner(x, tets, vol0, gamma0, G, out):
     d, c, cn, iL = np.empty((4, 4, 3)), np.empty((4, 3)), np.empty(4), np.empty((4, 4))
     M, ft = np.empty((4, 4)), np.empty((4, 3))
     for t in range(tets.shape[0]):
-        V6 = edges(x, tets, t, d)
+        V6 = tet_frame(x, tets, t, d, c, cn, iL)
         if V6 <= FLAT * 6.0 * vol0[t]:
             return t
-        face_vectors(d, c, cn)
-        inverse_lengths(d, iL)
         iV6 = 1.0 / V6
         M[:] = 0.0
         for s in range(24):
@@ -92,11 +88,9 @@ def shear_balanced(x, tets, vol0, gamma0, G, out):
     d, c, cn, iL = np.empty((4, 4, 3)), np.empty((4, 3)), np.empty(4), np.empty((4, 4))
     M, ft = np.empty((4, 4)), np.empty((4, 3))
     for t in range(tets.shape[0]):
-        V6 = edges(x, tets, t, d)
+        V6 = tet_frame(x, tets, t, d, c, cn, iL)
         if V6 <= FLAT * 6.0 * vol0[t]:
             return t
-        face_vectors(d, c, cn)
-        inverse_lengths(d, iL)
         iV6 = 1.0 / V6
         M[:] = 0.0
         for s in range(24):
@@ -123,11 +117,9 @@ def shear_variational(x, tets, vol0, gamma0, cG, out):
     d, c, cn, iL = np.empty((4, 4, 3)), np.empty((4, 3)), np.empty(4), np.empty((4, 4))
     M, ft, B, ch, g = np.empty((4, 4)), np.empty((4, 3)), np.empty(4), np.empty(3), np.empty(3)
     for t in range(tets.shape[0]):
-        V6 = edges(x, tets, t, d)
+        V6 = tet_frame(x, tets, t, d, c, cn, iL)
         if V6 <= FLAT * 6.0 * vol0[t]:
             return t
-        face_vectors(d, c, cn)
-        inverse_lengths(d, iL)
         iV6, cGV0 = 1.0 / V6, cG * vol0[t]
         M[:] = 0.0      # -dW from dq, as coefficients of edges
         B[:] = 0.0      # dW / d|c_j|
