@@ -14,6 +14,7 @@ import time
 import tracemalloc
 
 import numpy as np
+import numba
 from numba import njit
 
 from model import Material, PRESETS, build
@@ -58,6 +59,12 @@ class _Timed:
         self.calibration = time.perf_counter() - t0 if any(
             getattr(t, "calibrate", False) for t in self.pm.terms) else 0.0
         self.kernels = self.pm.kernels()
+        # the two-thread mode of the terms that have one (model.terms._threads)
+        threaded = [t.threaded_kernel() for t in self.pm.terms]
+        self.kernels_2 = None
+        if any(threaded) and numba.config.NUMBA_NUM_THREADS >= 2:
+            numba.set_num_threads(2)
+            self.kernels_2 = tuple(k or t.kernel() for k, t in zip(threaded, self.pm.terms))
         top, bot = mesh.nodes_on_plane("y", 0.032), mesh.nodes_on_plane("y", 0.0)
         ramp = Ramp(top, (0.0, -0.32e-3, 0.0), 1.0, fixed=bot)
         mask, start, moving = ramp._parts(mesh.n_nodes)
@@ -70,6 +77,8 @@ class _Timed:
         self.dt = self.pm.stable_dt(0.5)
         self.t = 0.0
         _force_loop(self.kernels, self.x, self.out, 1)    # compile outside the timings
+        if self.kernels_2 is not None:
+            _force_loop(self.kernels_2, self.x, self.out, 1)
         self._steps(1)
         self.reps_force = self._reps(lambda n: _force_loop(self.kernels, self.x, self.out, n))
         self.reps_step = self._reps(self._steps)
@@ -88,13 +97,22 @@ class _Timed:
         return max(1, int(SAMPLE_S / one))
 
     def sample(self):
-        """(seconds per force evaluation, seconds per RK4 step), thread CPU time."""
+        """(seconds per force evaluation, seconds per RK4 step) in thread CPU time, and the
+        two-thread mode's speed-up of the force evaluation (wall clock, serial and threaded
+        back to back; NaN without a two-thread mode)."""
         t0 = time.thread_time_ns()
         _force_loop(self.kernels, self.x, self.out, self.reps_force)
         t1 = time.thread_time_ns()
         self._steps(self.reps_step)
         t2 = time.thread_time_ns()
-        return (t1 - t0) * 1e-9 / self.reps_force, (t2 - t1) * 1e-9 / self.reps_step
+        speedup = float("nan")
+        if self.kernels_2 is not None:
+            w0 = time.perf_counter()
+            _force_loop(self.kernels, self.x, self.out, self.reps_force)
+            w1 = time.perf_counter()
+            _force_loop(self.kernels_2, self.x, self.out, self.reps_force)
+            speedup = (w1 - w0) / (time.perf_counter() - w1)
+        return (t1 - t0) * 1e-9 / self.reps_force, (t2 - t1) * 1e-9 / self.reps_step, speedup
 
 
 def run(sizes=SIZES, models=None, rounds=7, progress=print):
@@ -118,6 +136,8 @@ def run(sizes=SIZES, models=None, rounds=7, progress=print):
                    "us_per_step": float(np.median(own[:, 1]) * 1e6),
                    "step_over_4_forces": float(np.median(own[:, 1] / (4 * own[:, 0]))),
                    "calibration_s": timed[name].calibration,
+                   "two_thread_speedup": (float(np.median(own[:, 2]))
+                                          if timed[name].kernels_2 is not None else None),
                    "memory_mb": timed[name].memory / 1e6, "rounds": rounds}
             for base in BASELINES:
                 ref = np.array(samples[base])
@@ -161,15 +181,20 @@ def write(data, out):
     doc.p(f"Measured on {m['cpu']} ({m['cores']} cores), Python {m['python']}, serial kernels. "
           f"Times are medians over {rows[0]['rounds']} rounds of thread CPU time; ratios are "
           "the medians of per-round ratios (models timed round-robin), so machine drift "
-          "cancels.")
+          "cancels. The two-thread speed-up (`build(..., threads=2)`, forces equal bit for bit "
+          "to serial) is the median ratio of wall-clock times of the serial and the threaded "
+          "force evaluation run back to back; '-' where a model has no threaded term.")
     for line in summary(data):
         doc.p(line)
     doc.table(["model", "tets", "ns/tet (force)", "us/step", "step / 4 forces",
-               "step vs msm", "step vs fem-linear", "calibration [s]", "memory [MB]"],
+               "step vs msm", "step vs fem-linear", "calibration [s]", "memory [MB]",
+               "2-thread force speed-up"],
               [[r["model"], r["tets"], fmt(r["ns_per_tet"]), fmt(r["us_per_step"]),
                 fmt(r["step_over_4_forces"]), fmt(r["step_vs_msm"]),
                 fmt(r["step_vs_fem-linear"]), fmt(r["calibration_s"], 2),
-                fmt(r["memory_mb"], 3)] for r in rows])
+                fmt(r["memory_mb"], 3),
+                "-" if r.get("two_thread_speedup") is None else fmt(r["two_thread_speedup"])]
+               for r in rows])
     doc.ul([f"{name}: {state}" for name, state in data["engines"].items()])
     doc.img("step_time.png", "RK4 step time against tetrahedra, every model")
     doc.write(out, stem="bench")

@@ -31,11 +31,13 @@ PRESETS = {
 }
 
 
-def build(model, mesh, material, **term_params):
+def build(model, mesh, material, threads=1, **term_params):
     """A :class:`ParticleModel` from a preset name or a list of ``(term, params)``.
 
     ``term_params`` override parameters per term name, e.g.
-    ``build("pbcm-variational", mesh, mat, shear={"scale": 0.5})``.
+    ``build("pbcm-variational", mesh, mat, shear={"scale": 0.5})``. ``threads`` > 1 runs the
+    terms that have a threaded kernel (the shear readings) on that many of numba's threads,
+    with forces equal bit for bit to the serial ones.
     """
     if isinstance(model, str):
         if model not in PRESETS:
@@ -48,7 +50,7 @@ def build(model, mesh, material, **term_params):
         raise ModelError(f"parameters given for term(s) {', '.join(sorted(unknown))} that "
                          f"model {name!r} does not have ({', '.join(t for t, _ in terms)})")
     terms = [(t, {**p, **term_params.get(t, {})}) for t, p in terms]
-    return ParticleModel(mesh, material, terms, name=name)
+    return ParticleModel(mesh, material, terms, name=name, threads=threads)
 
 
 __all__ = ["Material", "build", "PRESETS", "ParticleModel", "PbcmError", "MeshError",

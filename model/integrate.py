@@ -60,10 +60,9 @@ warnings.filterwarnings("ignore", category=NumbaExperimentalFeatureWarning)
 
 
 @njit
-def total_forces(kernels, x, out):
-    """out = the sum of every term's forces at x; returns (term, element) of the first
+def add_forces(kernels, x, out):
+    """out += the sum of every term's forces at x; returns (term, element) of the first
     degenerate element a kernel found, or (-1, -1)."""
-    out[:] = 0.0
     term, bad, i = -1, -1, 0
     for k in literal_unroll(kernels):
         b = k[0](x, *k[1], out)
@@ -74,33 +73,37 @@ def total_forces(kernels, x, out):
 
 
 @njit
-def _accel(kernels, x, v, f_ext, mass, damping, mask, a):
-    term, bad = total_forces(kernels, x, a)
-    for i in range(x.shape[0]):
-        for k in range(3):
-            a[i, k] = 0.0 if mask[i, k] else ((a[i, k] + f_ext[i, k]) / mass[i]
-                                              - damping * v[i, k])
-    return term, bad
+def total_forces(kernels, x, out):
+    """out = the sum of every term's forces at x (see :func:`add_forces`)."""
+    out[:] = 0.0
+    return add_forces(kernels, x, out)
 
 
 @njit(cache=True)
-def _constrain(x, v, t, X, mask, start, moving, t_ramp):
-    """The ramp's prescribed components at time t (model.bc.Ramp.arrays and .velocity)."""
+def _accel_then_stage(a, vs, f_ext, inv_mass, damping, x, v, h, xn, vn, an):
+    """One pass over the nodes: a = (f + f_ext) / m - zeta vs in place (a holds f), the next
+    stage xn = x + h vs, vn = v + h a, and an zeroed for the next stage's forces. The
+    prescribed components are fixed after (:func:`_prescribe`)."""
+    for i in range(x.shape[0]):
+        for k in range(3):
+            ai = (a[i, k] + f_ext[i, k]) * inv_mass[i] - damping * vs[i, k]
+            a[i, k] = ai
+            xn[i, k] = x[i, k] + h * vs[i, k]
+            vn[i, k] = v[i, k] + h * ai
+            an[i, k] = 0.0
+
+
+@njit(cache=True)
+def _prescribe(a, x, v, t, X, start, moving, t_ramp, pi, pk):
+    """The ramp's prescribed components (pi[c], pk[c]) at time t (model.bc.Ramp.arrays and
+    .velocity), and no acceleration there."""
     s = min(max(t / t_ramp, 0.0), 1.0)
     moving_now = 0.0 <= t < t_ramp
-    for i in range(x.shape[0]):
-        for k in range(3):
-            if mask[i, k]:
-                x[i, k] = X[i, k] + (start[i, k] + s * moving[i, k])
-                v[i, k] = moving[i, k] / t_ramp if moving_now else 0.0
-
-
-@njit(cache=True)
-def _stage(x, v, kx, kv, h, xs, vs):
-    for i in range(x.shape[0]):
-        for k in range(3):
-            xs[i, k] = x[i, k] + h * kx[i, k]
-            vs[i, k] = v[i, k] + h * kv[i, k]
+    for c in range(pi.shape[0]):
+        i, k = pi[c], pk[c]
+        a[i, k] = 0.0
+        x[i, k] = X[i, k] + (start[i, k] + s * moving[i, k])
+        v[i, k] = moving[i, k] / t_ramp if moving_now else 0.0
 
 
 @njit
@@ -111,42 +114,57 @@ def rk4_ramp(kernels, x, v, t0, dt, steps, X, mass, f_ext, damping, mask, start,
     step that breaks; returns (status, step, a, b, value): status 0 done, 1 NaN or inf,
     2 degenerate element b of term a, 3 tetrahedron b inverted, 4 a particle at speed value.
     ``check_volumes`` is needed where no term checks its tetrahedra (springs alone): the
-    volumes are then checked every 8th step and at the last."""
+    volumes are then checked every 8th step and at the last.
+
+    The node arithmetic is fused into one pass per stage (accelerations, next stage, zeroed
+    force buffer) and one at the end (update, finiteness, speed); the prescribed components
+    are a sparse list, so that a cheap model's step stays close to its four force
+    evaluations."""
     k1v, k2v, k3v, k4v, x2, v2, x3, v3, x4, v4 = (buf[0], buf[1], buf[2], buf[3], buf[4],
                                                   buf[5], buf[6], buf[7], buf[8], buf[9])
     n = x.shape[0]
+    pi, pk = np.nonzero(mask)
+    inv_mass = 1.0 / mass      # a division per node per stage would cost msm a fifth
+    pinned = np.zeros(n, dtype=np.bool_)
+    for c in range(pi.shape[0]):
+        pinned[pi[c]] = True
+    k1v[:] = 0.0
     for step in range(1, steps + 1):
         t = t0 + (step - 1) * dt
-        term, bad = _accel(kernels, x, v, f_ext, mass, damping, mask, k1v)
+        term, bad = add_forces(kernels, x, k1v)
         if term < 0:
-            _stage(x, v, v, k1v, 0.5 * dt, x2, v2)
-            _constrain(x2, v2, t + 0.5 * dt, X, mask, start, moving, t_ramp)
-            term, bad = _accel(kernels, x2, v2, f_ext, mass, damping, mask, k2v)
+            _accel_then_stage(k1v, v, f_ext, inv_mass, damping, x, v, 0.5 * dt, x2, v2, k2v)
+            _prescribe(k1v, x2, v2, t + 0.5 * dt, X, start, moving, t_ramp, pi, pk)
+            term, bad = add_forces(kernels, x2, k2v)
         if term < 0:
-            _stage(x, v, v2, k2v, 0.5 * dt, x3, v3)
-            _constrain(x3, v3, t + 0.5 * dt, X, mask, start, moving, t_ramp)
-            term, bad = _accel(kernels, x3, v3, f_ext, mass, damping, mask, k3v)
+            _accel_then_stage(k2v, v2, f_ext, inv_mass, damping, x, v, 0.5 * dt, x3, v3, k3v)
+            _prescribe(k2v, x3, v3, t + 0.5 * dt, X, start, moving, t_ramp, pi, pk)
+            term, bad = add_forces(kernels, x3, k3v)
         if term < 0:
-            _stage(x, v, v3, k3v, dt, x4, v4)
-            _constrain(x4, v4, t + dt, X, mask, start, moving, t_ramp)
-            term, bad = _accel(kernels, x4, v4, f_ext, mass, damping, mask, k4v)
+            _accel_then_stage(k3v, v3, f_ext, inv_mass, damping, x, v, dt, x4, v4, k4v)
+            _prescribe(k3v, x4, v4, t + dt, X, start, moving, t_ramp, pi, pk)
+            term, bad = add_forces(kernels, x4, k4v)
         if term >= 0:
             return 2, step, term, bad, 0.0
         h = dt / 6.0
-        for i in range(n):
-            for k in range(3):
-                x[i, k] = x[i, k] + h * (((v[i, k] + 2 * v2[i, k]) + 2 * v3[i, k]) + v4[i, k])
-                v[i, k] = v[i, k] + h * (((k1v[i, k] + 2 * k2v[i, k]) + 2 * k3v[i, k])
-                                         + k4v[i, k])
-        _constrain(x, v, t + dt, X, mask, start, moving, t_ramp)
         finite = True
         top = 0.0
         for i in range(n):
             sp = 0.0
             for k in range(3):
+                # the prescribed components' values are overwritten below
+                a4 = (k4v[i, k] + f_ext[i, k]) * inv_mass[i] - damping * v4[i, k]
+                x[i, k] = x[i, k] + h * (((v[i, k] + 2 * v2[i, k]) + 2 * v3[i, k]) + v4[i, k])
+                v[i, k] = v[i, k] + h * (((k1v[i, k] + 2 * k2v[i, k]) + 2 * k3v[i, k]) + a4)
                 finite = finite and np.isfinite(x[i, k]) and np.isfinite(v[i, k])
                 sp += v[i, k] * v[i, k]
-            top = max(top, sp)
+                k1v[i, k] = 0.0
+            if not pinned[i]:
+                top = max(top, sp)
+        _prescribe(k4v, x, v, t + dt, X, start, moving, t_ramp, pi, pk)
+        for c in range(pi.shape[0]):          # the prescribed nodes' speed, as prescribed
+            i = pi[c]
+            top = max(top, v[i, 0] * v[i, 0] + v[i, 1] * v[i, 1] + v[i, 2] * v[i, 2])
         if not finite:
             return 1, step, -1, -1, 0.0
         # a model whose kernels do not see tetrahedra (springs) is checked every 8th step and

@@ -1,4 +1,5 @@
 """A particle model: a mesh, a material and a list of force terms, with its lumped masses."""
+import numba
 import numpy as np
 
 from .calibrate import calibrate
@@ -17,8 +18,12 @@ class ParticleModel:
     their parameters and calibration constants (``shear_c``, ``normal_c``).
     """
 
-    def __init__(self, mesh, material, terms, name="custom"):
+    def __init__(self, mesh, material, terms, name="custom", threads=1):
         self.mesh, self.material, self.name = mesh, material, name
+        if not (isinstance(threads, int) and 1 <= threads <= numba.config.NUMBA_NUM_THREADS):
+            raise ModelError(f"threads must be an integer from 1 to {numba.config.NUMBA_NUM_THREADS}"
+                             f" (numba's threads on this machine), got {threads!r}")
+        self.threads = threads
         self.terms = [make_term(t, mesh, material, **p) for t, p in terms]
         if not self.terms:
             raise ModelError("a model needs at least one force term")
@@ -43,13 +48,19 @@ class ParticleModel:
         if x.shape != self.mesh.points.shape:
             raise ModelError(f"positions must have shape {self.mesh.points.shape}, got {x.shape}")
         out = np.zeros_like(x)
-        for t in self.terms:
-            t.forces(x, out)
+        for term, (fn, args) in zip(self.terms, self.kernels()):
+            bad = fn(x, *args, out)
+            if bad >= 0:
+                raise term.degenerate(bad)
         return out
 
     def kernels(self):
-        """The terms' kernels as a tuple of ``(fn, args)`` for the compiled integrator."""
-        return tuple(t.kernel() for t in self.terms)
+        """The terms' kernels as a tuple of ``(fn, args)`` for the compiled integrator; with
+        ``threads`` > 1 a term's threaded kernel where it has one (same bits as serial)."""
+        if self.threads == 1:
+            return tuple(t.kernel() for t in self.terms)
+        numba.set_num_threads(self.threads)
+        return tuple(t.threaded_kernel() or t.kernel() for t in self.terms)
 
     def energy(self, x):
         """Total stored energy [J]; an error for a model with a non-conservative term."""

@@ -2,6 +2,7 @@
 a wall-clock time: timings are the benchmark's output, not a pass condition."""
 import json
 
+import numba
 import numpy as np
 
 from cases import bench
@@ -26,6 +27,12 @@ def test_bench_writes_table_figure_and_in_round_ratios(tmp_path):
             assert r[f"step_vs_{model}"] == 1.0 and r[f"force_vs_{model}"] == 1.0
     assert rows[("pbcm-variational", 625)]["calibration_s"] > 0
     assert rows[("msm", 625)]["calibration_s"] == 0
+    # the two-thread mode exists for the shear readings only; where numba has two threads
+    # its speed-up is a measured positive number
+    assert rows[("msm", 625)]["two_thread_speedup"] is None
+    two = rows[("pbcm-variational", 625)]["two_thread_speedup"]
+    assert (two is None) == (numba.config.NUMBA_NUM_THREADS < 2)
+    assert two is None or (np.isfinite(two) and two > 0)
     assert set(data["engines"]) == {"newton", "warp-lang"}
     md = (out / "bench.md").read_text()
     assert "not installed" in md or "installed" in md

@@ -1,8 +1,9 @@
 """Force terms: rest state, invariance, conservation, gradients, kernels, stiffness."""
+import numba
 import numpy as np
 import pytest
 
-from model import PRESETS, build
+from model import Material, PRESETS, build
 from model.errors import DegenerateTetError, ModelError
 from model.terms import make_term
 from model.terms.shear import Shear
@@ -251,3 +252,57 @@ def test_fast_calibration_form_equals_the_energy_form(preset, mat):
             fast = strain_quadratic_form(t, m.points, deviatoric_basis(), chunk=7)
             slow = quadratic_form(t.unit_energy, m.points, deviatoric_basis())
             assert np.allclose(fast, slow, rtol=0, atol=1e-6 * np.abs(slow).max())
+
+
+def test_generated_shear_kernels_are_current():
+    """_shear_kernels.py is what _shear_codegen.py writes from the current helpers: edit the
+    generator and forget to rerun it, and this goes red (as it must: the file is what runs)."""
+    from model.terms import _shear_codegen
+    assert _shear_codegen.TARGET.read_text() == _shear_codegen.source(), (
+        "run: python model/terms/_shear_codegen.py")
+
+
+THREADED = [k for k in TERMS if make_term(*TERMS[k][:1], cube(2, 0.01, "five"), Material(
+    E=1e4, nu=0.3), **TERMS[k][1]).threaded_kernel() is not None]
+
+
+def test_the_shear_readings_have_a_threaded_kernel():
+    assert THREADED == ["corner", "balanced", "variational"]
+
+
+@pytest.mark.parametrize("key", THREADED)
+@pytest.mark.parametrize("family", ["five", "six"])
+def test_threaded_kernel_equals_serial_bit_for_bit(key, family, mat):
+    """The two-thread mode sums each node's contributions in the serial kernel's order, so
+    the forces are the same bits (not merely close)."""
+    mesh = cube(7, 0.02, family)
+    t = term(key, mesh, mat)
+    x = perturbed(mesh, 0.05, seed=5)
+    fn, args = t.threaded_kernel()
+    out = np.full_like(x, 0.25)             # adds into out, as the serial kernel does
+    assert fn(x, *args, out) == -1
+    assert np.array_equal(out, t.forces(x, np.full_like(x, 0.25)))
+
+
+@pytest.mark.parametrize("key", THREADED)
+def test_threaded_kernel_reports_the_first_flattened_tetrahedron(key, mat):
+    mesh = cube(4, 0.02, "five")
+    t = term(key, mesh, mat)
+    x = mesh.points.copy()
+    for k in (40, 7):                       # flatten two; the first (7) is reported
+        x[mesh.tets[k, 3]] = x[mesh.tets[k, :3]].mean(axis=0)
+    fn, args = t.threaded_kernel()
+    assert fn(x, *args, np.zeros_like(x)) == t.kernel()[0](x, *t.kernel()[1], np.zeros_like(x))
+    with pytest.raises(DegenerateTetError) as serial:
+        t.forces(x)
+    assert fn(x, *args, np.zeros_like(x)) == serial.value.tets[0]
+
+
+def test_threads_of_a_model(small_mesh, mat):
+    serial = build("pbcm-balanced", small_mesh, mat)
+    x = perturbed(small_mesh, 0.05, seed=1)
+    if numba.config.NUMBA_NUM_THREADS >= 2:
+        two = build("pbcm-balanced", small_mesh, mat, threads=2)
+        assert np.array_equal(two.forces(x), serial.forces(x))
+    with pytest.raises(ModelError, match="threads must be an integer from 1"):
+        build("pbcm-balanced", small_mesh, mat, threads=0)

@@ -49,6 +49,9 @@ class Term:
         forces at positions ``x`` (n, 3) into ``out`` (n, 3) and returns -1, or the index of
         the first element it found flattened or inverted (``degenerate_tets`` turns that index
         into tetrahedra). The compiled integrator calls it directly, with no Python between;
+    ``threaded_kernel()``
+        optional: the same contract run on several threads with a result equal bit for bit
+        to ``kernel()`` (model.terms._threads); None, the default, runs the serial kernel;
     ``forces_numpy(x)``
         the same forces in plain numpy, written from the formula, for the tests;
     ``energy(x)``
@@ -88,6 +91,9 @@ class Term:
 
     def kernel(self):
         raise NotImplementedError(f"term {self.name!r} provides no kernel")
+
+    def threaded_kernel(self):
+        return None
 
     def degenerate_tets(self, bad):
         """The tetrahedra behind the index a kernel returned (its own element)."""

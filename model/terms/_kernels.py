@@ -1,22 +1,33 @@
-"""Small numba helpers shared by the per-tetrahedron kernels, inlined into each kernel. They
-write into preallocated arrays so that the element loops allocate nothing.
+"""Small numba helpers shared by the per-tetrahedron kernels, inlined into each kernel, and
+the tetrahedron's combinatorics.
 
-Conventions: ``d[a, b] = x_b - x_a`` (4, 4, 3) for the edges of one tetrahedron; ``c[j]``
-(4, 3) is the doubled area vector of the face opposite vertex j, oriented as the gradient of
-6V with respect to x_j, so that ``|c[j]| = 2 S_j`` and ``sum_j c[j] = 0``.
+Conventions: ``d_ab = x_b - x_a`` for the edges of one tetrahedron; ``c_j`` is the doubled
+area vector of the face opposite vertex j, oriented as the gradient of 6V with respect to
+x_j, so that ``|c_j| = 2 S_j`` and ``sum_j c_j = 0``.
 """
 import numpy as np
 from numba import njit
 
-# face opposite vertex j as (a, m, l) with c[j] = d[a, m] x d[a, l] = d(6V)/dx_j
+# face opposite vertex j as (a, m, l) with c_j = d_am x d_al = d(6V)/dx_j
 FACE = np.array([(1, 3, 2), (0, 2, 3), (0, 3, 1), (0, 1, 2)], dtype=np.int64)
 
 
+# (a, j, m, l) of the 24 shear combinations: corner, tip, in-plane edge end, other base vertex
+COMBOS = np.array([(a, j, m, l) for a in range(4) for j in range(4) if j != a
+                   for m in range(4) if m not in (a, j)
+                   for l in range(4) if l not in (a, j, m)], dtype=np.int64)
+
+
+# 3-vectors as tuples: numba keeps them in registers, where small arrays would live in memory
 @njit(cache=True, inline="always")
-def cross(a, b, out):
-    out[0] = a[1] * b[2] - a[2] * b[1]
-    out[1] = a[2] * b[0] - a[0] * b[2]
-    out[2] = a[0] * b[1] - a[1] * b[0]
+def vec(x, n):
+    """Row n of x (n, 3) as a tuple."""
+    return (x[n, 0], x[n, 1], x[n, 2])
+
+
+@njit(cache=True, inline="always")
+def sub(a, b):
+    return (a[0] - b[0], a[1] - b[1], a[2] - b[2])
 
 
 @njit(cache=True, inline="always")
@@ -25,66 +36,36 @@ def dot(a, b):
 
 
 @njit(cache=True, inline="always")
-def edges(x, tets, t, d):
-    """d[a, b] = x_b - x_a for the corners of tetrahedron t; returns 6V, the signed volume
-    times six (positive for a right-handed tetrahedron)."""
-    for a in range(4):
-        na = tets[t, a]
-        for b in range(a + 1, 4):
-            nb = tets[t, b]
-            for k in range(3):
-                e = x[nb, k] - x[na, k]
-                d[a, b, k] = e
-                d[b, a, k] = -e
-    return (d[0, 1, 0] * (d[0, 2, 1] * d[0, 3, 2] - d[0, 2, 2] * d[0, 3, 1])
-            + d[0, 1, 1] * (d[0, 2, 2] * d[0, 3, 0] - d[0, 2, 0] * d[0, 3, 2])
-            + d[0, 1, 2] * (d[0, 2, 0] * d[0, 3, 1] - d[0, 2, 1] * d[0, 3, 0]))
+def cross(a, b):
+    return (a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0])
 
 
 @njit(cache=True, inline="always")
-def face_vectors(d, c, cn):
-    """c[j] = d(6V)/dx_j, the doubled area vector of the face opposite j, and cn[j] = |c[j]|."""
-    for j in range(4):
-        cross(d[FACE[j, 0], FACE[j, 1]], d[FACE[j, 0], FACE[j, 2]], c[j])
-        cn[j] = np.sqrt(dot(c[j], c[j]))
+def axpy(k, a, y):
+    """y + k a."""
+    return (y[0] + k * a[0], y[1] + k * a[1], y[2] + k * a[2])
 
 
 @njit(cache=True, inline="always")
-def inverse_lengths(d, iL):
-    """iL[a, b] = 1 / |x_b - x_a| (symmetric; reciprocals so that the strain loops multiply)."""
-    for a in range(4):
-        iL[a, a] = 0.0
-        for b in range(a + 1, 4):
-            iL[a, b] = iL[b, a] = 1.0 / np.sqrt(dot(d[a, b], d[a, b]))
+def lin(p, a, q, b):
+    """p a + q b."""
+    return (p * a[0] + q * b[0], p * a[1] + q * b[1], p * a[2] + q * b[2])
 
 
 @njit(cache=True, inline="always")
-def tet_frame(x, tets, t, d, c, cn, iL):
-    """Everything the shear kernels take of tetrahedron t once: edges d, face vectors c with
-    norms cn, reciprocal lengths iL; returns 6V."""
-    V6 = edges(x, tets, t, d)
-    face_vectors(d, c, cn)
-    inverse_lengths(d, iL)
-    return V6
+def add_to(out, n, f):
+    """out[n] += f."""
+    out[n, 0] += f[0]
+    out[n, 1] += f[1]
+    out[n, 2] += f[2]
 
 
 @njit(cache=True, inline="always")
-def apply_laplacian(M, d, ft):
-    """ft[i] += sum_k M[i, k] x_k for a coefficient matrix whose rows sum to zero, computed
-    from the edges d[0, k] so that no absolute position enters (no cancellation)."""
-    for i in range(4):
-        for k in range(3):
-            ft[i, k] += M[i, 1] * d[0, 1, k] + M[i, 2] * d[0, 2, k] + M[i, 3] * d[0, 3, k]
-
-
-@njit(cache=True, inline="always")
-def scatter(tets, t, ft, out):
-    """out[node of corner i] += ft[i]."""
-    for i in range(4):
-        n = tets[t, i]
-        out[n, 0] += ft[i, 0]
-        out[n, 1] += ft[i, 1]
-        out[n, 2] += ft[i, 2]
+def put(ft, t, i, f):
+    """ft[t, i] = f."""
+    ft[t, i, 0] = f[0]
+    ft[t, i, 1] = f[1]
+    ft[t, i, 2] = f[2]
 
 
 def volume_gradient_numpy(x, tets):
@@ -105,34 +86,38 @@ def rest_shape_inverse(points, tets):
     return np.linalg.inv(Dm)
 
 
+# 3 x 3 matrices as tuples of rows (F0, F1, F2)
 @njit(cache=True, inline="always")
-def deformation_gradient(x, tets, t, Dinv, F):
-    """F = Ds Dm^-1 of tetrahedron t into F (3, 3); returns det F."""
-    n0 = tets[t, 0]
-    for i in range(3):
-        e1 = x[tets[t, 1], i] - x[n0, i]
-        e2 = x[tets[t, 2], i] - x[n0, i]
-        e3 = x[tets[t, 3], i] - x[n0, i]
-        for j in range(3):
-            F[i, j] = e1 * Dinv[t, 0, j] + e2 * Dinv[t, 1, j] + e3 * Dinv[t, 2, j]
-    return (F[0, 0] * (F[1, 1] * F[2, 2] - F[1, 2] * F[2, 1])
-            - F[0, 1] * (F[1, 0] * F[2, 2] - F[1, 2] * F[2, 0])
-            + F[0, 2] * (F[1, 0] * F[2, 1] - F[1, 1] * F[2, 0]))
+def deformation_gradient(x, tets, t, Dinv):
+    """F = Ds Dm^-1 of tetrahedron t as rows, and det F: row i of F is
+    sum_c (x_c - x_0)[i] (row c of Dm^-1)."""
+    x0 = vec(x, tets[t, 0])
+    e1, e2, e3 = sub(vec(x, tets[t, 1]), x0), sub(vec(x, tets[t, 2]), x0), sub(vec(x, tets[t, 3]), x0)
+    r0, r1, r2 = vec(Dinv[t], 0), vec(Dinv[t], 1), vec(Dinv[t], 2)
+    F = (lin(e1[0], r0, 1.0, lin(e2[0], r1, e3[0], r2)),
+         lin(e1[1], r0, 1.0, lin(e2[1], r1, e3[1], r2)),
+         lin(e1[2], r0, 1.0, lin(e2[2], r1, e3[2], r2)))
+    return F, dot(F[0], cross(F[1], F[2]))
+
+
+@njit(cache=True, inline="always")
+def cofactor(F):
+    """cof(F) = det(F) F^-T: row i is the cross product of the two other rows (cyclic)."""
+    return cross(F[1], F[2]), cross(F[2], F[0]), cross(F[0], F[1])
 
 
 @njit(cache=True, inline="always")
 def add_piola_forces(P, Dinv, vol0, tets, t, out):
-    """Nodal forces of a constant first Piola-Kirchhoff stress P: H = -V0 P Dm^-T gives the
-    forces on corners 1..3 as its columns, corner 0 takes minus their sum."""
-    n0 = tets[t, 0]
-    for i in range(3):
-        f0 = 0.0
-        for c in range(3):
-            h = -vol0[t] * (P[i, 0] * Dinv[t, c, 0] + P[i, 1] * Dinv[t, c, 1]
-                            + P[i, 2] * Dinv[t, c, 2])
-            out[tets[t, c + 1], i] += h
-            f0 -= h
-        out[n0, i] += f0
+    """Nodal forces of a constant first Piola-Kirchhoff stress P (rows): H = -V0 P Dm^-T, so
+    the force on corner c + 1 has components -V0 P_i . (row c of Dm^-1); corner 0 takes minus
+    their sum."""
+    f0 = (0.0, 0.0, 0.0)
+    for c in range(3):
+        r = vec(Dinv[t], c)
+        f = (-vol0[t] * dot(P[0], r), -vol0[t] * dot(P[1], r), -vol0[t] * dot(P[2], r))
+        add_to(out, tets[t, c + 1], f)
+        f0 = sub(f0, f)
+    add_to(out, tets[t, 0], f0)
 
 
 def deformation_gradients_numpy(x, tets, Dinv):

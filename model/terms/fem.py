@@ -19,67 +19,58 @@ import numpy as np
 from numba import njit
 
 from . import Term, register
-from ._kernels import (add_piola_forces, deformation_gradient, deformation_gradients_numpy,
-                       piola_forces_numpy, rest_shape_inverse)
+from ._kernels import (add_piola_forces, cofactor, deformation_gradient,
+                       deformation_gradients_numpy, dot, lin, piola_forces_numpy,
+                       rest_shape_inverse, sub)
 from .volume import FLAT
 
 
 @njit(cache=True, fastmath=True)
 def linear_forces(x, tets, Dinv, vol0, lam, mu, out):
     """Small-strain constant-strain tetrahedra; returns the first flattened one, or -1."""
-    F, P = np.empty((3, 3)), np.empty((3, 3))
     for t in range(tets.shape[0]):
-        if deformation_gradient(x, tets, t, Dinv, F) <= FLAT:
+        F, J = deformation_gradient(x, tets, t, Dinv)
+        if J <= FLAT:
             return t
-        tr = F[0, 0] + F[1, 1] + F[2, 2] - 3.0
-        for i in range(3):
-            for j in range(3):
-                P[i, j] = mu * (F[i, j] + F[j, i])            # 2 mu eps, off the diagonal
-            P[i, i] += lam * tr - 2.0 * mu
+        s = lam * (F[0][0] + F[1][1] + F[2][2] - 3.0) - 2.0 * mu   # P = 2 mu eps + lam tr(eps) I
+        P = ((2.0 * mu * F[0][0] + s, mu * (F[0][1] + F[1][0]), mu * (F[0][2] + F[2][0])),
+             (mu * (F[1][0] + F[0][1]), 2.0 * mu * F[1][1] + s, mu * (F[1][2] + F[2][1])),
+             (mu * (F[2][0] + F[0][2]), mu * (F[2][1] + F[1][2]), 2.0 * mu * F[2][2] + s))
         add_piola_forces(P, Dinv, vol0, tets, t, out)
     return -1
 
 
 @njit(cache=True, inline="always")
-def polar_rotation(F, R, Rn):
+def polar_rotation(F):
     """R of F = R S by Newton's iteration R <- (R + R^-T) / 2 from R = F (det F > 0):
     quadratic convergence, stopped at 1e-14 or 30 iterations."""
-    R[:] = F
+    R = F
     for _ in range(30):
-        det = (R[0, 0] * (R[1, 1] * R[2, 2] - R[1, 2] * R[2, 1])
-               - R[0, 1] * (R[1, 0] * R[2, 2] - R[1, 2] * R[2, 0])
-               + R[0, 2] * (R[1, 0] * R[2, 1] - R[1, 1] * R[2, 0]))
-        # R^-T = cofactor(R) / det
-        for i in range(3):
-            i1, i2 = (i + 1) % 3, (i + 2) % 3
-            for j in range(3):
-                j1, j2 = (j + 1) % 3, (j + 2) % 3
-                Rn[i, j] = 0.5 * (R[i, j] + (R[i1, j1] * R[i2, j2] - R[i1, j2] * R[i2, j1]) / det)
-        change = 0.0
-        for i in range(3):
-            for j in range(3):
-                change = max(change, abs(Rn[i, j] - R[i, j]))
-                R[i, j] = Rn[i, j]
+        C = cofactor(R)
+        h = 0.5 / dot(R[0], C[0])                           # R^-T = cof(R) / det R
+        Rn = (lin(0.5, R[0], h, C[0]), lin(0.5, R[1], h, C[1]), lin(0.5, R[2], h, C[2]))
+        d0, d1, d2 = sub(Rn[0], R[0]), sub(Rn[1], R[1]), sub(Rn[2], R[2])
+        change = max(abs(d0[0]), abs(d0[1]), abs(d0[2]), abs(d1[0]), abs(d1[1]), abs(d1[2]),
+                     abs(d2[0]), abs(d2[1]), abs(d2[2]))
+        R = Rn
         if change < 1e-14:
             break
+    return R
 
 
 @njit(cache=True, fastmath=True)
 def corotated_forces(x, tets, Dinv, vol0, lam, mu, out):
     """Co-rotated constant-strain tetrahedra; returns the first flattened one, or -1."""
-    F, R, Rn, S, P = (np.empty((3, 3)), np.empty((3, 3)), np.empty((3, 3)), np.empty((3, 3)),
-                      np.empty((3, 3)))
     for t in range(tets.shape[0]):
-        if deformation_gradient(x, tets, t, Dinv, F) <= FLAT:
+        F, J = deformation_gradient(x, tets, t, Dinv)
+        if J <= FLAT:
             return t
-        polar_rotation(F, R, Rn)
-        for i in range(3):              # S = R^T F
-            for j in range(3):
-                S[i, j] = R[0, i] * F[0, j] + R[1, i] * F[1, j] + R[2, i] * F[2, j]
-        tr = S[0, 0] + S[1, 1] + S[2, 2] - 3.0
-        for i in range(3):              # P = 2 mu (F - R) + lam tr(S - I) R
-            for j in range(3):
-                P[i, j] = 2.0 * mu * (F[i, j] - R[i, j]) + lam * tr * R[i, j]
+        R = polar_rotation(F)
+        tr = dot(R[0], F[0]) + dot(R[1], F[1]) + dot(R[2], F[2]) - 3.0    # tr(R^T F - I)
+        # P = 2 mu (F - R) + lam tr(S - I) R
+        P = (lin(2.0 * mu, F[0], lam * tr - 2.0 * mu, R[0]),
+             lin(2.0 * mu, F[1], lam * tr - 2.0 * mu, R[1]),
+             lin(2.0 * mu, F[2], lam * tr - 2.0 * mu, R[2]))
         add_piola_forces(P, Dinv, vol0, tets, t, out)
     return -1
 
@@ -88,17 +79,13 @@ def corotated_forces(x, tets, Dinv, vol0, lam, mu, out):
 def neohookean_forces(x, tets, Dinv, vol0, lam, mu, out):
     """Compressible neo-Hookean constant-strain tetrahedra; returns the first one with
     det F <= FLAT, or -1."""
-    F, P = np.empty((3, 3)), np.empty((3, 3))
     for t in range(tets.shape[0]):
-        J = deformation_gradient(x, tets, t, Dinv, F)
+        F, J = deformation_gradient(x, tets, t, Dinv)
         if J <= FLAT:
             return t
         a = (lam * np.log(J) - mu) / J   # P = mu F + (lam ln J - mu) F^-T, F^-T = cof(F) / J
-        for i in range(3):
-            i1, i2 = (i + 1) % 3, (i + 2) % 3
-            for j in range(3):
-                j1, j2 = (j + 1) % 3, (j + 2) % 3
-                P[i, j] = mu * F[i, j] + a * (F[i1, j1] * F[i2, j2] - F[i1, j2] * F[i2, j1])
+        C = cofactor(F)
+        P = (lin(mu, F[0], a, C[0]), lin(mu, F[1], a, C[1]), lin(mu, F[2], a, C[2]))
         add_piola_forces(P, Dinv, vol0, tets, t, out)
     return -1
 

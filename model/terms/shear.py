@@ -20,153 +20,23 @@ import numpy as np
 from numba import njit
 
 from . import Term, register
-from ._kernels import (FACE, apply_laplacian, cross, dot, scatter, tet_frame,
-                       volume_gradient_numpy)
-from .volume import FLAT
+from ._kernels import COMBOS, volume_gradient_numpy
+from ._shear_kernels import (shear_balanced, shear_balanced_tets, shear_corner,
+                             shear_corner_tets, shear_strains, shear_variational,
+                             shear_variational_tets)
+from ._threads import TwoThreads
 from ..errors import ModelError, DegenerateTetError
 
-# (a, j, m, l): corner, tip, in-plane edge end, the other base vertex
-COMBOS = np.array([(a, j, m, l) for a in range(4) for j in range(4) if j != a
-                   for m in range(4) if m not in (a, j)
-                   for l in range(4) if l not in (a, j, m)], dtype=np.int64)
 # +1 when (a, m, l, j) is an even permutation of (0, 1, 2, 3)
 _PARITY = np.array([round(np.linalg.det(np.eye(4)[[a, m, l, j]])) for a, j, m, l in COMBOS])
 READINGS = {"corner": 0, "balanced": 1, "variational": 2}
 
-
-# Every kernel below works on one tetrahedron at a time: the edges d[a, b], 6V, the face
-# vectors c[j] (|c[j]| = 2 S_j) and the lengths L once, then the 24 strains
-#     gamma_s = q |c_j| / (6V) - gamma0_s,   q = d[a, j] . d[a, m] / L[a, m].
-# The forces of the corner and balanced readings and the q-part of the variational gradient
-# are sums of coefficients times edges x_b - x_a: they are gathered in a 4 x 4 matrix M and
-# applied once (apply_laplacian).
-
-
-@njit(cache=True, fastmath=True)
-def shear_strains(x, tets, gamma0, gamma_out):
-    """The 24 strains of every tetrahedron into gamma_out (m, 24); returns the first
-    flattened tetrahedron (6V <= 0), or -1."""
-    d, c, cn, iL = np.empty((4, 4, 3)), np.empty((4, 3)), np.empty(4), np.empty((4, 4))
-    for t in range(tets.shape[0]):
-        V6 = tet_frame(x, tets, t, d, c, cn, iL)
-        if V6 <= 0.0:
-            return t
-        for j in range(4):
-            cn[j] /= V6                  # 1 / height over the face opposite j
-        for s in range(24):
-            a, j, m = COMBOS[s, 0], COMBOS[s, 1], COMBOS[s, 2]
-            gamma_out[t, s] = dot(d[a, j], d[a, m]) * iL[a, m] * cn[j] - gamma0[t, s]
-    return -1
-
-
-@njit(cache=True, fastmath=True)
-def shear_corner(x, tets, vol0, gamma0, G, out):
-    """Literal eq. 5: f_a += (1/4) tau S_F e, tau = G gamma, S_F = |c_j| / 2, e = d[a, m] / L."""
-    d, c, cn, iL = np.empty((4, 4, 3)), np.empty((4, 3)), np.empty(4), np.empty((4, 4))
-    M, ft = np.empty((4, 4)), np.empty((4, 3))
-    for t in range(tets.shape[0]):
-        V6 = tet_frame(x, tets, t, d, c, cn, iL)
-        if V6 <= FLAT * 6.0 * vol0[t]:
-            return t
-        iV6 = 1.0 / V6
-        M[:] = 0.0
-        for s in range(24):
-            a, j, m = COMBOS[s, 0], COMBOS[s, 1], COMBOS[s, 2]
-            gamma = dot(d[a, j], d[a, m]) * iL[a, m] * cn[j] * iV6 - gamma0[t, s]
-            w = 0.125 * G * gamma * cn[j] * iL[a, m]   # (1/4) tau S_F / L on the edge a -> m
-            M[a, m] += w
-            M[a, a] -= w
-        ft[:] = 0.0
-        apply_laplacian(M, d, ft)
-        scatter(tets, t, ft, out)
-    return -1
-
-
-@njit(cache=True, fastmath=True)
-def shear_balanced(x, tets, vol0, gamma0, G, out):
-    """f_j -= tau S_F e on the tip, + tau S_F e / 3 on each base vertex a, m, l."""
-    d, c, cn, iL = np.empty((4, 4, 3)), np.empty((4, 3)), np.empty(4), np.empty((4, 4))
-    M, ft = np.empty((4, 4)), np.empty((4, 3))
-    for t in range(tets.shape[0]):
-        V6 = tet_frame(x, tets, t, d, c, cn, iL)
-        if V6 <= FLAT * 6.0 * vol0[t]:
-            return t
-        iV6 = 1.0 / V6
-        M[:] = 0.0
-        for s in range(24):
-            a, j, m, l = COMBOS[s, 0], COMBOS[s, 1], COMBOS[s, 2], COMBOS[s, 3]
-            gamma = dot(d[a, j], d[a, m]) * iL[a, m] * cn[j] * iV6 - gamma0[t, s]
-            w = 0.5 * G * gamma * cn[j] * iL[a, m]     # tau S_F / L on the edge a -> m
-            for i in range(4):                         # f_i += coef_i (x_m - x_a)
-                coef = -w if i == j else w / 3.0
-                M[i, m] += coef
-                M[i, a] -= coef
-        ft[:] = 0.0
-        apply_laplacian(M, d, ft)
-        scatter(tets, t, ft, out)
-    return -1
-
-
-@njit(cache=True, fastmath=True)
-def shear_variational(x, tets, vol0, gamma0, cG, out):
-    """f = -dW/dx, W = (c/2) G V0 sum_s gamma_s^2 (cG = c G). With w_s = c G V0 gamma_s:
-
-        dW = sum_s w_s [ |c_j|/(6V) dq + q/(6V) d|c_j| - gamma_raw d(6V)/(6V) ],
-        dq = d(d_aj . d_am) / L_am - q dL_am / L_am.
-    """
-    d, c, cn, iL = np.empty((4, 4, 3)), np.empty((4, 3)), np.empty(4), np.empty((4, 4))
-    M, ft, B, ch, g = np.empty((4, 4)), np.empty((4, 3)), np.empty(4), np.empty(3), np.empty(3)
-    for t in range(tets.shape[0]):
-        V6 = tet_frame(x, tets, t, d, c, cn, iL)
-        if V6 <= FLAT * 6.0 * vol0[t]:
-            return t
-        iV6, cGV0 = 1.0 / V6, cG * vol0[t]
-        M[:] = 0.0      # -dW from dq, as coefficients of edges
-        B[:] = 0.0      # dW / d|c_j|
-        A = 0.0         # dW / d(6V)
-        for s in range(24):
-            a, j, m = COMBOS[s, 0], COMBOS[s, 1], COMBOS[s, 2]
-            q = dot(d[a, j], d[a, m]) * iL[a, m]
-            raw = q * cn[j] * iV6
-            w = cGV0 * (raw - gamma0[t, s])
-            A -= w * raw * iV6
-            B[j] += w * q * iV6
-            k = w * cn[j] * iV6 * iL[a, m]              # dW/dD for D = d_aj . d_am
-            # -k dD: f_j -= k d_am, f_m -= k d_aj, f_a += k (d_am + d_aj)
-            M[j, m] -= k
-            M[j, a] += k
-            M[m, j] -= k
-            M[m, a] += k
-            M[a, m] += k
-            M[a, j] += k
-            M[a, a] -= 2.0 * k
-            # -dW/dL_am = k q: f_m += r d_am, f_a -= r d_am, r = k q / L
-            r = k * q * iL[a, m]
-            M[m, m] += r
-            M[m, a] -= r
-            M[a, m] -= r
-            M[a, a] += r
-        ft[:] = 0.0
-        apply_laplacian(M, d, ft)
-        for j in range(4):
-            # -A d(6V)/dx_j = -A c[j]; -B_j d|c_j|/dx over the face (a, m, l) of c_j
-            a, m, l = FACE[j, 0], FACE[j, 1], FACE[j, 2]
-            for k in range(3):
-                ft[j, k] -= A * c[j, k]
-                ch[k] = B[j] * c[j, k] / cn[j]   # B_j c_hat
-            cross(d[a, l], ch, g)      # d|c|/dx_m = d_al x c_hat
-            for k in range(3):
-                ft[m, k] -= g[k]
-                ft[a, k] += g[k]
-            cross(ch, d[a, m], g)      # d|c|/dx_l = c_hat x d_am
-            for k in range(3):
-                ft[l, k] -= g[k]
-                ft[a, k] += g[k]
-        scatter(tets, t, ft, out)
-    return -1
-
-
+# One kernel per reading, written out combination by combination by _shear_codegen.py (whose
+# docstrings carry each reading's derivation): the edges d_ab, squared lengths l_ab, face
+# vectors c_j and 6V once per tetrahedron, then the 24 strains
+#     gamma_s = D / L_am * |c_j| / (6V) - gamma0_s,   D = d_aj . d_am = (l_aj + l_am - l_jm) / 2.
 KERNELS = {0: shear_corner, 1: shear_balanced, 2: shear_variational}
+PER_TET = {0: shear_corner_tets, 1: shear_balanced_tets, 2: shear_variational_tets}
 
 
 def strains_numpy(x, tets, gamma0):
@@ -218,6 +88,7 @@ class Shear(Term):
         self.vol0 = mesh.volumes
         self.gamma0 = np.zeros((mesh.n_tets, 24))
         self.gamma0 = self.strains(mesh.points)
+        self._threads = None
 
     def describe(self):
         return f"shear/{self.p['reading']}"
@@ -247,6 +118,11 @@ class Shear(Term):
                              "build the model with model.build, or pass a number for c")
         k = self.scale * self.G * (self.coef if self.reading == 2 else 1.0)
         return KERNELS[self.reading], (self.mesh.tets, self.vol0, self.gamma0, k)
+
+    def threaded_kernel(self):
+        if self._threads is None:
+            self._threads = TwoThreads(self.mesh.tets, self.mesh.n_nodes)
+        return self._threads.kernel(PER_TET[self.reading], self.kernel()[1])
 
     def forces_numpy(self, x):
         tets = self.mesh.tets

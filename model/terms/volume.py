@@ -7,7 +7,7 @@ import numpy as np
 from numba import njit
 
 from . import Term, register
-from ._kernels import cross, dot, volume_gradient_numpy
+from ._kernels import add_to, cross, dot, sub, vec, volume_gradient_numpy
 
 # V / V0 below this is a flattened tetrahedron (the energy's log barrier is meaningless there)
 FLAT = 1e-6
@@ -17,26 +17,20 @@ FLAT = 1e-6
 def volume_forces(x, tets, vol0, K, out):
     """f_i = p dV/dx_i, p = -K (V - V0) / V, for every tetrahedron; returns the first one
     flattened below FLAT V0, or -1."""
-    e1, e2, e3, g = np.empty(3), np.empty(3), np.empty(3), np.empty((4, 3))
     for t in range(tets.shape[0]):
         n0, n1, n2, n3 = tets[t, 0], tets[t, 1], tets[t, 2], tets[t, 3]
-        for k in range(3):
-            e1[k] = x[n1, k] - x[n0, k]
-            e2[k] = x[n2, k] - x[n0, k]
-            e3[k] = x[n3, k] - x[n0, k]
-        cross(e2, e3, g[1])
-        cross(e3, e1, g[2])
-        cross(e1, e2, g[3])
-        V6 = dot(e1, g[1])
+        x0 = vec(x, n0)
+        d01, d02, d03 = sub(vec(x, n1), x0), sub(vec(x, n2), x0), sub(vec(x, n3), x0)
+        c1, c2, c3 = cross(d02, d03), cross(d03, d01), cross(d01, d02)   # d(6V)/dx_1..3
+        V6 = dot(d01, c1)
         if V6 <= FLAT * 6.0 * vol0[t]:
             return t
-        p6 = -K * (V6 - 6.0 * vol0[t]) / (6.0 * V6)   # p / 6: g holds d(6V)/dx
-        for k in range(3):
-            g[0, k] = -(g[1, k] + g[2, k] + g[3, k])
-        for i in range(4):
-            n = tets[t, i]
-            for k in range(3):
-                out[n, k] += p6 * g[i, k]
+        p6 = -K * (V6 - 6.0 * vol0[t]) / (6.0 * V6)   # p / 6: c_j is d(6V)/dx_j
+        add_to(out, n0, (-p6 * (c1[0] + c2[0] + c3[0]), -p6 * (c1[1] + c2[1] + c3[1]),
+                         -p6 * (c1[2] + c2[2] + c3[2])))
+        add_to(out, n1, (p6 * c1[0], p6 * c1[1], p6 * c1[2]))
+        add_to(out, n2, (p6 * c2[0], p6 * c2[1], p6 * c2[2]))
+        add_to(out, n3, (p6 * c3[0], p6 * c3[1], p6 * c3[2]))
     return -1
 
 

@@ -1,0 +1,217 @@
+"""Writes ``_shear_kernels.py``: the shear kernels with their 24 combinations written out.
+
+Why generated: in a loop over a combination table the edges, lengths and accumulators live in
+arrays that numba cannot keep in registers (it cannot prove they do not alias ``x`` and
+``out``), and the variational kernel cost 210 ns per tetrahedron; written out, every quantity
+is a named scalar and it costs 60 (``pbcm bench``). This file holds the maths once, per
+combination, and the generated file is what runs. After editing this file or the helpers in
+``_kernels.py`` run ``python model/terms/_shear_codegen.py``; tests/test_terms.py fails while
+the generated file is stale (and its changed text makes numba recompile the cached kernels).
+
+Notation of the generated code, for the tetrahedron's corners 0..3:
+
+* ``d01 = x1 - x0`` the six edges (p < q), ``l01 = |d01|^2``, ``iL01 = 1 / |d01|``;
+* ``c0..c3`` the doubled face vectors, ``c_j = d(6V)/dx_j``, ``cn_j = |c_j| = 2 S_j``,
+  ``V6 = 6V``, ``h_j = cn_j / V6`` = 1 / (height of tip j over its face);
+* combination (a, j, m) (corner a, tip j, in-plane edge a -> m) has
+  ``D = d_aj . d_am = (l_aj + l_am - l_jm) / 2`` and
+  ``gamma = D / L_am * h_j - gamma0`` (the paper's eq. 4, as in shear.py).
+"""
+import hashlib
+import importlib.util
+import pathlib
+
+HERE = pathlib.Path(__file__).parent
+if __package__:
+    from ._kernels import COMBOS, FACE
+else:   # run as a script, without importing the package (whose import needs the output)
+    _spec = importlib.util.spec_from_file_location("_kernels", HERE / "_kernels.py")
+    _kernels = importlib.util.module_from_spec(_spec)
+    _spec.loader.exec_module(_kernels)
+    COMBOS, FACE = _kernels.COMBOS, _kernels.FACE
+TARGET = HERE / "_shear_kernels.py"
+PAIRS = [(p, q) for p in range(4) for q in range(p + 1, 4)]
+
+
+def e(p, q):
+    """The name suffix of edge {p, q}."""
+    return f"{min(p, q)}{max(p, q)}"
+
+
+def frame(check):
+    """Per tetrahedron: corners, edges, squared and reciprocal lengths, face vectors, 6V,
+    reciprocal heights; ``check`` is the flattening test (a string of code, or None)."""
+    lines = ["n0, n1, n2, n3 = tets[t, 0], tets[t, 1], tets[t, 2], tets[t, 3]",
+             "x0, x1, x2, x3 = vec(x, n0), vec(x, n1), vec(x, n2), vec(x, n3)"]
+    for p, q in PAIRS:
+        lines += [f"d{p}{q} = sub(x{q}, x{p})", f"l{p}{q} = dot(d{p}{q}, d{p}{q})",
+                  f"iL{p}{q} = 1.0 / np.sqrt(l{p}{q})"]
+    for j in range(4):
+        a, m, l = FACE[j]
+        lines += [f"c{j} = cross(d{e(a, m)}, d{e(a, l)})", f"cn{j} = np.sqrt(dot(c{j}, c{j}))"]
+    lines += ["V6 = dot(d01, c1)", f"if {check}:", FLATTENED_ACTION, "iV6 = 1.0 / V6"]
+    lines += [f"h{j} = cn{j} * iV6" for j in range(4)]
+    return lines
+
+
+def strain(s, a, j, m):
+    """D and gamma of combination s = (a, j, m)."""
+    return [f"# combination {s}: corner {a}, tip {j}, edge {a} -> {m}",
+            f"D = 0.5 * (l{e(a, j)} + l{e(a, m)} - l{e(j, m)})",
+            f"gamma = D * iL{e(a, m)} * h{j} - gamma0[t, {s}]"]
+
+
+def strains():
+    body = []
+    for s, (a, j, m, _) in enumerate(COMBOS):
+        body += strain(s, a, j, m) + [f"gamma_out[t, {s}] = gamma"]
+    return ("shear_strains", "x, tets, gamma0, gamma_out",
+            "The 24 strains of every tetrahedron into gamma_out (m, 24); returns the first "
+            "flattened tetrahedron (6V <= 0), or -1.", [], frame("V6 <= 0.0") + body)
+
+
+def edge_forces(coef):
+    """f_p += k_pq d_pq, f_q += k_qp d_qp for the ordered edge coefficients ``coef(p, q)``."""
+    lines = [f"f{i} = (0.0, 0.0, 0.0)" for i in range(4)]
+    for p, q in PAIRS:
+        lines += [f"f{p} = axpy({coef(p, q)}, d{p}{q}, f{p})",
+                  f"f{q} = axpy(-({coef(q, p)}), d{p}{q}, f{q})"]
+    return lines
+
+
+FLATTENED = "V6 <= FLAT * 6.0 * vol0[t]"
+# what the serial and the per-tetrahedron (threaded) variants do at these two places
+FLATTENED_ACTION, SCATTER = "@flattened@", "@scatter@"
+SERIAL = {FLATTENED_ACTION: ["    return t"],
+          SCATTER: [f"add_to(out, n{i}, f{i})" for i in range(4)]}
+PER_TET = {FLATTENED_ACTION: ["    flat[t] = 1", "    n_flat += 1", "    continue"],
+           SCATTER: [f"put(ft, t, {i}, f{i})" for i in range(4)]}
+
+
+def corner():
+    """f_a += (1/4) tau S_F e = K_am d_am with K_am = G gamma cn_j / (8 L_am), summed over
+    the two tips j of each ordered edge a -> m."""
+    init = [f"K{a}{m} = 0.0" for a in range(4) for m in range(4) if a != m]
+    body = []
+    for s, (a, j, m, _) in enumerate(COMBOS):
+        body += strain(s, a, j, m)
+        body += [f"K{a}{m} += G8 * gamma * cn{j} * iL{e(a, m)}"]
+    return ("shear_corner", "x, tets, vol0, gamma0, G, out",
+            "Literal eq. 5: f_a += (1/4) tau S_F e, tau = G gamma, S_F = cn_j / 2, "
+            "e = d_am / L_am; returns the first flattened tetrahedron, or -1.",
+            ["G8 = 0.125 * G"], frame(FLATTENED) + init + body
+            + edge_forces(lambda p, q: f"K{p}{q}") + [SCATTER])
+
+
+def balanced():
+    """f_j -= w d_am on the tip, + w d_am / 3 on each of a, m, l (w = tau S_F / L_am): with
+    U_i = sum over the combinations of tip i of w d_am and T = sum_i U_i,
+    f_i = T / 3 - (4/3) U_i. U_j collects the edges p < q of the face opposite j."""
+    init = [f"B{j}_{e(p, q)} = 0.0" for j in range(4) for p, q in PAIRS if j not in (p, q)]
+    body = []
+    for s, (a, j, m, _) in enumerate(COMBOS):
+        sign = "+=" if a < m else "-="       # d_am = -d_ma
+        body += strain(s, a, j, m)
+        body += [f"B{j}_{e(a, m)} {sign} G2 * gamma * cn{j} * iL{e(a, m)}"]
+    forces = []
+    for j in range(4):
+        u = "(0.0, 0.0, 0.0)"
+        for p, q in PAIRS:
+            if j not in (p, q):
+                u = f"axpy(B{j}_{p}{q}, d{p}{q}, {u})"
+        forces.append(f"U{j} = {u}")
+    forces.append("T = (U0[0] + U1[0] + U2[0] + U3[0], U0[1] + U1[1] + U2[1] + U3[1], "
+                  "U0[2] + U1[2] + U2[2] + U3[2])")
+    forces += [f"f{i} = lin(1.0 / 3.0, T, -4.0 / 3.0, U{i})" for i in range(4)]
+    return ("shear_balanced", "x, tets, vol0, gamma0, G, out",
+            "f_j -= tau S_F e on the tip, + tau S_F e / 3 on each base vertex a, m, l; returns "
+            "the first flattened tetrahedron, or -1.",
+            ["G2 = 0.5 * G"], frame(FLATTENED) + init + body + forces + [SCATTER])
+
+
+def variational():
+    """f = -dW/dx, W = (c/2) G V0 sum_s gamma_s^2 (cG = c G). W depends on x through the six
+    squared lengths l, the four face norms cn_j and 6V; cn_j^2 = l_am l_al - D_j^2 is itself a
+    function of its face's l, so
+
+        f = -sum_edges 2 dW/dl_pq (d_pq at q, -d_pq at p) - dW/d(6V) c_j.
+
+    Per combination, with g = h_j / L_am, E = w g / 2 (w = cG V0 gamma) and P = E D:
+    dW/dl_aj += E, dW/dl_jm -= E, dW/dl_am += E - P / l_am, dW/dcn_j += 2 P / cn_j,
+    dW/d(6V) -= 2 P / (6V)."""
+    init = [f"W{p}{q} = 0.0" for p, q in PAIRS] + [f"P{j} = 0.0" for j in range(4)]
+    body = ["half = 0.5 * cG * vol0[t]"]
+    for s, (a, j, m, _) in enumerate(COMBOS):
+        am = e(a, m)
+        body += strain(s, a, j, m)
+        body += [f"E = half * gamma * iL{am} * h{j}", "P = E * D",
+                 f"W{e(a, j)} += E", f"W{e(j, m)} -= E",
+                 f"W{am} += E - P * iL{am} * iL{am}", f"P{j} += P"]
+    faces = []
+    for j in range(4):
+        a, m, l = FACE[j]
+        # dcn/dl_am = (l_al - D) / (2 cn), dcn/dl_al = (l_am - D) / (2 cn), dcn/dl_ml = D / (2 cn)
+        faces += [f"b = P{j} / (cn{j} * cn{j})",
+                  f"D = 0.5 * (l{e(a, m)} + l{e(a, l)} - l{e(m, l)})",
+                  f"W{e(a, m)} += b * (l{e(a, l)} - D)", f"W{e(a, l)} += b * (l{e(a, m)} - D)",
+                  f"W{e(m, l)} += b * D"]
+    forces = ["A = 2.0 * (P0 + P1 + P2 + P3) * iV6"]        # -dW/d(6V)
+    forces += edge_forces(lambda p, q: f"2.0 * W{e(p, q)}")   # l_pq is symmetric
+    forces += [f"f{j} = axpy(A, c{j}, f{j})" for j in range(4)]
+    return ("shear_variational", "x, tets, vol0, gamma0, cG, out",
+            "f = -dW/dx, W = (c/2) G V0 sum_s gamma_s^2 (cG = c G); returns the first "
+            "flattened tetrahedron, or -1.",
+            [], frame(FLATTENED) + init + body + faces + forces + [SCATTER])
+
+
+READERS = (strains, corner, balanced, variational)
+
+
+def expand(lines, variant):
+    return [new for line in lines for new in
+            ([line[:len(line) - len(line.lstrip())] + n for n in variant[line.strip()]]
+             if line.strip() in variant else [line])]
+
+
+def function(name, args, doc, before, per_tet):
+    """The serial kernel, and for a force kernel (``out`` last) its per-tetrahedron twin
+    ``name_tets`` for the two-thread mode: the same lines over a range of tetrahedra (the
+    threads take ranges, model.terms._threads), each tetrahedron's four forces stored in
+    ft (m, 4, 3) for a fixed-order sum, flattened ones flagged in ``flat``; it returns their
+    count."""
+    pad = " " * 8
+    text = "\n".join(
+        ["", "", "@njit(cache=True, fastmath=FAST)", f"def {name}({args}):", f'    """{doc}"""']
+        + [f"    {line}" for line in before]
+        + ["    for t in range(tets.shape[0]):"] + [pad + x for x in expand(per_tet, SERIAL)]
+        + ["    return -1"])
+    if not args.endswith(", out"):
+        return text
+    return text + "\n".join(
+        ["", "", "@njit(cache=True, fastmath=FAST)",
+         f"def {name}_tets({args[:-len(', out')]}, ft, flat, first, stop):",
+         f'    """{name} per tetrahedron for t in [first, stop) into ft (m, 4, 3); flattened '
+         'ones flagged in flat."""']
+        + [f"    {line}" for line in before] + ["    n_flat = 0"]
+        + ["    for t in range(first, stop):"] + [pad + x for x in expand(per_tet, PER_TET)]
+        + ["    return n_flat"])
+
+
+def source():
+    """The text of ``_shear_kernels.py``."""
+    helpers = hashlib.sha256((HERE / "_kernels.py").read_bytes()).hexdigest()[:16]
+    head = [f'"""GENERATED by model/terms/_shear_codegen.py: do not edit (see its docstring).',
+            "", "Each reading's derivation is in the docstring of its writer there.", "",
+            f"_kernels.py sha256 {helpers}", '"""',
+            "import numpy as np", "from numba import njit", "",
+            "from ._kernels import add_to, axpy, cross, dot, lin, put, sub, vec",
+            "from .volume import FLAT", "",
+            "# fast maths without reassociation: the serial and the per-tetrahedron twins then",
+            "# round the same way (the two-thread mode's bit-for-bit promise)",
+            'FAST = {"nnan", "ninf", "nsz", "arcp", "contract", "afn"}', ""]
+    return "\n".join(head) + "".join(function(*r()) for r in READERS) + "\n"
+
+
+if __name__ == "__main__":
+    TARGET.write_text(source())
+    print(f"wrote {TARGET}")
