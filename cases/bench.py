@@ -8,7 +8,6 @@ presets are timed round-robin, one sample of each per round, and a ratio (to msm
 fem-linear) is taken within each round, then the median over rounds: drift of the machine
 between rounds cancels. Every cost sentence of the reports comes from these ratios.
 """
-import importlib.util
 import json
 import time
 import tracemalloc
@@ -24,13 +23,14 @@ from model.integrate import rk4_ramp, total_forces
 from model.mesh import cube
 
 from . import figures
+from .engines import ENGINES
 from .document import Document, fmt
 
 SIZES = (1e2, 1e3, 1e4, 1e5, 1e6)
 QUICK_SIZES = (1e2, 1e3)
 BASELINES = ("msm", "fem-linear")
 SAMPLE_S = 0.02          # each timing sample runs at least this long (many calls if need be)
-ENGINES = {"newton": "newton", "warp": "warp-lang"}   # optional engines, by module
+ENGINE_REFERENCE = "fem-neohookean"   # what the optional engines' forces are compared with
 
 
 @njit   # not cached: it takes the kernels (see model.integrate)
@@ -67,7 +67,7 @@ class _Timed:
             self.kernels_2 = tuple(k or t.kernel() for k, t in zip(threaded, self.pm.terms))
         top, bot = mesh.nodes_on_plane("y", 0.032), mesh.nodes_on_plane("y", 0.0)
         ramp = Ramp(top, (0.0, -0.32e-3, 0.0), 1.0, fixed=bot)
-        mask, start, moving = ramp._parts(mesh.n_nodes)
+        mask, start, moving = ramp.parts(mesh.n_nodes)
         self.x, self.v = mesh.points.copy(), np.zeros_like(mesh.points)
         self.out = np.zeros_like(mesh.points)
         self.step_args = (mesh.points, self.pm.mass, np.zeros_like(mesh.points), 50.0, mask,
@@ -115,21 +115,77 @@ class _Timed:
         return (t1 - t0) * 1e-9 / self.reps_force, (t2 - t1) * 1e-9 / self.reps_step, speedup
 
 
+class _EngineTimed:
+    """An optional engine's force evaluation on the mesh of a built fem-neohookean model."""
+
+    def __init__(self, engine, pm, x):
+        self.call = engine.force_evaluation(pm, x)
+        self.call()                                   # compile outside the timings
+        t0 = time.thread_time()
+        self.call()
+        self.reps = max(1, int(SAMPLE_S / max(time.thread_time() - t0, 1e-7)))
+
+    def sample(self):
+        """Seconds per force evaluation, thread CPU time (Warp runs CPU kernels on the
+        calling thread)."""
+        t0 = time.thread_time_ns()
+        for _ in range(self.reps):
+            self.call()
+        return (time.thread_time_ns() - t0) * 1e-9 / self.reps
+
+
+def _engine_timers(mesh, timed, progress):
+    """The installed engines' timers at this size, and a status line per engine."""
+    timers, status = {}, {}
+    for name, engine in ENGINES.items():
+        if not engine.installed():
+            status[name] = "not installed"
+            continue
+        if engine.max_tets is not None and mesh.n_tets > engine.max_tets:
+            status[name] = f"{engine.law}; not timed above {engine.max_tets} tetrahedra"
+            continue
+        try:
+            timers[name] = _EngineTimed(engine, timed[ENGINE_REFERENCE].pm, timed[
+                ENGINE_REFERENCE].x)
+            status[name] = f"timed: {engine.law}"
+        except Exception as exc:    # an optional engine must not stop the benchmark
+            status[name] = f"installed, failed: {type(exc).__name__}: {exc}"
+            progress(f"bench: {name} not timed: {exc}")
+    return timers, status
+
+
 def run(sizes=SIZES, models=None, rounds=7, progress=print):
     """Measure every model at every size; returns the bench document (plain data)."""
     models = list(models or PRESETS)
     timed_models = models + [b for b in BASELINES if b not in models]
+    if any(e.installed() for e in ENGINES.values()) and ENGINE_REFERENCE not in timed_models:
+        timed_models.append(ENGINE_REFERENCE)
     mat = Material(10e3, 0.45, 1000.0)
-    rows = []
+    for name in timed_models:   # load every module once, so that memory counts the model only
+        build(name, bench_mesh(1), mat)
+    rows, engine_rows, engines = [], [], {}
     for target in sizes:
         mesh = bench_mesh(target)
         progress(f"bench: {mesh.n_tets} tetrahedra, {len(timed_models)} models")
         timed = {name: _Timed(name, mesh, mat) for name in timed_models}
+        timers, status = _engine_timers(mesh, timed, progress)
+        for name, line in status.items():
+            if line not in engines.setdefault(name, []):
+                engines[name].append(line)
         samples = {name: [] for name in timed}
+        engine_samples = {name: [] for name in timers}
         for _ in range(rounds):       # round-robin: one sample of every model per round
             for name, t in timed.items():
                 samples[name].append(t.sample())
-        for name in models:
+            for name, t in timers.items():
+                engine_samples[name].append(t.sample())
+        for name, own in engine_samples.items():
+            own, ref = np.array(own), np.array(samples[ENGINE_REFERENCE])[:, 0]
+            engine_rows.append({"engine": name, "tets": mesh.n_tets,
+                                "ns_per_tet": float(np.median(own) / mesh.n_tets * 1e9),
+                                f"force_vs_{ENGINE_REFERENCE}": float(np.median(own / ref)),
+                                "law": ENGINES[name].law, "rounds": rounds})
+        for name in (m for m in timed_models if m in models):
             own = np.array(samples[name])
             row = {"model": name, "tets": mesh.n_tets, "nodes": mesh.n_nodes,
                    "ns_per_tet": float(np.median(own[:, 0]) / mesh.n_tets * 1e9),
@@ -144,11 +200,10 @@ def run(sizes=SIZES, models=None, rounds=7, progress=print):
                 row[f"force_vs_{base}"] = float(np.median(own[:, 0] / ref[:, 0]))
                 row[f"step_vs_{base}"] = float(np.median(own[:, 1] / ref[:, 1]))
             rows.append(row)
-        del timed
-    engines = {name: ("installed, not timed by this version" if importlib.util.find_spec(mod)
-                      else "not installed") for mod, name in ENGINES.items()}
+        del timed, timers
     return {"machine": _machine(), "sizes": [int(s) for s in sizes], "rows": rows,
-            "engines": engines}
+            "engines": {k: "; ".join(v) for k, v in engines.items()},
+            "engine_rows": engine_rows}
 
 
 def _machine():
@@ -195,7 +250,14 @@ def write(data, out):
                 fmt(r["memory_mb"], 3),
                 "-" if r.get("two_thread_speedup") is None else fmt(r["two_thread_speedup"])]
                for r in rows])
-    doc.ul([f"{name}: {state}" for name, state in data["engines"].items()])
+    doc.p("Optional engines, timed on the same meshes in the same rounds (`pip install "
+          "'pbcm[engines]'`), with the ratio of their force evaluation to pbcm's "
+          f"{ENGINE_REFERENCE} kernel taken in-round:")
+    doc.ul([f"{name}: {state}" for name, state in sorted(data["engines"].items())])
+    if data.get("engine_rows"):
+        doc.table(["engine", "tets", "ns/tet (force)", f"force vs pbcm {ENGINE_REFERENCE}"],
+                  [[r["engine"], r["tets"], fmt(r["ns_per_tet"]),
+                    fmt(r[f"force_vs_{ENGINE_REFERENCE}"])] for r in data["engine_rows"]])
     doc.img("step_time.png", "RK4 step time against tetrahedra, every model")
     doc.write(out, stem="bench")
 

@@ -159,7 +159,8 @@ def _bench_command(args):
     from . import bench
     models = _choose("model", args.models, list(model.PRESETS))
     sizes = args.sizes or (bench.QUICK_SIZES if args.quick else bench.SIZES)
-    with StagedFolder(Path(args.out)) as out:   # checked before any timing starts
+    # checked before any timing starts
+    with StagedFolder(Path(args.out), mark="bench.json") as out:
         data = bench.run(sizes=sizes, models=models, rounds=3 if args.quick else args.rounds)
         bench.write(data, out.path)
         path = out.commit()

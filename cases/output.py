@@ -54,11 +54,12 @@ def writable_folder(path, flag="--out"):
     return path
 
 
-def owned(path):
-    """True when the suite may replace ``path``: missing, empty, or a pbcm case folder."""
+def owned(path, mark=OWNED_MARK):
+    """True when the suite may replace ``path``: missing, empty, or a folder pbcm wrote (it
+    holds ``mark``: a case's metrics.json, the benchmark's bench.json)."""
     path = Path(path)
     return not path.exists() or (path.is_dir() and (
-        (path / OWNED_MARK).is_file() or not any(path.iterdir())))
+        (path / mark).is_file() or not any(path.iterdir())))
 
 
 class StagedFolder:
@@ -71,13 +72,13 @@ class StagedFolder:
     removes the staging folder and leaves ``target`` as it was.
     """
 
-    def __init__(self, target, flag="--out"):
+    def __init__(self, target, flag="--out", mark=OWNED_MARK):
         self.target = Path(target)
         if self.target.exists() and not self.target.is_dir():
             raise OutputError(f"{flag} {self.target} is a file, not a folder; give a folder")
-        if not owned(self.target):
+        if not owned(self.target, mark):
             raise OutputError(f"{flag} {self.target} holds files that pbcm did not write (no "
-                              f"{OWNED_MARK}); pbcm replaces the whole folder it writes, so "
+                              f"{mark}); pbcm replaces the whole folder it writes, so "
                               "give a new or empty folder")
         parent = writable_folder(self.target.parent, flag=f"{flag} {self.target}: the folder")
         self.path = Path(tempfile.mkdtemp(prefix=f".{self.target.name}{TMP_TAG}", dir=parent))

@@ -81,16 +81,19 @@ class Ramp:
         self.held = dict(held or {})
         self._cache = None
 
-    def _scale(self, t):
+    def scale(self, t):
+        """The fraction of the displacement reached at t (0 before, 1 after the ramp)."""
         return min(max(t / self.t_ramp, 0.0), 1.0)
 
     def __call__(self, t):
-        s = self._scale(t)
+        s = self.scale(t)
         out = [(i, (0.0, 0.0, 0.0)) for i in self.fixed] + list(self.held.items())
         out += [(i, tuple(None if d is None else s * d for d in self.disp)) for i in self.nodes]
         return merge(out)
 
-    def _parts(self, n_nodes):
+    def parts(self, n_nodes):
+        """(mask, start, moving) (n, 3): the prescribed components, their values at t = 0
+        and the change over the ramp; the prescribed values at t are start + scale(t) moving."""
         if self._cache is None or self._cache[0] != n_nodes:
             mask, end = bc_arrays(self(self.t_ramp), n_nodes)
             _, start = bc_arrays(self(0.0), n_nodes)
@@ -99,12 +102,12 @@ class Ramp:
 
     def arrays(self, t, n_nodes):
         """(mask, displacement) at time t, as bc_arrays(self(t), n_nodes) gives them."""
-        mask, start, moving = self._parts(n_nodes)
-        return mask, start + self._scale(t) * moving
+        mask, start, moving = self.parts(n_nodes)
+        return mask, start + self.scale(t) * moving
 
     def velocity(self, t, n_nodes):
         """Prescribed velocity at t (the ramp's slope before t_ramp, zero after)."""
-        _, _, moving = self._parts(n_nodes)
+        _, _, moving = self.parts(n_nodes)
         return moving / self.t_ramp if 0.0 <= t < self.t_ramp else np.zeros_like(moving)
 
 

@@ -244,7 +244,7 @@ def simulate(model, bc_of_t, t_end, dt=None, damping=0.0, f_ext=None, frames=101
 
     record(0, x)
     if isinstance(bc_of_t, Ramp):   # the whole step compiled, forces included
-        _, start, moving = bc_of_t._parts(mesh.n_nodes)
+        _, start, moving = bc_of_t.parts(mesh.n_nodes)
         kernels = model.kernels()
         check = not any(t.checks_inversion for t in model.terms)
         buf = np.empty((10,) + x.shape)

@@ -12,13 +12,12 @@ import math
 
 import numpy as np
 import scipy.sparse as sp
-from scipy.sparse.linalg import splu
 from skfem import asm
-from skfem.models.elasticity import linear_elasticity
 
 from model.bc import bc_arrays
 from model.errors import MaterialError, ModelError
-from .fem import dirichlet_dofs, dof_hats, element_basis, lame, skfem_mesh
+from .fem import (dirichlet_dofs, dof_hats, element_basis, lame, skfem_mesh, spd_factor,
+                  stiffness)
 from .linear import body_load, dof_component
 from .modal import lumped, mass_form
 
@@ -81,27 +80,37 @@ def solve(mesh, E, nu, rho, dirichlet_of_t, t_end, dt=None, damping=0.0, element
 
     m = skfem_mesh(mesh)
     basis = element_basis(m, element)
-    K = asm(linear_elasticity(lam, mu), basis).tocsr()
+    K = stiffness(basis, lam, mu)
     M = rho * asm(mass_form, basis)
     M = (lumped(M) if mass == "lumped" else M).tocsr()
     f = body_load(basis, body_force) if body_force is not None else np.zeros(basis.N)
     n = mesh.n_nodes
 
-    def prescribed(t):   # a Ramp gives its arrays without building a mapping per step
-        mask, vals = (dirichlet_of_t.arrays(t, n) if hasattr(dirichlet_of_t, "arrays")
-                      else bc_arrays(dirichlet_of_t(t), n))
+    def prescribed(t):
+        mask, vals = bc_arrays(dirichlet_of_t(t), n)
         D, x = dirichlet_dofs(basis, mask, vals, None)
         return mask, D, x
 
-    mask0, D, _ = prescribed(0.0)
-    I = np.setdiff1d(np.arange(basis.N), D)
+    if hasattr(dirichlet_of_t, "parts"):
+        # a Ramp: its dof values are start + scale(t) moving, the dof values being linear in
+        # the nodal ones (P2 midpoints take the mean of their ends), so two evaluations serve
+        # every step
+        mask0, start, moving = dirichlet_of_t.parts(n)
+        D, x_start = dirichlet_dofs(basis, mask0, start, None)
+        x_start, x_moving = x_start[D], dirichlet_dofs(basis, mask0, moving, None)[1][D]
 
-    def path(t):
-        mask, D_t, x = prescribed(t)
-        if not np.array_equal(mask, mask0):
-            raise ModelError(f"dirichlet_of_t({t:g}) prescribes other components than at "
-                             "t = 0; the set of prescribed components must stay the same")
-        return x[D]
+        def path(t):
+            return x_start + dirichlet_of_t.scale(t) * x_moving
+    else:
+        mask0, D, _ = prescribed(0.0)
+
+        def path(t):
+            mask, D_t, x = prescribed(t)
+            if not np.array_equal(mask, mask0):
+                raise ModelError(f"dirichlet_of_t({t:g}) prescribes other components than at "
+                                 "t = 0; the set of prescribed components must stay the same")
+            return x[D]
+    I = np.setdiff1d(np.arange(basis.N), D)
 
     # the prescribed velocity and acceleration: central differences of the path over one step
     # (exact on a piecewise-linear path but for its kinks; at t = 0 the path's own slope)
@@ -127,10 +136,10 @@ def solve(mesh, E, nu, rho, dirichlet_of_t, t_end, dt=None, damping=0.0, element
     K_II, K_ID, M_II, M_ID = K[I][:, I], K[I][:, D], M[I][:, I], M[I][:, D]
     # initial acceleration of the free dofs from the equation of motion
     rhs0 = f[I] - K[I] @ u - damping * (M[I] @ v) - M_ID @ a[D]
-    a[I] = splu(M_II.tocsc()).solve(rhs0)
+    a[I] = spd_factor(M_II).solve(rhs0)
 
     c1 = 4.0 / dt**2 + 2.0 * damping / dt
-    lu = splu((K_II + c1 * M_II).tocsc())
+    lu = spd_factor(K_II + c1 * M_II)
 
     keep = (np.arange(steps + 1) if frames is None else
             np.unique(np.linspace(0, steps, max(int(frames), 2)).round().astype(int)))
@@ -147,12 +156,12 @@ def solve(mesh, E, nu, rho, dirichlet_of_t, t_end, dt=None, damping=0.0, element
         pot.append(0.5 * u @ (K @ u))
 
     record(0)
+    f_I = f[I]
     for k in range(1, steps + 1):
         uD, vD, aD = path_rates(k * dt)
         uI, vI, aI = u[I], v[I], a[I]
-        rhs = (f[I] - K_ID @ uD - M_ID @ (aD + damping * vD)
-               + M_II @ (4.0 / dt**2 * (uI + dt * vI) + aI)
-               + damping * (M_II @ (2.0 / dt * uI + vI)))
+        rhs = (f_I - K_ID @ uD - M_ID @ (aD + damping * vD)
+               + M_II @ (4.0 / dt**2 * (uI + dt * vI) + aI + damping * (2.0 / dt * uI + vI)))
         uI1 = lu.solve(rhs)
         aI1 = 4.0 / dt**2 * (uI1 - uI - dt * vI) - aI
         v[I] = vI + 0.5 * dt * (aI + aI1)

@@ -4,12 +4,15 @@ carries Dirichlet data along, element choice, Dirichlet dofs, linear solvers, st
 Physics lives in the modules that use it (linear.py, hyperelastic.py, modal.py); the mesh and
 the boundary-condition format come from ``model``, nothing else does.
 """
+import collections
 import contextlib
+import hashlib
 
 import numpy as np
 import scipy.sparse as sp
-from scipy.sparse.linalg import spsolve
-from skfem import Basis, ElementTetP1, ElementTetP2, ElementVector, MeshTet
+from scipy.sparse.linalg import splu, spsolve
+from skfem import Basis, ElementTetP1, ElementTetP2, ElementVector, MeshTet, asm
+from skfem.models.elasticity import linear_elasticity
 
 from model.errors import ConvergenceError, MaterialError, ModelError
 from model.material import poisson_message
@@ -26,6 +29,43 @@ DIRECT_BYTES_AT_1E5 = 5.8 * 2**30
 AMG_SETTINGS = (("default aggregation", {}),
                 ("evolution strength, energy prolongation",
                  {"strength": "evolution", "smooth": "energy"}))
+
+
+def spd_factor(A):
+    """Sparse LU of a symmetric positive definite matrix, ordered as one: minimum degree on
+    A + A^T with the diagonal pivots kept (SuperLU's symmetric mode). For the FEM transient,
+    factored once and solved at every step: on the P2 cube's matrix it fills half what the
+    default column ordering does and solves 2x faster (0.14 against 0.29 ms, 1 509 unknowns).
+    The static solves keep the default ordering: on large P1 cubes minimum degree factors
+    slower (29 against 18 s at 46 875 unknowns)."""
+    return splu(sp.csc_matrix(A), permc_spec="MMD_AT_PLUS_A", diag_pivot_thresh=0.0,
+                options={"SymmetricMode": True})
+
+
+# the last few stiffness matrices assembled, by mesh, element and Lame constants: a case solves
+# one mesh under several boundary conditions, and assembling the paper cube's P2 matrix on two
+# refinements (108 000 unknowns) takes 4 s of its 12 s solve
+_STIFFNESS = collections.OrderedDict()
+STIFFNESS_CACHE = 4
+
+
+def stiffness(basis, lam, mu):
+    """The linear elastic stiffness matrix (CSR) of ``basis``, reused when the same mesh,
+    element and constants were assembled recently (the arrays are compared by content).
+    Callers must not modify it."""
+    m = basis.mesh
+    key = (hashlib.blake2b(np.ascontiguousarray(m.p).tobytes()
+                           + np.ascontiguousarray(m.t).tobytes(), digest_size=16).digest(),
+           type(basis.elem).__name__, type(basis.elem.elem).__name__, basis.X.shape,
+           float(lam), float(mu))
+    if key in _STIFFNESS:
+        _STIFFNESS.move_to_end(key)
+        return _STIFFNESS[key]
+    K = asm(linear_elasticity(lam, mu), basis).tocsr()
+    _STIFFNESS[key] = K
+    while len(_STIFFNESS) > STIFFNESS_CACHE:
+        _STIFFNESS.popitem(last=False)
+    return K
 
 
 def lame(E, nu):

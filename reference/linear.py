@@ -4,13 +4,13 @@ from dataclasses import dataclass, field
 import numpy as np
 from skfem import FacetBasis, LinearForm, asm, condense
 from skfem.helpers import dot, sym_grad
-from skfem.models.elasticity import linear_elasticity, linear_stress
+from skfem.models.elasticity import linear_stress
 
 from model.bc import bc_arrays
 from model.errors import ModelError
 from .fem import (INTORDER, cell_average, check_finite, dirichlet_dofs, dof_hats,
-                  element_basis, lame,
-                  linear_solve, parent_of, refine_with_data, skfem_mesh, stress_measures)
+                  element_basis, lame, linear_solve, parent_of, refine_with_data, skfem_mesh,
+                  stiffness, stress_measures)
 
 
 @dataclass
@@ -102,7 +102,7 @@ def solve(mesh, E, nu, dirichlet, body_force=None, traction=None, element="P1", 
     m, mask_f, vals_f, W = refine_with_data(coarse, mask, vals, dirichlet_fn, refine)
     basis = element_basis(m, element)
     D, x_D = dirichlet_dofs(basis, mask_f, vals_f, dirichlet_fn)
-    K = asm(linear_elasticity(lam, mu), basis)
+    K = stiffness(basis, lam, mu)
     f = np.zeros(basis.N)
     if body_force is not None:
         f += body_load(basis, body_force)

@@ -7,12 +7,10 @@ import scipy.sparse as sp
 from scipy.sparse.linalg import eigsh
 from skfem import BilinearForm, asm
 from skfem.helpers import dot
-from skfem.models.elasticity import linear_elasticity
 
 from model.bc import bc_arrays
 from model.errors import MaterialError, ModelError
-from .fem import (dirichlet_dofs, element_basis, lame, refine_with_data,
-                  skfem_mesh)
+from .fem import dirichlet_dofs, element_basis, lame, refine_with_data, skfem_mesh, stiffness
 
 
 @BilinearForm
@@ -48,7 +46,7 @@ def frequencies(mesh, E, nu, rho, dirichlet, k=6, mass="consistent", element="P2
     m, mask_f, vals_f, _ = refine_with_data(skfem_mesh(mesh), mask, vals, None, refine)
     basis = element_basis(m, element)
     D, _ = dirichlet_dofs(basis, mask_f, vals_f, None)
-    K = asm(linear_elasticity(lam, mu), basis)
+    K = stiffness(basis, lam, mu)
     M = rho * asm(mass_form, basis)
     if mass == "lumped":
         M = lumped(M)

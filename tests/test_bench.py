@@ -3,6 +3,7 @@ a wall-clock time: timings are the benchmark's output, not a pass condition."""
 import json
 
 import numba
+import pytest
 import numpy as np
 
 from cases import bench
@@ -33,10 +34,24 @@ def test_bench_writes_table_figure_and_in_round_ratios(tmp_path):
     two = rows[("pbcm-variational", 625)]["two_thread_speedup"]
     assert (two is None) == (numba.config.NUMBA_NUM_THREADS < 2)
     assert two is None or (np.isfinite(two) and two > 0)
+    # optional engines: "not installed", or timed beside fem-neohookean in the same rounds
+    from cases.engines import ENGINES
     assert set(data["engines"]) == {"newton", "warp-lang"}
     md = (out / "bench.md").read_text()
-    assert "not installed" in md or "installed" in md
+    for name, engine in ENGINES.items():
+        timed = [r for r in data["engine_rows"] if r["engine"] == name]
+        if engine.installed():
+            assert data["engines"][name].startswith("timed") and len(timed) == 2
+            assert all(r["force_vs_fem-neohookean"] > 0 and r["ns_per_tet"] > 0 for r in timed)
+            assert f"| {name} | 625 |" in md
+        else:
+            assert data["engines"][name] == "not installed" and not timed
+            assert f"{name}: not installed" in md
     assert "pbcm-variational" in md and "step vs msm" in md
+    # a second run replaces its own folder (bench.json marks it as pbcm's)
+    assert main(["bench", "--sizes", "100", "--rounds", "1", "--models", "msm",
+                 "--out", str(out)]) == 0
+    assert {r["tets"] for r in json.loads((out / "bench.json").read_text())["rows"]} == {135}
 
 
 def test_cost_sentences_come_from_the_nearest_bench_size():
@@ -66,3 +81,19 @@ def test_a_rerun_writes_the_same_committed_files(tmp_path):
     assert "metrics.json" in files and "report.md" in files
     for name in files:
         assert (a / name).read_bytes() == (b / name).read_bytes(), name
+
+
+def test_warp_engine_computes_our_neohookean_forces():
+    """Where warp-lang is installed, bench times pbcm's fem-neohookean law written as a Warp
+    kernel: it must be the same computation (equal forces), or the ratio compares apples and
+    pears. Skipped where warp-lang is not installed (it is an optional extra)."""
+    pytest.importorskip("warp")
+    from model import Material, build
+    from model.mesh import cube
+    from cases.warp_neohookean import WarpNeoHookean
+    mesh = cube(4, 0.02, "six")
+    pm = build("fem-neohookean", mesh, Material(1e4, 0.4))
+    x = mesh.points * (1.0, 0.97, 1.01) + 1e-4 * np.sin(mesh.points * 300)
+    ours = pm.forces(x)
+    assert np.abs(WarpNeoHookean(pm.terms[0], x)().numpy() - ours).max() < 1e-12 * np.abs(
+        ours).max()

@@ -341,3 +341,23 @@ def test_solver_falls_back_or_names_the_direct_solver(monkeypatch):
     assert r.info["solver"].startswith("amg-cg")
     with pytest.raises(ModelError, match="solver must be"):
         linear.solve(mesh, E, 0.3, bc, solver="cholesky")
+
+
+def test_stiffness_is_reused_for_the_same_mesh_element_and_constants():
+    """Assembly is cached by content: the same mesh (a new object with equal arrays) reuses
+    the matrix; another element, constant or mesh assembles afresh, and every matrix equals a
+    fresh assembly."""
+    from skfem import asm
+    from skfem.models.elasticity import linear_elasticity
+    from reference.fem import element_basis, skfem_mesh, stiffness
+
+    def basis(n=3, element="P1"):
+        return element_basis(skfem_mesh(cube(n, 0.01, "five")), element)
+
+    K = stiffness(basis(), 2.0, 3.0)
+    assert stiffness(basis(), 2.0, 3.0) is K
+    for b, lam, mu in ((basis(), 2.0, 4.0), (basis(element="P2"), 2.0, 3.0),
+                       (basis(n=4), 2.0, 3.0)):
+        other = stiffness(b, lam, mu)
+        assert other is not K
+        assert abs(other - asm(linear_elasticity(lam, mu), b)).max() == 0.0

@@ -1,6 +1,5 @@
 """Every input a user can give ends in a result or a clear error, and nothing is lost (issue 8)."""
 import json
-import os
 import shutil
 import signal
 import subprocess
@@ -9,7 +8,6 @@ import time
 from pathlib import Path
 
 import meshio
-import numpy as np
 import pytest
 
 from cases import runner

@@ -3,7 +3,6 @@
 Timoshenko shear deflection."""
 from dataclasses import dataclass
 
-import numpy as np
 
 from reference import analytic
 from ..document import fmt

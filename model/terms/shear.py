@@ -17,7 +17,6 @@ Readings of the force (``reading``):
 * ``variational`` f = -dW/dx with W = (c/2) G V0 sum gamma^2, every derivative taken.
 """
 import numpy as np
-from numba import njit
 
 from . import Term, register
 from ._kernels import COMBOS, volume_gradient_numpy
