@@ -142,7 +142,8 @@ def _engine_timers(mesh, timed, progress):
             status[name] = "not installed"
             continue
         if engine.max_tets is not None and mesh.n_tets > engine.max_tets:
-            status[name] = f"{engine.law}; not timed above {engine.max_tets} tetrahedra"
+            status[name] = (f"not timed above {engine.max_tets} tetrahedra (building its model "
+                            "loops in Python)")
             continue
         try:
             timers[name] = _EngineTimed(engine, timed[ENGINE_REFERENCE].pm, timed[
