@@ -369,8 +369,10 @@ def _main(argv):
         return 143
 
 
-class Terminated(Exception):
-    """SIGTERM, raised where the program is so that staging folders are removed."""
+class Terminated(BaseException):
+    """SIGTERM, raised where the program is so that staging folders are removed. A
+    BaseException, as KeyboardInterrupt is: library code that catches Exception (numba's
+    cache loading does) must not swallow it and let the run go on."""
 
 
 def _terminated(signum, frame):
