@@ -133,3 +133,22 @@ def test_list(capsys):
     assert main(["list"]) == 0
     out = capsys.readouterr().out
     assert "paper-cube" in out and "pbcm-variational+normal" in out and "unstructured" in out
+
+
+def test_paper_cube_conclusion_groups_the_artefact_by_model():
+    """The first line names each model once with where it shows the pattern, and calls it an
+    artefact only when some model shows it and the converged FEM never does."""
+    from cases.library import paper_cube_report as R
+    from cases.library.paper_cube import Config
+    run = dict(model="msm", mesh="five", bc="sliding", disp_rel_l2_p2=0.1, paper_pattern=True,
+               zigzag=0.07)
+    runs = [run, dict(run, model="pbcm-balanced", zigzag=0.03), dict(run, mesh="six")]
+    assert R.conclusion(Config(), runs)[0] == (
+        "The paper's bulge/neck pattern is reproduced clearly by msm (on five/sliding, "
+        "six/sliding) and pbcm-balanced (on five/sliding), never by the converged FEM: it is an "
+        "artefact of those models.")
+    faint = [dict(run, zigzag=0.001)]
+    assert R.conclusion(Config(), faint)[0] == (
+        "No model reproduces the paper's bulge/neck pattern clearly, nor does the converged FEM.")
+    assert "and by the converged FEM on five/sliding." in R.conclusion(
+        Config(), [dict(run, paper_pattern_fem=True)])[0]

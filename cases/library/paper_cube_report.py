@@ -82,13 +82,25 @@ def _runs(runs, **kw):
 def conclusion(cfg, runs):
     """Three lines: the artefact, the accuracy, the dynamics, computed from the runs."""
     solved = [r for r in runs if r.get("disp_rel_l2_p2") is not None]
-    clear = sorted({f"{r['model']} on {r['mesh']}/{r['bc']}" for r in solved
-                    if r["paper_pattern"] and r["zigzag"] >= CLEAR_ZIGZAG})
+    where = {}     # model -> the mesh/bc where it shows the pattern clearly
+    for r in solved:
+        if r["paper_pattern"] and r["zigzag"] >= CLEAR_ZIGZAG:
+            where.setdefault(r["model"], set()).add(f"{r['mesh']}/{r['bc']}")
+    clear = [f"{m} (on {', '.join(sorted(w))})" for m, w in sorted(where.items())]
     fem = sorted({f"{r['mesh']}/{r['bc']}" for r in runs if r.get("paper_pattern_fem")})
-    out = [("The paper's bulge/neck pattern is reproduced clearly by " + "; ".join(clear)
-            if clear else "No model reproduces the paper's bulge/neck pattern clearly")
-           + (f", and by the converged FEM on {', '.join(fem)}." if fem
-              else ", never by the converged FEM: it is an artefact of the model.")]
+    if not clear:
+        first = "No model reproduces the paper's bulge/neck pattern clearly"
+    else:
+        first = ("The paper's bulge/neck pattern is reproduced clearly by "
+                 + (clear[0] if len(clear) == 1 else ", ".join(clear[:-1]) + " and " + clear[-1]))
+    if fem:
+        first += f", and by the converged FEM on {', '.join(fem)}."
+    elif clear:
+        first += (", never by the converged FEM: it is an artefact of "
+                  + ("that model." if len(clear) == 1 else "those models."))
+    else:
+        first += ", nor does the converged FEM."
+    out = [first]
     if solved:
         by_model = {}
         for r in solved:

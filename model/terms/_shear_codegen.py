@@ -181,14 +181,15 @@ def function(name, args, doc, before, per_tet):
     count."""
     pad = " " * 8
     text = "\n".join(
-        ["", "", "@njit(cache=True, fastmath=FAST)", f"def {name}({args}):", f'    """{doc}"""']
+        ["", "", "", "@njit(cache=True, fastmath=FAST)", f"def {name}({args}):",
+         f'    """{doc}"""']
         + [f"    {line}" for line in before]
         + ["    for t in range(tets.shape[0]):"] + [pad + x for x in expand(per_tet, SERIAL)]
         + ["    return -1"])
     if not args.endswith(", out"):
         return text
     return text + "\n".join(
-        ["", "", "@njit(cache=True, fastmath=FAST)",
+        ["", "", "", "@njit(cache=True, fastmath=FAST)",
          f"def {name}_tets({args[:-len(', out')]}, ft, flat, first, stop):",
          f'    """{name} per tetrahedron for t in [first, stop) into ft (m, 4, 3); flattened '
          'ones flagged in flat."""']
@@ -208,7 +209,7 @@ def source():
             "from .volume import FLAT", "",
             "# fast maths without reassociation: the serial and the per-tetrahedron twins then",
             "# round the same way (the two-thread mode's bit-for-bit promise)",
-            'FAST = {"nnan", "ninf", "nsz", "arcp", "contract", "afn"}', ""]
+            'FAST = {"nnan", "ninf", "nsz", "arcp", "contract", "afn"}']
     return "\n".join(head) + "".join(function(*r()) for r in READERS) + "\n"
 
 

@@ -153,6 +153,7 @@ def shear_strains(x, tets, gamma0, gamma_out):
         gamma_out[t, 23] = gamma
     return -1
 
+
 @njit(cache=True, fastmath=FAST)
 def shear_corner(x, tets, vol0, gamma0, G, out):
     """Literal eq. 5: f_a += (1/4) tau S_F e, tau = G gamma, S_F = cn_j / 2, e = d_am / L_am; returns the first flattened tetrahedron, or -1."""
@@ -323,6 +324,7 @@ def shear_corner(x, tets, vol0, gamma0, G, out):
         add_to(out, n2, f2)
         add_to(out, n3, f3)
     return -1
+
 
 @njit(cache=True, fastmath=FAST)
 def shear_corner_tets(x, tets, vol0, gamma0, G, ft, flat, first, stop):
@@ -498,6 +500,7 @@ def shear_corner_tets(x, tets, vol0, gamma0, G, ft, flat, first, stop):
         put(ft, t, 3, f3)
     return n_flat
 
+
 @njit(cache=True, fastmath=FAST)
 def shear_balanced(x, tets, vol0, gamma0, G, out):
     """f_j -= tau S_F e on the tip, + tau S_F e / 3 on each base vertex a, m, l; returns the first flattened tetrahedron, or -1."""
@@ -661,6 +664,7 @@ def shear_balanced(x, tets, vol0, gamma0, G, out):
         add_to(out, n2, f2)
         add_to(out, n3, f3)
     return -1
+
 
 @njit(cache=True, fastmath=FAST)
 def shear_balanced_tets(x, tets, vol0, gamma0, G, ft, flat, first, stop):
@@ -828,6 +832,7 @@ def shear_balanced_tets(x, tets, vol0, gamma0, G, ft, flat, first, stop):
         put(ft, t, 2, f2)
         put(ft, t, 3, f3)
     return n_flat
+
 
 @njit(cache=True, fastmath=FAST)
 def shear_variational(x, tets, vol0, gamma0, cG, out):
@@ -1142,6 +1147,7 @@ def shear_variational(x, tets, vol0, gamma0, cG, out):
         add_to(out, n2, f2)
         add_to(out, n3, f3)
     return -1
+
 
 @njit(cache=True, fastmath=FAST)
 def shear_variational_tets(x, tets, vol0, gamma0, cG, ft, flat, first, stop):
