@@ -186,7 +186,7 @@ def run(sizes=SIZES, models=None, rounds=7, progress=print):
                                 "ns_per_tet": float(np.median(own) / mesh.n_tets * 1e9),
                                 f"force_vs_{ENGINE_REFERENCE}": float(np.median(own / ref)),
                                 "law": ENGINES[name].law, "rounds": rounds})
-        for name in (m for m in timed_models if m in models):
+        for name in models:
             own = np.array(samples[name])
             row = {"model": name, "tets": mesh.n_tets, "nodes": mesh.n_nodes,
                    "ns_per_tet": float(np.median(own[:, 0]) / mesh.n_tets * 1e9),
