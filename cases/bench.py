@@ -22,7 +22,7 @@ from model.calibrate import calibrate
 from model.integrate import rk4_ramp, total_forces
 from model.mesh import cube
 
-from . import figures
+from . import figures, stop
 from .engines import ENGINES
 from .document import Document, fmt
 
@@ -176,6 +176,7 @@ def run(sizes=SIZES, models=None, rounds=7, progress=print):
         samples = {name: [] for name in timed}
         engine_samples = {name: [] for name in timers}
         for _ in range(rounds):       # round-robin: one sample of every model per round
+            stop.checkpoint()
             for name, t in timed.items():
                 samples[name].append(t.sample())
             for name, t in timers.items():

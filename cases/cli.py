@@ -6,15 +6,14 @@ are one line ``pbcm: error: ...`` with exit status 2, Ctrl-C is one line with ex
 import argparse
 import math
 import re
-import signal
 import sys
-import threading
 import textwrap
 from pathlib import Path
 
 import model
 from model.errors import PbcmError
 from model.mesh import SCHEMES, box, read
+from . import stop
 from .output import StagedFolder, writable_folder, write_text_atomic
 
 DESCRIPTION = """\
@@ -339,14 +338,8 @@ def parser():
 def main(argv=None):
     """Run the command line on ``argv``; return the exit status (also for --help and for
     argument errors, which argparse would raise as SystemExit)."""
-    main_thread = threading.current_thread() is threading.main_thread()
-    if main_thread:   # clean up staging folders on SIGTERM as on Ctrl-C
-        previous = signal.signal(signal.SIGTERM, _terminated)
-    try:
+    with stop.handling():   # staging folders are removed on SIGTERM as on Ctrl-C
         return _main(argv)
-    finally:
-        if main_thread:
-            signal.signal(signal.SIGTERM, previous)
 
 
 def _main(argv):
@@ -355,7 +348,9 @@ def _main(argv):
             args = parser().parse_args(argv)
         except SystemExit as exc:
             return exc.code if isinstance(exc.code, int) else 2
-        return args.func(args)
+        status = args.func(args)
+        stop.checkpoint()   # a signal whose exception a library swallowed still stops us
+        return status
     except (UsageError, PbcmError) as exc:
         print(f"pbcm: error: {exc}", file=sys.stderr)
         return 2
@@ -363,20 +358,10 @@ def _main(argv):
         print("\npbcm: interrupted; output folders hold what they held before the unfinished "
               "one", file=sys.stderr)
         return 130
-    except Terminated:
+    except stop.Terminated:
         print("\npbcm: terminated; output folders hold what they held before the unfinished "
               "one", file=sys.stderr)
         return 143
-
-
-class Terminated(BaseException):
-    """SIGTERM, raised where the program is so that staging folders are removed. A
-    BaseException, as KeyboardInterrupt is: library code that catches Exception (numba's
-    cache loading does) must not swallow it and let the run go on."""
-
-
-def _terminated(signum, frame):
-    raise Terminated()
 
 
 if __name__ == "__main__":

@@ -14,6 +14,7 @@ import threading
 from pathlib import Path
 
 from model.errors import PbcmError
+from . import stop
 
 # a folder the suite may replace: empty, or written by it before (it always holds this file)
 OWNED_MARK = "metrics.json"
@@ -26,12 +27,12 @@ class OutputError(PbcmError, OSError):
 
 @contextlib.contextmanager
 def no_interrupt():
-    """Hold Ctrl-C (SIGINT) back until the block is done: for the few system calls that must
-    not be separated (a swap of folders, a rename)."""
+    """Hold Ctrl-C (SIGINT) and SIGTERM back until the block is done: for the few system calls
+    that must not be separated (a swap of folders, a rename)."""
     if threading.current_thread() is not threading.main_thread():
         yield
         return
-    old = signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGINT})
+    old = signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGINT, signal.SIGTERM})
     try:
         yield
     finally:
@@ -98,6 +99,7 @@ class StagedFolder:
             self.path = None
 
     def commit(self):
+        stop.checkpoint()   # never swap in the output of a run that was told to stop
         with no_interrupt():
             if self.target.exists():
                 if not _exchange(self.path, self.target):   # no atomic swap on this system

@@ -13,6 +13,7 @@ from model import PbcmError
 from model.terms.shear import Shear
 from reference import linear
 from . import metrics as M
+from . import stop
 from .framework import Reference, err_name, ref_name
 
 # a reference field that varies by less than this fraction of its size is uniform: its
@@ -157,6 +158,7 @@ def run(case, s, log=True):
                   disable=not (log and sys.stderr.isatty())) as bar:
         task = bar.add_task(case.name, total=total)
         for mesh_name in s.meshes:
+            stop.checkpoint()
             try:
                 mesh = case.mesh(mesh_name, s)
             except FINDINGS as exc:
@@ -180,6 +182,7 @@ def run(case, s, log=True):
                         "pressure": ref.p2.pressure, **ref.extra}
                 bar.advance(task)
                 for model_name in s.models:
+                    stop.checkpoint()
                     bar.update(task, description=f"{case.name} {mesh_name}/{bc}/{model_name}")
                     r, f = model_run(case, mesh_name, mesh, bc, model_name, s, ref)
                     runs.append(r)

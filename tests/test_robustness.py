@@ -1,5 +1,6 @@
 """Every input a user can give ends in a result or a clear error, and nothing is lost (issue 8)."""
 import json
+import os
 import shutil
 import signal
 import subprocess
@@ -177,6 +178,35 @@ def test_ctrl_c_prints_one_line_exits_130_and_keeps_the_earlier_set(sig, status,
     assert sorted(p.name for p in out.iterdir()) == ["metrics.json", "report.md"]
     assert (out / "report.md").read_text() == "earlier complete run"
     assert sorted(p.name for p in tmp_path.iterdir()) == ["paper-cube"]
+
+
+@pytest.mark.parametrize("sig,status", [(signal.SIGINT, 130), (signal.SIGTERM, 143)])
+def test_a_signal_whose_exception_a_library_swallows_still_stops_the_run(sig, status, tmp_path,
+                                                                         monkeypatch):
+    """A handler's exception raised inside a finaliser or a C callback is printed and dropped
+    by Python: the run must stop at the next checkpoint anyway, without swapping in output."""
+    out = tmp_path / "paper-cube"
+    out.mkdir()
+    (out / "metrics.json").write_text("{}")
+    real = runner.model_run
+    calls = []
+
+    def swallowing(*args, **kw):
+        calls.append(args[4])
+        try:
+            os.kill(os.getpid(), sig)
+            time.sleep(0.5)   # the handler runs here; its exception is dropped below
+        except BaseException:
+            pass
+        return real(*args, **kw)
+
+    monkeypatch.setattr(runner, "model_run", swallowing)
+    assert main(["run", "paper-cube", "--quick", "--meshes", "five", "--bcs", "clamped",
+                 "--models", "msm", "fem-linear", "--out", str(out)]) == status
+    assert calls == ["msm"]   # stopped before the next model
+    assert sorted(p.name for p in out.iterdir()) == ["metrics.json"]
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["paper-cube"]
+    assert signal.getsignal(signal.SIGTERM) is signal.SIG_DFL   # handlers restored
 
 
 # ------------------------------------------------------------ unreadable meshes

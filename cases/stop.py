@@ -1,0 +1,50 @@
+"""Stopping on Ctrl-C (SIGINT) and SIGTERM, even where a library swallows the exception.
+
+A Python signal handler raises in whatever bytecode the main thread runs next. That may be a
+finaliser (``__del__``, llvmlite frees LLVM objects that way while numba compiles) or a
+callback from C, where Python prints "Exception ignored" and goes on. The run then finished
+and exited 0 after SIGTERM on a CI machine. So the handler also records the signal, and
+``checkpoint()`` raises it again at points the suite owns: between runs and before any output
+folder is swapped in.
+"""
+import signal
+import threading
+
+
+class Terminated(BaseException):
+    """SIGTERM. A BaseException, as KeyboardInterrupt is: library code that catches Exception
+    must not swallow it."""
+
+
+_EXCEPTIONS = {signal.SIGINT: KeyboardInterrupt, signal.SIGTERM: Terminated}
+_received = []
+
+
+def _handler(signum, frame):
+    _received.append(signum)
+    raise _EXCEPTIONS[signum]()
+
+
+def checkpoint():
+    """Raise KeyboardInterrupt or Terminated if such a signal arrived since ``handling``
+    began, whether or not its first exception got through."""
+    if _received:
+        raise _EXCEPTIONS[_received[0]]()
+
+
+class handling:
+    """Within this block SIGINT and SIGTERM raise and are remembered for ``checkpoint``
+    (main thread only; elsewhere nothing changes)."""
+
+    def __enter__(self):
+        self._previous = {}
+        if threading.current_thread() is threading.main_thread():
+            _received.clear()
+            for sig in _EXCEPTIONS:
+                self._previous[sig] = signal.signal(sig, _handler)
+        return self
+
+    def __exit__(self, *exc):
+        for sig, previous in self._previous.items():
+            signal.signal(sig, previous)
+        _received.clear()
