@@ -25,20 +25,26 @@ def bar():
     return mesh, fixed, pull
 
 
-def released(bar, element, damping=0.0, periods=2.2):
+def released(bar, element, damping=0.0, periods=2.2, method="newmark"):
     mesh, fixed, pull = bar
     u0 = linear.solve(mesh, E, 0.0, fixed, traction=pull, element=element).u
-    r = dynamic.solve(mesh, E, 0.0, RHO, lambda t: fixed, periods * T, dt=T / 400,
-                      element=element, u0=u0, damping=damping)
+    if method == "modal":   # the same frames as the Newmark steps; a Ramp that stays put
+        r = dynamic.solve(mesh, E, 0.0, RHO, Ramp([], (0.0, 0.0, 0.0), 1.0, held=fixed),
+                          periods * T, element=element, u0=u0, damping=damping,
+                          frames=int(round(periods * 400)) + 1, method="modal")
+    else:
+        r = dynamic.solve(mesh, E, 0.0, RHO, lambda t: fixed, periods * T, dt=T / 400,
+                          element=element, u0=u0, damping=damping)
     tip = r.u[:, np.isclose(mesh.points[:, 0], L), 0].mean(axis=1)
     return r, tip
 
 
+@pytest.mark.parametrize("method", ["newmark", "modal"])
 @pytest.mark.parametrize("element", ["P1", "P2"])
-def test_fixed_free_bar_period_is_4L_over_c(bar, element):
+def test_fixed_free_bar_period_is_4L_over_c(bar, element, method):
     """Released from its static deflection under an end load, the tip moves as a triangle
     wave of period 4 L / c: its zero crossings are T / 2 apart."""
-    r, tip = released(bar, element)
+    r, tip = released(bar, element, method=method)
     z = np.flatnonzero(np.diff(np.sign(tip)) != 0)
     crossing = r.t[z] - tip[z] * (r.t[z + 1] - r.t[z]) / (tip[z + 1] - tip[z])
     assert len(crossing) >= 4
@@ -46,27 +52,30 @@ def test_fixed_free_bar_period_is_4L_over_c(bar, element):
     assert tip[0] > 0 and abs(tip.min() / tip[0] + 1) < 0.05      # swings to -u0
 
 
-def test_undamped_energy_is_constant(bar):
-    r, _ = released(bar, "P1")
+@pytest.mark.parametrize("method,tol", [("newmark", 1e-6), ("modal", 1e-11)])
+def test_undamped_energy_is_constant(bar, method, tol):
+    r, _ = released(bar, "P1", method=method)
     e = r.kinetic + r.strain
     assert r.kinetic[0] == 0 and r.kinetic.max() > 0.5 * e[0]    # energy is exchanged
-    assert np.ptp(e) / e[0] < 1e-6
+    assert np.ptp(e) / e[0] < tol
 
 
-def test_mass_proportional_damping_decays_energy_at_its_rate(bar):
+@pytest.mark.parametrize("method", ["newmark", "modal"])
+def test_mass_proportional_damping_decays_energy_at_its_rate(bar, method):
     """Every mode decays as exp(-zeta t / 2): the energy as exp(-zeta t), checked at whole
     periods where the oscillating part vanishes."""
     zeta = 0.2 * 2 * np.pi / T
-    r, _ = released(bar, "P1", damping=zeta, periods=2.0)
+    r, _ = released(bar, "P1", damping=zeta, periods=2.0, method=method)
     e = r.kinetic + r.strain
     for k in (1, 2):
         i = np.argmin(abs(r.t - k * T))
         assert abs(e[i] / e[0] / np.exp(-zeta * r.t[i]) - 1) < 0.01
 
 
+@pytest.mark.parametrize("method", ["newmark", "modal"])
 @pytest.mark.parametrize("element,mass", [("P1", "lumped"), ("P1", "consistent"),
                                           ("P2", "consistent")])
-def test_slow_push_then_rest_gives_the_static_reaction(element, mass):
+def test_slow_push_then_rest_gives_the_static_reaction(element, mass, method):
     """A cube pushed 1 % over many periods and held with damping comes to the static FEM
     state: displacement and reaction (sign and size) equal to linear.solve. (The default step
     resolves the mesh's modes: at a step 2.5 times longer, the modes the kinks of the path
@@ -77,7 +86,7 @@ def test_slow_push_then_rest_gives_the_static_reaction(element, mass):
     held = {int(i): (0.0, 0.0, 0.0) for i in bottom}
     ramp = Ramp(top, (0.0, -0.32e-3, 0.0), 0.2, held=held)
     r = dynamic.solve(mesh, E, 0.3, RHO, ramp, 1.0, damping=60.0, element=element, mass=mass,
-                      frames=11)
+                      frames=11, method=method)
     static = linear.solve(mesh, E, 0.3, ramp(1.0), element=element)
     assert np.abs(r.u[-1] - static.u).max() < 1e-6 * np.abs(static.u).max()
     assert np.allclose(r.reaction[-1], static.reaction, atol=1e-4 * np.abs(static.reaction).max())
@@ -125,3 +134,80 @@ def test_model_frequencies_of_one_spring_node_by_hand():
     assert rigid == 0 and np.allclose(freq, expected, rtol=1e-5)
     _, rigid = model_frequencies(pm, np.ones(12, dtype=bool))
     assert rigid == 6
+
+
+@pytest.mark.parametrize("zeta", [20.0, 2000.0])   # every mode underdamped; the lowest over
+def test_modal_ramp_equals_the_matrix_exponential(zeta):
+    """The exact-in-time transient of a push with a kink (ramp, then hold) against the
+    matrix exponential of the first-order system, written here from scikit-fem's own forms:
+    z = (u_I, v_I, 1, t), z' = A z on each piece, the kink's impulse
+    M_II dv_I = M_ID x_moving / T between."""
+    from scipy.linalg import expm, solve
+    from skfem import BilinearForm, Basis, ElementTetP1, ElementVector, asm
+    from skfem.helpers import dot
+    from skfem.models.elasticity import lame_parameters, linear_elasticity
+    from reference.fem import skfem_mesh
+    mesh = cube(3, 0.032, "six")
+    top, bottom = mesh.nodes_on_plane("y", 0.032), mesh.nodes_on_plane("y", 0.0)
+    held = {int(i): (0.0, 0.0, 0.0) for i in bottom}
+    push = np.array([1e-4, -0.32e-3])
+    T_push, t_end, nu = 0.03, 0.06, 0.3
+    ramp = Ramp(top, (push[0], push[1], None), T_push, held=held)
+    r = dynamic.solve(mesh, E, nu, RHO, ramp, t_end, damping=zeta, frames=13, method="modal")
+
+    basis = Basis(skfem_mesh(mesh), ElementVector(ElementTetP1()))
+    K = asm(linear_elasticity(*lame_parameters(E, nu)), basis).toarray()
+    M = RHO * asm(BilinearForm(lambda u, v, w: dot(u, v)), basis).toarray()
+    dof = basis.nodal_dofs            # dof[k, i]: component k of node i
+    D = np.concatenate([dof[:, bottom].ravel(), dof[:2, top].ravel()])
+    x_mov = np.concatenate([np.zeros(3 * len(bottom)), np.repeat(push, len(top))])
+    Ifree = np.setdiff1d(np.arange(basis.N), D)
+    nI = len(Ifree)
+    K_II, K_ID, M_II, M_ID = (K[np.ix_(Ifree, Ifree)], K[np.ix_(Ifree, D)],
+                              M[np.ix_(Ifree, Ifree)], M[np.ix_(Ifree, D)])
+
+    def generator(a, b):              # z' = A z for M u'' + zeta M u' + K u = a + b t
+        A = np.zeros((2 * nI + 2, 2 * nI + 2))
+        A[:nI, nI:2 * nI] = np.eye(nI)
+        A[nI:2 * nI, :nI] = -solve(M_II, K_II)
+        A[nI:2 * nI, nI:2 * nI] = -zeta * np.eye(nI)
+        A[nI:2 * nI, 2 * nI] = solve(M_II, a)
+        A[nI:2 * nI, 2 * nI + 1] = solve(M_II, b)
+        A[2 * nI + 1, 2 * nI] = 1.0
+        return A
+
+    pushing = generator(-zeta * M_ID @ x_mov / T_push, -K_ID @ x_mov / T_push)
+    holding = generator(-K_ID @ x_mov, np.zeros(nI))
+    z0 = np.zeros(2 * nI + 2)
+    z0[2 * nI] = 1.0
+    zT = expm(pushing * T_push) @ z0
+    zT[nI:2 * nI] += solve(M_II, M_ID @ x_mov) / T_push
+    for k, t in enumerate(r.t):
+        z = expm(pushing * t) @ z0 if t < T_push else expm(holding * (t - T_push)) @ zT
+        u = np.zeros(basis.N)
+        u[Ifree], u[D] = z[:nI], min(t / T_push, 1.0) * x_mov
+        assert np.abs(r.u[k] - u[dof].T).max() <= 1e-9 * np.abs(push).max(), t
+        v = z[nI:2 * nI]
+        assert np.abs(r.v[k].ravel()[Ifree] - v).max() <= 1e-9 * np.abs(push).max() / T_push
+
+
+@pytest.mark.parametrize("w2", [1.0e4, 2.5e5 * (1 - 1e-13), 2.5e5, 2.5e5 * (1 + 1e-13),
+                                1.0e7])
+def test_free_response_is_the_damped_oscillator(w2):
+    """C and S of the free response against the textbook forms: over-, critically and
+    underdamped (zeta = 1000 1/s, so critical at omega^2 = 2.5e5), continuous across
+    critical."""
+    zeta, tau = 1000.0, np.linspace(0.0, 0.02, 9)
+    C, S = dynamic._free_response(np.array([w2]), zeta, tau)
+    decay = np.exp(-zeta * tau / 2)
+    d = zeta**2 / 4 - w2
+    if abs(d) < 1e-6 * w2:
+        C_ok, S_ok = decay, tau * decay
+    elif d > 0:
+        lam = np.sqrt(d)
+        C_ok, S_ok = decay * np.cosh(lam * tau), decay * np.sinh(lam * tau) / lam
+    else:
+        wd = np.sqrt(-d)
+        C_ok, S_ok = decay * np.cos(wd * tau), decay * np.sin(wd * tau) / wd
+    assert np.allclose(C[0], C_ok, rtol=1e-9, atol=1e-14)
+    assert np.allclose(S[0], S_ok, rtol=1e-9, atol=1e-14 * tau[-1])

@@ -138,6 +138,38 @@ def test_cantilever_first_frequency(nu):
         assert r.modes.shape == (2, mesh.n_nodes, 3)
 
 
+def test_p1_element_mass_matrix_is_rho_v_over_20_times_1_plus_delta():
+    """The consistent mass of one tetrahedron, by hand: M_ij = rho V (1 + delta_ij) / 20 per
+    component (a one-point rule gives rho V / 16 everywhere)."""
+    from model.mesh import TetMesh
+    from reference.fem import skfem_mesh
+    X = np.array([[0.0, 0, 0], [0.02, 0, 0], [0.003, 0.01, 0], [0.004, 0.002, 0.015]])
+    V = abs(np.linalg.det(X[1:] - X[0])) / 6
+    M = modal.mass_matrix(skfem_mesh(TetMesh(X, np.array([[0, 1, 2, 3]]))), "P1", 1000.0)
+    expected = 1000.0 * V / 20 * (np.ones((4, 4)) + np.eye(4))
+    assert np.allclose(M.toarray()[::3, ::3], expected, rtol=1e-12)
+    assert np.allclose(M.toarray()[1::3, 1::3], expected, rtol=1e-12)
+    assert abs(M[0, 1]) == 0                       # components do not couple
+
+
+@pytest.mark.parametrize("element,power", [("P1", 1), ("P2", 2)])
+def test_mass_matrix_integrates_the_square_of_a_field_it_represents(element, power):
+    """u = x^p (p the element's degree) is represented exactly, so u.M u must be
+    rho int x^(2p) dV = rho L^(2p+3) / (2p + 1) on the cube [0, L]^3: exact only with a
+    quadrature of degree 2p."""
+    from reference.fem import element_basis, skfem_mesh
+    L, rho = 0.032, 1000.0
+    m = skfem_mesh(cube(3, L, "six"))
+    M = modal.mass_matrix(m, element, rho)
+    basis = element_basis(m, element)
+    x_dofs = np.concatenate([basis.nodal_dofs[0]]    # the x components
+                            + ([basis.edge_dofs[0]] if basis.edge_dofs.size else []))
+    u = np.zeros(basis.N)
+    u[x_dofs] = basis.doflocs[0, x_dofs] ** power      # interpolation at the dof locations
+    assert u @ (M @ u) == pytest.approx(rho * L ** (2 * power + 3) / (2 * power + 1),
+                                        rel=1e-12)
+
+
 @pytest.mark.parametrize("nu", NUS)
 def test_neo_hookean_equals_linear_at_small_strain(nu):
     mesh = cube(4, L, "five")
