@@ -25,8 +25,8 @@ DEFINITIONS = (
     "(max Re sqrt(eig(M^-1 df/dx))); above zero the force field flutters.",
     "dt/4: the dynamic run repeated at a quarter of the step (does its verdict hold?).",
     "reaction(t) err: relative L2 of the top reaction over push and hold against the FEM "
-    "transient on the same boundary motion (Newmark, consistent mass, the same mass "
-    "damping); disp end push err: relative L2 of the displacement at the end of the push "
+    "transient on the same boundary motion (exact in time by superposing every mode, "
+    "consistent mass, the same mass damping); disp end push err: relative L2 of the displacement at the end of the push "
     "against it; rest: when every node is slower than the rest speed (checked every "
     "0.1 s of hold).",
     "modal err: the first 10 frequencies of the model linearised at rest, with the case's "
