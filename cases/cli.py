@@ -5,6 +5,7 @@ are one line ``pbcm: error: ...`` with exit status 2, Ctrl-C is one line with ex
 """
 import argparse
 import math
+import os
 import re
 import sys
 import textwrap
@@ -362,6 +363,9 @@ def _main(argv):
         print("\npbcm: terminated; output folders hold what they held before the unfinished "
               "one", file=sys.stderr)
         return 143
+    except BrokenPipeError:   # `pbcm check | head`: the reader left; say nothing more
+        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
+        return 141
 
 
 if __name__ == "__main__":

@@ -209,6 +209,17 @@ def test_a_signal_whose_exception_a_library_swallows_still_stops_the_run(sig, st
     assert signal.getsignal(signal.SIGTERM) is signal.SIG_DFL   # handlers restored
 
 
+def test_a_reader_that_leaves_early_gets_no_traceback(quick):
+    """`pbcm check | head -0`: the pipe is closed before the table is written; exit 141
+    (SIGPIPE's status), nothing on stderr."""
+    proc = subprocess.Popen([sys.executable, "-m", "cases.cli", "check", "--metrics",
+                             str(quick), "--thresholds", str(ROOT / "thresholds.toml")],
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, cwd=ROOT)
+    proc.stdout.close()
+    err = proc.stderr.read().decode()
+    assert proc.wait(timeout=120) == 141 and "Traceback" not in err, err
+
+
 # ------------------------------------------------------------ unreadable meshes
 
 def _gmsh_text(tmp_path):
