@@ -81,16 +81,58 @@ def total_forces(kernels, x, out):
 
 @njit(cache=True)
 def _accel_then_stage(a, vs, f_ext, inv_mass, damping, x, v, h, xn, vn, an):
-    """One pass over the nodes: a = (f + f_ext) / m - zeta vs in place (a holds f), the next
-    stage xn = x + h vs, vn = v + h a, and an zeroed for the next stage's forces. The
-    prescribed components are fixed after (:func:`_prescribe`)."""
-    for i in range(x.shape[0]):
+    """One pass over the flat (3n,) arrays: a = f / m - zeta vs in place (a holds the forces,
+    f_ext included), the next stage xn = x + h vs, vn = v + h a, and an set to f_ext for the
+    next stage's forces (zero when f_ext is empty). The prescribed components are fixed after
+    (:func:`_prescribe`). Flat and branch-free inside, so that it runs in SIMD lanes."""
+    if f_ext.shape[0] == 0:
+        for j in range(a.shape[0]):
+            aj = a[j] * inv_mass[j] - damping * vs[j]
+            a[j] = aj
+            xn[j] = x[j] + h * vs[j]
+            vn[j] = v[j] + h * aj
+            an[j] = 0.0
+    else:
+        for j in range(a.shape[0]):
+            aj = a[j] * inv_mass[j] - damping * vs[j]
+            a[j] = aj
+            xn[j] = x[j] + h * vs[j]
+            vn[j] = v[j] + h * aj
+            an[j] = f_ext[j]
+
+
+@njit(cache=True)
+def _start_forces(an, f_ext):
+    """an = f_ext: the force accumulator of a stage starts at the external forces (the
+    kernels add theirs); an empty f_ext stands for zero."""
+    if f_ext.shape[0] == 0:
+        an[:] = 0.0
+    else:
+        an[:] = f_ext
+
+
+@njit(cache=True)
+def _update(x, v, v2, v3, v4, k1v, k2v, k3v, k4v, inv_mass, damping, h, f_ext, free):
+    """The RK4 update of the flat (3n,) state from the four stages (k4v holds the last
+    stage's forces), k1v restarted at f_ext for the next step; returns (finite, the largest
+    squared speed of a ``free`` node)."""
+    finite = True
+    top = 0.0
+    ext = f_ext.shape[0] > 0
+    for i in range(free.shape[0]):
+        sp = 0.0
         for k in range(3):
-            ai = (a[i, k] + f_ext[i, k]) * inv_mass[i] - damping * vs[i, k]
-            a[i, k] = ai
-            xn[i, k] = x[i, k] + h * vs[i, k]
-            vn[i, k] = v[i, k] + h * ai
-            an[i, k] = 0.0
+            j = 3 * i + k
+            a4 = k4v[j] * inv_mass[j] - damping * v4[j]
+            xj = x[j] + h * (((v[j] + 2 * v2[j]) + 2 * v3[j]) + v4[j])
+            vj = v[j] + h * (((k1v[j] + 2 * k2v[j]) + 2 * k3v[j]) + a4)
+            x[j], v[j] = xj, vj
+            finite = finite and np.isfinite(xj) and np.isfinite(vj)
+            sp += vj * vj
+            k1v[j] = f_ext[j] if ext else 0.0
+        if free[i]:
+            top = max(top, sp)
+    return finite, top
 
 
 @njit(cache=True)
@@ -123,44 +165,43 @@ def rk4_ramp(kernels, x, v, t0, dt, steps, X, mass, f_ext, damping, mask, start,
     k1v, k2v, k3v, k4v, x2, v2, x3, v3, x4, v4 = (buf[0], buf[1], buf[2], buf[3], buf[4],
                                                   buf[5], buf[6], buf[7], buf[8], buf[9])
     n = x.shape[0]
+    flat = buf.reshape(10, 3 * n)    # the node arithmetic runs on flat views of the same data
+    f1, f2, f3, f4, fx2, fv2, fx3, fv3, fx4, fv4 = (flat[0], flat[1], flat[2], flat[3],
+                                                    flat[4], flat[5], flat[6], flat[7],
+                                                    flat[8], flat[9])
+    fx, fv = x.reshape(3 * n), v.reshape(3 * n)
+    fext = f_ext.reshape(3 * n) if np.any(f_ext != 0.0) else np.empty(0)
     pi, pk = np.nonzero(mask)
-    inv_mass = 1.0 / mass      # a division per node per stage would cost msm a fifth
-    pinned = np.zeros(n, dtype=np.bool_)
+    # per component, so that the flat passes need no index arithmetic (a division per node
+    # per stage would cost msm a fifth)
+    inv_mass = np.empty(3 * n)
+    for i in range(n):
+        for k in range(3):
+            inv_mass[3 * i + k] = 1.0 / mass[i]
+    free = np.ones(n, dtype=np.bool_)
     for c in range(pi.shape[0]):
-        pinned[pi[c]] = True
-    k1v[:] = 0.0
+        free[pi[c]] = False
+    _start_forces(f1, fext)
     for step in range(1, steps + 1):
         t = t0 + (step - 1) * dt
         term, bad = add_forces(kernels, x, k1v)
         if term < 0:
-            _accel_then_stage(k1v, v, f_ext, inv_mass, damping, x, v, 0.5 * dt, x2, v2, k2v)
+            _accel_then_stage(f1, fv, fext, inv_mass, damping, fx, fv, 0.5 * dt, fx2, fv2, f2)
             _prescribe(k1v, x2, v2, t + 0.5 * dt, X, start, moving, t_ramp, pi, pk)
             term, bad = add_forces(kernels, x2, k2v)
         if term < 0:
-            _accel_then_stage(k2v, v2, f_ext, inv_mass, damping, x, v, 0.5 * dt, x3, v3, k3v)
+            _accel_then_stage(f2, fv2, fext, inv_mass, damping, fx, fv, 0.5 * dt, fx3, fv3, f3)
             _prescribe(k2v, x3, v3, t + 0.5 * dt, X, start, moving, t_ramp, pi, pk)
             term, bad = add_forces(kernels, x3, k3v)
         if term < 0:
-            _accel_then_stage(k3v, v3, f_ext, inv_mass, damping, x, v, dt, x4, v4, k4v)
+            _accel_then_stage(f3, fv3, fext, inv_mass, damping, fx, fv, dt, fx4, fv4, f4)
             _prescribe(k3v, x4, v4, t + dt, X, start, moving, t_ramp, pi, pk)
             term, bad = add_forces(kernels, x4, k4v)
         if term >= 0:
             return 2, step, term, bad, 0.0
-        h = dt / 6.0
-        finite = True
-        top = 0.0
-        for i in range(n):
-            sp = 0.0
-            for k in range(3):
-                # the prescribed components' values are overwritten below
-                a4 = (k4v[i, k] + f_ext[i, k]) * inv_mass[i] - damping * v4[i, k]
-                x[i, k] = x[i, k] + h * (((v[i, k] + 2 * v2[i, k]) + 2 * v3[i, k]) + v4[i, k])
-                v[i, k] = v[i, k] + h * (((k1v[i, k] + 2 * k2v[i, k]) + 2 * k3v[i, k]) + a4)
-                finite = finite and np.isfinite(x[i, k]) and np.isfinite(v[i, k])
-                sp += v[i, k] * v[i, k]
-                k1v[i, k] = 0.0
-            if not pinned[i]:
-                top = max(top, sp)
+        # the prescribed components' values are overwritten by _prescribe below
+        finite, top = _update(fx, fv, fv2, fv3, fv4, f1, f2, f3, f4, inv_mass, damping,
+                              dt / 6.0, fext, free)
         _prescribe(k4v, x, v, t + dt, X, start, moving, t_ramp, pi, pk)
         for c in range(pi.shape[0]):          # the prescribed nodes' speed, as prescribed
             i = pi[c]
