@@ -79,6 +79,12 @@ def test_quick_library_passes_the_committed_bounds(library, capsys):
     assert status == 0, out[-3000:]
 
 
+# measured against the FEM transient or FEM modes, whose references were corrected after the
+# baseline was stored (consistent mass integrated exactly, transient exact in time)
+FEM_DYNAMICS_CHANGED = {"reaction_time_rel_l2", "disp_end_push_rel_l2", "modal_rel_err",
+                        "modal_rel_err_free", "rest_time_fem_s"}
+
+
 def test_paper_cube_on_the_framework_matches_the_landed_case(quick):
     """Every non-timing metric of the quick paper cube equals the one the pre-framework code
     wrote (stored in tests/data). The framework move was bit for bit (commit b783075). Issue 11
@@ -86,7 +92,11 @@ def test_paper_cube_on_the_framework_matches_the_landed_case(quick):
     calibration from strain measures instead of whole energies (c moves by 1e-9), so values
     now agree to 1e-7 relative with a floor of 1e-7 (an error that is a difference of two
     numbers moves by the Newton tolerance), series to 1e-7 of their largest value, and the
-    Newton residual only has to stay converged (rounding noise, 1e-16 to 1e-9 N)."""
+    Newton residual only has to stay converged (rounding noise, 1e-16 to 1e-9 N). The
+    metrics measured against the FEM transient and FEM modes are left out since those
+    references changed on purpose (mass matrices integrated exactly, the transient exact in
+    time): the model's own series (reactions, frequencies) must still match, and those metrics
+    are gated by thresholds.toml."""
     before = json.loads(BASELINE.read_text())
     now = {(r["mesh"], r["bc"], r["model"]): r
            for r in json.loads((quick / "metrics.json").read_text())["runs"]}
@@ -94,7 +104,7 @@ def test_paper_cube_on_the_framework_matches_the_landed_case(quick):
         new = now[(old["mesh"], old["bc"], old["model"])]
         for k, v in old.items():
             assert k not in TIMING_KEYS
-            if k == "step_time_state":   # step timing left the case for `pbcm bench`
+            if k == "step_time_state" or k in FEM_DYNAMICS_CHANGED:
                 continue
             if k == "static_residual_n":
                 assert (new[k] is None) == (v is None) and (v is None or new[k] < 1e-8), k
