@@ -8,6 +8,7 @@ and exited 0 after SIGTERM on a CI machine. So the handler also records the sign
 folder is swapped in.
 """
 import signal
+import sys
 import threading
 
 
@@ -34,17 +35,27 @@ def checkpoint():
 
 class handling:
     """Within this block SIGINT and SIGTERM raise and are remembered for ``checkpoint``
-    (main thread only; elsewhere nothing changes)."""
+    (main thread only; elsewhere nothing changes). Python's "Exception ignored" report of
+    such an exception dropped in a finaliser or a C callback is silenced: ``checkpoint``
+    raises it again, and the run ends with its one-line message."""
 
     def __enter__(self):
-        self._previous = {}
+        self._previous, self._hook = {}, None
         if threading.current_thread() is threading.main_thread():
             _received.clear()
             for sig in _EXCEPTIONS:
                 self._previous[sig] = signal.signal(sig, _handler)
+            self._hook = sys.unraisablehook
+            sys.unraisablehook = self._unraisable
         return self
+
+    def _unraisable(self, unraisable):
+        if not (_received and isinstance(unraisable.exc_value, tuple(_EXCEPTIONS.values()))):
+            self._hook(unraisable)
 
     def __exit__(self, *exc):
         for sig, previous in self._previous.items():
             signal.signal(sig, previous)
+        if self._hook is not None:
+            sys.unraisablehook = self._hook
         _received.clear()
