@@ -4,9 +4,9 @@
 
 integrated with Newmark's average acceleration (beta = 1/4, gamma = 1/2): unconditionally
 stable, second order, and energy conserving without damping; or, for a ramped boundary
-motion, solved exactly in time by superposing every mode (``method="modal"``). ``zeta`` is the mass-proportional
-damping rate [1/s] of the particle runs (MODEL.md "Time integration"): every mode decays as
-exp(-zeta t / 2).
+motion, solved exactly in time by superposing every mode (``method="modal"``). ``zeta`` is
+the mass-proportional damping rate [1/s] of the particle runs (MODEL.md "Time integration"):
+every mode decays as exp(-zeta t / 2).
 """
 from dataclasses import dataclass
 import math
@@ -267,7 +267,7 @@ def modal_ramp(system, ramp, t_end, u, v, frames):
     t = np.linspace(0.0, t_end, max(int(frames), 2))
     eta, deta = PhiM @ u[I], PhiM @ v[I]
     pieces = [(0.0, f0 - zeta * g_M / T, -g_K / T), (T, f0 - g_K, np.zeros_like(f0))]
-    E, dE, ddE = (np.empty((len(w2), len(t))) for _ in range(3))
+    q, dq, ddq = (np.empty((len(w2), len(t))) for _ in range(3))
     for k, (t0, a, b) in enumerate(pieces):
         t1 = pieces[k + 1][0] if k + 1 < len(pieces) else np.inf
         if t0 > t_end:
@@ -279,9 +279,9 @@ def modal_ramp(system, ramp, t_end, u, v, frames):
         tau = t[sel] - t0
         C, S = _free_response(w2, zeta, tau)
         y0, dy0 = (eta - A)[:, None], (deta - B)[:, None]
-        E[:, sel] = A[:, None] + B[:, None] * tau + y0 * C + (dy0 + 0.5 * zeta * y0) * S
-        dE[:, sel] = B[:, None] + dy0 * C - (w2[:, None] * y0 + 0.5 * zeta * dy0) * S
-        ddE[:, sel] = a[:, None] + b[:, None] * tau - zeta * dE[:, sel] - w2[:, None] * E[:, sel]
+        q[:, sel] = A[:, None] + B[:, None] * tau + y0 * C + (dy0 + 0.5 * zeta * y0) * S
+        dq[:, sel] = B[:, None] + dy0 * C - (w2[:, None] * y0 + 0.5 * zeta * dy0) * S
+        ddq[:, sel] = a[:, None] + b[:, None] * tau - zeta * dq[:, sel] - w2[:, None] * q[:, sel]
         if np.isfinite(t1):               # the state at the next kink, then its jump
             C, S = _free_response(w2, zeta, np.array([t1 - t0]))
             y0, dy0 = eta - A, deta - B
@@ -289,10 +289,10 @@ def modal_ramp(system, ramp, t_end, u, v, frames):
             deta = B + dy0 * C[:, 0] - (w2 * y0 + 0.5 * zeta * dy0) * S[:, 0] + g_M / T
     s = np.clip(t / T, 0.0, 1.0)
     uu, vv = np.empty((len(t), basis.N)), np.empty((len(t), basis.N))
-    uu[:, I], vv[:, I] = (phi @ E).T, (phi @ dE).T
+    uu[:, I], vv[:, I] = (phi @ q).T, (phi @ dq).T
     uu[:, D] = x_start + s[:, None] * x_moving
     vv[:, D] = np.where(t < T, 1.0 / T, 0.0)[:, None] * x_moving
-    return system.result(D, t, uu, vv, (phi @ ddE).T, I, None,
+    return system.result(D, t, uu, vv, (phi @ ddq).T, I, None,
                          {"modes": int(len(w2)), "method": "modal"})
 
 
