@@ -211,3 +211,15 @@ def test_free_response_is_the_damped_oscillator(w2):
         C_ok, S_ok = decay * np.cos(wd * tau), decay * np.sin(wd * tau) / wd
     assert np.allclose(C[0], C_ok, rtol=1e-9, atol=1e-14)
     assert np.allclose(S[0], S_ok, rtol=1e-9, atol=1e-14 * tau[-1])
+
+
+def test_modal_method_names_what_it_needs():
+    mesh = cube(3, 0.032, "six")
+    held = {int(i): (0.0, 0.0, 0.0) for i in mesh.nodes_on_plane("y", 0.0)}
+    ramp = Ramp(mesh.nodes_on_plane("y", 0.032), (0.0, -1e-4, 0.0), 0.01, held=held)
+    free = Ramp([0], (0.0, 0.0, None), 0.01)      # one component held: rigid motions left
+    for args, kw, word in [((lambda t: held,), {}, "Ramp"), ((ramp,), {"dt": 1e-3}, "dt"),
+                           ((free,), {}, "rigid"), ((ramp,), {"method": "euler"}, "method")]:
+        kw = {"method": "modal", **kw}
+        with pytest.raises(ModelError, match=word):
+            dynamic.solve(mesh, E, 0.3, RHO, *args, 0.02, **kw)
