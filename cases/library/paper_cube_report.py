@@ -26,9 +26,9 @@ DEFINITIONS = (
     "dt/4: the dynamic run repeated at a quarter of the step (does its verdict hold?).",
     "reaction(t) err: relative L2 of the top reaction over push and hold against the FEM "
     "transient on the same boundary motion (exact in time by superposing every mode, "
-    "consistent mass, the same mass damping); disp end push err: relative L2 of the displacement at the end of the push "
-    "against it; rest: when every node is slower than the rest speed (checked every "
-    "0.1 s of hold).",
+    "consistent mass, the same mass damping); disp end push err: relative L2 of the "
+    "displacement at the end of the push against it; rest: when every node is slower than "
+    "the rest speed (checked every 0.1 s of hold).",
     "modal err: the first 10 frequencies of the model linearised at rest, with the case's "
     "constraints, against FEM P2 (largest relative error); modal err free: the same "
     "free-free after the rigid modes; rigid modes: zero eigenvalues free-free (6 expected).",
