@@ -19,7 +19,7 @@ from numba import njit
 from model import Material, PRESETS, build
 from model.bc import Ramp
 from model.calibrate import calibrate
-from model.integrate import rk4_ramp, total_forces
+from model.integrate import STEP_BUFFERS, rk4_ramp, total_forces
 from model.mesh import cube
 
 from . import figures, stop
@@ -73,7 +73,7 @@ class _Timed:
         self.step_args = (mesh.points, self.pm.mass, np.zeros_like(mesh.points), 50.0, mask,
                           start, moving, 1.0, mesh.tets,
                           not any(t.checks_inversion for t in self.pm.terms),
-                          self.pm.material.p_wave_speed, np.empty((10,) + mesh.points.shape))
+                          self.pm.material.p_wave_speed, np.empty((STEP_BUFFERS,) + mesh.points.shape))
         self.dt = self.pm.stable_dt(0.5)
         self.t = 0.0
         _force_loop(self.kernels, self.x, self.out, 1)    # compile outside the timings

@@ -114,14 +114,25 @@ def _config(case, args):
                          E=args.E, nu=args.nu, rho=args.rho, shear_scale=args.shear_scale)
 
 
-def _run_into(name, cfg, folder):
-    """Run case ``name`` with ``cfg`` and write its files into the existing ``folder``."""
+def _run_into(name, cfg, folder, workers=None):
+    """Run case ``name`` with ``cfg`` (on ``workers``, a started Workers, when given) and
+    write its files into the existing ``folder``."""
     from .report import write_case
     from .runner import run
     case = _case(name)
-    runs, fields = run(case, cfg)
+    runs, fields = run(case, cfg, workers=workers)
     write_case(folder, case, cfg, runs, fields)
     return runs
+
+
+def _workers(args, cfgs):
+    """The worker pool of a command (a context; nothing to start for one worker or one
+    (mesh, bc) unit in all)."""
+    from contextlib import nullcontext
+    from .workers import Workers, available_cores
+    units = max(len(c.meshes) * len(c.bcs) for c in cfgs.values())
+    n = min(args.workers or available_cores(), units)
+    return Workers(n) if n > 1 else nullcontext()
 
 
 def _configs(names, args):
@@ -147,9 +158,10 @@ def _list_command(args):
 
 
 def _run_command(args):
-    cfg = _configs([args.case], args)[args.case]
-    with StagedFolder(Path(args.out) if args.out else Path("reports") / args.case) as out:
-        runs = _run_into(args.case, cfg, out.path)
+    cfgs = _configs([args.case], args)
+    with StagedFolder(Path(args.out) if args.out else Path("reports") / args.case) as out, \
+            _workers(args, cfgs) as workers:
+        runs = _run_into(args.case, cfgs[args.case], out.path, workers)
         path = out.commit()
     print(f"{args.case}: {len(runs)} runs written to {path}")
     return 0
@@ -176,8 +188,9 @@ def _report_command(args):
     root = writable_folder(args.out or "reports")
     with ExitStack() as stack:   # every case folder checked and staged before any computing
         staged = {name: stack.enter_context(StagedFolder(root / name)) for name in CASES}
+        workers = stack.enter_context(_workers(args, cfgs))
         for name, out in staged.items():
-            runs = _run_into(name, cfgs[name], out.path)
+            runs = _run_into(name, cfgs[name], out.path, workers)
             print(f"{name}: {len(runs)} runs written to {out.commit()}")
     md, html = index_documents(root, list(CASES))
     write_text_atomic(root / "index.md", md)
@@ -223,10 +236,11 @@ def _bless_command(args):
             values = measured(args.metrics)
         else:
             cfgs = _configs(CASES, args)
-            with tempfile.TemporaryDirectory(prefix="pbcm-bless-") as tmp:
+            with tempfile.TemporaryDirectory(prefix="pbcm-bless-") as tmp, \
+                    _workers(args, cfgs) as workers:
                 for name in CASES:
                     (Path(tmp) / name).mkdir()
-                    _run_into(name, cfgs[name], Path(tmp) / name)
+                    _run_into(name, cfgs[name], Path(tmp) / name, workers)
                 values = measured(tmp)
         new, changes = bless(values, old, rtol=args.margin, prune=args.prune)
     except CheckError as exc:
@@ -251,6 +265,10 @@ def _selection(p):
     p.add_argument("--nu", type=_poisson, help="Poisson's ratio, -1 < nu < 0.5 (default 0.45)")
     p.add_argument("--rho", type=_number("--rho", "a density in kg/m^3, a number > 0", low=0),
                    help="density [kg/m^3] (default 1000)")
+    p.add_argument("--workers", type=_number("--workers", "an integer >= 1", low=0,
+                                             integer=True),
+                   help="processes running a case's (mesh, bc) units side by side (default: "
+                        "the cores available); the metrics do not depend on it")
     # test-only: scale the shear term, to prove that the error gate catches a worse model
     p.add_argument("--shear-scale", type=float, default=None, help=argparse.SUPPRESS)
 

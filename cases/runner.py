@@ -15,6 +15,7 @@ from reference import linear
 from . import metrics as M
 from . import stop
 from .framework import Reference, err_name, ref_name
+from .workers import one_blas_thread
 
 # a reference field that varies by less than this fraction of its size is uniform: its
 # variation is the iterative solver's (relative residual 1e-10 gives about 1e-9 here), and a
@@ -147,49 +148,90 @@ def failed_runs(mesh_name, bc, models, phase, exc):
             for m in models]
 
 
-def run(case, s, log=True):
-    """Run every (mesh, bc, model) of ``case`` with settings ``s``; return the runs (metrics)
-    and the fields for the figures ({(mesh, bc, model or 'fem-p2'): arrays})."""
-    total = len(s.meshes) * len(s.bcs) * (len(s.models) + 1)
+def unit(case, s, mesh_name, bc, mesh_of=None, step=None):
+    """The runs and figure fields of one (mesh, bc): its references, then every model.
+    ``mesh_of(name)`` builds (or recalls) the mesh; ``step(text, done)`` reports progress
+    (``done`` items of the case's total finished since the last call)."""
+    step = step or (lambda text, done: None)
+    mesh_of = mesh_of or (lambda name: case.mesh(name, s))
     runs, fields = [], {}
+    try:
+        mesh = mesh_of(mesh_name)
+    except FINDINGS as exc:
+        step(f"{case.name} {mesh_name}/{bc}: mesh failed", len(s.models) + 1)
+        return failed_runs(mesh_name, bc, s.models, "mesh", exc), fields
+    probe = Shear(mesh, s.material, reading="corner")  # the paper's max |tau| measure
+    step(f"{case.name} {mesh_name}/{bc}: FEM references", 0)
+    try:
+        ref = case.solve_reference(mesh, bc, s, probe) or reference(case, mesh, bc, s, probe)
+    except FINDINGS as exc:
+        step(f"{case.name} {mesh_name}/{bc}: references failed", len(s.models) + 1)
+        return failed_runs(mesh_name, bc, s.models, "reference", exc), fields
+    if ref.p2 is not None:
+        fields[(mesh_name, bc, "fem-p2")] = {
+            "mesh": mesh, "u": ref.p2.u, "max_tau": ref.tau, "pressure": ref.p2.pressure,
+            **ref.extra}
+    step(f"{case.name} {mesh_name}/{bc}", 1)
+    for model_name in s.models:
+        stop.checkpoint()
+        step(f"{case.name} {mesh_name}/{bc}/{model_name}", 0)
+        r, f = model_run(case, mesh_name, mesh, bc, model_name, s, ref)
+        runs.append(r)
+        if f is not None:
+            fields[(mesh_name, bc, model_name)] = f
+        step(f"{case.name} {mesh_name}/{bc}/{model_name}", 1)
+    return runs, fields
+
+
+def _unit_in_worker(job):
+    index, case, s, mesh_name, bc = job
+    with one_blas_thread():
+        return index, unit(case, s, mesh_name, bc)
+
+
+def run(case, s, log=True, workers=None):
+    """Run every (mesh, bc, model) of ``case`` with settings ``s``; return the runs (metrics)
+    and the fields for the figures ({(mesh, bc, model or 'fem-p2'): arrays}). The (mesh, bc)
+    units run in this process, or on ``workers`` (a started ``cases.workers.Workers``); the
+    results are the same either way and come in the declared order."""
+    units = [(mesh_name, bc) for mesh_name in s.meshes for bc in s.bcs]
+    per_unit = len(s.models) + 1
+    results = [None] * len(units)
     with Progress(TextColumn("{task.description:<56}"), BarColumn(),
                   TextColumn("{task.completed}/{task.total}"), TimeElapsedColumn(),
                   TextColumn("left"), TimeRemainingColumn(), console=Console(stderr=True),
                   disable=not (log and sys.stderr.isatty())) as bar:
-        task = bar.add_task(case.name, total=total)
-        for mesh_name in s.meshes:
-            stop.checkpoint()
-            try:
-                mesh = case.mesh(mesh_name, s)
-            except FINDINGS as exc:
-                for bc in s.bcs:
-                    runs += failed_runs(mesh_name, bc, s.models, "mesh", exc)
-                bar.advance(task, len(s.bcs) * (len(s.models) + 1))
-                continue
-            probe = Shear(mesh, s.material, reading="corner")  # the paper's max |tau| measure
-            for bc in s.bcs:
-                bar.update(task, description=f"{case.name} {mesh_name}/{bc}: FEM references")
-                try:
-                    ref = (case.solve_reference(mesh, bc, s, probe)
-                           or reference(case, mesh, bc, s, probe))
-                except FINDINGS as exc:
-                    runs += failed_runs(mesh_name, bc, s.models, "reference", exc)
-                    bar.advance(task, len(s.models) + 1)
-                    continue
-                if ref.p2 is not None:
-                    fields[(mesh_name, bc, "fem-p2")] = {
-                        "mesh": mesh, "u": ref.p2.u, "max_tau": ref.tau,
-                        "pressure": ref.p2.pressure, **ref.extra}
-                bar.advance(task)
-                for model_name in s.models:
+        task = bar.add_task(case.name, total=len(units) * per_unit)
+        if workers is None or len(units) < 2:
+            meshes = {}
+
+            def mesh_of(name):   # one mesh for all its bcs
+                if name not in meshes:
+                    meshes[name] = case.mesh(name, s)
+                return meshes[name]
+
+            def step(text, done):
+                bar.update(task, description=text, advance=done)
+
+            with one_blas_thread():
+                for i, (mesh_name, bc) in enumerate(units):
                     stop.checkpoint()
-                    bar.update(task, description=f"{case.name} {mesh_name}/{bc}/{model_name}")
-                    r, f = model_run(case, mesh_name, mesh, bc, model_name, s, ref)
-                    runs.append(r)
-                    if f is not None:
-                        fields[(mesh_name, bc, model_name)] = f
-                    bar.advance(task)
+                    results[i] = unit(case, s, mesh_name, bc, mesh_of, step)
+        else:
+            bar.update(task, description=f"{case.name}: {len(units)} (mesh, bc) on "
+                       f"{workers.n} workers")
+            jobs = [(i, case, s, mesh_name, bc) for i, (mesh_name, bc) in enumerate(units)]
+            for i, result in workers.unordered(_unit_in_worker, jobs):
+                stop.checkpoint()
+                results[i] = result
+                mesh_name, bc = units[i]
+                bar.update(task, description=f"{case.name} {mesh_name}/{bc}: done",
+                           advance=per_unit)
         bar.update(task, description=f"{case.name}: done")
+    runs, fields = [], {}
+    for r, f in results:
+        runs += r
+        fields.update(f)
     return runs, fields
 
 
@@ -206,4 +248,4 @@ def jsonable(d):
     return d
 
 
-__all__ = ["run", "reference", "model_run", "uniform", "jsonable", "STATIC_KEYS"]
+__all__ = ["run", "unit", "reference", "model_run", "uniform", "jsonable", "STATIC_KEYS"]

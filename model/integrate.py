@@ -80,42 +80,43 @@ def total_forces(kernels, x, out):
 
 
 @njit(cache=True)
-def _accel_then_stage(a, vs, f_ext, inv_mass, damping, x, v, h, xn, vn, an):
-    """One pass over the flat (3n,) arrays: a = f / m - zeta vs in place (a holds the forces,
-    f_ext included), the next stage xn = x + h vs, vn = v + h a, and an set to f_ext for the
-    next stage's forces (zero when f_ext is empty). The prescribed components are fixed after
-    (:func:`_prescribe`). Flat and branch-free inside, so that it runs in SIMD lanes."""
-    if f_ext.shape[0] == 0:
-        for j in range(a.shape[0]):
-            aj = a[j] * inv_mass[j] - damping * vs[j]
-            a[j] = aj
-            xn[j] = x[j] + h * vs[j]
-            vn[j] = v[j] + h * aj
-            an[j] = 0.0
-    else:
-        for j in range(a.shape[0]):
-            aj = a[j] * inv_mass[j] - damping * vs[j]
-            a[j] = aj
-            xn[j] = x[j] + h * vs[j]
-            vn[j] = v[j] + h * aj
-            an[j] = f_ext[j]
+def _stage(f, vs_in, vs_out, xs, x, v, inv_mass, damping, f_ext, c, w, acc_x, acc_v, first):
+    """One pass over the flat (3n,) arrays after a stage's forces ``f`` (f_ext included) at
+    stage velocity ``vs_in``: its acceleration a = f / m - zeta vs is added to the RK4 sums
+    (acc_x += w vs, acc_v += w a; started from x, v when ``first``), the next stage set
+    (xs = x + c vs, vs_out = v + c a; vs_out may be vs_in) and f restarted at f_ext (zero when
+    f_ext is empty). Flat and element by element, so that it runs in SIMD lanes; the
+    prescribed components are fixed after (:func:`_prescribe`)."""
+    ext = f_ext.shape[0] > 0
+    for j in range(f.shape[0]):
+        vj = vs_in[j]
+        aj = f[j] * inv_mass[j] - damping * vj
+        if first:
+            acc_x[j] = x[j] + w * vj
+            acc_v[j] = v[j] + w * aj
+        else:
+            acc_x[j] += w * vj
+            acc_v[j] += w * aj
+        xs[j] = x[j] + c * vj
+        vs_out[j] = v[j] + c * aj
+        f[j] = f_ext[j] if ext else 0.0
 
 
 @njit(cache=True)
-def _start_forces(an, f_ext):
-    """an = f_ext: the force accumulator of a stage starts at the external forces (the
+def _start_forces(f, f_ext):
+    """f = f_ext: the force accumulator of a stage starts at the external forces (the
     kernels add theirs); an empty f_ext stands for zero."""
     if f_ext.shape[0] == 0:
-        an[:] = 0.0
+        f[:] = 0.0
     else:
-        an[:] = f_ext
+        f[:] = f_ext
 
 
 @njit(cache=True)
-def _update(x, v, v2, v3, v4, k1v, k2v, k3v, k4v, inv_mass, damping, h, f_ext, free):
-    """The RK4 update of the flat (3n,) state from the four stages (k4v holds the last
-    stage's forces), k1v restarted at f_ext for the next step; returns (finite, the largest
-    squared speed of a ``free`` node)."""
+def _update(x, v, acc_x, acc_v, vs, f, inv_mass, damping, w, f_ext, free):
+    """The end of an RK4 step on the flat (3n,) state: the last stage (forces ``f`` at
+    velocity ``vs``) completes the sums, x = acc_x + w vs, v = acc_v + w a, and f restarts at
+    f_ext for the next step; returns (finite, the largest squared speed of a ``free`` node)."""
     finite = True
     top = 0.0
     ext = f_ext.shape[0] > 0
@@ -123,52 +124,53 @@ def _update(x, v, v2, v3, v4, k1v, k2v, k3v, k4v, inv_mass, damping, h, f_ext, f
         sp = 0.0
         for k in range(3):
             j = 3 * i + k
-            a4 = k4v[j] * inv_mass[j] - damping * v4[j]
-            xj = x[j] + h * (((v[j] + 2 * v2[j]) + 2 * v3[j]) + v4[j])
-            vj = v[j] + h * (((k1v[j] + 2 * k2v[j]) + 2 * k3v[j]) + a4)
+            a4 = f[j] * inv_mass[j] - damping * vs[j]
+            xj = acc_x[j] + w * vs[j]
+            vj = acc_v[j] + w * a4
             x[j], v[j] = xj, vj
             finite = finite and np.isfinite(xj) and np.isfinite(vj)
             sp += vj * vj
-            k1v[j] = f_ext[j] if ext else 0.0
+            f[j] = f_ext[j] if ext else 0.0
         if free[i]:
             top = max(top, sp)
     return finite, top
 
 
 @njit(cache=True)
-def _prescribe(a, x, v, t, X, start, moving, t_ramp, pi, pk):
+def _prescribe(x, v, t, X, start, moving, t_ramp, pi, pk):
     """The ramp's prescribed components (pi[c], pk[c]) at time t (model.bc.Ramp.arrays and
-    .velocity), and no acceleration there."""
+    .velocity)."""
     s = min(max(t / t_ramp, 0.0), 1.0)
     moving_now = 0.0 <= t < t_ramp
     for c in range(pi.shape[0]):
         i, k = pi[c], pk[c]
-        a[i, k] = 0.0
         x[i, k] = X[i, k] + (start[i, k] + s * moving[i, k])
         v[i, k] = moving[i, k] / t_ramp if moving_now else 0.0
+
+
+# the step's scratch arrays, each (n, 3): forces, stage position, stage velocity, the two sums
+STEP_BUFFERS = 5
 
 
 @njit
 def rk4_ramp(kernels, x, v, t0, dt, steps, X, mass, f_ext, damping, mask, start, moving,
              t_ramp, tets, check_volumes, vmax, buf):
     """``steps`` classical RK4 steps from (x, v) at t0, in place, under a ramp (the arithmetic
-    of :func:`rk4_step`, element by element). ``buf`` (10, n, 3) is scratch. Stops at the first
-    step that breaks; returns (status, step, a, b, value): status 0 done, 1 NaN or inf,
-    2 degenerate element b of term a, 3 tetrahedron b inverted, 4 a particle at speed value.
-    ``check_volumes`` is needed where no term checks its tetrahedra (springs alone): the
-    volumes are then checked every 8th step and at the last.
+    of :func:`rk4_step`, summed as the stages come). ``buf`` (STEP_BUFFERS, n, 3) is scratch.
+    Stops at the first step that breaks; returns (status, step, a, b, value): status 0 done,
+    1 NaN or inf, 2 degenerate element b of term a, 3 tetrahedron b inverted, 4 a particle at
+    speed value. ``check_volumes`` is needed where no term checks its tetrahedra (springs
+    alone): the volumes are then checked every 8th step and at the last.
 
-    The node arithmetic is fused into one pass per stage (accelerations, next stage, zeroed
-    force buffer) and one at the end (update, finiteness, speed); the prescribed components
-    are a sparse list, so that a cheap model's step stays close to its four force
-    evaluations."""
-    k1v, k2v, k3v, k4v, x2, v2, x3, v3, x4, v4 = (buf[0], buf[1], buf[2], buf[3], buf[4],
-                                                  buf[5], buf[6], buf[7], buf[8], buf[9])
+    Low storage: one force buffer, one stage (xs, vs) overwritten stage by stage, and the RK4
+    sums of x and v accumulated as the stages come, so that the node passes stream 5 arrays
+    of 3n doubles beside the state rather than 10 (at 1e4 tetrahedra the arrays outgrow the
+    L2 cache and a cheap model's step is bound by them). The prescribed components are a
+    sparse list."""
+    f, xs, vs = buf[0], buf[1], buf[2]
     n = x.shape[0]
-    flat = buf.reshape(10, 3 * n)    # the node arithmetic runs on flat views of the same data
-    f1, f2, f3, f4, fx2, fv2, fx3, fv3, fx4, fv4 = (flat[0], flat[1], flat[2], flat[3],
-                                                    flat[4], flat[5], flat[6], flat[7],
-                                                    flat[8], flat[9])
+    flat = buf.reshape(STEP_BUFFERS, 3 * n)    # the node passes run on flat views
+    ff, fxs, fvs, acc_x, acc_v = flat[0], flat[1], flat[2], flat[3], flat[4]
     fx, fv = x.reshape(3 * n), v.reshape(3 * n)
     fext = f_ext.reshape(3 * n) if np.any(f_ext != 0.0) else np.empty(0)
     pi, pk = np.nonzero(mask)
@@ -181,28 +183,30 @@ def rk4_ramp(kernels, x, v, t0, dt, steps, X, mass, f_ext, damping, mask, start,
     free = np.ones(n, dtype=np.bool_)
     for c in range(pi.shape[0]):
         free[pi[c]] = False
-    _start_forces(f1, fext)
+    h, w1, w2 = 0.5 * dt, dt / 6.0, dt / 3.0
+    _start_forces(ff, fext)
     for step in range(1, steps + 1):
         t = t0 + (step - 1) * dt
-        term, bad = add_forces(kernels, x, k1v)
+        term, bad = add_forces(kernels, x, f)
         if term < 0:
-            _accel_then_stage(f1, fv, fext, inv_mass, damping, fx, fv, 0.5 * dt, fx2, fv2, f2)
-            _prescribe(k1v, x2, v2, t + 0.5 * dt, X, start, moving, t_ramp, pi, pk)
-            term, bad = add_forces(kernels, x2, k2v)
+            _stage(ff, fv, fvs, fxs, fx, fv, inv_mass, damping, fext, h, w1, acc_x, acc_v, True)
+            _prescribe(xs, vs, t + h, X, start, moving, t_ramp, pi, pk)
+            term, bad = add_forces(kernels, xs, f)
         if term < 0:
-            _accel_then_stage(f2, fv2, fext, inv_mass, damping, fx, fv, 0.5 * dt, fx3, fv3, f3)
-            _prescribe(k2v, x3, v3, t + 0.5 * dt, X, start, moving, t_ramp, pi, pk)
-            term, bad = add_forces(kernels, x3, k3v)
+            _stage(ff, fvs, fvs, fxs, fx, fv, inv_mass, damping, fext, h, w2, acc_x, acc_v,
+                   False)
+            _prescribe(xs, vs, t + h, X, start, moving, t_ramp, pi, pk)
+            term, bad = add_forces(kernels, xs, f)
         if term < 0:
-            _accel_then_stage(f3, fv3, fext, inv_mass, damping, fx, fv, dt, fx4, fv4, f4)
-            _prescribe(k3v, x4, v4, t + dt, X, start, moving, t_ramp, pi, pk)
-            term, bad = add_forces(kernels, x4, k4v)
+            _stage(ff, fvs, fvs, fxs, fx, fv, inv_mass, damping, fext, dt, w2, acc_x, acc_v,
+                   False)
+            _prescribe(xs, vs, t + dt, X, start, moving, t_ramp, pi, pk)
+            term, bad = add_forces(kernels, xs, f)
         if term >= 0:
             return 2, step, term, bad, 0.0
         # the prescribed components' values are overwritten by _prescribe below
-        finite, top = _update(fx, fv, fv2, fv3, fv4, f1, f2, f3, f4, inv_mass, damping,
-                              dt / 6.0, fext, free)
-        _prescribe(k4v, x, v, t + dt, X, start, moving, t_ramp, pi, pk)
+        finite, top = _update(fx, fv, acc_x, acc_v, fvs, ff, inv_mass, damping, w1, fext, free)
+        _prescribe(x, v, t + dt, X, start, moving, t_ramp, pi, pk)
         for c in range(pi.shape[0]):          # the prescribed nodes' speed, as prescribed
             i = pi[c]
             top = max(top, v[i, 0] * v[i, 0] + v[i, 1] * v[i, 1] + v[i, 2] * v[i, 2])
@@ -288,7 +292,7 @@ def simulate(model, bc_of_t, t_end, dt=None, damping=0.0, f_ext=None, frames=101
         _, start, moving = bc_of_t.parts(mesh.n_nodes)
         kernels = model.kernels()
         check = not any(t.checks_inversion for t in model.terms)
-        buf = np.empty((10,) + x.shape)
+        buf = np.empty((STEP_BUFFERS,) + x.shape)
         done = 0
         for k in frame_steps[1:]:
             status, at, term, bad, speed = rk4_ramp(

@@ -180,9 +180,11 @@ def test_fem_neohookean_statics_are_the_hyperelastic_reference(mat):
 
 @pytest.mark.parametrize("preset", ["msm", "pbcm-variational"])
 def test_compiled_ramp_step_is_the_plain_rk4_step(preset, mat):
-    """The compiled step (fused node passes, sparse prescribed components) does the
+    """The compiled step (low-storage node passes, sparse prescribed components) does the
     arithmetic of model.integrate.rk4_step: both paths agree to rounding, damping, external
-    force and a half-prescribed node included."""
+    force and a half-prescribed node included. The compiled step sums the stages as they come,
+    in another order, and the stiff stages' large h a terms cancel: rounding reaches about
+    1e-12 of the state, where a wrong RK4 weight would give 1e-3."""
     mesh = cube(3, L, "five")
     bot, top, _ = cube_bc(mesh, 0)
     pm = build(preset, mesh, mat)
@@ -200,5 +202,5 @@ def test_compiled_ramp_step_is_the_plain_rk4_step(preset, mat):
     a = pm.simulate(r, 0.02, damping=30.0, f_ext=f_ext, frames=5)
     b = pm.simulate(Plain(), 0.02, damping=30.0, f_ext=f_ext, frames=5)
     assert a.steps == b.steps > 20
-    assert np.abs(a.x - b.x).max() < 1e-12 * np.abs(a.x - mesh.points).max()
-    assert np.abs(a.v - b.v).max() < 1e-12 * np.abs(a.v).max()
+    assert np.abs(a.x - b.x).max() < 1e-10 * np.abs(a.x - mesh.points).max()
+    assert np.abs(a.v - b.v).max() < 1e-10 * np.abs(a.v).max()

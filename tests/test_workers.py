@@ -1,0 +1,79 @@
+"""A case's (mesh, bc) units on worker processes: the same metrics as in one process, in the
+declared order, and no worker left behind when the run is stopped."""
+import os
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import pytest
+
+from cases.cli import main
+from cases.workers import Workers
+
+UNITS = ["--quick", "--meshes", "five", "six", "--models", "msm", "fem-linear"]
+
+
+def test_workers_write_the_metrics_of_one_process(tmp_path):
+    for n in ("1", "2"):
+        assert main(["run", "cantilever", *UNITS, "--workers", n,
+                     "--out", str(tmp_path / n)]) == 0
+    one, two = ((tmp_path / n / "metrics.json").read_bytes() for n in ("1", "2"))
+    assert one == two
+    assert one.index(b'"mesh": "five"') < one.index(b'"mesh": "six"')   # declared order
+
+
+@pytest.mark.parametrize("n", [0, -1, 1.5, "2"])
+def test_workers_refuse_a_count_that_is_not_a_positive_integer(n):
+    with pytest.raises(ValueError, match="integer >= 1"):
+        Workers(n)
+
+
+def test_workers_flag_is_checked_before_computing(capsys, tmp_path):
+    assert main(["run", "cantilever", "--workers", "0", "--out", str(tmp_path / "c")]) == 2
+    assert "--workers" in capsys.readouterr().err
+    assert not (tmp_path / "c").exists()
+
+
+def _children(pid):
+    """The pids of the processes whose parent is ``pid``."""
+    kids = []
+    for stat in Path("/proc").glob("[0-9]*/stat"):
+        try:
+            fields = stat.read_text().rsplit(")", 1)[1].split()
+        except OSError:     # gone meanwhile
+            continue
+        if int(fields[1]) == pid:
+            kids.append(int(stat.parent.name))
+    return kids
+
+
+@pytest.mark.skipif(not Path("/proc/self/stat").exists(), reason="reads /proc")
+@pytest.mark.parametrize("sig,status", [(signal.SIGINT, 130), (signal.SIGTERM, 143)])
+def test_a_stopped_run_leaves_no_worker_behind(sig, status, tmp_path):
+    """Ctrl-C reaches the whole process group (as from a terminal): the workers stay quiet,
+    the parent says one line and takes them down; SIGTERM reaches the parent alone."""
+    proc = subprocess.Popen([sys.executable, "-m", "cases.cli", "run", "paper-cube", "--quick",
+                             "--workers", "2", "--out", str(tmp_path / "pc")],
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+                            start_new_session=True)
+    deadline = time.monotonic() + 120
+    while len(workers := [p for p in _children(proc.pid)
+                          if b"spawn_main" in Path(f"/proc/{p}/cmdline").read_bytes()]) < 2:
+        assert proc.poll() is None and time.monotonic() < deadline
+        time.sleep(0.05)
+    time.sleep(3.0)   # the workers are computing
+    if sig == signal.SIGINT:
+        os.killpg(proc.pid, sig)
+    else:
+        proc.send_signal(sig)
+    _, err = proc.communicate(timeout=60)
+    assert proc.returncode == status, err
+    lines = [line for line in err.replace("\r", "\n").splitlines()
+             if line.strip() and not line.startswith("[")]   # the progress bar aside
+    assert len(lines) == 1, err
+    for pid in workers:
+        with pytest.raises(ProcessLookupError):
+            os.kill(pid, 0)
+    assert not (tmp_path / "pc").exists()
