@@ -126,11 +126,11 @@ def _run_into(name, cfg, folder, workers=None):
 
 
 def _workers(args, cfgs):
-    """The worker pool of a command (a context; nothing to start for one worker or one
-    (mesh, bc) unit in all)."""
+    """The worker pool of a command (a context; nothing to start for one worker or one mesh
+    in every case: a worker runs one mesh with all its bcs)."""
     from contextlib import nullcontext
     from .workers import Workers, available_cores
-    units = max(len(c.meshes) * len(c.bcs) for c in cfgs.values())
+    units = max(len(c.meshes) for c in cfgs.values())
     n = min(args.workers or available_cores(), units)
     return Workers(n) if n > 1 else nullcontext()
 
@@ -267,8 +267,8 @@ def _selection(p):
                    help="density [kg/m^3] (default 1000)")
     p.add_argument("--workers", type=_number("--workers", "an integer >= 1", low=0,
                                              integer=True),
-                   help="processes running a case's (mesh, bc) units side by side (default: "
-                        "the cores available); the metrics do not depend on it")
+                   help="processes running a case's meshes side by side (default: the cores "
+                        "available); the metrics do not depend on it")
     # test-only: scale the shear term, to prove that the error gate catches a worse model
     p.add_argument("--shear-scale", type=float, default=None, help=argparse.SUPPRESS)
 

@@ -183,17 +183,28 @@ def unit(case, s, mesh_name, bc, mesh_of=None, step=None):
     return runs, fields
 
 
-def _unit_in_worker(job):
-    index, case, s, mesh_name, bc = job
+def _mesh_in_worker(job):
+    """Every bc of one mesh, in one worker: the bcs share the mesh and the FEM stiffness
+    matrices (reference.fem keeps the last ones assembled), which a (mesh, bc) per worker
+    would assemble twice."""
+    case, s, mesh_name = job
+    meshes = {}
+
+    def mesh_of(name):
+        if name not in meshes:
+            meshes[name] = case.mesh(name, s)
+        return meshes[name]
+
     with one_blas_thread():
-        return index, unit(case, s, mesh_name, bc)
+        return mesh_name, [unit(case, s, mesh_name, bc, mesh_of) for bc in s.bcs]
 
 
 def run(case, s, log=True, workers=None):
     """Run every (mesh, bc, model) of ``case`` with settings ``s``; return the runs (metrics)
     and the fields for the figures ({(mesh, bc, model or 'fem-p2'): arrays}). The (mesh, bc)
-    units run in this process, or on ``workers`` (a started ``cases.workers.Workers``); the
-    results are the same either way and come in the declared order."""
+    units run in this process, or on ``workers`` (a started ``cases.workers.Workers``), one
+    mesh with all its bcs per task; the results are the same either way and come in the
+    declared order."""
     units = [(mesh_name, bc) for mesh_name in s.meshes for bc in s.bcs]
     per_unit = len(s.models) + 1
     results = [None] * len(units)
@@ -202,7 +213,7 @@ def run(case, s, log=True, workers=None):
                   TextColumn("left"), TimeRemainingColumn(), console=Console(stderr=True),
                   disable=not (log and sys.stderr.isatty())) as bar:
         task = bar.add_task(case.name, total=len(units) * per_unit)
-        if workers is None or len(units) < 2:
+        if workers is None or len(s.meshes) < 2:
             meshes = {}
 
             def mesh_of(name):   # one mesh for all its bcs
@@ -218,15 +229,15 @@ def run(case, s, log=True, workers=None):
                     stop.checkpoint()
                     results[i] = unit(case, s, mesh_name, bc, mesh_of, step)
         else:
-            bar.update(task, description=f"{case.name}: {len(units)} (mesh, bc) on "
+            bar.update(task, description=f"{case.name}: {len(s.meshes)} meshes on "
                        f"{workers.n} workers")
-            jobs = [(i, case, s, mesh_name, bc) for i, (mesh_name, bc) in enumerate(units)]
-            for i, result in workers.unordered(_unit_in_worker, jobs):
+            jobs = [(case, s, mesh_name) for mesh_name in s.meshes]
+            for mesh_name, done in workers.unordered(_mesh_in_worker, jobs):
                 stop.checkpoint()
-                results[i] = result
-                mesh_name, bc = units[i]
-                bar.update(task, description=f"{case.name} {mesh_name}/{bc}: done",
-                           advance=per_unit)
+                for bc, result in zip(s.bcs, done):
+                    results[units.index((mesh_name, bc))] = result
+                bar.update(task, description=f"{case.name} {mesh_name}: done",
+                           advance=per_unit * len(s.bcs))
         bar.update(task, description=f"{case.name}: done")
     runs, fields = [], {}
     for r, f in results:

@@ -1,4 +1,4 @@
-"""A case's (mesh, bc) units on worker processes: the same metrics as in one process, in the
+"""A case's meshes on worker processes: the same metrics as in one process, in the
 declared order, and no worker left behind when the run is stopped."""
 import os
 import signal
