@@ -379,8 +379,7 @@ def test_stiffness_is_reused_for_the_same_mesh_element_and_constants():
     """Assembly is cached by content: the same mesh (a new object with equal arrays) reuses
     the matrix; another element, constant or mesh assembles afresh, and every matrix equals a
     fresh assembly."""
-    from skfem import asm
-    from skfem.models.elasticity import linear_elasticity
+    from reference.assembly import elasticity_matrix
     from reference.fem import element_basis, skfem_mesh, stiffness
 
     def basis(n=3, element="P1"):
@@ -392,4 +391,40 @@ def test_stiffness_is_reused_for_the_same_mesh_element_and_constants():
                        (basis(n=4), 2.0, 3.0)):
         other = stiffness(b, lam, mu)
         assert other is not K
-        assert abs(other - asm(linear_elasticity(lam, mu), b)).max() == 0.0
+        assert abs(other - elasticity_matrix(b, lam, mu)).max() == 0.0
+
+
+@pytest.mark.parametrize("element", ["P1", "P2"])
+def test_numba_stiffness_is_scikit_fems_linear_elasticity_form(element):
+    """reference.assembly sums the same integrand as scikit-fem's own form on a distorted
+    mesh (an independent writing of lam div u div v + 2 mu eps(u):eps(v))."""
+    from skfem import asm
+    from skfem.models.elasticity import linear_elasticity
+    from reference.assembly import elasticity_matrix
+    from reference.fem import element_basis, skfem_mesh
+    mesh = cube(3, 0.02, "unstructured", seed=3)
+    basis = element_basis(skfem_mesh(mesh), element)
+    ours = elasticity_matrix(basis, 3.7e4, 1.3e4)
+    theirs = asm(linear_elasticity(3.7e4, 1.3e4), basis).tocsr()
+    assert abs(ours - theirs).max() <= 1e-13 * abs(theirs).max()
+    assert abs(ours - ours.T).max() <= 1e-13 * abs(ours).max()
+
+
+@pytest.mark.parametrize("element", ["P1", "P2"])
+def test_numba_stiffness_energy_of_a_homogeneous_strain_is_the_closed_form(element):
+    """u = eps x on a cube of volume V: u^T K u = V (lam tr(eps)^2 + 2 mu eps:eps), exactly
+    (the field is in P1 and P2), and a rigid rotation carries no energy."""
+    from reference.assembly import elasticity_matrix
+    from reference.fem import element_basis, skfem_mesh
+    L, lam, mu = 0.02, 3.7e4, 1.3e4
+    basis = element_basis(skfem_mesh(cube(3, L, "six")), element)
+    K = elasticity_matrix(basis, lam, mu)
+    eps = np.array([[1e-3, 4e-4, -2e-4], [4e-4, -5e-4, 3e-4], [-2e-4, 3e-4, 2e-3]])
+    X = basis.doflocs                                   # (3, N): the location of each dof
+    comp = np.arange(basis.N) % 3                       # dofs interleave the components
+    u = np.einsum("ij,jn->in", eps, X)[comp, np.arange(basis.N)]
+    expected = L ** 3 * (lam * np.trace(eps) ** 2 + 2 * mu * np.sum(eps * eps))
+    assert u @ K @ u == pytest.approx(expected, rel=1e-12)
+    w = np.array([[0.0, -2e-3, 1e-3], [2e-3, 0.0, -3e-3], [-1e-3, 3e-3, 0.0]])  # skew
+    r = np.einsum("ij,jn->in", w, X)[comp, np.arange(basis.N)]
+    assert np.abs(K @ r).max() <= 1e-12 * np.abs(K).max() * np.abs(r).max()
