@@ -188,15 +188,21 @@ def _mesh_in_worker(job):
     matrices (reference.fem keeps the last ones assembled), which a (mesh, bc) per worker
     would assemble twice."""
     case, s, mesh_name = job
+    mesh_of = _built_once(case, s)
+    with one_blas_thread():
+        return mesh_name, [unit(case, s, mesh_name, bc, mesh_of) for bc in s.bcs]
+
+
+def _built_once(case, s):
+    """``mesh_of(name)``: the case's mesh ``name``, built on first use and then recalled, so
+    that its bcs share one mesh."""
     meshes = {}
 
     def mesh_of(name):
         if name not in meshes:
             meshes[name] = case.mesh(name, s)
         return meshes[name]
-
-    with one_blas_thread():
-        return mesh_name, [unit(case, s, mesh_name, bc, mesh_of) for bc in s.bcs]
+    return mesh_of
 
 
 def run(case, s, log=True, workers=None):
@@ -214,12 +220,7 @@ def run(case, s, log=True, workers=None):
                   disable=not (log and sys.stderr.isatty())) as bar:
         task = bar.add_task(case.name, total=len(units) * per_unit)
         if workers is None or len(s.meshes) < 2:
-            meshes = {}
-
-            def mesh_of(name):   # one mesh for all its bcs
-                if name not in meshes:
-                    meshes[name] = case.mesh(name, s)
-                return meshes[name]
+            mesh_of = _built_once(case, s)
 
             def step(text, done):
                 bar.update(task, description=text, advance=done)
