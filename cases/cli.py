@@ -334,11 +334,11 @@ def parser():
     b = sub.add_parser(
         "bless", help="rewrite the bounds from measured metrics and print what changed",
         description="Set the bounds of thresholds.toml from measured metrics. Without --metrics "
-                    "it first runs every case: in full mode (about 11 minutes on 2 cores) unless --quick "
-                    "is given. It keeps the bounds of runs it did not see (other modes, meshes, "
-                    "models) unless --prune is given, and each existing bound's tolerances "
-                    "unless --margin is given; new bounds get --margin or 0.1. It prints every "
-                    "bound it adds, changes or removes.")
+                    "it first runs every case: in full mode (about 11 minutes on 2 cores) unless "
+                    "--quick is given. It keeps the bounds of runs it did not see (other modes, "
+                    "meshes, models) unless --prune is given, and each existing bound's "
+                    "tolerances unless --margin is given; new bounds get --margin or 0.1. It "
+                    "prints every bound it adds, changes or removes.")
     b.add_argument("--margin", type=_number("--margin", "a relative tolerance, a number > 0",
                                             low=0), default=None,
                    help="relative tolerance rtol of every bound written (default: keep each "

@@ -1,10 +1,11 @@
-"""Worker processes for the independent (mesh, bc) units of a case.
+"""Worker processes for the independent meshes of a case.
 
-Each unit (its mesh, FEM references and every model's run) depends on nothing else, so a case
-runs its units on a pool of processes (``multiprocessing``'s spawn pool: no state is inherited
-from the parent, whose numba and BLAS threads are not fork-safe). A worker uses one BLAS
-thread, and so does a serial run (``one_blas_thread``): the dense eigensolvers' last bits then
-do not depend on how many workers ran, and metrics are the same for every ``--workers``.
+Each mesh (with its bcs: their FEM references and every model's runs) depends on nothing
+else, so a case runs its meshes on a pool of processes (``multiprocessing``'s spawn pool: no
+state is inherited from the parent, whose numba and BLAS threads are not fork-safe). A worker
+uses one BLAS thread, and so does a serial run (``one_blas_thread``): the dense eigensolvers'
+last bits then do not depend on how many workers ran, and metrics are the same for every
+``--workers``.
 
 Ctrl-C reaches the whole process group: workers ignore it and the parent, which owns the
 output folders, stops them (``Pool.terminate``) on its way out.
