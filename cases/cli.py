@@ -99,11 +99,34 @@ class UsageError(Exception):
     pass
 
 
+CHECKOUT_BENCH = Path(__file__).resolve().parents[1] / "reports" / "bench" / "bench.json"
+
+
 def _case(name):
-    from .registry import CASES
+    from .registry import CASES, STUDY_MODULES
     if name not in CASES:
-        raise UsageError(f"unknown case {name}; valid: {', '.join(CASES)}")
+        raise UsageError(f"unknown case {name}; valid: {', '.join([*CASES, *STUDY_MODULES])}")
     return CASES[name]
+
+
+def _study_config(study, args):
+    """A study's settings from the command line, checked before anything runs."""
+    from model.mesh import SCHEMES
+    if getattr(args, "bcs", None):
+        raise UsageError(f"--bcs does not apply to the {study.name} study: it runs each "
+                         "problem's own boundary conditions; leave --bcs out")
+    return study.settings(quick=args.quick, meshes=_choose("mesh", args.meshes, SCHEMES),
+                          models=_choose("model", args.models, list(model.PRESETS)),
+                          E=args.E, nu=args.nu, rho=args.rho)
+
+
+def _run_study_into(study, cfg, folder, workers=None):
+    """Run ``study`` and write its files into ``folder``; the step costs come from the bench
+    beside the folder (reports/bench), or the checkout's."""
+    from . import bench
+    here = Path(folder).parent / "bench" / "bench.json"
+    data = bench.load(here if here.is_file() else CHECKOUT_BENCH)
+    study.write(folder, cfg, study.run(cfg, workers=workers, bench=data))
 
 
 def _config(case, args):
@@ -126,11 +149,12 @@ def _run_into(name, cfg, folder, workers=None):
 
 
 def _workers(args, cfgs):
-    """The worker pool of a command (a context; nothing to start for one worker or one mesh
-    in every case: a worker runs one mesh with all its bcs)."""
+    """The worker pool of a command (a context; nothing to start for one worker or one unit
+    in every case: a worker runs one mesh of a case with all its bcs, or one problem and bc
+    of a study)."""
     from contextlib import nullcontext
     from .workers import Workers, available_cores
-    units = max(len(c.meshes) for c in cfgs.values())
+    units = max(len(c.meshes) if not hasattr(c, "problems") else 4 for c in cfgs.values())
     n = min(args.workers or available_cores(), units)
     return Workers(n) if n > 1 else nullcontext()
 
@@ -149,15 +173,29 @@ def _summary(case):
 
 def _list_command(args):
     from .registry import CASES
+    from .registry import studies
     for name, case in CASES.items():
         print(textwrap.fill(f"{name}: {_summary(case)}", width=96, subsequent_indent="  "))
         print(f"  meshes: {', '.join(case.meshes)} (quick: {', '.join(case.quick_meshes)})")
         print(f"  bcs:    {', '.join(case.bcs)}")
         print(f"  models: {', '.join(case.models)}")
+    for name, study in studies().items():
+        print(textwrap.fill(f"{name} (study): {_summary(study)}", width=96,
+                            subsequent_indent="  "))
     return 0
 
 
 def _run_command(args):
+    from .registry import STUDY_MODULES, studies
+    if args.case in STUDY_MODULES:
+        study = studies()[args.case]
+        cfg = _study_config(study, args)
+        with StagedFolder(Path(args.out) if args.out else Path("reports") / args.case) as out, \
+                _workers(args, {args.case: cfg}) as workers:
+            _run_study_into(study, cfg, out.path, workers)
+            path = out.commit()
+        print(f"{args.case}: written to {path}")
+        return 0
     cfgs = _configs([args.case], args)
     with StagedFolder(Path(args.out) if args.out else Path("reports") / args.case) as out, \
             _workers(args, cfgs) as workers:
@@ -182,17 +220,22 @@ def _bench_command(args):
 
 def _report_command(args):
     from contextlib import ExitStack
-    from .registry import CASES
+    from .registry import CASES, studies
     from .index import index_documents
     cfgs = _configs(CASES, args)
+    study_cfgs = {name: _study_config(st, args) for name, st in studies().items()}
     root = writable_folder(args.out or "reports")
     with ExitStack() as stack:   # every case folder checked and staged before any computing
-        staged = {name: stack.enter_context(StagedFolder(root / name)) for name in CASES}
-        workers = stack.enter_context(_workers(args, cfgs))
-        for name, out in staged.items():
-            runs = _run_into(name, cfgs[name], out.path, workers)
-            print(f"{name}: {len(runs)} runs written to {out.commit()}")
-    md, html = index_documents(root, list(CASES))
+        staged = {name: stack.enter_context(StagedFolder(root / name))
+                  for name in [*CASES, *study_cfgs]}
+        workers = stack.enter_context(_workers(args, {**cfgs, **study_cfgs}))
+        for name in CASES:
+            runs = _run_into(name, cfgs[name], staged[name].path, workers)
+            print(f"{name}: {len(runs)} runs written to {staged[name].commit()}")
+        for name, cfg in study_cfgs.items():
+            _run_study_into(studies()[name], cfg, staged[name].path, workers)
+            print(f"{name}: written to {staged[name].commit()}")
+    md, html = index_documents(root, list(CASES), list(study_cfgs))
     write_text_atomic(root / "index.md", md)
     write_text_atomic(root / "index.html", html)
     print(f"index written to {root / 'index.md'} and {root / 'index.html'}")
@@ -226,7 +269,7 @@ def _bless_command(args):
     it keeps: bounds of runs it did not see (other modes, meshes, models...) unless
     ``--prune``; each existing bound's tolerances unless ``--margin`` is given."""
     import tempfile
-    from .registry import CASES
+    from .registry import CASES, studies
     from .thresholds import CheckError, bless, dumps, load, measured
     path = Path(args.thresholds)
     try:   # every check before the run: the old file must load and the new one be writable
@@ -236,11 +279,15 @@ def _bless_command(args):
             values = measured(args.metrics)
         else:
             cfgs = _configs(CASES, args)
+            study_cfgs = {name: _study_config(st, args) for name, st in studies().items()}
             with tempfile.TemporaryDirectory(prefix="pbcm-bless-") as tmp, \
-                    _workers(args, cfgs) as workers:
+                    _workers(args, {**cfgs, **study_cfgs}) as workers:
                 for name in CASES:
                     (Path(tmp) / name).mkdir()
                     _run_into(name, cfgs[name], Path(tmp) / name, workers)
+                for name, cfg in study_cfgs.items():
+                    (Path(tmp) / name).mkdir()
+                    _run_study_into(studies()[name], cfg, Path(tmp) / name, workers)
                 values = measured(tmp)
         new, changes = bless(values, old, rtol=args.margin, prune=args.prune)
     except CheckError as exc:
@@ -293,7 +340,7 @@ def parser():
     ls = sub.add_parser("list", help="list the cases with their meshes, conditions and models")
     ls.set_defaults(func=_list_command)
     r = sub.add_parser("run", help="run one case and write its report folder")
-    r.add_argument("case", help="a case name (see pbcm list)")
+    r.add_argument("case", help="a case or study name (see pbcm list)")
     r.add_argument("--out", help="output folder (default reports/CASE)")
     _selection(r)
     r.set_defaults(func=_run_command)

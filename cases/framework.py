@@ -278,6 +278,39 @@ class Case(abc.ABC):
         """Case-specific sections and figures, written into ``out`` and added to ``doc``."""
 
 
+class Study(abc.ABC):
+    """A study: runs of its own shape (several cases, mesh sizes, derived fits) rather than
+    the (mesh, bc, model) runs of a Case; it runs, writes its folder and declares what the
+    gate reads. ``pbcm run NAME`` and ``pbcm report`` treat it as they treat a case.
+
+    Attributes
+    ----------
+    name, title : as for a Case.
+    """
+
+    name: ClassVar[str]
+    title: ClassVar[str]
+
+    @abc.abstractmethod
+    def settings(self, quick=False, **kw):
+        """The study's settings: full by default, quick overrides, then ``kw`` (None values
+        ignored). Settings have ``problem()`` (what the gate compares) and ``describe()``."""
+
+    @abc.abstractmethod
+    def run(self, s, workers=None, log=True, bench=None):
+        """Compute everything; return the data its ``write`` takes. ``bench`` is the
+        `pbcm bench` document (cost), or None."""
+
+    @abc.abstractmethod
+    def write(self, out, s, data):
+        """Write metrics.json (with ``gate_runs``: rows keyed by mesh, bc and model, and
+        ``gated``), the report and the figures into the folder ``out``."""
+
+    def headline(self, data):
+        """Sentences for the top of reports/index.md, computed from ``data``."""
+        return []
+
+
 def ref_name(name):
     """The run key of the FEM value of quantity ``name``: '_fem' before a unit suffix
     (bulge_profile_mm -> bulge_profile_fem_mm, zigzag -> zigzag_fem)."""
@@ -296,5 +329,5 @@ def err_name(name):
     return name + "_rel_err"
 
 
-__all__ = ["Case", "Settings", "Loads", "Traction", "Headline", "Reference", "MM",
+__all__ = ["Case", "Study", "Settings", "Loads", "Traction", "Headline", "Reference", "MM",
            "MESH_FAMILIES", "STANDARD_GATED", "ref_name", "err_name"]

@@ -71,14 +71,31 @@ def conclusion(table, metric):
     return out
 
 
-def index_documents(root, cases):
-    """The Markdown and HTML of reports/index."""
+def study_headlines(root, studies):
+    """{study: its headline sentences} for the studies whose metrics.json is under ``root``."""
+    from .registry import studies as declared
+    out = {}
+    for name in studies:
+        path = Path(root) / name / "metrics.json"
+        if path.is_file():
+            out[name] = declared()[name].headline(json.loads(path.read_text()))
+    return out
+
+
+def index_documents(root, cases, studies=()):
+    """The Markdown and HTML of reports/index: the studies' headlines first (the convergence
+    study says whether the models converge at all), then the cases' conclusion and
+    scorecard."""
     root = Path(root)
     table, metric, data = headline_table(root, cases)
     models = []
     for row in table.values():
         models += [m for m in row if m not in models]
     doc = Document("pbcm reports")
+    for name, lines in study_headlines(root, studies).items():
+        mode = " (quick mode)" if json.loads((root / name / "metrics.json").read_text())[
+            "parameters"]["quick"] else ""
+        doc.p(f"**{name}{mode}** ([report]({name}/report.md)): " + " ".join(lines))
     for line in conclusion(table, metric):
         doc.p(line)
     doc.h(2, "Scorecard")

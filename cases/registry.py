@@ -1,5 +1,6 @@
 """The case library: name -> the module that declares it (a ``CASE``, see
-``cases.framework.Case``). Adding a case is one line here."""
+``cases.framework.Case``), and the studies: name -> the module that declares a ``STUDY``
+(``cases.framework.Study``). Adding a case or a study is one line here."""
 import importlib
 
 MODULES = {
@@ -11,5 +12,13 @@ MODULES = {
     "self-weight": "cases.library.self_weight",
     "modes": "cases.library.modes",
 }
+STUDY_MODULES = {
+    "convergence": "cases.convergence",
+}
 
 CASES = {name: importlib.import_module(module).CASE for name, module in MODULES.items()}
+
+
+def studies():
+    """{name: Study}, imported on first use (a study builds on the cases)."""
+    return {name: importlib.import_module(module).STUDY for name, module in STUDY_MODULES.items()}

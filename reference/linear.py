@@ -33,6 +33,17 @@ class LinearResult:
     reaction: np.ndarray
     energy: float
     info: dict = field(default_factory=dict)
+    basis: object = field(default=None, repr=False)
+    dofs: np.ndarray = field(default=None, repr=False)
+
+    def at(self, points):
+        """The displacement (k, 3) of the finite-element solution at arbitrary ``points``
+        (k, 3) inside the mesh (its basis functions evaluated there, not the nodal values
+        interpolated): what compares a solution with results on another mesh."""
+        pts = np.asarray(points, dtype=float)
+        values = self.basis.probes(np.ascontiguousarray(pts.T)) @ self.dofs
+        return check_finite("displacement at the probed points",
+                            values.reshape(3, len(pts)).T.copy())
 
 
 @LinearForm
@@ -137,7 +148,7 @@ def solve(mesh, E, nu, dirichlet, body_force=None, traction=None, element="P1", 
                         max_shear=tmax, pressure=p, reaction=reaction,
                         energy=float(0.5 * u_all @ (K @ u_all)),
                         info={"element": element, "refine": int(refine), "dofs": int(basis.N),
-                              **sinfo})
+                              **sinfo}, basis=basis, dofs=u_all)
 
 
 def transfer_to_nodes(basis, W, dofs, values):

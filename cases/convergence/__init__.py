@@ -1,0 +1,45 @@
+"""Does each model converge to the continuum? The paper cube (clamped and sliding), the
+cantilever and the torsion bar at falling mesh sizes h on every mesh family, every model
+against one converged FEM reference per problem: observed order, extrapolated limit e_inf with
+its uncertainty and a verdict (converges, floor, diverges); the effective elasticity tensor of
+every model on every lattice, which explains the floors; and the error against the cost of one
+RK4 step, with the models on the Pareto front.
+"""
+from dataclasses import fields
+
+from ..framework import Study
+from . import report
+from .study import ConvergenceSettings, run
+
+
+class Convergence(Study):
+    name = "convergence"
+    title = ("h-convergence of every model on the paper cube, cantilever and torsion bar; "
+             "effective elasticity of every lattice; accuracy per cost")
+    # --quick: two levels on the two mesh families the paper cube's quick mode keeps
+    quick = {"h_mm": (8.0, 4.0), "meshes": ("five", "six")}
+
+    def settings(self, quick=False, **kw):
+        kw = {k: v for k, v in kw.items() if v is not None}
+        names = {f.name for f in fields(ConvergenceSettings) if f.init}
+        base = {**(self.quick if quick else {}), "quick": quick}
+        return ConvergenceSettings(**{k: v for k, v in {**base, **kw}.items() if k in names})
+
+    def run(self, s, workers=None, log=True, bench=None):
+        return run(s, workers=workers, log=log, bench=bench)
+
+    def write(self, out, s, data):
+        return report.write(out, self, s, data)
+
+    def headline(self, data):
+        """The conclusion of a written metrics.json, as the report opens with it."""
+        p = data["parameters"]
+        s = ConvergenceSettings(E=p["E_Pa"], nu=p["nu"], rho=p["rho_kg_m3"],
+                                problems=tuple(p["problems"]), meshes=tuple(p["meshes"]),
+                                models=tuple(p["models"]), h_mm=tuple(p["h_mm"]),
+                                load_scale=p["load_scale"], patch_n=p["patch_n"],
+                                quick=p["quick"])
+        return report.conclusion(s, data)
+
+
+STUDY = Convergence()

@@ -1,0 +1,67 @@
+"""Accuracy per cost: each run's displacement error against what one RK4 step of its model
+costs on its mesh, from `pbcm bench` (reports/bench/bench.json), and the Pareto front of the
+models: for a given cost budget, the least error any model reaches.
+
+The cost of a step on a mesh of T tetrahedra is fem-linear's step time interpolated in T
+(log-log between the bench sizes) times the model's step ratio to fem-linear at T, itself
+interpolated: the ratios are medians of interleaved rounds (one process), steadier than
+either time alone. Outside the bench sizes the nearest size's values are used.
+"""
+import numpy as np
+
+BASE = "fem-linear"
+
+
+def step_cost_us(bench, model, tets):
+    """Microseconds per RK4 step of ``model`` on ``tets`` tetrahedra, or None when the bench
+    lacks the model."""
+    rows = [r for r in bench["rows"] if r["model"] == model]
+    base = [r for r in bench["rows"] if r["model"] == BASE]
+    if not rows or not base:
+        return None
+    rows, base = sorted(rows, key=lambda r: r["tets"]), sorted(base, key=lambda r: r["tets"])
+    lt = np.log(tets)
+    t_base = np.exp(np.interp(lt, np.log([r["tets"] for r in base]),
+                              np.log([r["us_per_step"] for r in base])))
+    ratio = np.exp(np.interp(lt, np.log([r["tets"] for r in rows]),
+                             np.log([r[f"step_vs_{BASE}"] for r in rows])))
+    return float(t_base * ratio)
+
+
+def pareto(points):
+    """The indices of the points (cost, error) no other point beats in both (lower cost and
+    lower error, one of them strictly), in increasing cost."""
+    order = sorted(range(len(points)), key=lambda i: (points[i][0], points[i][1]))
+    front, best = [], np.inf
+    for i in order:
+        if points[i][1] < best:
+            front.append(i)
+            best = points[i][1]
+    return front
+
+
+def accuracy_per_cost(runs, bench):
+    """{"source", "groups": [{case, bc, points: [...], front: [...]}], "front_counts"}: every
+    model run with its step cost, grouped by (case, bc), and how often each model is on the
+    front. None without a bench."""
+    if not bench:
+        return None
+    groups, counts = [], {}
+    for case, bc in dict.fromkeys((r["case"], r["bc"]) for r in runs):
+        pts = []
+        for r in runs:
+            if (r["case"], r["bc"]) != (case, bc) or r.get("disp_rel_l2") is None:
+                continue
+            c = step_cost_us(bench, r["model"], r["tets"])
+            if c is not None:
+                pts.append({"model": r["model"], "mesh": r["mesh"], "h_mm": r["h_mm"],
+                            "tets": r["tets"], "cost_us": c, "disp_rel_l2": r["disp_rel_l2"]})
+        front = pareto([(p["cost_us"], p["disp_rel_l2"]) for p in pts])
+        for i in front:
+            counts[pts[i]["model"]] = counts.get(pts[i]["model"], 0) + 1
+        groups.append({"case": case, "bc": bc, "points": pts, "front": front})
+    return {"source": "reports/bench/bench.json", "groups": groups,
+            "front_counts": dict(sorted(counts.items(), key=lambda kv: -kv[1]))}
+
+
+__all__ = ["step_cost_us", "pareto", "accuracy_per_cost"]

@@ -1,0 +1,57 @@
+"""The effective elasticity of every model on every lattice (``model.homogenize``): a cube
+patch of the lattice, its surface moved by each unit homogeneous strain, its interior relaxed.
+"""
+import numpy as np
+
+from model import build
+from model.homogenize import (anisotropy_index, asymmetry, directional_young, distance,
+                              effective_stiffness, engineering_constants, isotropic_stiffness)
+from model.mesh import cube
+from .. import stop
+from ..runner import FINDINGS
+
+PATCH_MM = 32.0
+# directions of the directional Young's modulus figure: the x-y plane, every 5 degrees
+ANGLES_DEG = np.arange(0.0, 360.0 + 1e-9, 5.0)
+
+
+def patch(family, n):
+    """The lattice patch: a cube of ``n`` nodes per side (SI units)."""
+    return cube(n, PATCH_MM * 1e-3, family)
+
+
+def entry(model_name, family, s):
+    """C_eff of one model on one lattice and what it says, relative to the isotropic target
+    (E, nu of the settings)."""
+    mesh = patch(family, s.patch_n)
+    pm = build(model_name, mesh, s.material)
+    C = effective_stiffness(pm)
+    target = isotropic_stiffness(s.E, s.nu)
+    const = engineering_constants(C)
+    diag = np.array([[1, 1, 0], [1, -1, 0], [1, 1, 1]], float)
+    E_dir = directional_young(C, diag)
+    theta = np.radians(ANGLES_DEG)
+    return {"model": model_name, "mesh": family, "C_eff_Pa": C.tolist(),
+            **{k: v for k, v in const.items()},
+            "E_110": float(E_dir[0]), "E_111": float(E_dir[2]),
+            "anisotropy_AU": anisotropy_index(C), "distance": distance(C, target),
+            "asymmetry": asymmetry(C),
+            "E_xy_plane": directional_young(
+                C, np.column_stack([np.cos(theta), np.sin(theta), 0 * theta])).tolist()}
+
+
+def table(s):
+    """Every (model, lattice) entry; a model whose patch stiffness is singular (no interior
+    equilibrium) is recorded with the reason."""
+    out = []
+    for family in s.meshes:
+        for name in s.models:
+            stop.checkpoint()
+            try:
+                out.append(entry(name, family, s))
+            except FINDINGS as exc:
+                out.append({"model": name, "mesh": family, "failed": str(exc)})
+    return out
+
+
+__all__ = ["table", "entry", "patch", "ANGLES_DEG", "PATCH_MM"]

@@ -1,0 +1,142 @@
+"""What a sequence of errors at falling mesh sizes says: the observed order, the limit e_inf of
+e(h) = e_inf + C h^p (MODEL.md "Convergence and effective elasticity") with its uncertainty,
+and a verdict.
+
+The limit is Richardson's extrapolation from the three finest levels, its uncertainty Roache's
+grid convergence index (GCI, Roache 1994, J. Fluids Eng. 116: 405-413): the extrapolation's
+correction times a safety factor, 1.25 with three or more levels, 3 with two. With two levels
+no order can be observed: the extrapolation then assumes first order, the lowest a consistent
+model shows, which gives the smallest floor the two errors allow. With four or more levels a
+least-squares fit of all of them is reported as well, and the larger uncertainty kept.
+"""
+from dataclasses import dataclass
+import math
+
+import numpy as np
+from scipy.optimize import brentq, least_squares
+
+FS_THREE, FS_TWO = 1.25, 3.0   # Roache's safety factors for 3+ and for 2 levels
+ASSUMED_ORDER = 1.0            # the order assumed with two levels
+GROWTH = 1.1                   # error at the finest level above this x the coarsest: diverges
+# errors all below this are the reference itself: the static solver's tolerance (1e-12 of
+# E h^2) and the nonlinearity left at the study's scaled load (strains about 5e-5)
+EXACT = 1e-4
+ORDER_RANGE = (0.05, 8.0)      # orders the three-level equation is solved over
+
+
+@dataclass(frozen=True)
+class Fit:
+    """``order`` observed (None when the errors do not fall monotonically), ``e_inf`` the
+    extrapolated limit, ``e_inf_err`` its uncertainty, ``verdict`` 'exact', 'converges',
+    'floor' or 'diverges', ``why`` one sentence, ``levels`` the number of mesh sizes used."""
+
+    order: float
+    e_inf: float
+    e_inf_err: float
+    verdict: str
+    why: str
+    levels: int
+
+    def label(self):
+        """The verdict as the report prints it."""
+        if self.verdict == "converges":
+            return ("converges" if self.order is None else f"converges (order {self.order:.2g})")
+        if self.verdict == "exact":
+            return "exact"
+        if self.verdict == "floor":
+            return f"floor {self.e_inf:.2g} +- {self.e_inf_err:.1g}"
+        return "diverges"
+
+
+def observed_order(h, e):
+    """The order p of e = e_inf + C h^p through three points (h descending), or None when the
+    differences change sign or do not shrink (no asymptotic range)."""
+    (h1, h2, h3), (e1, e2, e3) = h, e
+    d1, d2 = e1 - e2, e2 - e3
+    if d1 == 0 or d2 == 0 or (d1 > 0) != (d2 > 0) or abs(d1) <= abs(d2):
+        return None
+    ratio = d1 / d2
+
+    def gap(p):
+        return (h1**p - h2**p) / (h2**p - h3**p) - ratio
+    lo, hi = ORDER_RANGE
+    if gap(lo) * gap(hi) > 0:
+        return None
+    return float(brentq(gap, lo, hi, xtol=1e-12))
+
+
+def _least_squares(h, e, p0, e0):
+    """(e_inf, its standard error) of the least-squares fit e = e_inf + C h^p over all
+    levels, or None when it is not determined (as many levels as unknowns)."""
+    h, e = np.asarray(h, float), np.asarray(e, float)
+    if len(h) <= 3:
+        return None
+    scale = h.max()
+    c0 = (e[-1] - e0) / (h[-1] / scale) ** p0
+
+    def resid(q):
+        return q[0] + q[1] * (h / scale) ** q[2] - e
+    sol = least_squares(resid, [e0, c0, p0], bounds=([-np.inf, -np.inf, ORDER_RANGE[0]],
+                                                     [np.inf, np.inf, ORDER_RANGE[1]]))
+    dof = len(h) - 3
+    s2 = float(sol.fun @ sol.fun) / dof
+    try:
+        cov = np.linalg.inv(sol.jac.T @ sol.jac) * s2
+    except np.linalg.LinAlgError:
+        return None
+    return float(sol.x[0]), float(math.sqrt(max(cov[0, 0], 0.0)))
+
+
+def extrapolate(h, v):
+    """(limit, uncertainty, observed order or None) of values ``v`` at mesh sizes ``h`` (h
+    descending, at least two): Richardson on the three finest levels with Roache's GCI, the
+    least-squares fit of all when there are four or more; with two levels first order
+    assumed; without an asymptotic range the last value within the last changes."""
+    n = len(h)
+    r = h[-2] / h[-1]
+    p = observed_order(h[-3:], v[-3:]) if n >= 3 else None
+    if p is not None:
+        corr = (v[-2] - v[-1]) / (r**p - 1)
+        limit, err = v[-1] - corr, FS_THREE * abs(corr)
+        ls = _least_squares(h, v, p, limit)
+        if ls is not None:
+            limit, err = ls[0], max(err, ls[1])
+        return limit, err, p
+    if n >= 3:
+        return v[-1], FS_THREE * max(abs(v[-1] - v[-2]), abs(v[-2] - v[-3])), None
+    corr = (v[-2] - v[-1]) / (r**ASSUMED_ORDER - 1)
+    return v[-1] - corr, FS_TWO * abs(corr), None
+
+
+def fit(h, e):
+    """The Fit of errors ``e`` at mesh sizes ``h`` (any order; NaN-free, at least two)."""
+    order = np.argsort(h)[::-1]
+    h = [float(h[i]) for i in order]
+    e = [float(e[i]) for i in order]
+    if len(h) < 2:
+        raise ValueError("a convergence fit needs errors at two mesh sizes at least")
+    if not all(math.isfinite(v) for v in h + e):
+        raise ValueError(f"a convergence fit needs finite errors, got {e}")
+    n = len(h)
+    if max(e) < EXACT:
+        return Fit(None, e[-1], max(e), "exact",
+                   f"every error is below {EXACT:g}: the reference's own to within its "
+                   "solver and the load's remaining nonlinearity", n)
+    if e[-1] > GROWTH * e[0]:
+        return Fit(None, e[-1], abs(e[-1] - e[-2]), "diverges",
+                   f"the error grows from {e[0]:.3g} to {e[-1]:.3g} as h falls", n)
+    e_inf, err, p = extrapolate(h, e)
+    r = h[-2] / h[-1]
+    p_obs = p if p is not None else (
+        math.log(e[-2] / e[-1]) / math.log(r) if n == 2 and e[-1] > 0 and e[-2] > e[-1]
+        else None)
+    if e_inf - err > 0 and e_inf > 0.2 * e[-1]:
+        return Fit(p_obs, e_inf, err, "floor",
+                   f"the error tends to {e_inf:.3g} +- {err:.2g}, which no refinement removes",
+                   n)
+    why = (f"observed order {p_obs:.2g}" if p_obs is not None else
+           "no asymptotic order observed, but no floor distinguishable from zero")
+    return Fit(p_obs, e_inf, err, "converges", why + f"; limit {e_inf:.2g} +- {err:.2g}", n)
+
+
+__all__ = ["Fit", "fit", "extrapolate", "observed_order", "EXACT"]

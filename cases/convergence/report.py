@@ -1,0 +1,296 @@
+"""The convergence study's files: metrics.json (runs, fits, references, effective elasticity,
+accuracy per cost, and the rows the gate reads), report.md/.html and the figures. Every
+sentence is computed from the data it is written with."""
+import json
+from pathlib import Path
+
+import numpy as np
+
+from ..document import Document, fmt
+from ..report import environment, provenance
+from ..runner import jsonable
+from . import plots
+from .elasticity import ANGLES_DEG, PATCH_MM
+from .problems import PROBLEMS
+from .fit import EXACT
+from .study import FEM_P1, MAX_NODES, REF_H_MAX_MM
+
+# what the gate bounds (two-sided) in the study's rows; fits and tensors are derived from runs
+# but gated too, so that a changed verdict shows as a changed e_inf
+GATED = {"disp_rel_l2": "max", "reaction_rel_err": "max", "e_inf": "max",
+         "distance": "max", "anisotropy_AU": "max"}
+ISOTROPIC_TOL = 0.01    # ||C_eff - C|| / ||C|| below this: the lattice answers as the target
+
+
+def gate_rows(data):
+    """The study's rows as the gate reads them: (mesh, bc, model) keys where bc names the
+    problem, its boundary condition and the level ('paper-cube/clamped/h4'), the fit
+    ('.../fit') or the effective tensor ('C_eff')."""
+    rows = [{"mesh": r["mesh"], "bc": f"{r['case']}/{r['bc']}/h{r['h_mm']:.4g}",
+             "model": r["model"], "disp_rel_l2": r.get("disp_rel_l2"),
+             "reaction_rel_err": r.get("reaction_rel_err")} for r in data["runs"]]
+    rows += [{"mesh": f["mesh"], "bc": f"{f['case']}/{f['bc']}/fit", "model": f["model"],
+              "e_inf": f.get("e_inf")} for f in data["fits"]]
+    rows += [{"mesh": e["mesh"], "bc": "C_eff", "model": e["model"],
+              "distance": e.get("distance"), "anisotropy_AU": e.get("anisotropy_AU")}
+             for e in data["elasticity"]]
+    return rows
+
+
+def metrics_document(study, s, data):
+    return jsonable({"case": study.name, "study": True, "parameters": s.describe(),
+                     "problem": s.problem(), "gated": GATED, "environment": environment(),
+                     **data, "gate_runs": gate_rows(data)})
+
+
+# ---------------------------------------------------------------------- sentences
+def _by_model(fits, models):
+    return {m: [f for f in fits if f["model"] == m and f.get("verdict") in
+                ("exact", "converges", "floor", "diverges")] for m in models}
+
+
+def conclusion(s, data):
+    """The study's headline: which models converge to the continuum, which stop at a floor
+    (and how high), what the lattices' effective tensors say, and who is on the cost front."""
+    models = [FEM_P1] + list(s.models)
+    by = _by_model(data["fits"], models)
+    conv = [m for m in models if by[m] and all(f["verdict"] in ("converges", "exact")
+                                                for f in by[m])]
+    floors = {m: [f for f in by[m] if f["verdict"] == "floor"] for m in models}
+    floored = [m for m in models if floors[m]]
+    out = []
+    total = len(by[models[0]]) if by[models[0]] else 0
+    out.append(
+        f"Convergence (h = {', '.join(f'{h:.3g}' for h in s.h_mm)} mm, {total} problem x mesh "
+        f"family combinations): converging everywhere: {', '.join(conv) or 'none'}; stopping "
+        "at a floor that no refinement removes: " + ("; ".join(
+            f"{m} in {len(floors[m])} of {len(by[m])} (median floor "
+            f"{np.median([f['e_inf'] for f in floors[m]]):.2g})" for m in floored) or "none")
+        + ".")
+    div = sorted({f["model"] for f in data["fits"] if f.get("verdict") == "diverges"})
+    if div:
+        out.append("Diverging somewhere (error growing as h falls): " + ", ".join(div) + ".")
+    eff = [e for e in data["elasticity"] if not e.get("failed")]
+    exact = [m for m in s.models if all(e["distance"] < ISOTROPIC_TOL for e in eff
+                                         if e["model"] == m)]
+    worst = {m: max((e for e in eff if e["model"] == m), key=lambda e: e["distance"])
+             for m in s.models if any(e["model"] == m for e in eff)}
+    out.append(
+        f"Effective elasticity: isotropic and equal to the target (within {ISOTROPIC_TOL:.0%}) "
+        f"on every lattice: {', '.join(exact) or 'none'}; farthest: " + "; ".join(
+            f"{m} {w['distance']:.2g} on {w['mesh']}" for m, w in sorted(
+                worst.items(), key=lambda kv: -kv[1]["distance"]) if m not in exact)
+        + ": a model whose lattice tensor is not the target's cannot converge to the "
+        "continuum, whatever h.")
+    c = data.get("cost")
+    if c:
+        counts = c["front_counts"]
+        out.append("Least error for a given step cost (the Pareto front over every run): "
+                   + ", ".join(f"{m} ({n} of the front's points)" for m, n in counts.items())
+                   + f", over {len(c['groups'])} problems.")
+    return out
+
+
+def ties(s, data):
+    """The reaction ratios explained by the effective tensors: on the sliding cube the state
+    is uniaxial stress, so a model whose lattice answers homogeneously gives a reaction ratio
+    of E_y,eff / E in the limit."""
+    out = []
+    eff = {(e["mesh"], e["model"]): e for e in data["elasticity"] if not e.get("failed")}
+    for f in data["fits"]:
+        if f["case"] != "paper-cube" or f["bc"] != "sliding" or f["model"] == FEM_P1:
+            continue
+        e = eff.get((f["mesh"], f["model"]))
+        rs = [r for r in data["runs"] if (r["case"], r["bc"], r["mesh"], r["model"])
+              == ("paper-cube", "sliding", f["mesh"], f["model"])
+              and r.get("reaction_ratio") is not None]
+        if e is None or not rs:
+            continue
+        fine = min(rs, key=lambda r: r["h_mm"])
+        out.append(f"{f['model']} on {f['mesh']}: sliding-cube reaction ratio "
+                   f"{fine['reaction_ratio']:.3g} at h = {fine['h_mm']:.3g} mm (limit "
+                   f"{fmt(f.get('ratio_inf'))}), lattice E_y,eff / E = {e['E_y'] / s.E:.3g}, "
+                   f"nu_yx = {e['nu_yx']:.3g} (target {s.nu:g}).")
+    return out
+
+
+# ---------------------------------------------------------------------- the document
+def write(out, study, s, data):
+    """Write metrics.json, run.json, report.md/.html and the PNG figures into ``out``."""
+    out = Path(out)
+    out.mkdir(parents=True, exist_ok=True)
+    (out / "metrics.json").write_text(json.dumps(metrics_document(study, s, data), indent=1)
+                                      + "\n")
+    prov = provenance([])
+    prov.pop("timings")
+    (out / "run.json").write_text(json.dumps(prov, indent=1) + "\n")
+    build(out, study, s, data).write(out)
+    return out
+
+
+def build(out, study, s, data):
+    doc = Document(f"pbcm report: {study.name}")
+    for line in conclusion(s, data):
+        doc.p(line)
+    doc.p("Generated by `pbcm run convergence` from the runs recorded in metrics.json; every "
+          "number below was computed by the run that wrote this file, but the step costs, which "
+          "are `pbcm bench`'s (reports/bench).")
+    doc.h(2, "What was run")
+    refs = data["references"]
+    doc.ul([
+        study.title + ".",
+        "Problems: " + "; ".join(f"{p} ({', '.join(PROBLEMS[p].bcs)}; stiffness read as "
+                                 f"{PROBLEMS[p].label})" for p in s.problems) + ".",
+        f"Mesh families {', '.join(s.meshes)} at h = {', '.join(f'{h:.3g}' for h in s.h_mm)} "
+        f"mm (nodes every h), where the mesh has at most {MAX_NODES} nodes; models "
+        f"{', '.join(s.models)}, and FEM P1 (scikit-fem) on the same mesh as the yardstick.",
+        f"Loads of each case scaled by {s.load_scale:g}: every model answers in its linear "
+        "regime, so its limit h -> 0 is the linear continuum and what remains there is its "
+        "consistency error, not geometric nonlinearity (the subject of large-compression).",
+        f"Reference per problem: FEM P2 on the 'five' mesh at h = {REF_H_MAX_MM:g} mm, "
+        "evaluated at every model mesh's nodes by its own basis functions; its error estimate "
+        "comes from P2 at 8, 4 and 2 mm (Richardson on the nodal change at the coarsest "
+        "mesh's nodes): " + "; ".join(f"{r['case']} {r['bc']} {fmt(r['error_estimate'], 2)}"
+                                      for r in refs) + ".",
+        f"Effective elasticity: a {PATCH_MM:g} mm cube patch of each lattice with {s.patch_n} "
+        "nodes per side; surface nodes moved by each unit homogeneous strain, interior relaxed "
+        "(the model's Jacobian at rest, condensed); C_eff from the averaged surface forces.",
+        f"Material E = {s.E:g} Pa, nu = {s.nu:g}.",
+        "Quick mode." if s.quick else "Full mode."])
+    worst_ref = max((r["error_estimate"] for r in refs), default=float("nan"))
+    exact = {(f["case"], f["bc"], f["mesh"], f["model"]) for f in data["fits"]
+             if f.get("verdict") == "exact"}
+    errs = [r["disp_rel_l2"] for r in data["runs"] if r.get("disp_rel_l2") is not None
+            and (r["case"], r["bc"], r["mesh"], r["model"]) not in exact]
+    doc.p(f"The references' largest error estimate is {fmt(worst_ref, 2)}; the smallest "
+          f"error of any run not exact (below {EXACT:g} at every h) is "
+          f"{fmt(min(errs, default=None), 2)}"
+          + (f", {min(errs) / worst_ref:.3g}x the largest reference estimate."
+             if errs and worst_ref > 0 else "."))
+    doc.h(2, "Definitions")
+    doc.ul([
+        "disp error: ||u_model - u_ref|| / ||u_ref|| over all nodes and components, u_ref the "
+        "reference's displacement at the model mesh's nodes.",
+        "stiffness (reaction) ratio: model over FEM for a force (paper cube: the top force; "
+        "torsion: the torque), FEM over model for a displacement under a given load "
+        "(cantilever: the tip deflection), so that above 1 is always stiffer.",
+        "order: p of e = e_inf + C h^p observed on the three finest levels (Richardson); with "
+        "two levels log(e1 / e2) / log(h1 / h2), the order if e_inf were 0.",
+        "e_inf +- err: the extrapolated limit of the error and Roache's grid convergence index "
+        "(safety factor 1.25 with three levels or more; with two, first order assumed and "
+        "factor 3); with four levels or more the least-squares fit of all, with the larger "
+        "uncertainty.",
+        f"verdict: 'exact' when every error is below {EXACT:g} (the reference's own level: "
+        "the static solver's tolerance and the nonlinearity left at the scaled load); 'floor' when e_inf - err > 0 and e_inf > 0.2 x the finest error (a "
+        "consistency error no refinement removes); 'diverges' when the finest error exceeds "
+        "the coarsest by 10 %; otherwise 'converges' (with the order when one is observed).",
+        "C_eff: 6 x 6 in Voigt order (xx, yy, zz, yz, xz, xy), engineering shear; E_i = "
+        "1 / S_ii, nu_ij = -S_ij / S_ii, G = 1 / S_44.. with S = C_eff^-1 (symmetric part); "
+        "A_U = 5 G_V / G_R + K_V / K_R - 6 (0 for isotropy); distance ||C_eff - C|| / ||C|| "
+        "against the isotropic C of E and nu; asymmetry ||C_eff - C_eff^T|| / ||C_eff|| (zero "
+        "for a model with an energy).",
+        "step cost: microseconds per RK4 step of the model on the run's mesh, fem-linear's "
+        "bench time interpolated log-log in the tetrahedron count times the model's step "
+        "ratio to fem-linear (medians of interleaved rounds)."])
+    doc.h(2, "Convergence")
+    for name in s.problems:
+        for bc in PROBLEMS[name].bcs:
+            _problem_section(doc, out, s, data, name, bc)
+    doc.h(2, "Effective elasticity")
+    _elasticity_section(doc, out, s, data)
+    doc.h(2, "Accuracy per cost")
+    _cost_section(doc, out, s, data)
+    bad = [r for r in data["runs"] if r.get("failed")]
+    if bad:
+        doc.h(2, "Runs without equilibrium")
+        doc.ul(sorted({f"{r['model']} on {r['case']}/{r['bc']}/{r['mesh']} at h = "
+                       f"{r['h_mm']:.3g} mm: {r['failed']}" for r in bad}))
+    return doc
+
+
+def _problem_section(doc, out, s, data, name, bc):
+    runs = [r for r in data["runs"] if r["case"] == name and r["bc"] == bc]
+    fits = {(f["mesh"], f["model"]): f for f in data["fits"]
+            if f["case"] == name and f["bc"] == bc}
+    models = [FEM_P1] + list(s.models)
+    hs = sorted({r["h_mm"] for r in runs}, reverse=True)
+    doc.h(3, f"{name}, {bc}")
+    ref = next((r for r in data["references"] if r["case"] == name and r["bc"] == bc), None)
+    if ref:
+        doc.p(f"Reference: FEM P2, {ref['dofs']} unknowns, {PROBLEMS[name].label} "
+              f"{ref['response_fem']:.4g} (SI units), error estimate "
+              f"{fmt(ref['error_estimate'], 2)}.")
+    header = ["mesh", "model"] + [f"e @ {h:.3g}" for h in hs] + \
+        ["order", "e_inf +- err", "verdict", f"ratio @ {hs[-1]:.3g}" if hs else "ratio",
+         "ratio limit"]
+    rows = []
+    series = {}
+    for fam in s.meshes:
+        for m in models:
+            rs = {r["h_mm"]: r for r in runs if r["mesh"] == fam and r["model"] == m}
+            if not rs:
+                continue
+            f = fits.get((fam, m), {})
+            pts = [(h, rs[h]["disp_rel_l2"]) for h in hs if h in rs
+                   and rs[h].get("disp_rel_l2") is not None]
+            if pts:
+                series[(fam, m)] = tuple(zip(*pts))
+            finest = rs[min(rs)]
+            rows.append([fam, m] + [fmt(rs[h].get("disp_rel_l2")) if h in rs else "-"
+                                    for h in hs]
+                        + [fmt(f.get("order"), 2),
+                           "n/a" if f.get("e_inf") is None
+                           else f"{f['e_inf']:.2g} +- {f['e_inf_err']:.1g}",
+                           f.get("verdict", "n/a"), fmt(finest.get("reaction_ratio")),
+                           fmt(f.get("ratio_inf"))])
+    doc.table(header, rows)
+    png = f"convergence_{name}_{bc}.png"
+    plots.error_vs_h(out / png, f"{name}, {bc}: displacement error against h",
+                     list(s.meshes), list(s.models), series, FEM_P1)
+    doc.img(png, f"{name}, {bc}: error against h, per mesh family (FEM P1 in black)")
+
+
+def _elasticity_section(doc, out, s, data):
+    eff = [e for e in data["elasticity"] if not e.get("failed")]
+    G = s.E / (2 * (1 + s.nu))
+    doc.p(f"Target: isotropic E = {s.E:g} Pa, nu = {s.nu:g}, G = {G:.4g} Pa. Moduli below are "
+          "over the target's.")
+    doc.table(["lattice", "model", "E_x/E", "E_y/E", "E_z/E", "E_110/E", "E_111/E", "nu_yx",
+               "nu_xz", "G_yz/G", "G_xz/G", "G_xy/G", "A_U", "distance", "asymmetry"],
+              [[e["mesh"], e["model"], fmt(e["E_x"] / s.E), fmt(e["E_y"] / s.E),
+                fmt(e["E_z"] / s.E), fmt(e["E_110"] / s.E), fmt(e["E_111"] / s.E),
+                fmt(e["nu_yx"]), fmt(e["nu_xz"]), fmt(e["G_yz"] / G), fmt(e["G_xz"] / G),
+                fmt(e["G_xy"] / G), fmt(e["anisotropy_AU"], 2), fmt(e["distance"], 2),
+                fmt(e["asymmetry"], 2)] for e in eff])
+    failed = [e for e in data["elasticity"] if e.get("failed")]
+    if failed:
+        doc.p("No effective tensor: " + "; ".join(f"{e['model']} on {e['mesh']}: {e['failed']}"
+                                                  for e in failed) + ".")
+    doc.h(3, "What the tensors explain")
+    doc.ul(ties(s, data))
+    plots.directional_young(out / "directional_young.png", ANGLES_DEG, list(s.meshes),
+                            list(s.models), {(e["mesh"], e["model"]): e["E_xy_plane"]
+                                             for e in eff}, s.E)
+    doc.img("directional_young.png", "Directional Young's modulus per lattice and model")
+
+
+def _cost_section(doc, out, s, data):
+    c = data.get("cost")
+    if not c:
+        doc.p("No benchmark found (reports/bench/bench.json): run `pbcm bench` for the step "
+              "costs.")
+        return
+    rows = []
+    for g in c["groups"]:
+        front = [g["points"][i] for i in g["front"]]
+        rows.append([f"{g['case']} {g['bc']}", len(g["points"]), "; ".join(
+            f"{p['model']} ({p['mesh']}, h {p['h_mm']:.3g}: {p['cost_us']:.3g} us, "
+            f"e {p['disp_rel_l2']:.2g})" for p in front)])
+    doc.p("The Pareto front of each problem: the runs no other run beats in both step cost "
+          "and displacement error, cheapest first.")
+    doc.table(["problem", "runs", "front"], rows)
+    plots.pareto(out / "pareto.png", c["groups"], list(s.models))
+    doc.img("pareto.png", "Error against the cost of one RK4 step, with the Pareto front")
+
+
+__all__ = ["write", "conclusion", "gate_rows", "GATED", "metrics_document"]

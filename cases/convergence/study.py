@@ -1,0 +1,296 @@
+"""The convergence study: every model on every mesh family at falling mesh sizes h, for the
+paper cube (clamped and sliding), the cantilever and the torsion bar, against one converged FEM
+reference per problem; then the fits, the effective elasticity of every model on every lattice
+and the accuracy per cost.
+"""
+from dataclasses import dataclass, field
+import sys
+import time
+
+import numpy as np
+from rich.console import Console
+from rich.progress import BarColumn, Progress, TextColumn, TimeElapsedColumn, TimeRemainingColumn
+
+from model import PRESETS, Material, build
+from reference import linear
+from .. import metrics as M
+from .. import stop
+from ..framework import MESH_FAMILIES
+from ..runner import FINDINGS, jsonable
+from ..workers import one_blas_thread
+from . import cost, elasticity
+from .fit import extrapolate, fit
+from .problems import PROBLEMS
+
+FEM_P1 = "FEM P1"              # the yardstick: scikit-fem P1 on the model's own mesh
+REF_H_MAX_MM = 2.0             # the reference is P2 at this spacing or the finest run, if finer
+MAX_NODES = 10_000             # a level is run where its mesh fits: Newton's sparse LU on a
+#                                bcc cube of 29 449 nodes took 5 min per model here
+STATIC_RTOL = 1e-12            # the static residual, relative to E h^2: far below the errors
+
+
+@dataclass
+class ConvergenceSettings:
+    """What the study runs: material, problems, mesh families, models, the mesh sizes h [mm],
+    the load scale (linear regime) and the lattice patch of the effective elasticity."""
+
+    E: float = 10e3
+    nu: float = 0.45
+    rho: float = 1000.0
+    problems: tuple = tuple(PROBLEMS)
+    meshes: tuple = MESH_FAMILIES
+    models: tuple = tuple(PRESETS)
+    h_mm: tuple = (8.0, 4.0, 2.0, 4.0 / 3.0)
+    load_scale: float = 1e-3
+    patch_n: int = 9
+    quick: bool = False
+    material: Material = field(init=False, repr=False, compare=False)
+
+    def __post_init__(self):
+        self.material = Material(E=self.E, nu=self.nu, rho=self.rho)
+
+    def problem(self):
+        """What the gate compares: the problem the metrics answer."""
+        return {"E_Pa": self.E, "nu": self.nu, "rho_kg_m3": self.rho,
+                "h_mm": [round(h, 6) for h in self.h_mm], "load_scale": self.load_scale,
+                "ref_h_max_mm": REF_H_MAX_MM, "max_nodes": MAX_NODES, "patch_n": self.patch_n}
+
+    def describe(self):
+        return {**self.problem(), "problems": list(self.problems), "meshes": list(self.meshes),
+                "bcs": sorted({bc for p in self.problems for bc in PROBLEMS[p].bcs}),
+                "models": list(self.models), "quick": self.quick}
+
+
+def levels(problem, family, s):
+    """The mesh sizes run for ``problem`` on ``family``: every h of the settings whose mesh
+    has at most MAX_NODES nodes (bcc adds a node per cell)."""
+    out = []
+    for h in s.h_mm:
+        n = np.prod(problem.nodes_per_side(h))
+        cells = np.prod([k - 1 for k in problem.nodes_per_side(h)])
+        if n + (cells if family == "bcc" else 0) <= MAX_NODES:
+            out.append(h)
+    return out
+
+
+# ---------------------------------------------------------------------- the FEM reference
+@dataclass
+class ProblemReference:
+    """The converged FEM of one (problem, bc): P2 on the structured mesh at ``h_mm``, its
+    response, and its own error estimate from P2 on the coarser levels."""
+
+    problem: str
+    bc: str
+    h_mm: float
+    result: object
+    response: float
+    error_estimate: float
+    increments: list
+    order: float
+
+    def summary(self):
+        return {"case": self.problem, "bc": self.bc, "ref_h_mm": self.h_mm,
+                "element": "P2", "dofs": self.result.info["dofs"],
+                "response_fem": self.response, "error_estimate": self.error_estimate,
+                "increments": self.increments, "order": self.order}
+
+
+def solve_reference(problem, bc, s, hs):
+    """P2 on the 'five' mesh at each spacing of ``hs`` down to the reference's (REF_H_MAX_MM);
+    the finest is the reference, the others give its error estimate: the relative L2 change
+    of the displacement at the nodes of the coarsest mesh between successive levels,
+    extrapolated to the finest (``reference.linear.richardson``: the last change itself where
+    no order above 0.5 is observed)."""
+    ref_h = REF_H_MAX_MM
+    ladder = sorted({h for h in hs if h > ref_h} | {ref_h}, reverse=True)
+    probe_mesh = problem.mesh("five", ladder[0])
+    ps = problem.settings(s.E, s.nu)
+    sols, finest = [], None
+    for h in ladder:
+        stop.checkpoint()
+        mesh = problem.mesh("five", h)
+        loads = problem.loads(mesh, bc, ps, s.load_scale)
+        r = linear.solve(mesh, s.E, s.nu, problem.dirichlet(mesh, bc, ps, s.load_scale),
+                         element="P2", solver=problem.spec.fem_solver, **_fem_loads(loads, mesh))
+        sols.append(r.at(probe_mesh.points))
+        finest = (mesh, r)
+    norm = max(float(np.linalg.norm(sols[-1])), 1e-300)
+    inc = [float(np.linalg.norm(b - a)) / norm for a, b in zip(sols, sols[1:])]
+    order, est = linear.richardson(inc)       # the ladder halves h
+    order = order if np.isfinite(order) else None
+    mesh, r = finest
+    response = problem.response_value(mesh, r.u, r.reaction, bc, ps)
+    return ProblemReference(problem.case, bc, ref_h, r, response, float(est), inc, order)
+
+
+# ---------------------------------------------------------------------- one (problem, bc, family)
+def family_runs(problem, bc, family, s, ref, hs):
+    """The runs of every model and of FEM P1 on ``family`` at each of ``hs``."""
+    rows = []
+    ps = problem.settings(s.E, s.nu)
+    for h in hs:
+        stop.checkpoint()
+        mesh = problem.mesh(family, h)
+        dirichlet = problem.dirichlet(mesh, bc, ps, s.load_scale)
+        loads = problem.loads(mesh, bc, ps, s.load_scale)
+        u_ref = ref.result.at(mesh.points)
+        fem = (ref.response if problem.reference_on_reference_mesh()
+               else problem.response_value(mesh, u_ref, None, bc, ps))
+        base = {"case": problem.case, "mesh": family, "bc": bc, "h_mm": float(h),
+                "nodes": mesh.n_nodes, "tets": mesh.n_tets, "response_fem": fem}
+        p1 = linear.solve(mesh, s.E, s.nu, dirichlet, element="P1",
+                          solver=problem.spec.fem_solver,
+                          **_fem_loads(loads, mesh))
+        rows.append({**base, "model": FEM_P1, **_metrics(problem, mesh, bc, ps, p1.u,
+                                                         p1.reaction, u_ref, fem)})
+        f_ext = loads.nodal_forces(mesh)
+        for name in s.models:
+            stop.checkpoint()
+            row = {**base, "model": name, "failed": None}
+            try:
+                pm = build(name, mesh, s.material)
+                st = pm.solve_static(dirichlet, f_ext=f_ext, rtol=STATIC_RTOL)
+                row.update(_metrics(problem, mesh, bc, ps, st.u, st.reaction, u_ref, fem))
+            except FINDINGS as exc:     # a model without equilibrium here: a finding
+                row.update(failed=str(exc), disp_rel_l2=None, reaction_ratio=None,
+                           reaction_rel_err=None, response=None)
+            rows.append(row)
+    return rows
+
+
+def _fem_loads(loads, mesh):
+    kw = {"traction": loads.fem_traction(1e-9 * mesh.size),
+          "body_force": None if loads.body_force is None else np.asarray(loads.body_force)}
+    return {k: v for k, v in kw.items() if v is not None}
+
+
+def _metrics(problem, mesh, bc, ps, u, reaction, u_ref, fem):
+    value = problem.response_value(mesh, u, reaction, bc, ps)
+    ratio = problem.ratio(value, fem)
+    return {"disp_rel_l2": M.rel_l2(u, u_ref), "response": value,
+            "reaction_ratio": M.finite("reaction_ratio", ratio) if ratio is not None else None,
+            "reaction_rel_err": None if ratio is None else abs(ratio - 1)}
+
+
+def problem_unit(job, step=None):
+    """One (problem, bc): its reference, then every family at its levels. ``step(family)`` is
+    called as each family finishes. Returns (reference summary, runs)."""
+    name, bc, s = job
+    problem = PROBLEMS[name]
+    hs = {fam: levels(problem, fam, s) for fam in s.meshes}
+    ref = solve_reference(problem, bc, s, sorted(set().union(*hs.values()), reverse=True))
+    rows = []
+    for fam in s.meshes:
+        rows += family_runs(problem, bc, fam, s, ref, hs[fam])
+        if step:
+            step(fam)
+    return ref.summary(), rows
+
+
+def _unit_in_worker(item):
+    i, job = item
+    with one_blas_thread():
+        return i, problem_unit(job)
+
+
+def _weights(name, s):
+    """{family: the expected cost of its runs}, for the time left (the sparse solves grow
+    about as nodes^1.3)."""
+    p = PROBLEMS[name]
+    return {fam: sum(float(np.prod(p.nodes_per_side(h))) ** 1.3 * (2 if fam == "bcc" else 1)
+                     for h in levels(p, fam, s)) * (len(s.models) + 1) for fam in s.meshes}
+
+
+# ---------------------------------------------------------------------- the study
+def fits(runs, s):
+    """A fit per (case, mesh, bc, model) of the displacement error over h, with the limit of
+    the stiffness ratio extrapolated alike."""
+    out = []
+    keys = dict.fromkeys((r["case"], r["mesh"], r["bc"], r["model"]) for r in runs)
+    for case, mesh, bc, model in keys:
+        rs = sorted((r for r in runs if (r["case"], r["mesh"], r["bc"], r["model"])
+                     == (case, mesh, bc, model) and r.get("disp_rel_l2") is not None),
+                    key=lambda r: -r["h_mm"])
+        row = {"case": case, "mesh": mesh, "bc": bc, "model": model, "levels": len(rs)}
+        if len(rs) < 2:
+            out.append({**row, "order": None, "e_inf": None, "e_inf_err": None,
+                        "verdict": "not enough levels", "why": "fewer than two levels solved",
+                        "ratio_inf": None, "ratio_inf_err": None})
+            continue
+        f = fit([r["h_mm"] for r in rs], [r["disp_rel_l2"] for r in rs])
+        row.update(order=f.order, e_inf=f.e_inf, e_inf_err=f.e_inf_err, verdict=f.verdict,
+                   why=f.why, label=f.label())
+        ratios = [r["reaction_ratio"] for r in rs]
+        if all(v is not None for v in ratios):
+            limit, err, _ = extrapolate([r["h_mm"] for r in rs], ratios)
+            row.update(ratio_inf=limit, ratio_inf_err=err)
+        else:
+            row.update(ratio_inf=None, ratio_inf_err=None)
+        out.append(row)
+    return out
+
+
+def run(s, workers=None, log=True, bench=None):
+    """Run the study with settings ``s``: the metrics document (runs, fits, references,
+    effective elasticity, accuracy per cost from the ``bench`` document). ``workers`` (a
+    started cases.workers.Workers) runs the (problem, bc) units side by side; the results do
+    not depend on it (one BLAS thread everywhere)."""
+    jobs = [(name, bc, s) for name in s.problems for bc in PROBLEMS[name].bcs]
+    weights = [_weights(name, s) for name, _, _ in jobs]
+    elastic_weight = 0.05 * sum(sum(w.values()) for w in weights)
+    results = [None] * len(jobs)
+    with Tracker(log, sum(sum(w.values()) for w in weights) + elastic_weight) as track:
+        if workers is None:
+            with one_blas_thread():
+                for i, job in enumerate(jobs):
+                    stop.checkpoint()
+                    results[i] = problem_unit(job, lambda fam, i=i: track.advance(
+                        weights[i][fam], f"{jobs[i][0]} {jobs[i][1]} {fam}"))
+        else:
+            for i, result in workers.unordered(_unit_in_worker, list(enumerate(jobs))):
+                stop.checkpoint()
+                results[i] = result
+                track.advance(sum(weights[i].values()), f"{jobs[i][0]} {jobs[i][1]}")
+        with one_blas_thread():
+            eff = elasticity.table(s)
+        track.advance(elastic_weight, "effective elasticity")
+    runs = [r for _, rows in results for r in rows]
+    data = {"runs": runs, "fits": fits(runs, s), "references": [ref for ref, _ in results],
+            "elasticity": eff, "cost": cost.accuracy_per_cost(runs, bench)}
+    return jsonable(data)
+
+
+class Tracker:
+    """Progress with the time left: a rich bar on a terminal, else one line per finished
+    unit on stderr (a log, CI). The time left assumes the rest goes at the pace so far,
+    measured in expected work (``advance``'s weights), not in units."""
+
+    def __init__(self, log, total):
+        self.log, self.total, self.done = log, float(total), 0.0
+        self.tty = log and sys.stderr.isatty()
+        self.bar = Progress(TextColumn("{task.description:<36}"), BarColumn(),
+                            TextColumn("{task.percentage:>3.0f}%"), TimeElapsedColumn(),
+                            TextColumn("left"), TimeRemainingColumn(),
+                            console=Console(stderr=True), disable=not self.tty)
+
+    def __enter__(self):
+        self.t0 = time.perf_counter()
+        self.bar.__enter__()
+        self.task = self.bar.add_task("convergence", total=self.total)
+        return self
+
+    def __exit__(self, *exc):
+        return self.bar.__exit__(*exc)
+
+    def advance(self, work, text):
+        self.done += work
+        self.bar.update(self.task, completed=self.done, description=text)
+        if self.log and not self.tty:
+            elapsed = time.perf_counter() - self.t0
+            left = elapsed * (self.total - self.done) / max(self.done, 1e-12)
+            print(f"convergence: {text} done; {self.done / self.total:.0%} after "
+                  f"{elapsed:.0f} s, about {left:.0f} s left", file=sys.stderr, flush=True)
+
+
+__all__ = ["ConvergenceSettings", "run", "fits", "levels", "solve_reference", "family_runs",
+           "problem_unit", "FEM_P1", "Tracker"]
