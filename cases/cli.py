@@ -242,6 +242,23 @@ def _report_command(args):
     return 0
 
 
+def _index_command(args):
+    """reports/index.md and index.html from the case and study folders already written (after
+    a `pbcm run` of one case or study, without running the others again)."""
+    from .registry import CASES, STUDY_MODULES
+    from .index import index_documents
+    root = Path(args.out)
+    missing = [name for name in CASES if not (root / name / "metrics.json").is_file()]
+    if missing:
+        raise UsageError(f"{root} lacks the metrics.json of {', '.join(missing)}: run "
+                         "`pbcm report` (or `pbcm run CASE` for each) first")
+    md, html = index_documents(root, list(CASES), list(STUDY_MODULES))
+    write_text_atomic(root / "index.md", md)
+    write_text_atomic(root / "index.html", html)
+    print(f"index written to {root / 'index.md'} and {root / 'index.html'}")
+    return 0
+
+
 def _check_command(args):
     from .thresholds import CheckError, check, load, measured
     try:
@@ -364,6 +381,12 @@ def parser():
                     default=7, help="timing rounds (default 7)")
     bn.add_argument("--models", nargs="+", help="model presets (default: all)")
     bn.set_defaults(func=_bench_command)
+
+    ix = sub.add_parser("index", help="rewrite reports/index.md from the folders written",
+                        description="Rewrite index.md and index.html from the case and study "
+                                    "folders under --out, without running anything.")
+    ix.add_argument("--out", default="reports", help="the reports folder (default reports)")
+    ix.set_defaults(func=_index_command)
 
     c = sub.add_parser("check", help="compare the latest metrics with thresholds.toml "
                        "(exit 0 pass, 1 fail, 2 missing or malformed)",

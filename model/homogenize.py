@@ -62,7 +62,11 @@ def effective_stiffness(model, boundary=None):
     if dof_i.size:
         Kii = K[dof_i][:, dof_i]
         rhs = -(K[dof_i][:, dof_b] @ U[dof_b])
-        U[dof_i] = splu(sp.csc_matrix(Kii)).solve(np.ascontiguousarray(rhs))
+        try:
+            U[dof_i] = splu(sp.csc_matrix(Kii)).solve(np.ascontiguousarray(rhs))
+        except RuntimeError as exc:      # SuperLU: "Factor is exactly singular"
+            raise ModelError(f"the effective stiffness of {model.name} is undefined: the patch "
+                             f"interior is not held by the model ({exc})") from None
     F = (K @ U).reshape(n, 3, 6)          # force the supports exert (zero inside)
     F[~on_b] = 0.0
     V = float(mesh.volumes.sum())

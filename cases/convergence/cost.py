@@ -40,10 +40,11 @@ def pareto(points):
     return front
 
 
-def accuracy_per_cost(runs, bench):
+def accuracy_per_cost(runs, bench, exact=0.0):
     """{"source", "groups": [{case, bc, points: [...], front: [...]}], "front_counts"}: every
     model run with its step cost, grouped by (case, bc), and how often each model is on the
-    front. None without a bench."""
+    front; errors below ``exact`` count as equal (the reference's own level), so that no
+    rounding puts a point on the front. None without a bench."""
     if not bench:
         return None
     groups, counts = [], {}
@@ -56,7 +57,7 @@ def accuracy_per_cost(runs, bench):
             if c is not None:
                 pts.append({"model": r["model"], "mesh": r["mesh"], "h_mm": r["h_mm"],
                             "tets": r["tets"], "cost_us": c, "disp_rel_l2": r["disp_rel_l2"]})
-        front = pareto([(p["cost_us"], p["disp_rel_l2"]) for p in pts])
+        front = pareto([(p["cost_us"], max(p["disp_rel_l2"], exact)) for p in pts])
         for i in front:
             counts[pts[i]["model"]] = counts.get(pts[i]["model"], 0) + 1
         groups.append({"case": case, "bc": bc, "points": pts, "front": front})

@@ -1,10 +1,12 @@
 """Figures of the convergence study (millimetres on every axis): error against h per problem,
 directional Young's modulus per lattice, error against step cost."""
 import numpy as np
+from matplotlib.ticker import NullLocator
 
 from ..figures import plt
 
-P1_STYLE = {"color": "k", "lw": 2.5, "marker": "o", "ms": 4}
+# drawn last, dashed: fem-linear (FEM P1's explicit twin) shows underneath
+P1_STYLE = {"color": "k", "lw": 2.0, "ls": "--", "marker": "o", "ms": 4, "zorder": 10}
 
 
 def _colours(models):
@@ -18,16 +20,19 @@ def error_vs_h(path, title, families, models, series, yardstick):
     colours = _colours(models)
     fig, axes = plt.subplots(1, len(families), figsize=(3.6 * len(families), 3.8),
                              sharey=True, squeeze=False)
+    hs = sorted({h for (fam, _), (hh, _) in series.items() for h in hh}, reverse=True)
     for ax, fam in zip(axes[0], families):
-        if (fam, yardstick) in series:
-            h, e = series[(fam, yardstick)]
-            ax.loglog(h, e, label=yardstick, **P1_STYLE)
         for m in models:
             if (fam, m) in series:
                 h, e = series[(fam, m)]
                 ax.loglog(h, e, "-s", ms=3, color=colours[m], label=m)
+        if (fam, yardstick) in series:
+            h, e = series[(fam, yardstick)]
+            ax.loglog(h, e, label=yardstick, **P1_STYLE)
         ax.set_title(fam, fontsize=9)
         ax.set_xlabel("h [mm]")
+        ax.set_xticks(hs, [f"{h:.3g}" for h in hs])
+        ax.xaxis.set_minor_locator(NullLocator())
         ax.invert_xaxis()
         ax.grid(alpha=0.3, which="both")
     axes[0][0].set_ylabel("displacement error (rel. L2)")
@@ -40,31 +45,36 @@ def error_vs_h(path, title, families, models, series, yardstick):
 
 
 def directional_young(path, angles_deg, families, models, curves, E):
-    """One polar panel per lattice: E(d) / E for d in the x-y plane, one line per model
-    (``curves[(family, model)]``), the isotropic target as a dashed circle."""
+    """One panel per lattice: E(d) / E for d turning in the x-y plane from [100] through
+    [110] (45 degrees) to [010], one line per model (``curves[(family, model)]``), the
+    isotropic target as a dashed line."""
     colours = _colours(models)
-    theta = np.radians(angles_deg)
-    fig, axes = plt.subplots(1, len(families), figsize=(3.6 * len(families), 4.0),
-                             subplot_kw={"projection": "polar"}, squeeze=False)
+    angles = np.asarray(angles_deg)
+    keep = angles <= 180.0
+    fig, axes = plt.subplots(1, len(families), figsize=(3.6 * len(families), 3.8),
+                             sharey=True, squeeze=False)
     for ax, fam in zip(axes[0], families):
-        ax.plot(theta, np.ones_like(theta), "k--", lw=1.5, label="isotropic target")
+        ax.axhline(1.0, color="k", ls="--", lw=1.5, label="isotropic target")
         for m in models:
             if (fam, m) in curves:
-                ax.plot(theta, np.asarray(curves[(fam, m)]) / E, color=colours[m], label=m)
+                ax.semilogy(angles[keep], np.asarray(curves[(fam, m)])[keep] / E,
+                            color=colours[m], label=m)
         ax.set_title(fam, fontsize=9)
-        ax.set_rscale("log")
-        ax.tick_params(labelsize=7)
+        ax.set_xticks([0, 45, 90, 135, 180], ["[100]", "[110]", "[010]", "[-110]", "[-100]"],
+                      fontsize=7)
+        ax.grid(alpha=0.3, which="both")
+    axes[0][0].set_ylabel("E(d) / E")
     handles, labels = axes[0][0].get_legend_handles_labels()
     fig.legend(handles, labels, loc="lower center", ncol=5, fontsize=7)
-    fig.suptitle("Directional Young's modulus E(d) / E in the x-y plane (log radius)",
-                 fontsize=10)
+    fig.suptitle("Directional Young's modulus in the x-y plane, per lattice", fontsize=10)
     fig.tight_layout(rect=(0, 0.12, 1, 1))
     fig.savefig(path, dpi=90)
     plt.close(fig)
 
 
-def pareto(path, groups, models):
-    """One panel per (case, bc): every run as (step cost, error), the Pareto front joined."""
+def pareto(path, groups, models, floor):
+    """One panel per (case, bc): every run as (step cost, error), the Pareto front joined;
+    errors below ``floor`` (exact: the reference's own level) are drawn on it."""
     colours = _colours(models)
     fig, axes = plt.subplots(1, len(groups), figsize=(3.8 * len(groups), 3.9), sharey=True,
                              squeeze=False)
@@ -73,11 +83,13 @@ def pareto(path, groups, models):
         for m in models:
             mine = [p for p in pts if p["model"] == m]
             if mine:
-                ax.loglog([p["cost_us"] for p in mine], [p["disp_rel_l2"] for p in mine],
+                ax.loglog([p["cost_us"] for p in mine],
+                          [max(p["disp_rel_l2"], floor) for p in mine],
                           "o", ms=3.5, color=colours[m], alpha=0.8, label=m)
         front = [pts[i] for i in g["front"]]
-        ax.loglog([p["cost_us"] for p in front], [p["disp_rel_l2"] for p in front], "k-",
-                  lw=1, label="Pareto front")
+        ax.loglog([p["cost_us"] for p in front], [max(p["disp_rel_l2"], floor) for p in front],
+                  "k-", lw=1, label="Pareto front")
+        ax.axhline(floor, color="grey", lw=0.8, ls=":")
         ax.set_title(f"{g['case']} {g['bc']}", fontsize=9)
         ax.set_xlabel("cost of one RK4 step [us]")
         ax.grid(alpha=0.3, which="both")

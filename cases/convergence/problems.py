@@ -33,6 +33,12 @@ class Problem:
     response: str
     compliance: bool = False
     label: str = ""
+    ref_ladder_mm: tuple = (8.0, 4.0, 2.0)   # spacings of the reference's P2 levels
+    ref_fine_solver: str = None              # the solver of levels below 2 mm (None: the case's)
+
+    def ref_solver(self, h_mm):
+        return self.ref_fine_solver if self.ref_fine_solver and h_mm < 2.0 \
+            else self.spec.fem_solver
 
     @property
     def spec(self):
@@ -86,8 +92,11 @@ PROBLEMS = {
                           label="top force"),
     "cantilever": Problem("cantilever", (64.0, 16.0, 16.0), ("clamped",), "tip_deflection_mm",
                           compliance=True, label="load / tip deflection"),
+    # P2 converges at order 1 here (the clamped root restrains the warping): a fourth level,
+    # solved by AMG-CG (19 s at 161 139 unknowns, where the direct solver took 234 s and 8 GB)
     "torsion": Problem("torsion", (64.0, 16.0, 16.0), ("clamped",), "torque_nm",
-                       label="torque"),
+                       label="torque", ref_ladder_mm=(8.0, 4.0, 2.0, 4.0 / 3.0),
+                       ref_fine_solver="amg"),
 }
 
 __all__ = ["Problem", "PROBLEMS"]

@@ -1,0 +1,194 @@
+"""The convergence study (issue 12): the fit recovers e_inf and p of synthetic sequences and
+says the right verdict; the Pareto front; the reference evaluated off its nodes; and the quick
+study end to end: its metrics, its ties to the effective tensors, its gate and its progress."""
+import json
+import math
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from conftest import floats_in
+
+from cases.cli import main
+from cases.convergence.cost import pareto, step_cost_us
+from cases.convergence.fit import EXACT, extrapolate, fit, observed_order
+from model.mesh import cube
+from reference import linear
+
+ROOT = Path(__file__).resolve().parents[1]
+
+
+@pytest.mark.parametrize("e_inf, C, p", [(0.0, 0.3, 1.0), (0.0, 0.05, 2.0), (0.12, 0.4, 1.5),
+                                         (0.05, 0.01, 3.0)])
+def test_three_levels_recover_the_limit_and_order_exactly(e_inf, C, p):
+    h = [8.0, 4.0, 2.0]
+    e = [e_inf + C * x**p for x in h]
+    assert observed_order(h, e) == pytest.approx(p, rel=1e-9)
+    f = fit(h, e)
+    assert f.order == pytest.approx(p, rel=1e-9)
+    assert f.e_inf == pytest.approx(e_inf, abs=1e-12)
+    # Roache's GCI: 1.25 x the Richardson correction
+    assert f.e_inf_err == pytest.approx(1.25 * abs(C) * 2.0**p, rel=1e-9)
+    assert f.verdict == ("floor" if e_inf > 0.2 * e[-1] and e_inf > f.e_inf_err
+                         else "converges")
+
+
+def test_four_levels_uneven_ratio_fit_all_of_them():
+    h = [8.0, 4.0, 2.0, 4.0 / 3.0]
+    e = [0.05 + 0.02 * x**1.3 for x in h]
+    f = fit(h, e)
+    assert f.e_inf == pytest.approx(0.05, abs=1e-9) and f.order == pytest.approx(1.3)
+    assert f.verdict == "floor" and f.levels == 4
+
+
+def test_verdicts_of_the_shapes_a_model_shows():
+    assert fit([8, 4, 2], [0.2, 0.1, 0.05]).verdict == "converges"
+    assert fit([8, 4, 2], [0.2, 0.19, 0.185]).verdict == "floor"
+    assert fit([8, 4, 2], [0.2, 0.4, 0.8]).verdict == "diverges"
+    assert fit([8, 4, 2], [3e-10, 1e-10, 2e-10]).verdict == "exact"
+    assert fit([8, 4], [EXACT * 2, EXACT * 1.5]).verdict != "exact"
+    # two levels: first order assumed, Roache's factor 3
+    f = fit([8, 4], [0.2, 0.18])
+    assert f.e_inf == pytest.approx(0.16) and f.e_inf_err == pytest.approx(0.06)
+    assert f.verdict == "floor" and f.order == pytest.approx(math.log2(0.2 / 0.18))
+    assert fit([8, 4], [0.2, 0.1]).verdict == "converges"
+    # no asymptotic range: the limit lies within the last changes
+    limit, err, p = extrapolate([8, 4, 2], [0.2, 0.1, 0.15])
+    assert p is None and limit == 0.15 and err == pytest.approx(1.25 * 0.1)
+    with pytest.raises(ValueError, match="finite"):
+        fit([8, 4], [0.1, float("nan")])
+
+
+def test_pareto_front_keeps_only_the_points_no_one_beats():
+    pts = [(1.0, 0.5), (2.0, 0.2), (2.0, 0.3), (3.0, 0.25), (4.0, 0.1), (0.5, 0.9)]
+    assert pareto(pts) == [5, 0, 1, 4]
+
+
+def test_step_cost_interpolates_the_bench_in_log_log():
+    bench = {"rows": [
+        {"model": "fem-linear", "tets": 100, "us_per_step": 10.0, "step_vs_fem-linear": 1.0},
+        {"model": "fem-linear", "tets": 10000, "us_per_step": 1000.0, "step_vs_fem-linear": 1.0},
+        {"model": "m", "tets": 100, "us_per_step": 40.0, "step_vs_fem-linear": 4.0},
+        {"model": "m", "tets": 10000, "us_per_step": 2000.0, "step_vs_fem-linear": 2.0}]}
+    assert step_cost_us(bench, "m", 1000) == pytest.approx(100.0 * math.sqrt(8.0))
+    assert step_cost_us(bench, "m", 10) == pytest.approx(40.0)   # the nearest size outside
+    assert step_cost_us(bench, "other", 1000) is None
+
+
+def test_reference_is_evaluated_off_its_nodes_by_its_basis():
+    """A P2 solution of an affine boundary motion is that affine field everywhere: probed at
+    the nodes of another mesh it is exact; at its own nodes the probe is its nodal values."""
+    m = cube(3, 0.032, "five")
+    A = np.array([[1e-3, 2e-4, 0.0], [0.0, -5e-4, 3e-4], [1e-4, 0.0, 2e-4]])
+    bc = {int(i): tuple(A @ m.points[i]) for i in range(m.n_nodes)
+          if np.isclose(m.points[i], 0).any() or np.isclose(m.points[i], 0.032).any()}
+    r = linear.solve(m, 10e3, 0.3, bc, element="P2")
+    assert np.allclose(r.at(m.points), r.u, atol=1e-15)
+    other = cube(4, 0.032, "unstructured").points
+    assert np.allclose(r.at(other), other @ A.T, atol=1e-12)
+
+
+# ---------------------------------------------------------------------- the quick study
+@pytest.fixture(scope="session")
+def study(tmp_path_factory):
+    out = tmp_path_factory.mktemp("convergence") / "convergence"
+    assert main(["run", "convergence", "--quick", "--out", str(out), "--workers", "1"]) == 0
+    return out
+
+
+def test_quick_study_writes_its_report_and_the_rows_asked_for(study):
+    data = json.loads((study / "metrics.json").read_text())
+    for f in ("report.md", "report.html", "pareto.png", "directional_young.png",
+              "convergence_paper-cube_clamped.png", "convergence_torsion_clamped.png"):
+        assert (study / f).is_file(), f
+    for r in data["runs"]:
+        assert {"case", "mesh", "bc", "model", "h_mm", "disp_rel_l2",
+                "reaction_ratio"} <= set(r)
+    for f in data["fits"]:
+        assert {"case", "mesh", "bc", "model", "order", "e_inf", "e_inf_err",
+                "verdict"} <= set(f)
+    assert {(r["case"], r["bc"]) for r in data["runs"]} == {
+        ("paper-cube", "clamped"), ("paper-cube", "sliding"), ("cantilever", "clamped"),
+        ("torsion", "clamped")}
+    assert {r["h_mm"] for r in data["runs"]} == {8.0, 4.0}
+    assert {r["mesh"] for r in data["runs"]} == {"five", "six"}
+    for v in floats_in(data):
+        assert math.isfinite(v)
+    md = (study / "report.md").read_text()
+    assert "## Effective elasticity" in md and "## Accuracy per cost" in md
+    for ref in data["references"]:   # the reference is converged below the errors it judges
+        assert ref["error_estimate"] < 0.01
+
+
+def test_fem_linear_statics_are_fem_p1(study):
+    runs = json.loads((study / "metrics.json").read_text())["runs"]
+    p1 = {(r["case"], r["bc"], r["mesh"], r["h_mm"]): r["disp_rel_l2"] for r in runs
+          if r["model"] == "FEM P1"}
+    for r in runs:
+        if r["model"] == "fem-linear":
+            key = (r["case"], r["bc"], r["mesh"], r["h_mm"])
+            assert r["disp_rel_l2"] == pytest.approx(p1[key], rel=1e-6, abs=1e-9)
+
+
+def test_sliding_cube_reaction_ratio_is_the_lattice_young_modulus(study):
+    """The sliding cube is in uniaxial stress: a model whose lattice answers homogeneously
+    (conservative, centrosymmetric patch: 'five') must give a reaction ratio E_y,eff / E."""
+    data = json.loads((study / "metrics.json").read_text())
+    E = data["parameters"]["E_Pa"]
+    eff = {(e["mesh"], e["model"]): e for e in data["elasticity"]}
+    for r in data["runs"]:
+        if (r["case"], r["bc"], r["mesh"]) == ("paper-cube", "sliding", "five") \
+                and r["model"] in ("msm", "msm+volume", "pbcm-variational", "fem-linear"):
+            assert r["reaction_ratio"] == pytest.approx(eff[("five", r["model"])]["E_y"] / E,
+                                                        rel=0.02), r["model"]
+
+
+def test_quick_study_passes_the_committed_bounds(study, capsys):
+    status = main(["check", "--metrics", str(study), "--thresholds",
+                   str(ROOT / "thresholds.toml")])
+    assert status == 0, capsys.readouterr().out[-3000:]
+
+
+def test_study_progress_says_the_time_left(study, capsys):
+    """A log (not a terminal) gets one line per finished unit with the time left."""
+    from cases.convergence.study import Tracker
+    with Tracker(True, 10.0) as t:
+        t.advance(4.0, "paper-cube clamped")
+    err = capsys.readouterr().err
+    assert "paper-cube clamped done; 40%" in err and "s left" in err
+
+
+def test_study_refuses_bcs_before_computing(capsys):
+    assert main(["run", "convergence", "--bcs", "clamped"]) == 2
+    assert "--bcs does not apply to the convergence study" in capsys.readouterr().err
+
+
+def test_study_metrics_do_not_depend_on_the_workers(study, tmp_path):
+    """The (problem, bc) units on two worker processes give the same rows, bit for bit, as
+    the serial run, for the models both ran."""
+    out = tmp_path / "convergence"
+    assert main(["run", "convergence", "--quick", "--out", str(out), "--workers", "2",
+                 "--models", "msm", "pbcm-corner"]) == 0
+    two = json.loads((out / "metrics.json").read_text())
+    one = json.loads((study / "metrics.json").read_text())
+    for key in ("runs", "fits", "elasticity"):
+        mine = [r for r in one[key] if r["model"] in ("msm", "pbcm-corner", "FEM P1")]
+        assert mine == two[key], key
+
+
+def test_index_leads_with_the_study_headline(study, tmp_path, capsys):
+    """`pbcm index` rewrites the index from the folders present: the convergence study's
+    conclusion first, then the cases' conclusion and scorecard."""
+    from cases.registry import CASES
+    for name in CASES:
+        (tmp_path / name).symlink_to(ROOT / "reports" / name, target_is_directory=True)
+    (tmp_path / "convergence").symlink_to(study, target_is_directory=True)
+    assert main(["index", "--out", str(tmp_path)]) == 0
+    md = (tmp_path / "index.md").read_text()
+    first = md.split("\n\n")[1]
+    assert first.startswith("**convergence (quick mode)**") and "Convergence (h = 8, 4 mm" in first
+    assert md.index("Convergence (h =") < md.index("## Scorecard")
+    (tmp_path / "torsion").unlink()
+    assert main(["index", "--out", str(tmp_path)]) == 2
+    assert "lacks the metrics.json of torsion" in capsys.readouterr().err

@@ -1,0 +1,90 @@
+"""Effective elasticity (model.homogenize) against closed forms: the isotropic tensor, a cubic
+crystal's Voigt and Reuss moduli and its anisotropy index, Young's modulus along [100], [110]
+and [111], and the constant-strain FEM whose patch must answer with exactly the target C."""
+import numpy as np
+import pytest
+
+from model import Material, ModelError, build
+from model.homogenize import (anisotropy_index, asymmetry, directional_young, distance,
+                              effective_stiffness, engineering_constants, isotropic_stiffness,
+                              voigt_reuss)
+from model.mesh import cube
+
+
+def cubic(c11, c12, c44):
+    C = np.zeros((6, 6))
+    C[:3, :3] = c12
+    C[range(3), range(3)] = c11
+    C[range(3, 6), range(3, 6)] = c44
+    return C
+
+
+def test_isotropic_tensor_gives_back_its_constants():
+    E, nu = 7.0e3, 0.3
+    C = isotropic_stiffness(E, nu)
+    # sigma_xx under a unit uniaxial strain is lambda + 2 mu
+    lam, mu = E * nu / ((1 + nu) * (1 - 2 * nu)), E / (2 * (1 + nu))
+    assert C[0, 0] == pytest.approx(lam + 2 * mu) and C[0, 1] == pytest.approx(lam)
+    assert C[3, 3] == pytest.approx(mu)
+    c = engineering_constants(C)
+    for k in ("E_x", "E_y", "E_z"):
+        assert c[k] == pytest.approx(E, rel=1e-12)
+    for k in ("nu_xy", "nu_yx", "nu_zx"):
+        assert c[k] == pytest.approx(nu, rel=1e-12)
+    assert c["G_xy"] == pytest.approx(mu, rel=1e-12)
+    assert anisotropy_index(C) == pytest.approx(0.0, abs=1e-12)
+    d = np.random.default_rng(1).standard_normal((20, 3))
+    assert np.allclose(directional_young(C, d), E, rtol=1e-12)
+
+
+def test_cubic_crystal_against_the_closed_forms():
+    c11, c12, c44 = 168.4, 121.4, 75.4           # copper, GPa (Hill's classic example)
+    C = cubic(c11, c12, c44)
+    K_V, G_V, K_R, G_R = voigt_reuss(C)
+    assert K_V == pytest.approx((c11 + 2 * c12) / 3) and K_R == pytest.approx(K_V)
+    assert G_V == pytest.approx((c11 - c12 + 3 * c44) / 5)
+    assert G_R == pytest.approx(5 * (c11 - c12) * c44 / (4 * c44 + 3 * (c11 - c12)))
+    assert anisotropy_index(C) == pytest.approx(5 * G_V / G_R - 5)
+    # compliances of a cubic crystal in closed form
+    s11 = (c11 + c12) / ((c11 - c12) * (c11 + 2 * c12))
+    s12 = -c12 / ((c11 - c12) * (c11 + 2 * c12))
+    s44 = 1 / c44
+    E = directional_young(C, [[1, 0, 0], [1, 1, 0], [1, 1, 1]])
+    assert E[0] == pytest.approx(1 / s11)
+    assert E[1] == pytest.approx(1 / (s11 - 0.5 * (s11 - s12 - s44 / 2)))
+    assert E[2] == pytest.approx(1 / (s11 - 2 / 3 * (s11 - s12 - s44 / 2)))
+    assert engineering_constants(C)["nu_xy"] == pytest.approx(-s12 / s11)
+
+
+@pytest.mark.parametrize("family", ["five", "six", "bcc", "unstructured"])
+def test_constant_strain_fem_patch_answers_with_the_target(family):
+    mat = Material(E=10e3, nu=0.45)
+    C = effective_stiffness(build("fem-linear", cube(4, 0.032, family), mat))
+    assert distance(C, isotropic_stiffness(mat.E, mat.nu)) < 1e-8
+    assert asymmetry(C) < 1e-8
+
+
+def test_springs_on_the_five_lattice_have_the_cauchy_poisson_ratio():
+    """Central springs on a lattice whose affine motion is in equilibrium obey Cauchy's
+    relation C12 = C44: with cubic symmetry nu = C12 / (C11 + C12), and van Gelder's
+    stiffness on 'five' gives nu = 0.2 whatever nu the material asks for."""
+    for nu in (0.3, 0.45):
+        C = effective_stiffness(build("msm", cube(5, 0.032, "five"), Material(E=10e3, nu=nu)))
+        assert C[0, 1] == pytest.approx(C[3, 3], rel=1e-6)
+        assert engineering_constants(C)["nu_xy"] == pytest.approx(
+            C[0, 1] / (C[0, 0] + C[0, 1]), rel=1e-9)
+        assert engineering_constants(C)["nu_xy"] == pytest.approx(0.2, abs=1e-6)
+
+
+def test_a_patch_is_refused_when_its_interior_is_not_held():
+    """A model that does not hold the interior nodes (no force on them) is singular: an
+    error naming the model, not a NaN tensor."""
+    class Free:
+        name = "nothing"
+        mesh = cube(4, 0.032, "five")
+
+        def jacobian(self, x):
+            import scipy.sparse as sp
+            return sp.csr_matrix((3 * len(x), 3 * len(x)))
+    with pytest.raises(ModelError, match="effective stiffness of nothing is undefined"):
+        effective_stiffness(Free())
