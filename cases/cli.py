@@ -154,7 +154,7 @@ def _workers(args, cfgs):
     of a study)."""
     from contextlib import nullcontext
     from .workers import Workers, available_cores
-    units = max(len(c.meshes) if not hasattr(c, "problems") else 4 for c in cfgs.values())
+    units = max(c.units for c in cfgs.values())
     n = min(args.workers or available_cores(), units)
     return Workers(n) if n > 1 else nullcontext()
 
@@ -404,8 +404,8 @@ def parser():
     b = sub.add_parser(
         "bless", help="rewrite the bounds from measured metrics and print what changed",
         description="Set the bounds of thresholds.toml from measured metrics. Without --metrics "
-                    "it first runs every case: in full mode (about 11 minutes on 2 cores) unless "
-                    "--quick is given. It keeps the bounds of runs it did not see (other modes, "
+                    "it first runs every case and study: in full mode (about 26 minutes on 2 "
+                    "cores) unless --quick is given. It keeps the bounds of runs it did not see (other modes, "
                     "meshes, models) unless --prune is given, and each existing bound's "
                     "tolerances unless --margin is given; new bounds get --margin or 0.1. It "
                     "prints every bound it adds, changes or removes.")

@@ -52,6 +52,12 @@ class Settings:
         return {"E_Pa": self.E, "nu": self.nu, "rho_kg_m3": self.rho,
                 "p2_levels": self.p2_levels}
 
+    @property
+    def units(self):
+        """The independent units a worker pool can share out: the meshes (a worker runs one
+        mesh with all its bcs)."""
+        return len(self.meshes)
+
     def describe(self):
         """Everything the run was given: the problem, the selection and the switches."""
         return {**self.problem(), "meshes": list(self.meshes), "bcs": list(self.bcs),

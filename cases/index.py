@@ -95,7 +95,9 @@ def index_documents(root, cases, studies=()):
     for name, lines in study_headlines(root, studies).items():
         mode = " (quick mode)" if json.loads((root / name / "metrics.json").read_text())[
             "parameters"]["quick"] else ""
-        doc.p(f"**{name}{mode}** ([report]({name}/report.md)): " + " ".join(lines))
+        doc.p(f"**{name}{mode}** ([report]({name}/report.md)): " + (lines[0] if lines else ""))
+        for line in lines[1:]:
+            doc.p(line)
     for line in conclusion(table, metric):
         doc.p(line)
     doc.h(2, "Scorecard")

@@ -169,7 +169,7 @@ def test_study_metrics_do_not_depend_on_the_workers(study, tmp_path):
     the serial run, for the models both ran."""
     out = tmp_path / "convergence"
     assert main(["run", "convergence", "--quick", "--out", str(out), "--workers", "2",
-                 "--models", "msm", "pbcm-corner"]) == 0
+                 "--models", "pbcm-corner", "msm"]) == 0
     two = json.loads((out / "metrics.json").read_text())
     one = json.loads((study / "metrics.json").read_text())
     for key in ("runs", "fits", "elasticity"):
@@ -192,3 +192,17 @@ def test_index_leads_with_the_study_headline(study, tmp_path, capsys):
     (tmp_path / "torsion").unlink()
     assert main(["index", "--out", str(tmp_path)]) == 2
     assert "lacks the metrics.json of torsion" in capsys.readouterr().err
+
+
+def test_study_bad_arguments_fail_before_computing(tmp_path, capsys, monkeypatch):
+    from cases.convergence import Convergence
+
+    def refuse(self, *a, **k):
+        raise AssertionError("the study started computing")
+    monkeypatch.setattr(Convergence, "run", refuse)
+    (tmp_path / "afile").write_text("x")
+    for argv in (["--out", str(tmp_path / "afile")], ["--nu", "0.5"], ["--meshes", "hex"],
+                 ["--models", "fem-p3"]):
+        assert main(["run", "convergence", "--quick", *argv]) == 2
+        err = capsys.readouterr().err.strip()
+        assert err.startswith("pbcm: error: ") and len(err.splitlines()) == 1, err

@@ -54,6 +54,11 @@ class ConvergenceSettings:
                 "h_mm": [round(h, 6) for h in self.h_mm], "load_scale": self.load_scale,
                 "ref_ladders_mm": {p: list(PROBLEMS[p].ref_ladder_mm) for p in self.problems}, "max_nodes": MAX_NODES, "patch_n": self.patch_n}
 
+    @property
+    def units(self):
+        """The independent units a worker pool can share out: (problem, bc) pairs."""
+        return sum(len(PROBLEMS[p].bcs) for p in self.problems)
+
     def describe(self):
         return {**self.problem(), "problems": list(self.problems), "meshes": list(self.meshes),
                 "bcs": sorted({bc for p in self.problems for bc in PROBLEMS[p].bcs}),
