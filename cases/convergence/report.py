@@ -68,7 +68,8 @@ def conclusion(s, data):
         "at a floor that no refinement removes: " + ("; ".join(
             f"{m} in {len(floors[m])} of {len(by[m])} (median floor "
             f"{np.median([f['e_inf'] for f in floors[m]]):.2g})" for m in floored) or "none")
-        + ".")
+        + f" (loads scaled by {s.load_scale:g}: the linear regime, so that a floor is the "
+        "model's consistency error, not geometric nonlinearity).")
     div = sorted({f["model"] for f in data["fits"] if f.get("verdict") == "diverges"})
     if div:
         out.append("Diverging somewhere (error growing as h falls): " + ", ".join(div) + ".")
