@@ -18,13 +18,16 @@ TERMS = {
     "balanced": ("shear", {"reading": "balanced"}),
     "variational": ("shear", {"reading": "variational", "c": 0.3}),
     "normal": ("normal", {"c": 0.7}),
+    "normal_tet": ("normal_tet", {"c": 0.7}),
+    "normal_sbd": ("normal_sbd", {"c": 0.7}),
+    "normal_corotated": ("normal_corotated", {"c": 0.7}),
     "springs": ("springs", {}),
     "fem_linear": ("fem_linear", {}),
     "fem_corotated": ("fem_corotated", {}),
     "fem_neohookean": ("fem_neohookean", {}),
 }
-CONSERVATIVE = ["volume", "variational", "normal", "springs", "fem_linear", "fem_corotated",
-                "fem_neohookean"]
+CONSERVATIVE = ["volume", "variational", "normal", "normal_tet", "normal_sbd", "normal_corotated",
+                "springs", "fem_linear", "fem_corotated", "fem_neohookean"]
 # small strain is not invariant under a finite rotation: that is what co-rotation fixes
 ROTATION_INVARIANT = [k for k in TERMS if k != "fem_linear"]
 
@@ -66,13 +69,15 @@ def test_forces_invariant_under_rigid_motion(key, small_mesh, mat):
 
 
 @pytest.mark.parametrize("key", ["balanced", "variational", "volume", "springs", "normal",
+                                 "normal_tet", "normal_sbd", "normal_corotated",
                                  "fem_linear", "fem_corotated", "fem_neohookean"])
 def test_zero_net_force(key, small_mesh, mat):
     f = term(key, small_mesh, mat).forces(perturbed(small_mesh, 0.05))
     assert np.linalg.norm(f.sum(axis=0)) <= 1e-10 * np.abs(f).sum()
 
 
-@pytest.mark.parametrize("key", ["variational", "volume", "springs", "normal", "fem_corotated",
+@pytest.mark.parametrize("key", ["variational", "volume", "springs", "normal", "normal_tet",
+                                 "normal_sbd", "normal_corotated", "fem_corotated",
                                  "fem_neohookean"])
 def test_zero_net_torque(key, small_mesh, mat):
     x = perturbed(small_mesh, 0.05)
@@ -188,6 +193,38 @@ def test_variational_calibration(mat):
     x = m.points @ F.T
     W = both.energy(x)
     assert W == pytest.approx(2 * mat.G * e**2 * m.volumes.sum(), rel=0.05)
+
+
+@pytest.mark.parametrize("name", ["normal_sbd", "normal_corotated"])
+def test_axis_normal_forms_see_exactly_the_normal_deviatoric_strains(name, mat):
+    """Linearised, both material-axis forms have the energy G V sum_i (dev eps)_ii^2: in the
+    deviatoric basis (two diagonal, three shear tensors) their quadratic form is G V
+    diag(1, 1, 0, 0, 0), whatever the mesh; a uniform stretch costs nothing."""
+    from model.calibrate import deviatoric_basis, strain_quadratic_form
+    m = cube(3, 0.02, "unstructured")
+    t = make_term(name, m, mat, c=1.0)
+    Q = strain_quadratic_form(t, m.points, deviatoric_basis())
+    assert np.allclose(Q / (mat.G * m.volumes.sum()), np.diag([1.0, 1, 0, 0, 0]), atol=1e-6)
+    assert t.energy(1.01 * m.points) < 1e-20
+
+
+def test_tet_edge_form_quadratic_form_closed_form(mat):
+    """normal_tet linearised: E_e = n_e . eps n_e (n_e the unit rest edge), so
+    Q_pq = G sum_T V0 sum_e (n.D_p n - mean)(n.D_q n - mean), worked out here edge by edge."""
+    from model.calibrate import deviatoric_basis, strain_quadratic_form
+    m = cube(3, 0.02, "six")
+    basis = deviatoric_basis()
+    t = make_term("normal_tet", m, mat, c=1.0)
+    Q = strain_quadratic_form(t, m.points, basis)
+    want = np.zeros((5, 5))
+    for tet, V0 in zip(m.tets, m.volumes):
+        n = np.array([m.points[tet[j]] - m.points[tet[i]]
+                      for i in range(4) for j in range(i + 1, 4)])
+        n /= np.linalg.norm(n, axis=1, keepdims=True)
+        e = np.einsum("ei,pij,ej->pe", n, basis, n)
+        e -= e.mean(axis=1, keepdims=True)
+        want += mat.G * V0 * e @ e.T
+    assert np.allclose(Q, want, rtol=1e-6, atol=1e-9 * np.abs(want).max())
 
 
 def test_flattened_tetrahedron_is_reported(one_tet, mat):

@@ -1,10 +1,20 @@
 """Force terms: a registry by name, as meshio registers formats.
 
-A term is one module in this package that defines a :class:`Term` subclass decorated with
-:func:`register`; every module here is imported on first use, so a new term is one new file.
+A term is one module that defines a :class:`Term` subclass decorated with :func:`register`.
+The registry holds, on first use:
+
+* every module of this package (a new built-in term is one new file here);
+* every module named by an installed package in the entry-point group ``pbcm.terms``
+  (``[project.entry-points."pbcm.terms"] myterm = "mypackage.myterm"``);
+* every file in the environment variable ``PBCM_TERMS`` (paths separated by ``os.pathsep``),
+  which ``pbcm --term FILE`` sets, so that worker processes load the same files.
 """
 import importlib
+import importlib.metadata
+import importlib.util
+import os
 import pkgutil
+from pathlib import Path
 
 import numpy as np
 
@@ -21,10 +31,74 @@ def register(cls):
     return cls
 
 
+ENTRY_POINT_GROUP = "pbcm.terms"
+_loaded_files = {}
+
+
+def load_file(path):
+    """Import the user term file ``path`` (a module that registers terms); return the names
+    it registered. A file is imported once per process."""
+    path = Path(path).resolve()
+    if path in _loaded_files:
+        return _loaded_files[path]
+    if not path.is_file() or path.suffix != ".py":
+        raise ModelError(f"term file {path} does not exist or is not a .py file: give the "
+                         "path of a Python file that registers a term with @register")
+    before = set(TERMS)
+    spec = importlib.util.spec_from_file_location(f"pbcm_user_terms.{path.stem}", path)
+    module = importlib.util.module_from_spec(spec)
+    try:
+        spec.loader.exec_module(module)
+    except ModelError:
+        raise
+    except Exception as exc:
+        raise ModelError(f"term file {path} failed to import: {type(exc).__name__}: {exc}") \
+            from exc
+    new = sorted(set(TERMS) - before)
+    if not new:
+        raise ModelError(f"term file {path} registers no term: decorate a Term subclass "
+                         "with @model.terms.register")
+    _loaded_files[path] = new
+    return new
+
+
+def user_files():
+    """The term files named in ``PBCM_TERMS``."""
+    return [p for p in os.environ.get("PBCM_TERMS", "").split(os.pathsep) if p]
+
+
+def add_user_file(path):
+    """Load ``path`` now and name it in ``PBCM_TERMS`` (inherited by worker processes)."""
+    names = load_file(path)
+    files = user_files()
+    if str(Path(path).resolve()) not in files:
+        os.environ["PBCM_TERMS"] = os.pathsep.join([*files, str(Path(path).resolve())])
+    return names
+
+
+_packages_loaded = []
+
+
 def _load_all():
-    for mod in pkgutil.iter_modules(__path__):
-        if not mod.name.startswith("_"):
-            importlib.import_module(f"{__name__}.{mod.name}")
+    if not _packages_loaded:
+        for mod in pkgutil.iter_modules(__path__):
+            if not mod.name.startswith("_"):
+                importlib.import_module(f"{__name__}.{mod.name}")
+        for ep in importlib.metadata.entry_points(group=ENTRY_POINT_GROUP):
+            try:
+                ep.load()
+            except Exception as exc:
+                raise ModelError(f"the term package {ep.value!r} (entry point {ep.name!r} of "
+                                 f"group {ENTRY_POINT_GROUP}) failed to import: {exc}") from exc
+        _packages_loaded.append(True)
+    for f in user_files():
+        load_file(f)
+
+
+def registered():
+    """Every registered term class by name (built-in, entry points and term files)."""
+    _load_all()
+    return dict(TERMS)
 
 
 def make_term(name, mesh, material, **params):
@@ -57,9 +131,18 @@ class Term:
     ``energy(x)``
         for a conservative term;
     ``calibrate``, ``coef``, ``unit_energy(x)`` and ``calibration_residuals(x, rows)``
-        for a term whose constant is fitted (``"auto"``): ``unit_energy`` is the energy with
-        ``coef`` = 1, written as ``sum_t w_t sum_k r_tk^2``, and ``calibration_residuals``
-        gives ``(r, w)`` for the tetrahedra ``rows``; ``model.calibrate`` sets ``coef``.
+        the calibration hooks, for a term whose constant ``c="auto"`` is fitted when the
+        model is built (:class:`CalibratedTerm` provides all but the residuals):
+        ``calibrate`` is true while ``coef`` awaits the fit; ``unit_energy`` is the energy with
+        ``coef`` = 1, written as ``sum_t w_t sum_k r_tk^2``; ``calibration_residuals`` gives
+        ``(r, w)`` for the tetrahedra ``rows``. ``model.calibrate`` then sets every ``coef``
+        at once by non-negative least squares on the quadratic forms of the unit energies
+        under homogeneous deviatoric strain, against the isotropic ``G |dev eps|^2 V``;
+    ``fit_constant``
+        the name under which ``pbcm fit`` reports the term's fitted constant (``"c"``,
+        ``"c_n"``, ``"k_scale"``), or None for a term with nothing to fit (the volume term:
+        its constant is the material's K). The fit varies ``scale``, so the constant
+        reported is ``scale * coef`` for a calibrated term and ``scale`` otherwise.
 
     ``scale`` multiplies the whole term (a testing and sensitivity knob, 1 by default).
     """
@@ -71,6 +154,8 @@ class Term:
     checks_inversion = False
     # parameters a user may pass, with defaults
     params = {}
+    # what `pbcm fit` calls the constant it fits (None: nothing to fit)
+    fit_constant = None
 
     def __init__(self, mesh, material, scale=1.0, **params):
         unknown = set(params) - set(self.params)
@@ -116,3 +201,48 @@ class Term:
     def info(self):
         """Parameters actually used (for reports)."""
         return {"scale": self.scale, **self.p}
+
+
+class CalibratedTerm(Term):
+    """A conservative term ``W = scale * coef * unit_energy`` whose ``c`` is ``"auto"`` (fitted
+    by ``model.calibrate`` when the model is built) or a positive number. A subclass provides
+    ``kernel_args(k)`` (the kernel and its arguments for the factor ``k = scale * coef``),
+    ``calibration_residuals(x, rows)`` and ``forces_numpy``; ``unit_energy`` follows."""
+
+    conservative = True
+    params = {"c": "auto"}
+    fit_constant = "c_n"
+
+    def __init__(self, mesh, material, scale=1.0, **params):
+        super().__init__(mesh, material, scale, **params)
+        c = self.p["c"]
+        if c != "auto" and not (isinstance(c, (int, float)) and not isinstance(c, bool)
+                                and np.isfinite(c) and c > 0):
+            raise ModelError(f"{self.name} c must be 'auto' or a positive number, got {c!r}")
+        self.coef = None if c == "auto" else float(c)
+        self.calibrate = c == "auto"
+        self.G = material.G        # scale multiplies forces and energy after calibration
+        self.vol0 = mesh.volumes
+
+    def info(self):
+        return {**super().info(), "c": self.coef}
+
+    def kernel(self):
+        if self.coef is None:
+            raise ModelError(f"{self.name} term with c='auto' is not calibrated yet: build the "
+                             "model with model.build, or pass a number for c")
+        return self.kernel_args(self.scale * self.coef)
+
+    def kernel_args(self, k):
+        raise NotImplementedError
+
+    def calibration_residuals(self, x, rows):
+        raise NotImplementedError
+
+    def unit_energy(self, x):
+        r, w = self.calibration_residuals(np.ascontiguousarray(x, dtype=np.float64),
+                                          slice(None))
+        return float(np.sum(w * np.sum(r.reshape(len(w), -1) ** 2, axis=1)))
+
+    def energy(self, x):
+        return self.scale * self.coef * self.unit_energy(x)

@@ -1,4 +1,4 @@
-"""Deviatoric normal-stress extension (MODEL.md "Normal-stress extensions").
+"""Deviatoric normal-stress extension of MODEL.md: the per-corner edge-strain deviation.
 
 The shear strains see no stretch along an edge. Per corner a, the three edge strains
 eps_j = (|d_j| - |D_j|) / |D_j| (d_j = x_j - x_a, D_j at rest) and their mean eps_a give
@@ -6,12 +6,13 @@ eps_j = (|d_j| - |D_j|) / |D_j| (d_j = x_j - x_a, D_j at rest) and their mean ep
     W = c_n G sum_T V0_T sum_a sum_j (eps_j - eps_a)^2,
 
 zero under uniform scaling (purely deviatoric, the volume term keeps the pressure).
+Registered as ``normal`` (the name of the ``pbcm-variational+normal`` preset) and as
+``normal_edge``, its name beside the other candidate forms.
 """
 import numpy as np
 from numba import njit
 
-from . import Term, register
-from ..errors import ModelError
+from . import CalibratedTerm, register
 
 # the three edges at each corner: (corner, other end)
 CORNER_EDGES = np.array([[(a, j) for j in range(4) if j != a] for a in range(4)], dtype=np.int64)
@@ -67,50 +68,26 @@ def edge_vectors(x, tets):
 
 
 @register
-class Normal(Term):
+class Normal(CalibratedTerm):
     """Deviatoric edge-strain term at each corner; ``c`` is ``"auto"`` or a positive number."""
 
     name = "normal"
-    conservative = True
-    params = {"c": "auto"}
 
     def __init__(self, mesh, material, scale=1.0, **params):
         super().__init__(mesh, material, scale, **params)
-        c = self.p["c"]
-        if c != "auto" and not (isinstance(c, (int, float)) and np.isfinite(c) and c > 0):
-            raise ModelError(f"normal c must be 'auto' or a positive number, got {c!r}")
-        self.coef = None if c == "auto" else float(c)
-        self.calibrate = c == "auto"
-        self.G = material.G  # scale multiplies forces and energy after calibration
-        self.vol0 = mesh.volumes
         self.rest_len = np.linalg.norm(edge_vectors(mesh.points, mesh.tets), axis=-1)
 
-    def info(self):
-        return {**super().info(), "c": self.coef}
-
-    def kernel(self):
-        if self.coef is None:
-            raise ModelError("normal term with c='auto' is not calibrated yet: build the model "
-                             "with model.build, or pass a number for c")
-        return normal_forces, (self.mesh.tets, self.vol0, self.rest_len,
-                               self.scale * self.coef * self.G)
-
-    def _dev_strain(self, x, rows=slice(None)):
-        tets = self.mesh.tets[rows]
-        out = np.empty((len(tets), 4, 3))
-        normal_strains(np.ascontiguousarray(x, dtype=np.float64), tets, self.rest_len[rows], out)
-        return out
+    def kernel_args(self, k):
+        return normal_forces, (self.mesh.tets, self.vol0, self.rest_len, k * self.G)
 
     def calibration_residuals(self, x, rows):
         """The deviatoric edge strains (r, 4, 3) of the tetrahedra ``rows`` and their weights
         G V0: unit_energy = sum w (eps - mean)^2."""
-        return self._dev_strain(x, rows), self.G * self.vol0[rows]
-
-    def unit_energy(self, x):
-        return float(self.G * np.sum(self.vol0[:, None, None] * self._dev_strain(x) ** 2))
-
-    def energy(self, x):
-        return self.scale * self.coef * self.unit_energy(x)
+        tets = self.mesh.tets[rows]
+        out = np.empty((len(tets), 4, 3))
+        normal_strains(np.ascontiguousarray(x, dtype=np.float64), tets, self.rest_len[rows],
+                       out)
+        return out, self.G * self.vol0[rows]
 
     def forces_numpy(self, x):
         d = edge_vectors(x, self.mesh.tets)
@@ -124,3 +101,10 @@ class Normal(Term):
         np.add.at(out, self.mesh.tets[:, CORNER_EDGES[..., 1]], fj)
         np.add.at(out, self.mesh.tets[:, CORNER_EDGES[..., 0]], -fj)
         return out
+
+
+@register
+class NormalEdge(Normal):
+    """The same term under its candidate name."""
+
+    name = "normal_edge"
