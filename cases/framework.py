@@ -15,6 +15,7 @@ from typing import ClassVar
 import numpy as np
 
 from model import PRESETS, Material, build
+from model.compose import parse
 from model.mesh import SCHEMES
 from model.loads import body_forces, traction_forces
 
@@ -229,8 +230,9 @@ class Case(abc.ABC):
 
     # ------------------------------------------------------------------ phases
     def build_model(self, name, mesh, s):
-        """The particle model ``name`` (a preset), with the test-only shear scale."""
-        has_shear = any(t == "shear" for t, _ in PRESETS[name])
+        """The particle model ``name`` (a preset or a composed spec, ``model.compose``), with
+        the test-only shear scale."""
+        has_shear = any(t == "shear" for t, _ in parse(name))
         extra = {"shear": {"scale": s.shear_scale}} if has_shear and s.shear_scale != 1 else {}
         return build(name, mesh, s.material, **extra)
 

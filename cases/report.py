@@ -10,6 +10,7 @@ from pathlib import Path
 
 import numpy as np
 
+from model.compose import slug
 from model.mesh import write as write_mesh
 from . import bench, figures
 from .document import Document, fmt
@@ -96,7 +97,7 @@ def write_case(out, case, s, runs, fields):
     (out / "run.json").write_text(json.dumps(jsonable(provenance(runs)), indent=1) + "\n")
     for (mesh, bc, model), f in fields.items():
         cdata = {k: f[k] for k in ("max_tau", "pressure") if k in f}
-        write_mesh(out / "vtu" / f"{mesh}_{bc}_{model}.vtu", f["mesh"],
+        write_mesh(out / "vtu" / f"{mesh}_{bc}_{slug(model)}.vtu", f["mesh"],
                    point_data={"displacement": f["u"]}, cell_data=cdata)
     build_report(case, s, runs, fields, out).write(out)
     return out

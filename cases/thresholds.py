@@ -190,12 +190,19 @@ def _same_problem(case, mode, recorded, ran):
                 "the case with the bounds' parameters, or bless these metrics on purpose")
 
 
+NEW = 3   # exit status: every bound holds, but some models ran that no bound covers yet
+
+
 def check(thresholds, measurements):
-    """Rows (bound, measured, passed) and the exit status: 0 all pass, 1 any fails. Bounds of
-    a case and mode that were not run are set aside; metrics run at other problem parameters
-    than the bounds', a bound without a measured value, a value that is not finite, or a
-    measured metric without a bound raise CheckError (exit 2): a missing reference never
-    passes."""
+    """Rows (bound, measured, passed), the exit status and the new models.
+
+    Status 0: every bound holds; 1: a metric left its bound; NEW (3): every bound holds but
+    some (case, mode, model) has no bound at all: "new, not gated yet" (a preset or user term
+    nobody has blessed), listed as ``new`` [(case, mode, model, n_metrics)]. Bounds of a case
+    and mode that were not run are set aside; metrics run at other problem parameters than the
+    bounds', a bound without a measured value, a value that is not finite, or a measured metric
+    without a bound for a model that has bounds raise CheckError (exit 2): a missing reference
+    never passes."""
     values = measurements.values
     rows, status = [], 0
     runs = {k[:2] for k in values}            # (case, mode) pairs that were measured
@@ -210,7 +217,13 @@ def check(thresholds, measurements):
         _same_problem(case, mode, thresholds.problems[(case, mode)],
                       measurements.problems[(case, mode)])
     keys = {b.key for b in bounds}
+    gated_models = {(b.case, b.mode, b.model) for b in bounds}
     unbounded = [k for k in values if k not in keys and values[k] is not None]
+    new = {}
+    for k in unbounded:
+        if (k[0], k[1], k[4]) not in gated_models:
+            new[(k[0], k[1], k[4])] = new.get((k[0], k[1], k[4]), 0) + 1
+    unbounded = [k for k in unbounded if (k[0], k[1], k[4]) in gated_models]
     if unbounded:
         raise CheckError(f"no bound for {len(unbounded)} measured metric(s), e.g. "
                          f"{'/'.join(unbounded[0])}: run `pbcm bless` to set them")
@@ -226,7 +239,14 @@ def check(thresholds, measurements):
         ok = b.passes(v)
         rows.append((b, v, ok))
         status = max(status, 0 if ok else 1)
-    return rows, status
+    for k in values:           # a new model's metrics must be numbers too
+        if (k[0], k[1], k[4]) in new and values[k] is not None and not (
+                isinstance(values[k], (int, float)) and math.isfinite(values[k])):
+            raise CheckError(f"metric {k[5]} of {'/'.join(k[:5])} is {values[k]!r}, not a "
+                             "finite number")
+    if new and status == 0:
+        status = NEW
+    return rows, status, [(*k, n) for k, n in sorted(new.items())]
 
 
 def bless(measurements, old=None, rtol=None, prune=False, today=None):

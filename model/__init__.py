@@ -32,7 +32,9 @@ PRESETS = {
 
 
 def build(model, mesh, material, threads=1, **term_params):
-    """A :class:`ParticleModel` from a preset name or a list of ``(term, params)``.
+    """A :class:`ParticleModel` from a preset name, a composed spec such as
+    ``"shear(reading=variational, c=auto) + normal_edge(c=auto) + volume"`` (see
+    :mod:`model.compose`), or a list of ``(term, params)``.
 
     ``term_params`` override parameters per term name, e.g.
     ``build("pbcm-variational", mesh, mat, shear={"scale": 0.5})``. ``threads`` > 1 runs the
@@ -40,9 +42,8 @@ def build(model, mesh, material, threads=1, **term_params):
     with forces equal bit for bit to the serial ones.
     """
     if isinstance(model, str):
-        if model not in PRESETS:
-            raise ModelError(f"unknown model {model!r}; presets: {', '.join(PRESETS)}")
-        name, terms = model, PRESETS[model]
+        from .compose import label, parse
+        name, terms = label(model), parse(model)
     else:
         name, terms = "custom", list(model)
     unknown = set(term_params) - {t for t, _ in terms}

@@ -15,7 +15,7 @@ SMALL = ["--quick", "--meshes", "five", "--models", "pbcm-variational", "msm"]
 def test_committed_bounds_hold_for_the_quick_run(quick, capsys):
     """The gate CI runs: every bound in thresholds.toml against this run's metrics."""
     status = main(["check", "--metrics", str(quick), "--thresholds",
-                   str(ROOT / "thresholds.toml")])
+                   str(ROOT / "thresholds.toml"), "--allow-new"])
     out = capsys.readouterr().out
     assert status == 0, out
     assert re.search(r"^\d+ passed, 0 failed$", out, re.M)
@@ -128,5 +128,37 @@ def test_a_better_result_fails_until_blessed(blessed, tmp_path, capsys):
 def test_committed_full_mode_bounds_hold_for_the_committed_reports(capsys):
     """`pbcm check` with its defaults on a clean checkout: the committed full-mode report."""
     assert main(["check", "--metrics", str(ROOT / "reports"), "--thresholds",
-                 str(ROOT / "thresholds.toml")]) == 0
+                 str(ROOT / "thresholds.toml"), "--allow-new"]) == 0
     assert "0 failed" in capsys.readouterr().out
+
+
+def test_a_model_without_bounds_is_new_not_gated_yet(blessed, tmp_path, capsys):
+    """A preset or composed model nobody has blessed: its metrics are listed as new (exit 3,
+    or 0 with --allow-new), while every blessed bound is still checked; a bounded model's
+    metric without a bound stays an error."""
+    data = json.loads((blessed / "good" / "paper-cube" / "metrics.json").read_text())
+    extra = "shear(reading=variational, c=auto) + normal_tet(c=auto) + volume"
+    data["runs"] += [{**r, "model": extra} for r in data["runs"] if r["model"] == "msm"]
+    (tmp_path / "m").mkdir()
+    (tmp_path / "m" / "metrics.json").write_text(json.dumps(data))
+    assert check(tmp_path / "m", blessed / "t.toml") == 3
+    out = capsys.readouterr().out
+    assert f"NEW  paper-cube (quick) {extra}: new, not gated yet" in out
+    assert re.search(r"^\d+ passed, 0 failed$", out, re.M)
+    assert main(["check", "--metrics", str(tmp_path / "m"), "--thresholds",
+                 str(blessed / "t.toml"), "--allow-new"]) == 0
+    # a failing bound still fails (1), new models or not
+    worse = [dict(r) for r in data["runs"]]
+    for r in worse:
+        if r["model"] == "msm" and r.get("disp_rel_l2_p2") is not None:
+            r["disp_rel_l2_p2"] *= 2
+    (tmp_path / "m" / "metrics.json").write_text(json.dumps({**data, "runs": worse}))
+    assert main(["check", "--metrics", str(tmp_path / "m"), "--thresholds",
+                 str(blessed / "t.toml"), "--allow-new"]) == 1
+    # a new model's NaN is an error, not news
+    nan = [dict(r) for r in data["runs"]]
+    for r in nan:
+        if r["model"] == extra:
+            r["disp_rel_l2_p2"] = float("nan")
+    (tmp_path / "m" / "metrics.json").write_text(json.dumps({**data, "runs": nan}))
+    assert check(tmp_path / "m", blessed / "t.toml") == 2
