@@ -155,11 +155,14 @@ def _engine_timers(mesh, timed, progress):
     return timers, status
 
 
-def run(sizes=SIZES, models=None, rounds=7, progress=print):
-    """Measure every model at every size; returns the bench document (plain data)."""
+def run(sizes=SIZES, models=None, rounds=7, progress=print, engines=True):
+    """Measure every model at every size; returns the bench document (plain data). The
+    baselines (msm, fem-linear) are always timed, for the ratios; the other engines only with
+    ``engines``."""
     models = list(models or PRESETS)
     timed_models = models + [b for b in BASELINES if b not in models]
-    if any(e.installed() for e in ENGINES.values()) and ENGINE_REFERENCE not in timed_models:
+    if engines and any(e.installed() for e in ENGINES.values()) \
+            and ENGINE_REFERENCE not in timed_models:
         timed_models.append(ENGINE_REFERENCE)
     mat = Material(10e3, 0.45, 1000.0)
     for name in timed_models:   # load every module once, so that memory counts the model only
@@ -169,7 +172,7 @@ def run(sizes=SIZES, models=None, rounds=7, progress=print):
         mesh = bench_mesh(target)
         progress(f"bench: {mesh.n_tets} tetrahedra, {len(timed_models)} models")
         timed = {name: _Timed(name, mesh, mat) for name in timed_models}
-        timers, status = _engine_timers(mesh, timed, progress)
+        timers, status = _engine_timers(mesh, timed, progress) if engines else ({}, {})
         for name, line in status.items():
             if line not in engines.setdefault(name, []):
                 engines[name].append(line)
@@ -206,6 +209,17 @@ def run(sizes=SIZES, models=None, rounds=7, progress=print):
     return {"machine": _machine(), "sizes": [int(s) for s in sizes], "rows": rows,
             "engines": {k: "; ".join(v) for k, v in engines.items()},
             "engine_rows": engine_rows}
+
+
+def merge(old, new):
+    """``old`` with the model rows of ``new`` added (replacing rows of the same model and size).
+    Each row's ratios were taken in its own process against the baselines timed with it, so
+    rows of separate runs stay comparable; the baselines' own rows, and the engines, stay
+    ``old``'s, so that costs computed from them elsewhere do not move."""
+    keys = {(r["model"], r["tets"]) for r in new["rows"]}
+    rows = [r for r in old["rows"] if (r["model"], r["tets"]) not in keys] + new["rows"]
+    sizes = sorted(set(old["sizes"]) | set(new["sizes"]))
+    return {**old, "sizes": sizes, "rows": rows}
 
 
 def _machine():

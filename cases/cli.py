@@ -227,9 +227,21 @@ def _bench_command(args):
     models = _models(args.models, list(model.PRESETS))
     sizes = args.sizes or (bench.QUICK_SIZES if args.quick else bench.SIZES)
     # checked before any timing starts
+    old = None
+    if args.merge:
+        if not models:
+            raise UsageError("--merge adds the rows of the --models given to a bench.json: "
+                             "name the models to time")
+        where = Path(args.out) / "bench.json"
+        if not where.is_file():
+            raise UsageError(f"--merge needs an existing {where}; run `pbcm bench` first or "
+                             "drop --merge")
+        old = bench.load(where)
+        models = tuple(m for m in models if m not in bench.BASELINES)
     with StagedFolder(Path(args.out), mark="bench.json") as out:
-        data = bench.run(sizes=sizes, models=models, rounds=3 if args.quick else args.rounds)
-        bench.write(data, out.path)
+        data = bench.run(sizes=sizes, models=models, rounds=3 if args.quick else args.rounds,
+                         engines=old is None)
+        bench.write(bench.merge(old, data) if old else data, out.path)
         path = out.commit()
     print(f"bench written to {path}")
     return 0
@@ -346,6 +358,37 @@ def _term_files(p):
                         "then be composed in --models")
 
 
+def _fit_command(args):
+    import json
+    from model.compose import label, slug
+    from .registry import CASES
+    from . import fit
+    name = label(args.model)
+    fit.fitted_terms(name)                       # a model with nothing to fit: refused now
+    train = [_case(c) for c in args.cases]
+    validate = [_case(c) for c in args.validate] if args.validate is not None else [
+        c for n, c in CASES.items() if c.static and n not in args.cases]
+    fit.check_cases(train, validate)
+    for c in [*train, *validate]:
+        _choose("mesh", args.meshes, c.meshes)
+        _choose(f"boundary condition of {c.name}", args.bcs, c.bcs)
+    overrides = {k: v for k, v in {"E": args.E, "nu": args.nu, "meshes": args.meshes and
+                                   tuple(args.meshes), "bcs": args.bcs and tuple(args.bcs)
+                                   }.items() if v is not None}
+    with StagedFolder(Path(args.out) if args.out else Path("reports") / "fit" / slug(name),
+                      mark="fit.json") as out:
+        doc = fit.fit(name, train, validate, quick=args.quick, overrides=overrides)
+        (out.path / "fit.json").write_text(json.dumps(doc, indent=1) + "\n")
+        fit.report(doc).write(out.path)
+        path = out.commit()
+    for k, v in doc["constants_fitted"].items():
+        print(f"{k:<24} auto {doc['constants_auto'][k]:.5g} -> fitted {v:.5g} "
+              f"(factor {doc['scales'][k.split('.')[0]]:.4g}, rel. s.e. "
+              f"{doc['scale_rel_se'][k.split('.')[0]]:.2g})")
+    print(f"condition number {doc['condition_number']:.3g}; report written to {path}")
+    return 0
+
+
 def _selection(p):
     p.add_argument("--models", nargs="+",
                    help="model presets, or terms composed with '+', e.g. \"shear(reading="
@@ -414,8 +457,32 @@ def parser():
                     default=7, help="timing rounds (default 7)")
     bn.add_argument("--models", nargs="+", help="model presets or composed models "
                                                 "(default: every preset)")
+    bn.add_argument("--merge", action="store_true",
+                    help="add the rows of --models to the bench.json in --out (timed against "
+                         "the baselines in this process) and keep every other row")
     _term_files(bn)
     bn.set_defaults(func=_bench_command)
+
+    ft = sub.add_parser(
+        "fit", help="fit a model's constants to the FEM references of chosen cases",
+        description="Fit the constants of MODEL's terms (shear c, normal c_n, spring stiffness "
+                    "scale) by least squares (scipy) to the FEM displacements of --cases, and "
+                    "cross-validate on the cases left out (--validate; default every other "
+                    "case with a static problem): error before and after. Writes fit.json and "
+                    "report.md/.html to --out (default reports/fit/MODEL).")
+    ft.add_argument("model", help="a preset or composed model")
+    ft.add_argument("--cases", nargs="+", required=True, help="cases to fit on")
+    ft.add_argument("--validate", nargs="*", help="cases left out, to cross-validate on")
+    ft.add_argument("--quick", action="store_true", help="each case's quick settings")
+    ft.add_argument("--meshes", nargs="+", help="mesh families of every case (default: each "
+                                                "case's own)")
+    ft.add_argument("--bcs", nargs="+", help="boundary conditions of every case (default: "
+                                             "each case's own)")
+    ft.add_argument("--out", help="output folder (default reports/fit/MODEL)")
+    ft.add_argument("--E", type=_number("--E", "Young's modulus in Pa, a number > 0", low=0))
+    ft.add_argument("--nu", type=_poisson)
+    _term_files(ft)
+    ft.set_defaults(func=_fit_command)
 
     ix = sub.add_parser("index", help="rewrite reports/index.md from the folders written",
                         description="Rewrite index.md and index.html from the case and study "

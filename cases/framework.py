@@ -161,6 +161,7 @@ class Case(abc.ABC):
     fem_solver : the linear FEM solver ("auto", "direct", "amg").
     draws_stress, magnify : whether the case draws its own stress panels; the magnification
         of the standard ones.
+    static : whether the case has a static displacement problem (what ``pbcm fit`` fits).
     """
 
     name: ClassVar[str]
@@ -179,6 +180,7 @@ class Case(abc.ABC):
     fem_solver: ClassVar[str] = "auto"    # the linear FEM solver (reference.fem.linear_solve)
     draws_stress: ClassVar[bool] = False   # True: the case draws its own max |tau| panels
     magnify: ClassVar[float] = 5.0         # displacement magnification of the panels
+    static: ClassVar[bool] = True          # False: no static displacement (modes)
 
     # ------------------------------------------------------------------ settings
     def settings(self, quick=False, **kw):

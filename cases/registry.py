@@ -14,6 +14,7 @@ MODULES = {
 }
 STUDY_MODULES = {
     "convergence": "cases.convergence",
+    "extensions": "cases.extensions",
 }
 
 CASES = {name: importlib.import_module(module).CASE for name, module in MODULES.items()}

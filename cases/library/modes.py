@@ -30,6 +30,7 @@ class Modes(Case):
     title = ("The first 10 frequencies of the 32 mm cube, free-free and with a clamped base, "
              "of every model linearised at rest, against FEM P2")
     settings_class = ModesSettings
+    static = False
     bcs = ("free", "clamped")
     quick = {"fem_refine": 0}
     headline = Headline("modal_rel_err", "largest error of the first 10 frequencies")

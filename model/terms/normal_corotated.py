@@ -23,8 +23,43 @@ from .volume import FLAT
 
 
 @njit(cache=True, fastmath=True)
+def jacobi_eigh3(A, V):
+    """Eigen-decomposition of the symmetric 3 x 3 ``A`` in place by cyclic Jacobi rotations:
+    on return diag(A) holds the eigenvalues and the columns of ``V`` the eigenvectors. Robust
+    where eigenvalues coincide (C = I at rest), and no LAPACK call per tetrahedron."""
+    for i in range(3):
+        for j in range(3):
+            V[i, j] = 1.0 if i == j else 0.0
+    for _ in range(20):
+        off = A[0, 1] ** 2 + A[0, 2] ** 2 + A[1, 2] ** 2
+        if off <= 1e-32 * (A[0, 0] ** 2 + A[1, 1] ** 2 + A[2, 2] ** 2):
+            return
+        for r in range(3):
+            p, q = (0, 0, 1)[r], (1, 2, 2)[r]
+            if abs(A[p, q]) <= 1e-18 * (abs(A[p, p]) + abs(A[q, q])):
+                continue
+            theta = (A[q, q] - A[p, p]) / (2.0 * A[p, q])
+            t = (1.0 if theta >= 0.0 else -1.0) / (abs(theta) + np.sqrt(theta * theta + 1.0))
+            c = 1.0 / np.sqrt(t * t + 1.0)
+            sn = t * c
+            for k in range(3):          # A <- A J (columns p, q)
+                akp, akq = A[k, p], A[k, q]
+                A[k, p], A[k, q] = c * akp - sn * akq, sn * akp + c * akq
+            for k in range(3):          # A <- J^T A (rows p, q)
+                apk, aqk = A[p, k], A[q, k]
+                A[p, k], A[q, k] = c * apk - sn * aqk, sn * apk + c * aqk
+            for k in range(3):          # V <- V J
+                vkp, vkq = V[k, p], V[k, q]
+                V[k, p], V[k, q] = c * vkp - sn * vkq, sn * vkp + c * vkq
+
+
+@njit(cache=True, fastmath=True)
 def corotated_normal_forces(x, tets, Dinv, vol0, kG, out):
     C = np.empty((3, 3))
+    V = np.empty((3, 3))
+    B = np.empty((3, 3))
+    sig = np.empty(3)
+    a = np.empty(3)
     for t in range(tets.shape[0]):
         F, J = deformation_gradient(x, tets, t, Dinv)
         if J <= FLAT:
@@ -32,15 +67,18 @@ def corotated_normal_forces(x, tets, Dinv, vol0, kG, out):
         for i in range(3):
             for j in range(3):
                 C[i, j] = F[0][i] * F[0][j] + F[1][i] * F[1][j] + F[2][i] * F[2][j]
-        lam, V = np.linalg.eigh(C)
-        sig = np.sqrt(lam)
+        jacobi_eigh3(C, V)
+        for i in range(3):
+            sig[i] = np.sqrt(C[i, i])
         trU = sig[0] + sig[1] + sig[2]
-        # A = 2 kG diag(U_ii - tr U / 3), in the eigenbasis: At = V^T A V
-        a = np.empty(3)
+        # A = dW/dU = 2 kG diag(U_ii - tr U / 3), U_ii = sum_p V_ip^2 sigma_p
         for i in range(3):
             a[i] = 2.0 * kG * (V[i, 0] ** 2 * sig[0] + V[i, 1] ** 2 * sig[1]
                                + V[i, 2] ** 2 * sig[2] - trU / 3.0)
-        B = np.zeros((3, 3))
+        # B = V Bt V^T with Bt_pq = (V^T A V)_pq / (sigma_p + sigma_q)
+        for i in range(3):
+            for j in range(3):
+                B[i, j] = 0.0
         for p in range(3):
             for q in range(3):
                 bt = (V[0, p] * a[0] * V[0, q] + V[1, p] * a[1] * V[1, q]

@@ -70,6 +70,7 @@ class Shear(Term):
     name = "shear"
     checks_inversion = True
     params = {"reading": "variational", "c": "auto"}
+    fit_constant = "c"      # for corner and balanced: the factor on G (they have no c)
 
     def __init__(self, mesh, material, scale=1.0, **params):
         super().__init__(mesh, material, scale, **params)

@@ -53,6 +53,8 @@ class Springs(Term):
     name = "springs"
     conservative = True
 
+    fit_constant = "k_scale"   # the factor on van Gelder's stiffness
+
     def __init__(self, mesh, material, scale=1.0, **params):
         super().__init__(mesh, material, scale, **params)
         self.edge, self.rest, k = van_gelder_stiffness(mesh)

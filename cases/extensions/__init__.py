@@ -1,0 +1,35 @@
+"""Which normal-stress extension, if any, fixes which failure of the paper's model? Every
+candidate (the paper's variational reading plus one deviatoric normal term each) on every case
+of the library and in the convergence study, ranked by error per case and overall, by cost
+(from `pbcm bench`), by the bulge/neck artefact, by convergence floor and by the distance of
+its effective elasticity from the isotropic target.
+"""
+from dataclasses import fields
+
+from ..framework import Study
+from . import report
+from .study import ExtensionSettings, run
+
+
+class Extensions(Study):
+    name = "extensions"
+    title = ("normal-stress extensions of the paper's model ranked over the case library and "
+             "the convergence study")
+
+    def settings(self, quick=False, **kw):
+        kw = {k: v for k, v in kw.items() if v is not None}
+        names = {f.name for f in fields(ExtensionSettings) if f.init}
+        return ExtensionSettings(**{k: v for k, v in {**kw, "quick": quick}.items()
+                                    if k in names})
+
+    def run(self, s, workers=None, log=True, bench=None):
+        return run(s, workers=workers, log=log, bench=bench)
+
+    def write(self, out, s, data):
+        return report.write(out, self, s, data)
+
+    def headline(self, data):
+        return report.conclusion(data)
+
+
+STUDY = Extensions()

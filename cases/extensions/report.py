@@ -1,0 +1,293 @@
+"""The extensions study's files: metrics.json (case rows, fits, tensors, costs, rankings,
+failures and the rows the gate reads), report.md/.html and the figures. Every sentence is
+computed from the data it is written with."""
+import json
+from pathlib import Path
+
+import numpy as np
+
+from ..document import Document, fmt
+from .. import figures
+from ..report import environment, provenance
+from ..runner import jsonable
+from .study import BASE, COST_TETS, YARDSTICK, short
+
+GATED = {"error": "max", "zigzag": "max", "e_inf": "max", "distance": "max"}
+FEM_FACTOR = 1.5      # a case error this many times FEM P1's on the same mesh is a failure
+ISOTROPIC_TOL = 0.01  # ||C_eff - C|| / ||C|| above this: the lattice is not the material
+ZIGZAG_FACTOR = 2.0   # a bulge/neck zig-zag this many times FEM P2's is the artefact
+ZIGZAG_FLOOR = 1e-3   # ... and above this (mm): FEM's own is near zero
+CHANGE = 0.25         # a relative change below this is "no change"
+
+
+# ---------------------------------------------------------------------- rankings
+def _median(values):
+    v = [x for x in values if x is not None]
+    return float(np.median(v)) if v else None
+
+
+def case_errors(data, models):
+    """{case: {model: median headline error over its runs, or None if any run failed}}."""
+    out = {}
+    for case in dict.fromkeys(r["case"] for r in data["case_runs"]):
+        out[case] = {}
+        for m in models:
+            rs = [r for r in data["case_runs"] if r["case"] == case and r["model"] == m]
+            out[case][m] = None if not rs or any(r["failed"] or r["error"] is None
+                                                 for r in rs) else _median(r["error"] for r in rs)
+    return out
+
+
+def overall(errors, models):
+    """The geometric mean over cases of each model's error over the paper model's (below 1:
+    better than the paper's model); None for a model that failed somewhere."""
+    out = {}
+    for m in models:
+        ratios = [e[m] / e[BASE] for e in errors.values()
+                  if e.get(m) is not None and e.get(BASE)]
+        failed = any(e.get(m) is None for e in errors.values())
+        out[m] = None if failed or not ratios else float(np.exp(np.mean(np.log(ratios))))
+    return out
+
+
+def zigzags(data, models):
+    """Median bulge/neck zig-zag of each model on the paper cube, and FEM P2's."""
+    rs = [r for r in data["case_runs"] if r["case"] == "paper-cube"]
+    return ({m: _median(r["zigzag"] for r in rs if r["model"] == m) for m in models},
+            _median(r["zigzag_fem"] for r in rs))
+
+
+def floors(data, models):
+    """Per model: the convergence verdicts over the (problem, family) fits and the median
+    extrapolated error e_inf."""
+    out = {}
+    for m in models:
+        fs = [f for f in data["fits"] if f["model"] == m]
+        out[m] = {"floor": sum(f["verdict"] == "floor" for f in fs),
+                  "diverges": sum(f["verdict"] == "diverges" for f in fs),
+                  "fits": len(fs), "e_inf": _median(f["e_inf"] for f in fs)}
+    return out
+
+
+def tensors(data, models):
+    """{model: {lattice: distance of C_eff from the isotropic target}}."""
+    return {m: {e["mesh"]: e.get("distance") for e in data["elasticity"] if e["model"] == m}
+            for m in models}
+
+
+def rankings(data, models):
+    errors = case_errors(data, models)
+    zz, zz_fem = zigzags(data, models)
+    return {"case_errors": errors, "overall": overall(errors, models), "zigzag": zz,
+            "zigzag_fem": zz_fem, "floors": floors(data, models),
+            "tensors": tensors(data, models), "cost": data["cost_vs_fem_linear"]}
+
+
+def order(values):
+    """Models by value, smallest first, those without a value last."""
+    return sorted(values, key=lambda m: (values[m] is None, values[m] if values[m] is not None
+                                         else 0.0))
+
+
+# ---------------------------------------------------------------------- failures and fixes
+def failures(rank):
+    """The paper model's failures, each with the criterion it fails: {what, kind, key, base,
+    limit}."""
+    out = []
+    for case, e in rank["case_errors"].items():
+        fem = e.get(YARDSTICK)
+        if e.get(BASE) is None:
+            out.append({"what": f"{case}: failed", "kind": "case", "key": case, "base": None,
+                        "limit": None})
+        elif fem is not None and e[BASE] > FEM_FACTOR * fem:
+            out.append({"what": f"{case} error (FEM P1 on the same mesh: {fmt(fem)})",
+                        "kind": "case", "key": case, "base": e[BASE], "limit": FEM_FACTOR * fem})
+    zz = rank["zigzag"].get(BASE)
+    limit = max(ZIGZAG_FACTOR * (rank["zigzag_fem"] or 0.0), ZIGZAG_FLOOR)
+    if zz is not None and zz > limit:
+        out.append({"what": "bulge/neck zig-zag on the paper cube", "kind": "zigzag",
+                    "key": "zigzag", "base": zz, "limit": limit})
+    for lattice, d in rank["tensors"].get(BASE, {}).items():
+        if d is not None and d > ISOTROPIC_TOL:
+            out.append({"what": f"C_eff on {lattice}", "kind": "tensor", "key": lattice,
+                        "base": d, "limit": ISOTROPIC_TOL})
+    return out
+
+
+def value(rank, failure, model):
+    k = failure["kind"]
+    if k == "case":
+        return rank["case_errors"][failure["key"]].get(model)
+    if k == "zigzag":
+        return rank["zigzag"].get(model)
+    return rank["tensors"].get(model, {}).get(failure["key"])
+
+
+def verdict(failure, v):
+    """'fixes' (meets the criterion), 'improves', 'worsens' (by CHANGE or more), 'no change',
+    or 'fails' (no value)."""
+    if v is None:
+        return "fails"
+    if failure["limit"] is not None and v <= failure["limit"]:
+        return "fixes"
+    if failure["base"] is None:
+        return "runs"
+    if v <= (1 - CHANGE) * failure["base"]:
+        return "improves"
+    if v >= (1 + CHANGE) * failure["base"]:
+        return "worsens"
+    return "no change"
+
+
+def fixes(rank, models):
+    """{candidate: [(failure, value, verdict)]} for every model but the base and FEM."""
+    fs = failures(rank)
+    return fs, {m: [(f, value(rank, f, m), verdict(f, value(rank, f, m))) for f in fs]
+                for m in models if m not in (BASE, YARDSTICK)}
+
+
+def conclusion(data):
+    """The study's headline, from a metrics document."""
+    models = data["parameters"]["models"]
+    rank = data["rankings"]
+    fs, table = fixes(rank, models)
+    cands = [m for m in models if m not in (BASE, YARDSTICK)]
+    lines = []
+    best = [m for m in order(rank["overall"]) if m in cands]
+    if best and rank["overall"][best[0]] is not None:
+        lines.append(
+            f"Over the {len(rank['case_errors'])} cases of the library the best normal-stress "
+            f"extension is {short(best[0])}: its errors are {fmt(rank['overall'][best[0]])} "
+            f"times the paper model's ({BASE}) in geometric mean; the others: "
+            + ", ".join(f"{short(m)} {fmt(rank['overall'][m])}" for m in best[1:]) + ".")
+    if not fs:
+        lines.append(f"{BASE} fails none of the criteria checked here (case error within "
+                     f"{FEM_FACTOR:g}x FEM P1, C_eff within {ISOTROPIC_TOL:g} of the target, no "
+                     "zig-zag beyond FEM's).")
+        return lines
+    lines.append(f"{BASE} fails {len(fs)} criteria: " + "; ".join(
+        f"{f['what']} {fmt(f['base'])}" for f in fs) + ".")
+    fixed = {m: [(f, v) for f, v, w in table[m] if w == "fixes"] for m in cands}
+    for m in cands:
+        worse = [(f, v) for f, v, w in table[m] if w in ("worsens", "fails")]
+        said = (f"{short(m)} fixes {len(fixed[m])} of them"
+                + (": " + "; ".join(f"{f['what']} {fmt(f['base'])} -> {fmt(v)}"
+                                    for f, v in fixed[m]) if fixed[m] else ""))
+        if worse:
+            said += " and worsens " + "; ".join(
+                f"{f['what']} {fmt(f['base'])} -> {fmt(v)}" for f, v in worse)
+        lines.append(said + ".")
+    nobody = [f for i, f in enumerate(fs) if not any(table[m][i][2] == "fixes" for m in cands)]
+    if nobody:
+        lines.append("No extension fixes " + "; ".join(f["what"] for f in nobody) + ".")
+    return lines
+
+
+# ---------------------------------------------------------------------- files
+def gate_rows(data, rank):
+    rows = [{"mesh": case, "bc": "median", "model": m, "error": e}
+            for case, es in rank["case_errors"].items() for m, e in es.items()]
+    rows += [{"mesh": "paper-cube", "bc": "zigzag", "model": m, "zigzag": z}
+             for m, z in rank["zigzag"].items()]
+    rows += [{"mesh": f["mesh"], "bc": f"{f['case']}/{f['bc']}/fit", "model": f["model"],
+              "e_inf": f.get("e_inf")} for f in data["fits"] if f["model"] != "FEM P1"]
+    rows += [{"mesh": e["mesh"], "bc": "C_eff", "model": e["model"],
+              "distance": e.get("distance")} for e in data["elasticity"]]
+    return rows
+
+
+def write(out, study, s, data):
+    """Write metrics.json, run.json, report.md/.html and the PNG figures into ``out``."""
+    out = Path(out)
+    out.mkdir(parents=True, exist_ok=True)
+    rank = rankings(data, list(s.models))
+    doc = jsonable({"case": study.name, "study": True, "parameters": s.describe(),
+                    "problem": s.problem(), "gated": GATED, "environment": environment(),
+                    **data, "rankings": rank, "gate_runs": gate_rows(data, rank)})
+    (out / "metrics.json").write_text(json.dumps(doc, indent=1) + "\n")
+    prov = provenance([])
+    prov.pop("timings")
+    (out / "run.json").write_text(json.dumps(prov, indent=1) + "\n")
+    build(out, study, s, doc).write(out)
+    return out
+
+
+def build(out, study, s, doc):
+    rank, models = doc["rankings"], list(s.models)
+    cases = list(rank["case_errors"])
+    d = Document(f"pbcm report: {study.name}")
+    for line in conclusion(doc):
+        d.p(line)
+    d.p("Generated by `pbcm run extensions` from the runs recorded in metrics.json; every "
+        "number below was computed by the run that wrote this file, but the step costs, which "
+        "are `pbcm bench`'s (reports/bench).")
+    d.h(2, "What was run")
+    d.ul([study.title + ".",
+          f"The paper's model: {BASE} (MODEL.md's variational reading, c fitted). Each "
+          "candidate adds one deviatoric normal-stress term with c_n = auto (fitted with the "
+          "shear c against the isotropic deviatoric energy): "
+          + "; ".join(f"{short(m)} = `{m}`" for m in models if short(m) != m) + ". "
+          f"{YARDSTICK} (constant-strain FEM on the same tetrahedra) is the yardstick.",
+          f"Cases: {', '.join(cases)}, each with its own {'quick' if s.quick else 'full'} "
+          "settings (meshes, boundary conditions, references), as `pbcm run CASE` runs them.",
+          "Convergence: the convergence study's problems, mesh families and sizes "
+          f"({'quick' if s.quick else 'full'} mode) with these models: the verdict of each "
+          "(problem, family) fit and the effective elasticity tensor of each lattice.",
+          f"Material E = {s.E:g} Pa, nu = {s.nu:g}."])
+    d.h(2, "Criteria")
+    d.ul([f"case error: the case's headline metric (its report's), median over its meshes "
+          f"and boundary conditions; a failure of {BASE} where it exceeds {FEM_FACTOR:g} times "
+          "FEM P1's on the same meshes.",
+          f"overall: geometric mean over the cases of the error over {BASE}'s (below 1: "
+          "better than the paper's model).",
+          f"bulge/neck artefact: the zig-zag of the paper cube's layer profile (mm), median; "
+          f"a failure above {ZIGZAG_FACTOR:g} times FEM P2's and above {ZIGZAG_FLOOR:g} mm.",
+          "convergence floor: fits (of the convergence study) whose verdict is floor or "
+          "diverges, and the median extrapolated error e_inf.",
+          f"C_eff: ||C_eff - C|| / ||C|| on each lattice; a failure above {ISOTROPIC_TOL:g}.",
+          f"cost: RK4 step time over fem-linear's at {COST_TETS:.0e} tetrahedra, from the "
+          "bench's interleaved in-process ratios.",
+          f"fixes: meets the criterion; improves / worsens: changes the value by "
+          f"{CHANGE:.0%} or more."])
+    d.h(2, "Ranking by error")
+    by = order(rank["overall"])
+    d.table(["rank", "model", "overall"] + cases,
+            [[str(i + 1), short(m), fmt(rank["overall"][m])]
+             + [fmt(rank["case_errors"][c][m]) for c in cases] for i, m in enumerate(by)])
+    figures.grouped_bars(Path(out) / "case_errors.png", cases, [short(m) for m in models],
+                         [[rank["case_errors"][c][m] or np.nan for m in models] for c in cases],
+                         "headline error", "Headline error of each case", log=True)
+    d.img("case_errors.png", "headline error of each case per model")
+    d.h(2, "Ranking by cost, artefact, convergence floor and effective elasticity")
+    lattices = sorted({e["mesh"] for e in doc["elasticity"]})
+    fl = rank["floors"]
+    d.table(["model", "step / fem-linear", "zig-zag (mm)", "floor + diverges",
+             "median e_inf"] + [f"C_eff {lat}" for lat in lattices],
+            [[short(m), fmt(rank["cost"].get(m)), fmt(rank["zigzag"].get(m)),
+              f"{fl[m]['floor'] + fl[m]['diverges']} of {fl[m]['fits']}", fmt(fl[m]["e_inf"])]
+             + [fmt(rank["tensors"][m].get(lat)) for lat in lattices] for m in models])
+    d.p(f"FEM P2's zig-zag: {fmt(rank['zigzag_fem'])} mm. By cost: "
+        + ", ".join(short(m) for m in order(rank["cost"])) + "; by zig-zag: "
+        + ", ".join(short(m) for m in order(rank["zigzag"])) + "; by floors: "
+        + ", ".join(short(m) for m in sorted(models, key=lambda m: (
+            fl[m]["floor"] + fl[m]["diverges"], fl[m]["e_inf"] or 0.0))) + ".")
+    missing = [short(m) for m in models if rank["cost"].get(m) is None]
+    if missing:
+        d.p(f"Not in bench.json, so without a cost: {', '.join(missing)}; `pbcm bench --merge "
+            "--models ...` adds them.")
+    figures.grouped_bars(Path(out) / "ceff_distance.png", lattices, [short(m) for m in models],
+                         [[rank["tensors"][m].get(lat) or np.nan for m in models]
+                          for lat in lattices], "||C_eff - C|| / ||C||",
+                         "Distance of the effective tensor from the isotropic target", log=True)
+    d.img("ceff_distance.png", "effective elasticity distance per lattice and model")
+    d.h(2, "Which extension fixes which failure")
+    fs, table = fixes(rank, models)
+    cands = [m for m in models if m not in (BASE, YARDSTICK)]
+    if fs:
+        d.table(["failure of " + BASE, "value", "criterion"] + [short(m) for m in cands],
+                [[f["what"], fmt(f["base"]), fmt(f["limit"])]
+                 + [f"{fmt(table[m][i][1])} ({table[m][i][2]})" for m in cands]
+                 for i, f in enumerate(fs)])
+    else:
+        d.p(f"{BASE} meets every criterion here.")
+    return d

@@ -1,0 +1,103 @@
+"""The extensions study's runs: the library's cases and the convergence study with the
+candidate models, reduced to what the rankings read."""
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from model import Material
+from model.compose import label
+from ..convergence import STUDY as CONVERGENCE
+from ..convergence.cost import step_cost_us
+from ..runner import jsonable, run as run_case
+
+BASE = "pbcm-variational"    # the paper's model: its best reading (MODEL.md "variational")
+YARDSTICK = "fem-linear"     # what the same tetrahedra give as constant-strain FEM
+# the normal-stress forms added to the paper's model, one candidate each
+NORMAL_FORMS = ("normal_edge", "normal_tet", "normal_corotated", "normal_sbd")
+CANDIDATES = tuple(label(f"{BASE} + {form}(c=auto)") for form in NORMAL_FORMS)
+COST_TETS = 1e4              # the mesh size at which costs are compared
+
+
+def short(model):
+    """The name the report's tables use: the added term of a candidate, else the preset."""
+    for form in NORMAL_FORMS:
+        if model == label(f"{BASE} + {form}(c=auto)"):
+            return f"+{form}"
+    return model
+
+
+@dataclass
+class ExtensionSettings:
+    """Material, the models (the paper's model, the candidates and the FEM yardstick) and the
+    mode; each case and the convergence study run with their own quick or full settings."""
+
+    E: float = 10e3
+    nu: float = 0.45
+    rho: float = 1000.0
+    models: tuple = (BASE, *CANDIDATES, YARDSTICK)
+    quick: bool = False
+    material: Material = field(init=False, repr=False, compare=False)
+
+    def __post_init__(self):
+        self.material = Material(E=self.E, nu=self.nu, rho=self.rho)
+        if BASE not in self.models:
+            from model.errors import ModelError
+            raise ModelError(f"the extensions study ranks models against the paper's model: "
+                             f"keep {BASE} among --models")
+
+    def case_settings(self):
+        from ..registry import CASES
+        return {name: case.settings(quick=self.quick, models=self.models, E=self.E, nu=self.nu,
+                                    rho=self.rho) for name, case in CASES.items()}
+
+    def convergence_settings(self):
+        return CONVERGENCE.settings(quick=self.quick, models=self.models, E=self.E, nu=self.nu,
+                                    rho=self.rho)
+
+    def problem(self):
+        """What the gate compares: each case's problem and the convergence study's."""
+        return {"E_Pa": self.E, "nu": self.nu, "rho_kg_m3": self.rho,
+                "cases": {n: c.problem() for n, c in self.case_settings().items()},
+                "convergence": self.convergence_settings().problem()}
+
+    @property
+    def units(self):
+        return max([c.units for c in self.case_settings().values()]
+                   + [self.convergence_settings().units])
+
+    def describe(self):
+        return {**self.problem(), "models": list(self.models), "quick": self.quick}
+
+
+def case_row(case, r):
+    """What the rankings read of one case run."""
+    failed = r.get("failed") or r.get("static_failed")
+    return {"case": case.name, "mesh": r["mesh"], "bc": r["bc"], "model": r["model"],
+            "metric": case.headline.metric, "error": None if failed else r.get(
+                case.headline.metric), "failed": failed,
+            "zigzag": r.get("zigzag"), "zigzag_fem": r.get("zigzag_fem")}
+
+
+def costs(bench, models):
+    """Each model's RK4 step time over fem-linear's at COST_TETS tetrahedra, from the bench's
+    in-process ratios (None where the bench lacks the model)."""
+    out = {}
+    base = step_cost_us(bench, YARDSTICK, COST_TETS) if bench else None
+    for m in models:
+        c = step_cost_us(bench, m, COST_TETS) if bench else None
+        out[m] = None if c is None or not base else c / base
+    return out
+
+
+def run(s, workers=None, log=True, bench=None):
+    """Every case with the study's models, then the convergence study with them."""
+    from ..registry import CASES
+    rows = []
+    for name, cfg in s.case_settings().items():
+        runs, _ = run_case(CASES[name], cfg, workers=workers)
+        rows += [case_row(CASES[name], r) for r in runs]
+    conv = CONVERGENCE.run(s.convergence_settings(), workers=workers, log=log, bench=None)
+    return jsonable({"case_runs": rows, "fits": conv["fits"], "elasticity": [
+        {k: e.get(k) for k in ("model", "mesh", "distance", "anisotropy_AU", "E_x", "nu_xy",
+                               "G_xy", "failed")} for e in conv["elasticity"]],
+        "cost_vs_fem_linear": costs(bench, s.models)})
