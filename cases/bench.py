@@ -159,7 +159,10 @@ def run(sizes=SIZES, models=None, rounds=7, progress=print, engines=True):
     """Measure every model at every size; returns the bench document (plain data). The
     baselines (msm, fem-linear) are always timed, for the ratios; the other engines only with
     ``engines``."""
-    models = list(models or PRESETS)
+    if not models:      # every preset and the normal-stress candidates of `pbcm run extensions`
+        from .extensions.study import CANDIDATES
+        models = [*PRESETS, *CANDIDATES]
+    models = list(models)
     timed_models = models + [b for b in BASELINES if b not in models]
     if engines and any(e.installed() for e in ENGINES.values()) \
             and ENGINE_REFERENCE not in timed_models:

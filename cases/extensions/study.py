@@ -36,6 +36,8 @@ class ExtensionSettings:
     rho: float = 1000.0
     models: tuple = (BASE, *CANDIDATES, YARDSTICK)
     quick: bool = False
+    cases: tuple = None        # library cases (None: every one)
+    problems: tuple = None     # convergence problems (None: the study's own)
     material: Material = field(init=False, repr=False, compare=False)
 
     def __post_init__(self):
@@ -48,11 +50,12 @@ class ExtensionSettings:
     def case_settings(self):
         from ..registry import CASES
         return {name: case.settings(quick=self.quick, models=self.models, E=self.E, nu=self.nu,
-                                    rho=self.rho) for name, case in CASES.items()}
+                                    rho=self.rho) for name, case in CASES.items()
+                if self.cases is None or name in self.cases}
 
     def convergence_settings(self):
         return CONVERGENCE.settings(quick=self.quick, models=self.models, E=self.E, nu=self.nu,
-                                    rho=self.rho)
+                                    rho=self.rho, problems=self.problems)
 
     def problem(self):
         """What the gate compares: each case's problem and the convergence study's."""
@@ -66,7 +69,8 @@ class ExtensionSettings:
                    + [self.convergence_settings().units])
 
     def describe(self):
-        return {**self.problem(), "models": list(self.models), "quick": self.quick}
+        return {**self.problem(), "models": list(self.models), "quick": self.quick,
+                "cases": list(self.case_settings())}
 
 
 def case_row(case, r):

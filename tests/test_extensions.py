@@ -1,0 +1,133 @@
+"""Normal-stress extensions ranked (pbcm run extensions) and parameter identification
+(pbcm fit), issue 13."""
+import json
+
+import numpy as np
+import pytest
+
+from cases.cli import main
+from cases.extensions import STUDY
+from cases.extensions import report as R
+from cases.extensions.study import BASE, CANDIDATES, YARDSTICK, short
+from cases.registry import CASES
+from cases.runner import reaction_along, reference
+from model import build
+from model.terms.shear import Shear
+
+TET = CANDIDATES[1]
+
+
+def test_candidates_are_the_paper_model_plus_one_normal_form_each():
+    assert [short(c) for c in CANDIDATES] == ["+normal_edge", "+normal_tet",
+                                              "+normal_corotated", "+normal_sbd"]
+    assert TET == "shear(reading=variational, c=auto) + volume + normal_tet(c=auto)"
+
+
+def _doc(case_errors, zigzag, tensors, fem_zigzag=0.01):
+    """A metrics document with the given per-case errors {case: {model: e}}."""
+    models = [BASE, "m1", "m2", YARDSTICK]
+    runs = [{"case": c, "mesh": "five", "bc": "clamped", "model": m, "error": e,
+             "failed": None, "zigzag": zigzag.get(m) if c == "paper-cube" else None,
+             "zigzag_fem": fem_zigzag if c == "paper-cube" else None}
+            for c, es in case_errors.items() for m, e in es.items()]
+    data = {"case_runs": runs, "fits": [], "cost_vs_fem_linear": dict.fromkeys(models, 1.0),
+            "elasticity": [{"model": m, "mesh": lat, "distance": d}
+                           for m, ds in tensors.items() for lat, d in ds.items()]}
+    return models, data
+
+
+def test_rankings_failures_and_verdicts_worked_by_hand():
+    errs = {"paper-cube": {BASE: 0.2, "m1": 0.05, "m2": 0.4, YARDSTICK: 0.1},
+            "cantilever": {BASE: 0.1, "m1": 0.1, "m2": 0.05, YARDSTICK: 0.1}}
+    tensors = {BASE: {"six": 0.04}, "m1": {"six": 0.035}, "m2": {"six": 0.005},
+               YARDSTICK: {"six": 0.0}}
+    models, data = _doc(errs, {BASE: 0.05, "m1": 0.01, "m2": 0.08, YARDSTICK: 0.01}, tensors)
+    rank = R.rankings(data, models)
+    # geometric means of the ratios to the base: m1 sqrt(0.25 * 1) = 0.5, m2 sqrt(2 * 0.5) = 1
+    assert rank["overall"]["m1"] == pytest.approx(0.5)
+    assert rank["overall"]["m2"] == pytest.approx(1.0)
+    assert R.order(rank["overall"])[0] == "m1"
+    fs = R.failures(rank)
+    # paper-cube 0.2 > 1.5 x 0.1; cantilever 0.1 is not; zig-zag 0.05 > 2 x 0.01; C_eff 0.04
+    assert [f["kind"] for f in fs] == ["case", "zigzag", "tensor"]
+    _, table = R.fixes(rank, models)
+    assert [v for _, _, v in table["m1"]] == ["fixes", "fixes", "no change"]
+    assert [v for _, _, v in table["m2"]] == ["worsens", "worsens", "fixes"]
+    doc = {"parameters": {"models": models}, "rankings": rank}
+    text = " ".join(R.conclusion(doc))
+    assert "m1 fixes 2 of them: paper-cube error" in text and "0.2 -> 0.05" in text
+    assert "m2 fixes 1 of them: C_eff on six 0.04 -> 0.005 and worsens" in text
+
+
+def test_a_failed_run_ranks_last_and_is_said():
+    errs = {"torsion": {BASE: 0.2, "m1": None, "m2": 0.1, YARDSTICK: 0.1}}
+    models, data = _doc(errs, {}, {})
+    data["case_runs"][1]["failed"] = "static: no equilibrium"
+    rank = R.rankings(data, models)
+    assert rank["overall"]["m1"] is None and R.order(rank["overall"])[-1] == "m1"
+    _, table = R.fixes(rank, models)
+    assert table["m1"][0][2] == "fails"
+
+
+@pytest.fixture(scope="module")
+def small_study(tmp_path_factory):
+    """One case and one convergence problem, quick, with the paper model, one candidate and
+    the yardstick: every file and the gate rows."""
+    out = tmp_path_factory.mktemp("ext")
+    s = STUDY.settings(quick=True, models=(BASE, TET, YARDSTICK), cases=("cantilever",),
+                       problems=("cantilever",))
+    data = STUDY.run(s, log=False, bench=json.loads(
+        (R.Path(__file__).resolve().parents[1] / "reports/bench/bench.json").read_text()))
+    STUDY.write(out, s, data)
+    return out
+
+
+def test_small_study_writes_rankings_and_gate_rows(small_study):
+    doc = json.loads((small_study / "metrics.json").read_text())
+    for f in ("report.md", "report.html", "case_errors.png", "ceff_distance.png"):
+        assert (small_study / f).is_file()
+    rank = doc["rankings"]
+    assert set(rank["case_errors"]) == {"cantilever"}
+    assert rank["overall"][BASE] == 1.0
+    assert rank["cost"][TET] > rank["cost"][BASE] > 1.0      # the bench's ratios
+    rows = {(r["mesh"], r["bc"], r["model"]) for r in doc["gate_runs"]}
+    assert ("cantilever", "median", TET) in rows and ("six", "C_eff", TET) in rows
+    md = (small_study / "report.md").read_text()
+    assert "## Which extension fixes which failure" in md and "+normal_tet" in md
+    # the candidate's C_eff on five is the target (calibration), the paper model's is not
+    t = rank["tensors"]
+    assert t[TET]["five"] < 1e-6 < t[BASE]["five"]
+
+
+def test_fit_recovers_the_closed_form_stiffness_scale(tmp_path):
+    """A single-term model under prescribed displacement: positions do not depend on the
+    stiffness scale k and the reaction is k times, so the least-squares k is 1 / the reaction
+    ratio of the model as built, worked out here from one static solve."""
+    case = CASES["paper-cube"]
+    s = case.settings(quick=True, models=("msm",), meshes=("five",), bcs=("sliding",))
+    mesh = case.mesh("five", s)
+    ref = reference(case, mesh, "sliding", s, Shear(mesh, s.material, reading="corner"),
+                    extra=False)
+    st = case.solve_static(build("msm", mesh, s.material), mesh, "sliding", s, ref)
+    ratio = reaction_along(st.reaction, case.driven(mesh, "sliding", s)) / ref.reaction
+    out = tmp_path / "fit"
+    assert main(["fit", "msm", "--cases", "paper-cube", "--meshes", "five", "--bcs",
+                 "sliding", "--validate", "--quick", "--out", str(out)]) == 0
+    doc = json.loads((out / "fit.json").read_text())
+    assert doc["scales"]["springs"] == pytest.approx(1 / ratio, rel=1e-4)
+    assert doc["constants_fitted"]["springs.k_scale"] == pytest.approx(1 / ratio, rel=1e-4)
+    assert doc["identified"]["springs"]
+    assert doc["train_rows"][0]["after"] < doc["train_rows"][0]["before"]
+    assert "k_scale" in (out / "report.md").read_text()
+
+
+@pytest.mark.parametrize("args, said", [
+    (["fem-linear", "--cases", "cantilever"], "no term with a constant to fit"),
+    (["msm", "--cases", "modes"], "no static displacement"),
+    (["msm", "--cases", "cantilever", "--validate", "cantilever"], "both fitted on and left"),
+    (["msm", "--cases", "nope"], "unknown case nope"),
+])
+def test_fit_refuses_before_computing(args, said, tmp_path, capsys):
+    assert main(["fit", *args, "--quick", "--out", str(tmp_path / "f")]) == 2
+    assert said in capsys.readouterr().err
+    assert not (tmp_path / "f").exists()
