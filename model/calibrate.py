@@ -6,7 +6,9 @@ and offers ``calibration_residuals(x, rows)`` -> (r, w) for the tetrahedra ``row
 homogeneous strain eps = sum_p a_p D_p over the orthonormal deviatoric basis D_p its energy is
 a^T Q a + O(|a|^3) with Q = sum_t w_t J_t^T J_t, J_t = dr_t/da (central differences). The
 coefficients c_i >= 0 are fitted jointly by non-negative least squares so that sum_i c_i Q_i
-is closest (Frobenius) to G V I, the energy G |dev eps|^2 V.
+is closest (Frobenius) to G V I, the energy G |dev eps|^2 V. A term the fit sets to 0 (it only
+moves the sum away from the target on this mesh) stays in the model with c = 0 and is named in
+``calibration_dropped``; all of them at 0 is an error.
 """
 import numpy as np
 from scipy.optimize import nnls
@@ -73,12 +75,16 @@ def calibrate(terms, mesh, G):
     Qs = [strain_quadratic_form(t, mesh.points, basis) for t in auto]
     target = G * mesh.volumes.sum() * np.eye(len(basis))
     coefs, _ = nnls(np.stack([q.ravel() for q in Qs], axis=1), target.ravel())
+    if not np.any(coefs > 0):
+        raise ModelError(f"calibration of {', '.join(t.describe() for t in auto)} gave c = 0: "
+                         "no term adds to the deviatoric fit on this mesh; pass a number for c")
     for t, c in zip(auto, coefs):
-        if not c > 0:
-            raise ModelError(f"calibration of {t.describe()} gave c = {c}: the term adds nothing "
-                             "to the deviatoric fit on this mesh; pass a number for c")
-        t.coef = float(c)
+        t.coef = float(c)     # 0: the fit drops the term on this mesh (a finding, said in info)
     fitted = sum(c * q for c, q in zip(coefs, Qs)) / target[0, 0]
     eig = np.linalg.eigvalsh(fitted)
     # eigenvalues of the fitted deviatoric stiffness over G: all 1 for an isotropic model
-    return {"deviatoric_eig_min": float(eig.min()), "deviatoric_eig_max": float(eig.max())}
+    out = {"deviatoric_eig_min": float(eig.min()), "deviatoric_eig_max": float(eig.max())}
+    dropped = [t.name for t, c in zip(auto, coefs) if not c > 0]
+    if dropped:
+        out["calibration_dropped"] = dropped
+    return out

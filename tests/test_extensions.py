@@ -42,20 +42,26 @@ def test_rankings_failures_and_verdicts_worked_by_hand():
     tensors = {BASE: {"six": 0.04}, "m1": {"six": 0.035}, "m2": {"six": 0.005},
                YARDSTICK: {"six": 0.0}}
     models, data = _doc(errs, {BASE: 0.05, "m1": 0.01, "m2": 0.08, YARDSTICK: 0.01}, tensors)
+    data["fits"] = [{"case": "cantilever", "mesh": "six", "bc": "clamped", "model": m,
+                     "verdict": v, "e_inf": e} for m, v, e in [
+                         (BASE, "floor", 0.1), ("m1", "converges", 0.001), ("m2", "floor", 0.2),
+                         (YARDSTICK, "converges", 0.0)]]
     rank = R.rankings(data, models)
+    assert rank["floors"][BASE]["floor"] == 1 and rank["floors"]["m1"]["floor"] == 0
     # geometric means of the ratios to the base: m1 sqrt(0.25 * 1) = 0.5, m2 sqrt(2 * 0.5) = 1
     assert rank["overall"]["m1"] == pytest.approx(0.5)
     assert rank["overall"]["m2"] == pytest.approx(1.0)
     assert R.order(rank["overall"])[0] == "m1"
     fs = R.failures(rank)
     # paper-cube 0.2 > 1.5 x 0.1; cantilever 0.1 is not; zig-zag 0.05 > 2 x 0.01; C_eff 0.04
-    assert [f["kind"] for f in fs] == ["case", "zigzag", "tensor"]
+    # ... and the floor of the cantilever on six
+    assert [f["kind"] for f in fs] == ["case", "zigzag", "floor", "tensor"]
     _, table = R.fixes(rank, models)
-    assert [v for _, _, v in table["m1"]] == ["fixes", "fixes", "no change"]
-    assert [v for _, _, v in table["m2"]] == ["worsens", "worsens", "fixes"]
+    assert [v for _, _, v in table["m1"]] == ["fixes", "fixes", "fixes", "no change"]
+    assert [v for _, _, v in table["m2"]] == ["worsens", "worsens", "worsens", "fixes"]
     doc = {"parameters": {"models": models}, "rankings": rank}
     text = " ".join(R.conclusion(doc))
-    assert "m1 fixes 2 of them: paper-cube error" in text and "0.2 -> 0.05" in text
+    assert "m1 fixes 3 of them: paper-cube error" in text and "0.2 -> 0.05" in text
     assert "m2 fixes 1 of them: C_eff on six 0.04 -> 0.005 and worsens" in text
 
 

@@ -343,3 +343,16 @@ def test_threads_of_a_model(small_mesh, mat):
         assert np.array_equal(two.forces(x), serial.forces(x))
     with pytest.raises(ModelError, match="threads must be an integer from 1"):
         build("pbcm-balanced", small_mesh, mat, threads=0)
+
+
+def test_calibration_may_drop_a_term_and_says_so(mat):
+    """On bcc the shear term alone is stiffer than G in the normal modes, so the joint fit
+    sets the co-rotated normal term's c to 0: the model is the paper's, and info names it."""
+    m = cube(4, 0.032, "bcc")
+    pm = build("pbcm-variational + normal_corotated(c=auto)", m, mat)
+    assert pm.info["normal_corotated_c"] == 0.0
+    assert pm.info["calibration_dropped"] == ["normal_corotated"]
+    base = build("pbcm-variational", m, mat)
+    x = perturbed(m, 0.05, seed=5)
+    assert np.array_equal(pm.forces(x), base.forces(x))
+    assert "calibration_dropped" not in base.info

@@ -57,15 +57,20 @@ def zigzags(data, models):
             _median(r["zigzag_fem"] for r in rs))
 
 
+STOPS = ("floor", "diverges")
+
+
 def floors(data, models):
-    """Per model: the convergence verdicts over the (problem, family) fits and the median
-    extrapolated error e_inf."""
+    """Per model: the convergence verdicts over the (problem, family) fits, the median
+    extrapolated error e_inf, and each fit's verdict and e_inf by 'problem/bc on family'."""
     out = {}
     for m in models:
         fs = [f for f in data["fits"] if f["model"] == m]
         out[m] = {"floor": sum(f["verdict"] == "floor" for f in fs),
                   "diverges": sum(f["verdict"] == "diverges" for f in fs),
-                  "fits": len(fs), "e_inf": _median(f["e_inf"] for f in fs)}
+                  "fits": len(fs), "e_inf": _median(f["e_inf"] for f in fs),
+                  "by_fit": {f"{f['case']}/{f['bc']} on {f['mesh']}": [f["verdict"], f["e_inf"]]
+                             for f in fs}}
     return out
 
 
@@ -100,13 +105,18 @@ def failures(rank):
             out.append({"what": f"{case}: failed", "kind": "case", "key": case, "base": None,
                         "limit": None})
         elif fem is not None and e[BASE] > FEM_FACTOR * fem:
-            out.append({"what": f"{case} error (FEM P1 on the same mesh: {fmt(fem)})",
+            out.append({"what": f"{case} error", "note": f"FEM P1: {fmt(fem)}",
                         "kind": "case", "key": case, "base": e[BASE], "limit": FEM_FACTOR * fem})
     zz = rank["zigzag"].get(BASE)
     limit = max(ZIGZAG_FACTOR * (rank["zigzag_fem"] or 0.0), ZIGZAG_FLOOR)
     if zz is not None and zz > limit:
         out.append({"what": "bulge/neck zig-zag on the paper cube", "kind": "zigzag",
+                    "note": f"FEM P2: {fmt(rank['zigzag_fem'])} mm",
                     "key": "zigzag", "base": zz, "limit": limit})
+    for key, (v, e_inf) in rank["floors"].get(BASE, {}).get("by_fit", {}).items():
+        if v in STOPS:
+            out.append({"what": f"convergence of {key}", "note": v, "kind": "floor",
+                        "key": key, "base": e_inf, "limit": None})
     for lattice, d in rank["tensors"].get(BASE, {}).items():
         if d is not None and d > ISOTROPIC_TOL:
             out.append({"what": f"C_eff on {lattice}", "kind": "tensor", "key": lattice,
@@ -120,6 +130,9 @@ def value(rank, failure, model):
         return rank["case_errors"][failure["key"]].get(model)
     if k == "zigzag":
         return rank["zigzag"].get(model)
+    if k == "floor":
+        fit = rank["floors"].get(model, {}).get("by_fit", {}).get(failure["key"])
+        return None if fit is None else fit[1]
     return rank["tensors"].get(model, {}).get(failure["key"])
 
 
@@ -139,10 +152,32 @@ def verdict(failure, v):
     return "no change"
 
 
+def judge(rank, failure, model):
+    """(value, verdict) of ``model`` on a failure of the base; a convergence floor is fixed
+    where the model's fit converges (or is exact)."""
+    v = value(rank, failure, model)
+    if failure["kind"] == "floor":
+        fit = rank["floors"].get(model, {}).get("by_fit", {}).get(failure["key"])
+        if fit is None or fit[0] not in ("converges", "exact", *STOPS):
+            return v, "fails"
+        if fit[0] not in STOPS:
+            return v, "fixes"
+        if v is None or failure["base"] is None:
+            return v, "no change"
+        # e_inf near zero on both sides is no change, whatever the ratio
+        base, scale = abs(failure["base"]), max(abs(failure["base"]), abs(v), 1e-300)
+        if abs(v) <= (1 - CHANGE) * base:
+            return v, "improves"
+        if abs(v) >= (1 + CHANGE) * base and scale > 0:
+            return v, "worsens"
+        return v, "no change"
+    return v, verdict(failure, v)
+
+
 def fixes(rank, models):
     """{candidate: [(failure, value, verdict)]} for every model but the base and FEM."""
     fs = failures(rank)
-    return fs, {m: [(f, value(rank, f, m), verdict(f, value(rank, f, m))) for f in fs]
+    return fs, {m: [(f, *judge(rank, f, m)) for f in fs]
                 for m in models if m not in (BASE, YARDSTICK)}
 
 
@@ -166,7 +201,8 @@ def conclusion(data):
                      "zig-zag beyond FEM's).")
         return lines
     lines.append(f"{BASE} fails {len(fs)} criteria: " + "; ".join(
-        f"{f['what']} {fmt(f['base'])}" for f in fs) + ".")
+        f"{f['what']} {fmt(f['base'])}" + (f" ({f['note']})" if f.get("note") else "")
+        for f in fs) + ".")
     fixed = {m: [(f, v) for f, v, w in table[m] if w == "fixes"] for m in cands}
     for m in cands:
         worse = [(f, v) for f, v, w in table[m] if w in ("worsens", "fails")]
@@ -284,8 +320,11 @@ def build(out, study, s, doc):
     fs, table = fixes(rank, models)
     cands = [m for m in models if m not in (BASE, YARDSTICK)]
     if fs:
+        d.p("A convergence failure's value is the fit's extrapolated error e_inf; it is fixed "
+            "where the candidate's fit converges.")
         d.table(["failure of " + BASE, "value", "criterion"] + [short(m) for m in cands],
-                [[f["what"], fmt(f["base"]), fmt(f["limit"])]
+                [[f["what"] + (f" ({f['note']})" if f.get("note") else ""), fmt(f["base"]),
+                  fmt(f["limit"]) if f["limit"] is not None else "converges"]
                  + [f"{fmt(table[m][i][1])} ({table[m][i][2]})" for m in cands]
                  for i, f in enumerate(fs)])
     else:
