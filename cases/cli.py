@@ -101,10 +101,15 @@ def _models(given, presets):
     ``presets``, or composed specs (``model.compose``) checked against the term registry."""
     if given is None:
         return None
-    from model.compose import label
+    from model.compose import label, parse
+    from model.mesh import cube
+    from model.terms import make_term
+    tiny = cube(2, 0.01, "five")
     out = []
     for g in given:
         name = label(g)        # a ModelError names the unknown term or parameter
+        for t, params in parse(name):   # and a term its bad value, on one cell, before computing
+            make_term(t, tiny, model.Material(E=1e4, nu=0.3), **params)
         if name in model.PRESETS and name not in presets:
             raise UsageError(f"model {name} is not run by this case; valid presets: "
                              f"{', '.join(presets)} (or terms composed with '+')")

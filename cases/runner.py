@@ -175,7 +175,10 @@ def unit(case, s, mesh_name, bc, mesh_of=None, step=None):
     for model_name in s.models:
         stop.checkpoint()
         step(f"{case.name} {mesh_name}/{bc}/{model_name}", 0)
-        r, f = model_run(case, mesh_name, mesh, bc, model_name, s, ref)
+        try:
+            r, f = model_run(case, mesh_name, mesh, bc, model_name, s, ref)
+        except FINDINGS as exc:   # the model cannot be built on this mesh (calibration)
+            [r], f = failed_runs(mesh_name, bc, [model_name], "model", exc), None
         runs.append(r)
         if f is not None:
             fields[(mesh_name, bc, model_name)] = f

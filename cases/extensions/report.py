@@ -10,7 +10,7 @@ from ..document import Document, fmt
 from .. import figures
 from ..report import environment, provenance
 from ..runner import jsonable
-from .study import BASE, COST_TETS, YARDSTICK, short
+from .study import BASE, COST_TETS, TWIN, YARDSTICK, CANDIDATES, short
 
 GATED = {"error": "max", "zigzag": "max", "e_inf": "max", "distance": "max"}
 FEM_FACTOR = 1.5      # a case error this many times FEM P1's on the same mesh is a failure
@@ -294,6 +294,17 @@ def build(out, study, s, doc):
                          [[rank["case_errors"][c][m] or np.nan for m in models] for c in cases],
                          "headline error", "Headline error of each case", log=True)
     d.img("case_errors.png", "headline error of each case per model")
+    d.p("Best per case: " + "; ".join(
+        f"{c} {short(order(rank['case_errors'][c])[0])}" for c in cases) + ".")
+    dropped = {}
+    for r in doc["case_runs"]:
+        for t in r.get("dropped") or []:
+            dropped.setdefault((short(r["model"]), t), set()).add(r["mesh"])
+    if dropped:
+        d.p("The joint calibration set c_n to 0, dropping the term (the shear term alone is "
+            "already stiffer than G in the modes it adds), for " + "; ".join(
+                f"{m} on {', '.join(sorted(ms))}" for (m, _), ms in sorted(dropped.items()))
+            + ": there the candidate is the paper's model.")
     d.h(2, "Ranking by cost, artefact, convergence floor and effective elasticity")
     lattices = sorted({e["mesh"] for e in doc["elasticity"]})
     fl = rank["floors"]
@@ -307,6 +318,12 @@ def build(out, study, s, doc):
         + ", ".join(short(m) for m in order(rank["zigzag"])) + "; by floors: "
         + ", ".join(short(m) for m in sorted(models, key=lambda m: (
             fl[m]["floor"] + fl[m]["diverges"], fl[m]["e_inf"] or 0.0))) + ".")
+    twin, edge = doc.get("cost_same_terms", {}).get(TWIN), rank["cost"].get(CANDIDATES[0])
+    if twin is not None and edge is not None:
+        d.p(f"The bench timed +normal_edge's terms twice, as the preset {TWIN} "
+            f"({fmt(twin)}) and as +normal_edge ({fmt(edge)}), in two runs: "
+            f"{abs(edge / twin - 1):.0%} apart, the spread of a cost ratio between bench runs "
+            "on this machine.")
     missing = [short(m) for m in models if rank["cost"].get(m) is None]
     if missing:
         d.p(f"Not in bench.json, so without a cost: {', '.join(missing)}; `pbcm bench --merge "

@@ -16,6 +16,7 @@ YARDSTICK = "fem-linear"     # what the same tetrahedra give as constant-strain 
 NORMAL_FORMS = ("normal_edge", "normal_tet", "normal_corotated", "normal_sbd")
 CANDIDATES = tuple(label(f"{BASE} + {form}(c=auto)") for form in NORMAL_FORMS)
 COST_TETS = 1e4              # the mesh size at which costs are compared
+TWIN = "pbcm-variational+normal"   # the preset whose terms are +normal_edge's
 
 
 def short(model):
@@ -76,10 +77,12 @@ class ExtensionSettings:
 def case_row(case, r):
     """What the rankings read of one case run."""
     failed = r.get("failed") or r.get("static_failed")
+    info = r.get("model_info") or {}
     return {"case": case.name, "mesh": r["mesh"], "bc": r["bc"], "model": r["model"],
             "metric": case.headline.metric, "error": None if failed else r.get(
                 case.headline.metric), "failed": failed,
-            "zigzag": r.get("zigzag"), "zigzag_fem": r.get("zigzag_fem")}
+            "zigzag": r.get("zigzag"), "zigzag_fem": r.get("zigzag_fem"),
+            "dropped": info.get("calibration_dropped", [])}
 
 
 def costs(bench, models):
@@ -104,4 +107,6 @@ def run(s, workers=None, log=True, bench=None):
     return jsonable({"case_runs": rows, "fits": conv["fits"], "elasticity": [
         {k: e.get(k) for k in ("model", "mesh", "distance", "anisotropy_AU", "E_x", "nu_xy",
                                "G_xy", "failed")} for e in conv["elasticity"]],
-        "cost_vs_fem_linear": costs(bench, s.models)})
+        "cost_vs_fem_linear": costs(bench, s.models),
+        # the preset with the same terms as +normal_edge, timed by another bench run
+        "cost_same_terms": {TWIN: costs(bench, [TWIN])[TWIN]}})
