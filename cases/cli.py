@@ -204,6 +204,12 @@ def _list_command(args):
     for name, study in studies().items():
         print(textwrap.fill(f"{name} (study): {_summary(study)}", width=96,
                             subsequent_indent="  "))
+    print("force terms (compose them with '+' in --models):")
+    for name, cls in sorted(model.terms.registered().items()):
+        params = ", ".join(f"{k}={v}" for k, v in cls.params.items())
+        doc = (cls.__doc__ or "").strip().split("\n")[0]
+        print(textwrap.fill(f"{name}({params}): {doc}", width=96, initial_indent="  ",
+                            subsequent_indent="    "))
     return 0
 
 
@@ -435,7 +441,8 @@ def parser():
     m.add_argument("--scheme", choices=SCHEMES, default="five", help="cube tetrahedralisation")
     m.add_argument("--seed", type=int, default=0, help="seed of the 'unstructured' scheme")
     m.set_defaults(func=_mesh_command)
-    ls = sub.add_parser("list", help="list the cases with their meshes, conditions and models")
+    ls = sub.add_parser("list", help="list the cases, studies and force terms")
+    _term_files(ls)
     ls.set_defaults(func=_list_command)
     r = sub.add_parser("run", help="run one case and write its report folder")
     r.add_argument("case", help="a case or study name (see pbcm list)")

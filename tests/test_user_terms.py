@@ -133,3 +133,11 @@ def test_term_file_that_registers_nothing_or_fails(tmp_path):
     for f, said in [("empty.py", "registers no term"), ("broken.py", "RuntimeError: boom")]:
         with pytest.raises(ModelError, match=said):
             model.terms.load_file(tmp_path / f)
+
+
+def test_pbcm_list_names_the_terms_with_their_parameters(capsys):
+    assert main(["list", "--term", str(EXAMPLE)]) == 0
+    out = capsys.readouterr().out
+    for line in ("normal_tet(c=auto):", "shear(reading=variational, c=auto):", "volume():",
+                 "normal_axis(c=auto):", "extensions (study):"):
+        assert line in out, line

@@ -105,6 +105,7 @@ class Normal(CalibratedTerm):
 
 @register
 class NormalEdge(Normal):
-    """The same term under its candidate name."""
+    """MODEL.md's per-corner edge-strain deviation (the term ``normal``) by its candidate
+    name."""
 
     name = "normal_edge"
