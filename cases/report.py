@@ -59,6 +59,19 @@ def provenance(runs):
                          **{k: r[k] for k in TIMING_KEYS if k in r}} for r in runs]}
 
 
+def write_study(out, metrics, make_document):
+    """A study's folder ``out``: ``metrics`` as metrics.json, run.json (the commit and the
+    date; no timings) and the report ``make_document(out)`` draws (its figures into ``out``)."""
+    out = Path(out)
+    out.mkdir(parents=True, exist_ok=True)
+    (out / "metrics.json").write_text(json.dumps(metrics, indent=1) + "\n")
+    prov = provenance([])
+    prov.pop("timings")
+    (out / "run.json").write_text(json.dumps(prov, indent=1) + "\n")
+    make_document(out).write(out)
+    return out
+
+
 def metrics_document(case, s, runs, extra=None):
     """The metrics.json content of a case run: the parameters, the problem the gate compares,
     the gated metrics with their direction, the runs, and what the case adds (``extra``)."""

@@ -1,13 +1,10 @@
 """The convergence study's files: metrics.json (runs, fits, references, effective elasticity,
 accuracy per cost, and the rows the gate reads), report.md/.html and the figures. Every
 sentence is computed from the data it is written with."""
-import json
-from pathlib import Path
-
 import numpy as np
 
 from ..document import Document, fmt
-from ..report import environment, provenance
+from ..report import environment, write_study
 from ..runner import jsonable
 from . import plots
 from .elasticity import ANGLES_DEG, PATCH_MM
@@ -158,15 +155,8 @@ def ties(s, data):
 # ---------------------------------------------------------------------- the document
 def write(out, study, s, data):
     """Write metrics.json, run.json, report.md/.html and the PNG figures into ``out``."""
-    out = Path(out)
-    out.mkdir(parents=True, exist_ok=True)
-    (out / "metrics.json").write_text(json.dumps(metrics_document(study, s, data), indent=1)
-                                      + "\n")
-    prov = provenance([])
-    prov.pop("timings")
-    (out / "run.json").write_text(json.dumps(prov, indent=1) + "\n")
-    build(out, study, s, data).write(out)
-    return out
+    return write_study(out, metrics_document(study, s, data),
+                       lambda folder: build(folder, study, s, data))
 
 
 def build(out, study, s, data):

@@ -1,14 +1,13 @@
 """The extensions study's files: metrics.json (case rows, fits, tensors, costs, rankings,
 failures and the rows the gate reads), report.md/.html and the figures. Every sentence is
 computed from the data it is written with."""
-import json
 from pathlib import Path
 
 import numpy as np
 
 from ..document import Document, fmt
 from .. import figures
-from ..report import environment, provenance
+from ..report import environment, write_study
 from ..runner import jsonable
 from .study import BASE, COST_TETS, TWIN, YARDSTICK, CANDIDATES, short
 
@@ -234,18 +233,11 @@ def gate_rows(data, rank):
 
 def write(out, study, s, data):
     """Write metrics.json, run.json, report.md/.html and the PNG figures into ``out``."""
-    out = Path(out)
-    out.mkdir(parents=True, exist_ok=True)
     rank = rankings(data, list(s.models))
     doc = jsonable({"case": study.name, "study": True, "parameters": s.describe(),
                     "problem": s.problem(), "gated": GATED, "environment": environment(),
                     **data, "rankings": rank, "gate_runs": gate_rows(data, rank)})
-    (out / "metrics.json").write_text(json.dumps(doc, indent=1) + "\n")
-    prov = provenance([])
-    prov.pop("timings")
-    (out / "run.json").write_text(json.dumps(prov, indent=1) + "\n")
-    build(out, study, s, doc).write(out)
-    return out
+    return write_study(out, doc, lambda folder: build(folder, study, s, doc))
 
 
 def build(out, study, s, doc):

@@ -2,7 +2,6 @@
 candidate models, reduced to what the rankings read."""
 from dataclasses import dataclass, field
 
-import numpy as np
 
 from model import Material
 from model.compose import label
