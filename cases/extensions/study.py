@@ -2,7 +2,6 @@
 candidate models, reduced to what the rankings read."""
 from dataclasses import dataclass, field
 
-
 from model import Material
 from model.compose import label
 from ..convergence import STUDY as CONVERGENCE
