@@ -54,6 +54,26 @@ def test_bench_writes_table_figure_and_in_round_ratios(tmp_path):
     assert {r["tets"] for r in json.loads((out / "bench.json").read_text())["rows"]} == {135}
 
 
+def test_merge_adds_a_composed_model_and_keeps_every_other_row(tmp_path):
+    """`pbcm bench --merge`: the new model's rows, with its in-process ratios, join the rows
+    already there, which stay as they were (the baselines included)."""
+    out = tmp_path / "b"
+    assert main(["bench", "--sizes", "100", "--rounds", "1", "--models", "msm", "fem-linear",
+                 "--out", str(out)]) == 0
+    before = json.loads((out / "bench.json").read_text())
+    tet = "pbcm-variational + normal_tet(c=auto)"
+    assert main(["bench", "--merge", "--sizes", "100", "--rounds", "2", "--models", tet,
+                 "msm", "--out", str(out)]) == 0
+    after = json.loads((out / "bench.json").read_text())
+    assert after["rows"][:len(before["rows"])] == before["rows"]
+    new = after["rows"][len(before["rows"]):]
+    assert [r["model"] for r in new] == ["shear(reading=variational, c=auto) + volume + "
+                                         "normal_tet(c=auto)"]
+    assert new[0]["step_vs_fem-linear"] > 1 and new[0]["rounds"] == 2
+    assert after["engines"] == before["engines"]
+    assert main(["bench", "--merge", "--models", "msm", "--out", str(tmp_path / "none")]) == 2
+
+
 def test_cost_sentences_come_from_the_nearest_bench_size():
     data = {"rows": [{"model": m, "tets": t, "rounds": 5, "step_vs_msm": r,
                       "step_vs_fem-linear": r / 2}
