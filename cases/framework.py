@@ -320,6 +320,12 @@ class Study(abc.ABC):
         """Sentences for the top of reports/index.md, computed from ``data``."""
         return []
 
+    def recorded(self, metrics):
+        """``(settings, data)`` as a run recorded them in ``metrics`` (its metrics.json), for
+        ``pbcm run NAME --rewrite``: the report drawn again from the recorded runs after a
+        change of the report's code, without computing. None: the study cannot."""
+        return None
+
 
 def ref_name(name):
     """The run key of the FEM value of quantity ``name``: '_fem' before a unit suffix

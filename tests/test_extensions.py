@@ -105,6 +105,22 @@ def test_small_study_writes_rankings_and_gate_rows(small_study):
     assert t[TET]["five"] < 1e-6 < t[BASE]["five"]
 
 
+def test_rewrite_draws_the_same_report_from_the_recorded_runs(small_study, tmp_path, capsys):
+    import shutil
+    copy = tmp_path / "copy"
+    shutil.copytree(small_study, copy)
+    (copy / "report.md").unlink()
+    assert main(["run", "extensions", "--rewrite", "--out", str(copy)]) == 0
+    for f in ("report.md", "metrics.json", "case_errors.png", "ceff_distance.png"):
+        assert (copy / f).read_bytes() == (small_study / f).read_bytes(), f
+    doc = json.loads((copy / "metrics.json").read_text())
+    doc["problem"]["nu"] = 0.3        # recorded at other parameters than the code's
+    (copy / "metrics.json").write_text(json.dumps(doc))
+    assert main(["run", "extensions", "--rewrite", "--out", str(copy)]) == 2
+    assert "problem parameters have changed" in capsys.readouterr().err
+    assert main(["run", "cantilever", "--rewrite", "--out", str(copy)]) == 2
+
+
 def test_fit_recovers_the_closed_form_stiffness_scale(tmp_path):
     """A single-term model under prescribed displacement: positions do not depend on the
     stiffness scale k and the reaction is k times, so the least-squares k is 1 / the reaction

@@ -8,7 +8,7 @@ from dataclasses import fields
 
 from ..framework import Study
 from . import report
-from .study import ExtensionSettings, run
+from .study import RUN_KEYS, ExtensionSettings, run
 
 
 class Extensions(Study):
@@ -30,6 +30,13 @@ class Extensions(Study):
 
     def headline(self, data):
         return report.conclusion(data)
+
+    def recorded(self, metrics):
+        p = metrics["parameters"]
+        s = self.settings(quick=p["quick"], models=tuple(p["models"]), E=p["E_Pa"], nu=p["nu"],
+                          rho=p["rho_kg_m3"], cases=tuple(p["cases"]),
+                          problems=tuple(p["convergence"]["ref_ladders_mm"]))
+        return s, {k: metrics[k] for k in RUN_KEYS}
 
 
 STUDY = Extensions()

@@ -25,15 +25,40 @@ def _median(values):
     return float(np.median(v)) if v else None
 
 
-def case_errors(data, models):
-    """{case: {model: median headline error over its runs, or None if any run failed}}."""
+def _runs_of(data, case):
+    return [r for r in data["case_runs"] if r["case"] == case]
+
+
+def _ok(r):
+    return not r["failed"] and r["error"] is not None
+
+
+def excluded(data, models):
+    """{case: ['mesh/bc', ...]} where no model of the study has a result (a reference or a
+    load the mesh cannot take): left out of every comparison, and said."""
     out = {}
     for case in dict.fromkeys(r["case"] for r in data["case_runs"]):
+        keys = dict.fromkeys((r["mesh"], r["bc"]) for r in _runs_of(data, case))
+        out[case] = [f"{m}/{b}" for m, b in keys if not any(
+            _ok(r) for r in _runs_of(data, case) if (r["mesh"], r["bc"]) == (m, b)
+            and r["model"] in models)]
+    return out
+
+
+def case_errors(data, models):
+    """{case: {model: median headline error}} over the (mesh, bc) where some model has a
+    result (``excluded`` are left out); None for a model that failed on one of them, so the
+    others are compared on the same (mesh, bc)."""
+    gone = excluded(data, models)
+    out = {}
+    for case in dict.fromkeys(r["case"] for r in data["case_runs"]):
+        rs = [r for r in _runs_of(data, case) if r["model"] in models
+              and f"{r['mesh']}/{r['bc']}" not in gone[case]]
         out[case] = {}
         for m in models:
-            rs = [r for r in data["case_runs"] if r["case"] == case and r["model"] == m]
-            out[case][m] = None if not rs or any(r["failed"] or r["error"] is None
-                                                 for r in rs) else _median(r["error"] for r in rs)
+            mine = [r for r in rs if r["model"] == m]
+            out[case][m] = None if not mine or not all(_ok(r) for r in mine) else _median(
+                r["error"] for r in mine)
     return out
 
 
@@ -68,8 +93,8 @@ def floors(data, models):
         out[m] = {"floor": sum(f["verdict"] == "floor" for f in fs),
                   "diverges": sum(f["verdict"] == "diverges" for f in fs),
                   "fits": len(fs), "e_inf": _median(f["e_inf"] for f in fs),
-                  "by_fit": {f"{f['case']}/{f['bc']} on {f['mesh']}": [f["verdict"], f["e_inf"]]
-                             for f in fs}}
+                  "by_fit": {f"{f['case']}/{f['bc']} on {f['mesh']}":
+                             [f["verdict"], f["e_inf"], f.get("e_inf_err")] for f in fs}}
     return out
 
 
@@ -82,7 +107,8 @@ def tensors(data, models):
 def rankings(data, models):
     errors = case_errors(data, models)
     zz, zz_fem = zigzags(data, models)
-    return {"case_errors": errors, "overall": overall(errors, models), "zigzag": zz,
+    return {"case_errors": errors, "excluded": excluded(data, models),
+            "overall": overall(errors, models), "zigzag": zz,
             "zigzag_fem": zz_fem, "floors": floors(data, models),
             "tensors": tensors(data, models), "cost": data["cost_vs_fem_linear"]}
 
@@ -112,7 +138,7 @@ def failures(rank):
         out.append({"what": "bulge/neck zig-zag on the paper cube", "kind": "zigzag",
                     "note": f"FEM P2: {fmt(rank['zigzag_fem'])} mm",
                     "key": "zigzag", "base": zz, "limit": limit})
-    for key, (v, e_inf) in rank["floors"].get(BASE, {}).get("by_fit", {}).items():
+    for key, (v, e_inf, _) in rank["floors"].get(BASE, {}).get("by_fit", {}).items():
         if v in STOPS:
             out.append({"what": f"convergence of {key}", "note": v, "kind": "floor",
                         "key": key, "base": e_inf, "limit": None})
@@ -149,6 +175,14 @@ def verdict(failure, v):
     if v >= (1 + CHANGE) * failure["base"]:
         return "worsens"
     return "no change"
+
+
+def cell(rank, failure, model, v):
+    """The text of a value: a convergence failure's is the candidate's fit verdict."""
+    if failure["kind"] == "floor":
+        fit = rank["floors"].get(model, {}).get("by_fit", {}).get(failure["key"])
+        return "no fit" if fit is None else f"{fit[0]}, e_inf {fmt(fit[1])} +- {fmt(fit[2])}"
+    return fmt(v)
 
 
 def judge(rank, failure, model):
@@ -194,6 +228,11 @@ def conclusion(data):
             f"extension is {short(best[0])}: its errors are {fmt(rank['overall'][best[0]])} "
             f"times the paper model's ({BASE}) in geometric mean; the others: "
             + ", ".join(f"{short(m)} {fmt(rank['overall'][m])}" for m in best[1:]) + ".")
+    cost = {m: rank["cost"].get(m) for m in cands if rank["cost"].get(m) is not None}
+    if cost and rank["cost"].get(BASE) is not None:
+        lines.append(f"Each adds cost: at {COST_TETS:.0e} tetrahedra an RK4 step of the "
+                     f"candidates takes {fmt(min(cost.values()))} to {fmt(max(cost.values()))} "
+                     f"times fem-linear's, the paper model's {fmt(rank['cost'][BASE])} times.")
     if not fs:
         lines.append(f"{BASE} fails none of the criteria checked here (case error within "
                      f"{FEM_FACTOR:g}x FEM P1, C_eff within {ISOTROPIC_TOL:g} of the target, no "
@@ -206,11 +245,11 @@ def conclusion(data):
     for m in cands:
         worse = [(f, v) for f, v, w in table[m] if w in ("worsens", "fails")]
         said = (f"{short(m)} fixes {len(fixed[m])} of them"
-                + (": " + "; ".join(f"{f['what']} {fmt(f['base'])} -> {fmt(v)}"
+                + (": " + "; ".join(f"{f['what']} {fmt(f['base'])} -> {cell(rank, f, m, v)}"
                                     for f, v in fixed[m]) if fixed[m] else ""))
         if worse:
             said += " and worsens " + "; ".join(
-                f"{f['what']} {fmt(f['base'])} -> {fmt(v)}" for f, v in worse)
+                f"{f['what']} {fmt(f['base'])} -> {cell(rank, f, m, v)}" for f, v in worse)
         lines.append(said + ".")
     nobody = [f for i, f in enumerate(fs) if not any(table[m][i][2] == "fixes" for m in cands)]
     if nobody:
@@ -246,9 +285,9 @@ def build(out, study, s, doc):
     d = Document(f"pbcm report: {study.name}")
     for line in conclusion(doc):
         d.p(line)
-    d.p("Generated by `pbcm run extensions` from the runs recorded in metrics.json; every "
-        "number below was computed by the run that wrote this file, but the step costs, which "
-        "are `pbcm bench`'s (reports/bench).")
+    d.p("Generated by `pbcm run extensions` (or `pbcm run extensions --rewrite`, from the same "
+        "recorded runs): every number is computed from the runs recorded in metrics.json, but "
+        "the step costs, which are `pbcm bench`'s (reports/bench/bench.json).")
     d.h(2, "What was run")
     d.ul([study.title + ".",
           f"The paper's model: {BASE} (MODEL.md's variational reading, c fitted). Each "
@@ -286,6 +325,12 @@ def build(out, study, s, doc):
                          [[rank["case_errors"][c][m] or np.nan for m in models] for c in cases],
                          "headline error", "Headline error of each case", log=True)
     d.img("case_errors.png", "headline error of each case per model")
+    gone = {c: ks for c, ks in rank.get("excluded", {}).items() if ks}
+    if gone:
+        first = {c: next(r["failed"] for r in doc["case_runs"] if r["case"] == c
+                         and f"{r['mesh']}/{r['bc']}" == ks[0]) for c, ks in gone.items()}
+        d.p("Left out of every comparison, because no model (FEM included) has a result there: "
+            + "; ".join(f"{c} on {', '.join(ks)} ({first[c]})" for c, ks in gone.items()) + ".")
     d.p("Best per case: " + "; ".join(
         f"{c} {short(order(rank['case_errors'][c])[0])}" for c in cases) + ".")
     dropped = {}
@@ -334,7 +379,7 @@ def build(out, study, s, doc):
         d.table(["failure of " + BASE, "value", "criterion"] + [short(m) for m in cands],
                 [[f["what"] + (f" ({f['note']})" if f.get("note") else ""), fmt(f["base"]),
                   fmt(f["limit"]) if f["limit"] is not None else "converges"]
-                 + [f"{fmt(table[m][i][1])} ({table[m][i][2]})" for m in cands]
+                 + [f"{cell(rank, f, m, table[m][i][1])} ({table[m][i][2]})" for m in cands]
                  for i, f in enumerate(fs)])
     else:
         d.p(f"{BASE} meets every criterion here.")

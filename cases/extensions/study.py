@@ -94,6 +94,10 @@ def costs(bench, models):
     return out
 
 
+# what a run computes (the rest of metrics.json is derived from it by the report)
+RUN_KEYS = ("case_runs", "fits", "elasticity", "cost_vs_fem_linear", "cost_same_terms")
+
+
 def run(s, workers=None, log=True, bench=None):
     """Every case with the study's models, then the convergence study with them."""
     from ..registry import CASES
