@@ -561,7 +561,7 @@ def parser():
     b = sub.add_parser(
         "bless", help="rewrite the bounds from measured metrics and print what changed",
         description="Set the bounds of thresholds.toml from measured metrics. Without --metrics "
-                    "it first runs every case and study: in full mode (about 26 minutes on 2 "
+                    "it first runs every case and study: in full mode (about 75 minutes on 2 "
                     "cores) unless --quick is given. It keeps the bounds of runs it did not see (other modes, "
                     "meshes, models) unless --prune is given, and each existing bound's "
                     "tolerances unless --margin is given; new bounds get --margin or 0.1. It "

@@ -164,7 +164,8 @@ def measured(metrics_dir):
             data = json.loads(f.read_text())
             case, mode = data["case"], "quick" if data["parameters"]["quick"] else "full"
             # a study's rows for the gate (e.g. one per case, bc and mesh size) are its own
-            runs, problem = data.get("gate_runs", data["runs"]), data["problem"]
+            runs = data["gate_runs"] if "gate_runs" in data else data["runs"]
+            problem = data["problem"]
             gated = data.get("gated", GATED)
         except (ValueError, KeyError, TypeError) as exc:
             raise CheckError(f"{f} is not a pbcm metrics file of this version (lacks {exc}); "
