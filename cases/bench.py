@@ -155,16 +155,16 @@ def _engine_timers(mesh, timed, progress):
     return timers, status
 
 
-def run(sizes=SIZES, models=None, rounds=7, progress=print, engines=True):
+def run(sizes=SIZES, models=None, rounds=7, progress=print, with_engines=True):
     """Measure every model at every size; returns the bench document (plain data). The
     baselines (msm, fem-linear) are always timed, for the ratios; the other engines only with
-    ``engines``."""
+    ``with_engines``."""
     if not models:      # every preset and the normal-stress candidates of `pbcm run extensions`
         from .extensions.study import CANDIDATES
         models = [*PRESETS, *CANDIDATES]
     models = list(models)
     timed_models = models + [b for b in BASELINES if b not in models]
-    if engines and any(e.installed() for e in ENGINES.values()) \
+    if with_engines and any(e.installed() for e in ENGINES.values()) \
             and ENGINE_REFERENCE not in timed_models:
         timed_models.append(ENGINE_REFERENCE)
     mat = Material(10e3, 0.45, 1000.0)
@@ -175,7 +175,8 @@ def run(sizes=SIZES, models=None, rounds=7, progress=print, engines=True):
         mesh = bench_mesh(target)
         progress(f"bench: {mesh.n_tets} tetrahedra, {len(timed_models)} models")
         timed = {name: _Timed(name, mesh, mat) for name in timed_models}
-        timers, status = _engine_timers(mesh, timed, progress) if engines else ({}, {})
+        timers, status = _engine_timers(mesh, timed, progress) if with_engines \
+            else ({}, {})
         for name, line in status.items():
             if line not in engines.setdefault(name, []):
                 engines[name].append(line)

@@ -284,7 +284,7 @@ def _bench_command(args):
         models = tuple(m for m in models if m not in bench.BASELINES)
     with StagedFolder(Path(args.out), mark="bench.json") as out:
         data = bench.run(sizes=sizes, models=models, rounds=3 if args.quick else args.rounds,
-                         engines=old is None)
+                         with_engines=old is None)
         bench.write(bench.merge(old, data) if old else data, out.path)
         path = out.commit()
     print(f"bench written to {path}")
