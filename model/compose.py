@@ -76,8 +76,8 @@ def parse(spec):
             out += [(t, dict(p)) for t, p in presets[name]]
             continue
         if name not in terms:
-            raise ModelError(f"unknown term or preset {name!r} in model {spec!r}; terms: "
-                             f"{', '.join(sorted(terms))}; presets: {', '.join(presets)} "
+            raise ModelError(f"unknown model {name!r} (a preset or a term) in {spec!r}; valid: "
+                             f"presets {', '.join(presets)}; terms {', '.join(sorted(terms))} "
                              "(a user term: pbcm --term FILE)")
         params = {}
         for kv in filter(str.strip, (args or "").split(",")):

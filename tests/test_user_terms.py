@@ -100,7 +100,7 @@ def test_composition_grammar():
     assert label("shear( reading = variational,c=auto )+volume") == \
         "shear(reading=variational, c=auto) + volume"
     assert parse("springs(scale=2)") == [("springs", {"scale": 2})]
-    for bad, said in [("shear(foo=1)", "has no parameter 'foo'"), ("nope", "unknown term"),
+    for bad, said in [("shear(foo=1)", "has no parameter 'foo'"), ("nope", "unknown model 'nope'"),
                       ("shear(reading=variational", "unbalanced"),
                       ("volume + volume", "appear twice"), ("shear(c)", "needs key=value"),
                       ("", "preset name or terms"), ("shear(c=1/2)", "cannot read the value")]:
@@ -111,7 +111,7 @@ def test_composition_grammar():
 @pytest.mark.parametrize("args, said", [
     (["--models", "shear(foo=1) + volume"], "has no parameter 'foo'"),
     (["--term", "no/such/file.py"], "does not exist"),
-    (["--models", "normal_axis(c=auto) + volume"], "unknown term or preset 'normal_axis'"),
+    (["--models", "normal_axis(c=auto) + volume"], "unknown model 'normal_axis'"),
 ])
 def test_bad_models_and_term_files_fail_before_computing(args, said, tmp_path, capsys):
     env = os.environ.pop("PBCM_TERMS", None)
