@@ -61,8 +61,18 @@ def test_rankings_failures_and_verdicts_worked_by_hand():
     assert [v for _, _, v in table["m2"]] == ["worsens", "worsens", "worsens", "fixes"]
     doc = {"parameters": {"models": models}, "rankings": rank}
     text = " ".join(R.conclusion(doc))
+    assert "the best normal-stress extension is m1: its errors are 0.5 times" in text
     assert "m1 fixes 3 of them: paper-cube error" in text and "0.2 -> 0.05" in text
     assert "m2 fixes 1 of them: C_eff on six 0.04 -> 0.005 and worsens" in text
+
+
+def test_headline_says_when_no_candidate_beats_the_paper_model():
+    errs = {"torsion": {BASE: 0.1, "m1": 0.2, "m2": 0.4, YARDSTICK: 0.1}}
+    models, data = _doc(errs, {}, {})
+    doc = {"parameters": {"models": models}, "rankings": R.rankings(data, models)}
+    assert R.conclusion(doc)[0].startswith("Over the 1 cases of the library no normal-stress "
+                                           "extension beats the paper model; the closest is m1: "
+                                           "its errors are 2 times")
 
 
 def test_a_failed_run_ranks_last_and_is_said():

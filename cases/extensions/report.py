@@ -223,10 +223,14 @@ def conclusion(data):
     lines = []
     best = [m for m in order(rank["overall"]) if m in cands]
     if best and rank["overall"][best[0]] is not None:
+        lead = (f"Over the {len(rank['case_errors'])} cases of the library the best "
+                f"normal-stress extension is {short(best[0])}"
+                if rank["overall"][best[0]] < 1 else
+                f"Over the {len(rank['case_errors'])} cases of the library no normal-stress "
+                f"extension beats the paper model; the closest is {short(best[0])}")
         lines.append(
-            f"Over the {len(rank['case_errors'])} cases of the library the best normal-stress "
-            f"extension is {short(best[0])}: its errors are {fmt(rank['overall'][best[0]])} "
-            f"times the paper model's ({BASE}) in geometric mean; the others: "
+            f"{lead}: its errors are {fmt(rank['overall'][best[0]])} times the paper model's "
+            f"({BASE}) in geometric mean; the others: "
             + ", ".join(f"{short(m)} {fmt(rank['overall'][m])}" for m in best[1:]) + ".")
     cost = {m: rank["cost"].get(m) for m in cands if rank["cost"].get(m) is not None}
     if cost and rank["cost"].get(BASE) is not None:
