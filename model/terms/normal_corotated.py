@@ -16,9 +16,9 @@ axis' stretch with the shear of the other axes removed; the two agree to first o
 import numpy as np
 from numba import njit
 
-from . import CalibratedTerm, register
-from ._kernels import (add_piola_forces, deformation_gradient, deformation_gradients_numpy,
-                       piola_forces_numpy, rest_shape_inverse)
+from . import register
+from ._constant_strain import ConstantStrainTerm
+from ._kernels import add_piola_forces, deformation_gradient, piola_forces_numpy
 from .volume import FLAT
 
 
@@ -107,31 +107,22 @@ def stretch_numpy(F):
 
 
 @register
-class NormalCorotated(CalibratedTerm):
+class NormalCorotated(ConstantStrainTerm):
     """Deviation of the co-rotated normal strains U_ii along the material axes."""
 
     name = "normal_corotated"
-    checks_inversion = True
-
-    def __init__(self, mesh, material, scale=1.0, **params):
-        super().__init__(mesh, material, scale, **params)
-        self.Dinv = np.ascontiguousarray(rest_shape_inverse(mesh.points, mesh.tets))
 
     def kernel_args(self, k):
         return corotated_normal_forces, (self.mesh.tets, self.Dinv, self.vol0, k * self.G)
 
-    def _F(self, x, rows=slice(None)):
-        return deformation_gradients_numpy(np.asarray(x, dtype=float), self.mesh.tets[rows],
-                                           self.Dinv[rows])
-
     def calibration_residuals(self, x, rows):
         """U_ii - tr U / 3 (r, 3) of the tetrahedra ``rows``, weights G V0."""
-        U, _, _ = stretch_numpy(self._F(x, rows))
+        U, _, _ = stretch_numpy(self.F(x, rows))
         d = np.diagonal(U, axis1=1, axis2=2)
         return d - d.mean(axis=1, keepdims=True), self.G * self.vol0[rows]
 
     def forces_numpy(self, x):
-        F = self._F(x)
+        F = self.F(x)
         U, sig, V = stretch_numpy(F)
         d = np.diagonal(U, axis1=1, axis2=2)
         A = 2 * self.scale * self.coef * self.G * (d - d.mean(axis=1, keepdims=True))

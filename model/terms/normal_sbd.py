@@ -13,9 +13,9 @@ zero under rigid motion (left rotations of F) and uniform scaling. The axes are 
 import numpy as np
 from numba import njit
 
-from . import CalibratedTerm, register
-from ._kernels import (add_piola_forces, deformation_gradient, deformation_gradients_numpy,
-                       piola_forces_numpy, rest_shape_inverse)
+from . import register
+from ._constant_strain import ConstantStrainTerm
+from ._kernels import add_piola_forces, deformation_gradient, piola_forces_numpy
 from .volume import FLAT
 
 
@@ -39,22 +39,16 @@ def axis_stretch_forces(x, tets, Dinv, vol0, kG, out):
 
 
 @register
-class NormalSBD(CalibratedTerm):
+class NormalSBD(ConstantStrainTerm):
     """Deviation of the stretches along the material axes (after Mueller et al. 2014)."""
 
     name = "normal_sbd"
-    checks_inversion = True
-
-    def __init__(self, mesh, material, scale=1.0, **params):
-        super().__init__(mesh, material, scale, **params)
-        self.Dinv = np.ascontiguousarray(rest_shape_inverse(mesh.points, mesh.tets))
 
     def kernel_args(self, k):
         return axis_stretch_forces, (self.mesh.tets, self.Dinv, self.vol0, k * self.G)
 
     def _stretch(self, x, rows=slice(None)):
-        F = deformation_gradients_numpy(np.asarray(x, dtype=float), self.mesh.tets[rows],
-                                        self.Dinv[rows])
+        F = self.F(x, rows)
         return F, np.linalg.norm(F, axis=1)          # s_i = |column i|
 
     def calibration_residuals(self, x, rows):
