@@ -101,15 +101,10 @@ def _models(given, presets):
     ``presets``, or composed specs (``model.compose``) checked against the term registry."""
     if given is None:
         return None
-    from model.compose import label, parse
-    from model.mesh import cube
-    from model.terms import make_term
-    tiny = cube(2, 0.01, "five")
+    from model.compose import checked
     out = []
     for g in given:
-        name = label(g)        # a ModelError names the unknown term or parameter
-        for t, params in parse(name):   # and a term its bad value, on one cell, before computing
-            make_term(t, tiny, model.Material(E=1e4, nu=0.3), **params)
+        name = checked(g)      # a ModelError names the unknown term, parameter or value
         if name in model.PRESETS and name not in presets:
             raise UsageError(f"model {name} is not run by this case; valid presets: "
                              f"{', '.join(presets)} (or terms composed with '+')")
@@ -433,6 +428,11 @@ def _fit_command(args):
     return 0
 
 
+def _sweep_command(args):
+    from .sweeps import command
+    return command.run(args)
+
+
 def _selection(p):
     p.add_argument("--models", nargs="+",
                    help="model presets, or terms composed with '+', e.g. \"shear(reading="
@@ -558,6 +558,28 @@ def parser():
                    help="the bounds file (default thresholds.toml in the current folder: the "
                         "repository's own when run from a checkout)")
     c.set_defaults(func=_check_command)
+    sw = sub.add_parser(
+        "sweep", help="run a parameter sweep (TOML spec) on Dask: table, runs and report",
+        description="Run every point of a sweep spec (cases, fixed settings, axes over E, nu, "
+                    "rho, resolution, load, mesh, bc and model; see cases/sweeps/nu.toml) as "
+                    "tasks on dask.distributed: a LocalCluster of --workers processes, or the "
+                    "cluster at --scheduler. Finished runs are kept (runs/<key>/metrics.json) "
+                    "and skipped on a rerun; a failing run is a row with its error. Writes "
+                    "table.parquet (table.csv without pyarrow), report.md and its plots. Exit "
+                    "status 1 when a task was lost with its workers (rerun to finish).")
+    sw.add_argument("spec", help="a sweep spec .toml, or the name of a shipped one (nu)")
+    sw.add_argument("--scheduler", help="address of a running Dask scheduler, e.g. "
+                                        "tcp://host:8786 (default: a LocalCluster here)")
+    sw.add_argument("--workers", type=_number("--workers", "an integer >= 1", low=0,
+                                              integer=True),
+                    help="LocalCluster worker processes (default: one per core)")
+    sw.add_argument("--out", help="output folder (default reports/sweeps/SPEC-NAME)")
+    sw.add_argument("--serial", action="store_true",
+                    help="run every task in this process, without Dask (same results)")
+    sw.add_argument("--retry-failed", action="store_true",
+                    help="compute again the runs an earlier sweep recorded as failed")
+    _term_files(sw)
+    sw.set_defaults(func=_sweep_command)
     b = sub.add_parser(
         "bless", help="rewrite the bounds from measured metrics and print what changed",
         description="Set the bounds of thresholds.toml from measured metrics. Without --metrics "

@@ -42,6 +42,9 @@ class Settings:
     p2_levels: int = 1          # refinements of the converged P2 reference
     quick: bool = False
     shear_scale: float = 1.0    # testing knob: scales every shear term (1 = the model)
+    # True: the standard static metrics and quantities only; the case's extra reference work
+    # and metrics (reference_extra, reference_entries, run_extra: dynamics, modes) are skipped
+    static_only: bool = False
     material: Material = field(init=False, repr=False, compare=False)
 
     def __post_init__(self):
@@ -114,6 +117,15 @@ class Loads:
 
 
 @dataclass(frozen=True)
+class Knob:
+    """A case setting a sweep may turn for a generic axis (``resolution``, ``load``): the
+    Settings field ``field`` and the label of its values (with their unit)."""
+
+    field: str
+    label: str
+
+
+@dataclass(frozen=True)
 class Headline:
     """The metric that sums a case up in the scorecard: ``metric`` (an error, smaller is
     better, per run) and how the index names it."""
@@ -162,6 +174,8 @@ class Case(abc.ABC):
     draws_stress, magnify : whether the case draws its own stress panels; the magnification
         of the standard ones.
     static : whether the case has a static displacement problem (what ``pbcm fit`` fits).
+    resolution, load : the Settings fields a sweep's ``resolution`` and ``load`` axes turn
+        (a Knob each), or None where the case has none.
     """
 
     name: ClassVar[str]
@@ -181,6 +195,8 @@ class Case(abc.ABC):
     draws_stress: ClassVar[bool] = False   # True: the case draws its own max |tau| panels
     magnify: ClassVar[float] = 5.0         # displacement magnification of the panels
     static: ClassVar[bool] = True          # False: no static displacement (modes)
+    resolution: ClassVar[Knob] = None      # what a sweep's resolution axis turns
+    load: ClassVar[Knob] = None            # what a sweep's load axis turns
 
     # ------------------------------------------------------------------ settings
     def settings(self, quick=False, **kw):
@@ -345,5 +361,5 @@ def err_name(name):
     return name + "_rel_err"
 
 
-__all__ = ["Case", "Study", "Settings", "Loads", "Traction", "Headline", "Reference", "MM",
-           "MESH_FAMILIES", "STANDARD_GATED", "ref_name", "err_name"]
+__all__ = ["Case", "Study", "Settings", "Loads", "Traction", "Headline", "Knob", "Reference",
+           "MM", "MESH_FAMILIES", "STANDARD_GATED", "ref_name", "err_name"]

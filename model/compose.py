@@ -122,3 +122,17 @@ def slug(name):
     """
     name = name.replace(" ", "").replace("(", ".").replace(")", "").replace(",", ".")
     return re.sub(r"[^A-Za-z0-9_.+=\-]+", "_", name)
+
+
+def checked(spec):
+    """The canonical label of ``spec``, each of its terms built on one cell first, so that an
+    unknown term or parameter, or a bad value, is a ModelError before any computing."""
+    from .material import Material
+    from .mesh import cube
+    from .terms import make_term
+    name = label(spec)        # names an unknown term or parameter
+    cell = cube(2, 0.01, "five")
+    for term, params in parse(name):
+        make_term(term, cell, Material(E=1e4, nu=0.3), **params)
+    return name
+

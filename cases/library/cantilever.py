@@ -6,7 +6,7 @@ from dataclasses import dataclass
 
 from reference import analytic
 from ..document import fmt
-from ..framework import MM, Case, Headline, Loads, Settings, Traction
+from ..framework import Case, Headline, Knob, Loads, MM, Settings, Traction
 from . import common
 
 LENGTH_MM, HEIGHT_MM, WIDTH_MM = 64.0, 16.0, 16.0
@@ -25,6 +25,8 @@ class CantileverSettings(Settings):
 
 class Cantilever(Case):
     name = "cantilever"
+    resolution = Knob("spacing_mm", "lattice spacing [mm]")
+    load = Knob("load_N", "end load [N]")
     title = ("Cantilever 64 x 16 x 16 mm, clamped at x = 0, 1 mN end load in -y (bending; "
              "closed form Euler-Bernoulli + Timoshenko)")
     settings_class = CantileverSettings

@@ -10,7 +10,7 @@ from model.mesh import cube
 from model.terms.shear import Shear
 from .. import metrics as M
 from ..document import fmt
-from ..framework import MM, Case, Headline, Settings
+from ..framework import Case, Headline, Knob, MM, Settings
 from . import common
 
 SIZE_MM, PATCH_MM, DEPTH_MM = 32.0, 8.0, 2.0
@@ -59,6 +59,7 @@ def edge_tets(mesh, spacing):
 
 class Indentation(Case):
     name = "indentation"
+    resolution = Knob("spacing_mm", "lattice spacing [mm]")
     title = ("Indentation of a 32 mm cube on a clamped base by a rigid 8 x 8 mm flat punch "
              "pressed 2 mm (punch force, surface profile, shear under the punch edge)")
     settings_class = IndentationSettings

@@ -10,7 +10,7 @@ from reference import hyperelastic, linear
 from .. import figures
 from .. import metrics as M
 from ..document import fmt
-from ..framework import MM, Case, Headline, Reference, Settings
+from ..framework import Case, Headline, Knob, MM, Reference, Settings
 from . import common
 from .paper_cube import boundary_sets
 
@@ -63,6 +63,7 @@ class Curve:
 
 class LargeCompression(Case):
     name = "large-compression"
+    load = Knob("push_mm", "push [mm]")
     title = ("The paper's cube on a sliding base pushed to 30 % (9.6 mm) in 6 steps, against "
              "neo-Hookean FEM (and linear FEM, to show where it fails)")
     settings_class = LargeCompressionSettings

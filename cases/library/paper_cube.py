@@ -13,7 +13,7 @@ from model.bc import Ramp, bc_arrays, merge
 from model.mesh import cube
 from .. import metrics as M
 from .. import transient
-from ..framework import MESH_FAMILIES, Case, Headline, Settings
+from ..framework import Case, Headline, Knob, MESH_FAMILIES, Settings
 from . import paper_cube_report as report
 
 SIZE_MM = 32.0
@@ -37,20 +37,35 @@ class Config(Settings):
     safety: float = 0.8           # RK4 step = safety * min h / c_p
     hold_max: float = 2.0         # longest hold after the push [s]
     rest_speed: float = 1e-3      # at rest: every node slower than this fraction of the push speed
+    nodes_per_side: int = NODES_PER_SIDE  # the lattice (sweeps vary it; the paper's is 5)
+    push_mm: float = PUSH_MM      # how far the top is pushed down (sweeps vary it)
 
     def problem(self):
         """The parameters that define the problem the metrics answer (what a bound was
         measured at): material, geometry, loading, damping, step and reference resolution.
         Selections (meshes, models) are not part of it."""
         return {"E_Pa": self.E, "nu": self.nu, "rho_kg_m3": self.rho, "size_mm": SIZE_MM,
-                "nodes_per_side": NODES_PER_SIDE, "push_mm": PUSH_MM,
-                "speed_mm_s": SPEED_MM_S, "layers_mm": list(LAYERS_MM),
+                "nodes_per_side": self.nodes_per_side, "push_mm": self.push_mm,
+                "speed_mm_s": SPEED_MM_S, "layers_mm": layers_mm(self.nodes_per_side),
                 "p2_levels": self.p2_levels, "transient_element": self.transient_element,
                 "damping_1_s": self.damping, "rk4_safety": self.safety,
                 "hold_max_s": self.hold_max, "rest_speed_fraction": self.rest_speed}
 
-def make_mesh(name):
-    return cube(NODES_PER_SIDE, SIZE_MM * MM, name)
+def make_mesh(name, nodes_per_side=NODES_PER_SIDE):
+    return cube(nodes_per_side, SIZE_MM * MM, name)
+
+
+def layers_mm(nodes_per_side):
+    """The y-layers of the layer profile: the lattice's node planes (the paper's five at 0, 8,
+    16, 24, 32 mm on its 5 x 5 x 5 lattice)."""
+    return np.linspace(0.0, SIZE_MM, nodes_per_side).tolist()
+
+
+def apparent_poisson(profile, push_mm):
+    """Mean lateral expansion of the side faces over the half side, divided by the axial
+    compression push / size: the Poisson ratio the cube shows (exactly nu for linear FEM on
+    the sliding base, a uniaxial stress; lower on the clamped base, which holds two layers)."""
+    return float(np.mean(profile) / (SIZE_MM * MM / 2) / (push_mm / SIZE_MM))
 
 
 def boundary_sets(mesh, bc):
@@ -72,22 +87,22 @@ def boundary_sets(mesh, bc):
     return top, (None, None, None), merge(held)
 
 
-def static_bc(mesh, bc):
+def static_bc(mesh, bc, push_mm=PUSH_MM):
     top, lateral, held = boundary_sets(mesh, bc)
     out = dict(held)
-    out.update({int(i): (lateral[0], -PUSH_MM * MM, lateral[2]) for i in top})
+    out.update({int(i): (lateral[0], -push_mm * MM, lateral[2]) for i in top})
     return out
 
 
-def dynamic_bc(mesh, bc):
+def dynamic_bc(mesh, bc, push_mm=PUSH_MM):
     top, lateral, held = boundary_sets(mesh, bc)
-    return Ramp(top, (lateral[0], -PUSH_MM * MM, lateral[2]), PUSH_MM / SPEED_MM_S, held=held)
+    return Ramp(top, (lateral[0], -push_mm * MM, lateral[2]), push_mm / SPEED_MM_S, held=held)
 
 
 def dynamic_run(pm, mesh, bc, cfg, dt_scale=1.0):
     """RK4 as in the paper: the push over 1 s, then held until at rest (or hold_max), at the
     case's step times ``dt_scale``."""
-    ramp = dynamic_bc(mesh, bc)
+    ramp = dynamic_bc(mesh, bc, cfg.push_mm)
     t_push = ramp.t_ramp
     dt = pm.stable_dt(cfg.safety) * dt_scale
     t0 = time.perf_counter()
@@ -153,6 +168,8 @@ class PaperCube(Case):
     name = "paper-cube"
     title = "The paper's cube pushed down 1.7 mm (5.3 %), clamped or sliding base"
     settings_class = Config
+    resolution = Knob("nodes_per_side", "nodes per side")
+    load = Knob("push_mm", "push [mm]")
     meshes = MESH_FAMILIES
     quick_meshes = ("five", "six")
     bcs = BCS
@@ -165,24 +182,27 @@ class PaperCube(Case):
     draws_stress = True
 
     def mesh(self, family, s):
-        return make_mesh(family)
+        return make_mesh(family, s.nodes_per_side)
 
     def dirichlet(self, mesh, bc, s):
-        return static_bc(mesh, bc)
+        return static_bc(mesh, bc, s.push_mm)
 
     def driven(self, mesh, bc, s):
         return boundary_sets(mesh, bc)[0], 1
 
     def quantities(self, mesh, u, reaction, s, bc):
-        profile = M.layer_profile(mesh.points, u, [y * MM for y in LAYERS_MM], SIZE_MM * MM)
+        profile = M.layer_profile(mesh.points, u, [y * MM for y in layers_mm(s.nodes_per_side)],
+                                  SIZE_MM * MM)
         return {"bulge_profile_mm": (profile / MM).tolist(), "zigzag": M.zigzag(profile),
-                "paper_pattern": M.paper_pattern(profile)}
+                # the paper's pattern is one of five layers (its lattice)
+                "paper_pattern": M.paper_pattern(profile) if len(profile) == 5 else None,
+                "apparent_poisson": apparent_poisson(profile, s.push_mm)}
 
     def reference_extra(self, mesh, bc, s, ref):
         rest = s.rest_speed * SPEED_MM_S * MM
         top = boundary_sets(mesh, bc)[0]
         free, held = transient.fem_modes(mesh, ref.dirichlet, s)
-        return {"transient": transient.fem_transient(mesh, dynamic_bc(mesh, bc), top, s, rest,
+        return {"transient": transient.fem_transient(mesh, dynamic_bc(mesh, bc, s.push_mm), top, s, rest,
                                                      element=s.transient_element),
                 "modes_free": free, "modes_held": held}
 

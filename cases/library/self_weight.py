@@ -9,7 +9,7 @@ from model.mesh import cube
 from reference import analytic
 from .. import metrics as M
 from ..document import fmt
-from ..framework import MM, Case, Headline, Loads, Settings
+from ..framework import Case, Headline, Knob, Loads, MM, Settings
 from . import common
 
 SIZE_MM = 32.0
@@ -32,6 +32,8 @@ def _top(mesh):
 
 class SelfWeight(Case):
     name = "self-weight"
+    resolution = Knob("spacing_mm", "lattice spacing [mm]")
+    load = Knob("g", "gravity [m/s^2]")
     title = ("A 32 mm block settling under its own weight, base sliding (closed form) or "
              "clamped (FEM)")
     settings_class = SelfWeightSettings

@@ -6,7 +6,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..document import fmt
-from ..framework import MM, Case, Headline, Settings
+from ..framework import Case, Headline, Knob, MM, Settings
 from . import common
 
 LENGTH_MM, SIDE_MM = 64.0, 16.0
@@ -34,6 +34,8 @@ def end_rotation(points, angle, centre):
 
 class Torsion(Case):
     name = "torsion"
+    resolution = Knob("spacing_mm", "lattice spacing [mm]")
+    load = Knob("angle_deg", "end rotation [deg]")
     title = ("Torsion of a 16 x 16 x 64 mm bar, x = 0 clamped, the end face turned 10 degrees "
              "(torque against FEM and Saint-Venant; end-face warping)")
     settings_class = TorsionSettings

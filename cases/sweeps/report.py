@@ -1,0 +1,275 @@
+"""The sweep's report: each metric of ``[report] metrics`` against each swept axis, one line
+per model (and FEM P2's own value, dashed, where the runs carry it), one panel per value of the
+other swept axes; and what the sweep shows, computed from its rows: how far each model is from
+its target (FEM P2's value, a ratio of 1, an error of 0), where it is worst, and whether that
+distance grows along each numeric axis.
+"""
+import io
+import math
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+import numpy as np  # noqa: E402
+
+from model import PbcmError  # noqa: E402
+from ..document import Document, fmt  # noqa: E402
+from ..framework import ref_name  # noqa: E402
+from .spec import NUMERIC_AXES  # noqa: E402
+from .table import atomic_write  # noqa: E402
+
+MAX_PANELS = 12       # more combinations of the other axes than this: the first ones drawn
+MAX_FAILURES = 40     # failed runs listed one by one; the rest counted
+CHANGE = 1.25         # "grows" / "shrinks" along an axis: a change by this factor or more
+RATIOS = {"reaction_ratio"}   # model over FEM: the target is 1
+ERRORS = ("_rel_err", "_rel_l2", "_rel_l2_p1", "_rel_l2_p2", "_max_rel_p1", "_max_rel_p2")
+PREFIX = "sweep_"     # every figure's file name starts so (earlier ones are cleaned up)
+
+
+class MissingMetric(PbcmError):
+    """A metric of ``[report] metrics`` that no run has."""
+
+
+def _value(v):
+    return None if v is None or isinstance(v, (bool, str, list, dict)) else float(v)
+
+
+def target(metric, rows):
+    """(name, function row -> target value) of a metric: FEM P2's value where the rows carry
+    it, 1 for a ratio to FEM, 0 for an error; None when the metric has no target."""
+    fem = ref_name(metric)
+    if any(_value(r.get(fem)) is not None for r in rows):
+        return "FEM P2", lambda r: _value(r.get(fem))
+    if metric in RATIOS:
+        return "1 (FEM P2)", lambda r: 1.0
+    if metric.endswith(ERRORS):
+        return "0", lambda r: 0.0
+    return None
+
+
+def deviations(metric, rows):
+    """{model: [(|value - target|, row)]} over the rows that have both."""
+    t = target(metric, rows)
+    out = {}
+    for r in rows:
+        v = _value(r.get(metric))
+        goal = None if t is None else t[1](r)
+        if v is not None and goal is not None:
+            out.setdefault(r["model"], []).append((abs(v - goal), r))
+    return out
+
+
+def _where(r, axes):
+    return ", ".join(f"{a} {fmt(r[a])}" if a in NUMERIC_AXES else str(r[a]) for a in axes)
+
+
+def _mean(xs):
+    return float(np.mean(xs)) if xs else None
+
+
+def findings(metric, rows, spec, models):
+    """(sentences, table header, table rows) on one metric over the sweep."""
+    axes = [a for a in ["case"] + spec.swept() if a != "model"]
+    if "case" not in spec.swept() and len(spec.cases) < 2:
+        axes.remove("case")
+    t = target(metric, rows)
+    if t is None:
+        header = ["model", "runs", "min", "max"]
+        body = []
+        for m in models:
+            vs = [(_value(r.get(metric)), r) for r in rows if r["model"] == m
+                  and _value(r.get(metric)) is not None]
+            if vs:
+                lo, hi = min(vs, key=lambda p: p[0]), max(vs, key=lambda p: p[0])
+                body.append([m, len(vs), f"{fmt(lo[0])} ({_where(lo[1], axes)})",
+                             f"{fmt(hi[0])} ({_where(hi[1], axes)})"])
+        return [f"{metric} has no target (no FEM value, not a ratio or an error): its range "
+                "per model."], header, body
+    dev = deviations(metric, rows)
+    numeric = [a for a in spec.swept() if a in NUMERIC_AXES]
+    ends = {a: _ends(a, rows, spec) for a in numeric}
+    header = ["model", "runs", f"mean abs dev from {t[0]}", "worst", "at"]
+    for a in numeric:
+        header += [f"mean at {a} = {fmt(ends[a][0])}", f"mean at {a} = {fmt(ends[a][1])}"]
+    body, trend = [], {a: ([], []) for a in numeric}
+    for m in models:
+        d = dev.get(m)
+        if not d:
+            continue
+        worst = max(d, key=lambda p: p[0])
+        line = [m, len(d), fmt(_mean([x for x, _ in d])), fmt(worst[0]), _where(worst[1], axes)]
+        for a in numeric:
+            at = [_mean([x for x, r in d if r[a] == v]) for v in ends[a]]
+            line += [fmt(at[0]), fmt(at[1])]
+            if None not in at:
+                if at[1] > CHANGE * at[0] and at[1] > 1e-12:
+                    trend[a][0].append(m)
+                elif at[1] * CHANGE < at[0]:
+                    trend[a][1].append(m)
+        body.append(line)
+    ranked = sorted((_mean([x for x, _ in d]), m) for m, d in dev.items())
+    out = []
+    if ranked:
+        out.append(f"{metric}: closest to {t[0]} over the sweep {ranked[0][1]} (mean "
+                   f"|deviation| {fmt(ranked[0][0])}), farthest {ranked[-1][1]} "
+                   f"({fmt(ranked[-1][0])}).")
+    for a in numeric:
+        grows, shrinks = trend[a]
+        first, last = map(fmt, ends[a])
+        if grows:
+            out.append(f"{metric}: the deviation grows by more than {CHANGE:g}x from {a} = "
+                       f"{first} to {a} = {last} for {', '.join(grows)}.")
+        if shrinks:
+            out.append(f"{metric}: it shrinks by more than {CHANGE:g}x for "
+                       f"{', '.join(shrinks)}.")
+    return out, header, body
+
+
+def _ends(axis, rows, spec):
+    """The first and last values of a swept axis (in the spec's order) that finished runs
+    reached."""
+    reached = [v for v in spec.axes[axis] if any(r[axis] == v for r in rows)]
+    return (reached[0], reached[-1]) if reached else (spec.axes[axis][0], spec.axes[axis][-1])
+
+
+def _panels(spec, axis):
+    """The combinations of the other swept axes (not ``axis``, not model), as dicts."""
+    others = [a for a in spec.swept() if a not in (axis, "model")]
+    combos = [{}]
+    for a in others:
+        combos = [{**c, a: v} for c in combos for v in spec.axes[a]]
+    if len(spec.cases) > 1:
+        combos = [{"case": c, **k} for c in spec.cases for k in combos]
+    return combos
+
+
+def figure(metric, axis, rows, spec, models, label):
+    """PNG bytes of ``metric`` against ``axis``: a panel per combination of the other swept
+    axes (at most MAX_PANELS), a line per model, FEM P2 dashed where the rows carry it; and
+    the number of panels left out."""
+    panels = _panels(spec, axis)
+    shown = panels[:MAX_PANELS]
+    xs = spec.axes[axis]
+    numeric = axis in NUMERIC_AXES
+    x = np.array(xs, float) if numeric else np.arange(len(xs))
+    cols = min(4, len(shown))
+    nrows = math.ceil(len(shown) / cols)
+    fig, axs = plt.subplots(nrows, cols, figsize=(4.2 * cols, 3.4 * nrows + 0.8),
+                            squeeze=False)
+    fem = ref_name(metric)
+    for k, combo in enumerate(shown):
+        ax = axs.flat[k]
+        sel = [r for r in rows if all(r.get(a) == v for a, v in combo.items())]
+        for i, m in enumerate(models):
+            y = [_pick(sel, m, axis, v, metric) for v in xs]
+            if any(v is not None for v in y):
+                ax.plot(x, [np.nan if v is None else v for v in y], marker="o", ms=3,
+                        lw=1.2, label=m, color=plt.get_cmap("tab10")(i % 10))
+        y = [_pick(sel, None, axis, v, fem) for v in xs]
+        if any(v is not None for v in y):
+            ax.plot(x, [np.nan if v is None else v for v in y], "k--", lw=1.5, label="FEM P2")
+        if metric in RATIOS:
+            ax.axhline(1.0, color="0.5", lw=0.8)
+        if not numeric:
+            ax.set_xticks(x, [str(v) for v in xs])
+        elif min(xs) > 0 and max(xs) / min(xs) >= 100:
+            ax.set_xscale("log")
+        ax.set_xlabel(label)
+        ax.set_ylabel(metric)
+        ax.set_title(", ".join(str(v) if a not in NUMERIC_AXES else f"{a} {fmt(v)}"
+                               for a, v in combo.items()) or spec.cases[0], fontsize=9)
+        ax.grid(alpha=0.3)
+    for ax in list(axs.flat)[len(shown):]:
+        ax.set_visible(False)
+    handles, labels = axs.flat[0].get_legend_handles_labels()
+    for ax in list(axs.flat)[1:len(shown)]:
+        for h, lab in zip(*ax.get_legend_handles_labels()):
+            if lab not in labels:
+                handles.append(h)
+                labels.append(lab)
+    fig.legend(handles, labels, loc="lower center", ncol=min(5, len(labels)), fontsize=8)
+    fig.suptitle(f"{metric} against {label}", fontsize=11)
+    fig.tight_layout(rect=(0, 0.06 + 0.02 * math.ceil(len(labels) / 5), 1, 0.97))
+    buf = io.BytesIO()
+    fig.savefig(buf, format="png", dpi=80, metadata={"Software": None})
+    plt.close(fig)
+    return buf.getvalue(), len(panels) - len(shown)
+
+
+def _pick(rows, model, axis, value, metric):
+    """The metric of the row at ``axis`` = ``value`` (of ``model``; None: the first row
+    there that has it)."""
+    for r in rows:
+        if r.get(axis) == value and (model is None or r["model"] == model):
+            v = _value(r.get(metric))
+            if v is not None or model is not None:
+                return v
+    return None
+
+
+def write(spec, rows, out, registry, table_path):
+    """Write ``report.md`` and its figures into ``out``; return the figure names. Raises
+    MissingMetric (after writing) when a metric of the spec has no value in any run."""
+    models = list(dict.fromkeys(r["model"] for r in rows))
+    ok = [r for r in rows if r["status"] == "ok"]
+    doc = Document(spec.title)
+    doc.p(f"Drawn by `pbcm sweep {spec.source}` from its {len(rows)} runs "
+          f"({len(rows) - len(ok)} failed). Every parameter and metric of every run is in "
+          f"[{table_path.name}]({table_path.name}); each run's metrics.json is under "
+          "runs/<run key>/.")
+    doc.h(2, "What was run")
+    items = [f"cases: {', '.join(spec.cases)} ({'quick' if spec.quick else 'full'} settings"
+             f"{'; static problem only, no dynamics or modes' if spec.static_only else ''})"]
+    items += [f"{a}: {', '.join(fmt(v) if a in NUMERIC_AXES else str(v) for v in vs)}"
+              for a, vs in spec.axes.items()]
+    items += [f"{k} = {fmt(v)} (fixed)" for k, v in spec.fixed.items()]
+    doc.ul(items)
+    missing = [m for m in spec.metrics if not any(_value(r.get(m)) is not None for r in ok)]
+    shows, sections, names = [], [], []
+    for metric in spec.metrics:
+        if metric in missing:
+            continue
+        sentences, header, body = findings(metric, ok, spec, models)
+        shows += sentences
+        sections.append((metric, header, body))
+    doc.h(2, "What it shows")
+    doc.ul(shows or ["No run finished, so there is nothing to show."])
+    case = registry[spec.cases[0]]
+    for metric, header, body in sections:
+        doc.h(2, metric)
+        doc.table(header, body)
+        for axis in [a for a in spec.swept() if a != "model"]:
+            png, left = figure(metric, axis, ok, spec, models, spec.label(axis, case))
+            name = f"{PREFIX}{metric}_vs_{axis}.png"
+            atomic_write(out / name, png)
+            names.append(name)
+            doc.img(name, f"{metric} against {spec.label(axis, case)}")
+            if left:
+                doc.p(f"{left} more panels (other combinations of the swept axes) are not "
+                      f"drawn; the table has them.")
+    if missing:
+        doc.h(2, "Metrics without values")
+        doc.p(f"No finished run has {', '.join(missing)}: check the names against the "
+              f"columns of {table_path.name}.")
+    failed = [r for r in rows if r["status"] == "failed"]
+    if failed:
+        doc.h(2, "Failed runs")
+        doc.table(["case", "mesh", "bc", "model", "point", "error"],
+                  [[r["case"], r["mesh"], r["bc"], r["model"],
+                    ", ".join(f"{a} {fmt(r[a])}" for a in NUMERIC_AXES if a in spec.axes),
+                    str(r["error"]).replace("|", "/")] for r in failed[:MAX_FAILURES]])
+        if len(failed) > MAX_FAILURES:
+            doc.p(f"... and {len(failed) - MAX_FAILURES} more (status = failed in the table).")
+    for old in out.glob(f"{PREFIX}*.png"):
+        if old.name not in names:
+            old.unlink()
+    atomic_write(out / "report.md", doc.markdown() + "\n")
+    if missing:
+        raise MissingMetric(f"no finished run has metric(s) {', '.join(missing)} named in "
+                            f"[report] metrics of {spec.source}; valid names are the columns "
+                            f"of {table_path}")
+    return names
+
+
+__all__ = ["write", "findings", "target", "deviations", "figure", "MissingMetric"]
