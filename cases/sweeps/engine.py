@@ -48,20 +48,18 @@ class Outcome:
 def parameters(unit, registry):
     """The parameter columns of a unit's rows: case, mesh, bc, the values of every numeric
     axis the run used (swept, fixed or the case's default; None where the case has no such
-    setting) and the fixed settings."""
+    setting) and the fixed settings. Read off the case's default settings with the unit's
+    values laid over them, so that a point whose settings fail still names them all."""
     case = registry[unit.case]
+    default = case.settings(quick=unit.settings.get("quick", False))
+    field = {"E": "E", "nu": "nu", "rho": "rho"}
+    for axis in ("resolution", "load"):
+        knob = getattr(case, axis)
+        field[axis] = None if knob is None else knob.field
     out = {"case": unit.case, "mesh": unit.mesh, "bc": unit.bc}
-    try:
-        s = case.settings(meshes=(unit.mesh,), bcs=(unit.bc,), models=unit.models,
-                          **unit.settings)
-        values = {"E": s.E, "nu": s.nu, "rho": s.rho}
-        for axis in ("resolution", "load"):
-            knob = getattr(case, axis)
-            values[axis] = None if knob is None else getattr(s, knob.field)
-    except Exception:     # settings refused: the values as given (the runs say why)
-        values = {a: unit.point.get(a) for a in NUMERIC_AXES}
-    out.update(values)
-    out.update({k: v for k, v in unit.settings.items() if k not in out})
+    out.update({a: None if f is None else unit.settings.get(f, getattr(default, f))
+                for a, f in field.items()})
+    out.update({k: v for k, v in unit.settings.items() if k not in field.values()})
     return out
 
 

@@ -1,0 +1,343 @@
+"""`pbcm sweep`: the spec is checked whole before computing, every run lands in one table and
+its own metrics.json, a rerun resumes, failing points are rows, serial and distributed runs
+agree, and a killed worker's task is run again."""
+import json
+import os
+import signal
+import threading
+import time
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from cases.cli import main
+from cases.registry import CASES
+from cases.sweeps import engine, report, spec as specs, table
+
+SMALL = """
+title = "small"
+cases = ["paper-cube"]
+quick = true
+static_only = true
+table = "{table}"
+[fixed]
+p2_levels = 1
+[axes]
+nu = [0.0, 0.3, 0.5]
+mesh = ["five"]
+bc = ["sliding"]
+model = ["pbcm-variational", "fem-linear"]
+[report]
+metrics = ["reaction_ratio", "apparent_poisson"]
+"""
+TIMING = {"task_wall_s"}
+
+
+def _spec(tmp_path, text=SMALL, table="csv", name="small.toml"):
+    path = tmp_path / name
+    path.write_text(text.format(table=table) if "{table}" in text else text)
+    return path
+
+
+def _values(rows):
+    """The rows without their timing columns (what must not depend on where they ran)."""
+    return [{k: v for k, v in r.items() if k not in TIMING} for r in rows]
+
+
+@pytest.fixture(scope="module")
+def serial(tmp_path_factory):
+    """The small sweep run serially through the command line, and its folder."""
+    root = tmp_path_factory.mktemp("sweep")
+    path = _spec(root)
+    out = root / "serial"
+    assert main(["sweep", str(path), "--serial", "--out", str(out)]) == 0
+    return path, out
+
+
+# ------------------------------------------------------------------ the spec
+def _parse(text):
+    import tomllib
+    return specs.parse(tomllib.loads(text), CASES)
+
+
+def test_ranges_are_the_values_written_out():
+    s = _parse('cases = ["paper-cube"]\n[axes]\nnu = {from = 0.0, to = 0.4, num = 5}\n'
+               'E = {from = 1e3, to = 1e5, num = 3, log = true}\n'
+               'resolution = {from = 3, to = 7, step = 2}\nload = {from = 0.5, to = 1.0, '
+               'step = 0.25}')
+    assert s.axes["nu"] == [0.0, 0.1, 0.2, 0.3, 0.4]
+    assert s.axes["E"] == [1e3, 1e4, 1e5]
+    assert s.axes["resolution"] == [3, 5, 7]
+    assert s.axes["load"] == [0.5, 0.75, 1.0]
+    assert s.swept() == ["E", "nu", "resolution", "load"]
+
+
+def test_units_map_generic_axes_to_each_cases_settings():
+    s = _parse('cases = ["paper-cube", "cantilever"]\nstatic_only = true\n[axes]\n'
+               'resolution = [4, 8]\nload = [2.0]\nmesh = ["five"]\nbc = ["clamped"]\n'
+               'model = ["msm"]')
+    units = s.units(CASES)
+    assert [(u.case, u.point["resolution"]) for u in units] == [
+        ("paper-cube", 4), ("paper-cube", 8), ("cantilever", 4), ("cantilever", 8)]
+    assert units[1].settings == {"quick": False, "static_only": True, "nodes_per_side": 8,
+                                 "push_mm": 2.0}
+    assert units[3].settings["spacing_mm"] == 8 and units[3].settings["load_N"] == 2.0
+    # a run key is the run's definition: another model, another key; the same, the same
+    assert units[0].run_key("msm") != units[0].run_key("fem-linear")
+    assert units[0].run_key("msm") == _parse(
+        'cases = ["paper-cube"]\nstatic_only = true\n[axes]\nresolution = [4]\nload = [2.0]\n'
+        'mesh = ["five"]\nbc = ["clamped"]\nmodel = ["msm"]').units(CASES)[0].run_key("msm")
+
+
+@pytest.mark.parametrize("text, says", [
+    ('cases = ["paper-cube"]\ncolour = 1', "unknown key(s) colour"),
+    ('cases = ["no-such"]', "unknown case(s) no-such"),
+    ('cases = ["convergence"]', "studies cannot be swept"),
+    ('cases = []', "at least one case"),
+    ('cases = ["paper-cube"]\n[axes]\nnuu = [0.1]', "unknown axis nuu"),
+    ('cases = ["paper-cube"]\n[axes]\nnu = ["a"]', "takes finite numbers"),
+    ('cases = ["paper-cube"]\n[axes]\nnu = []', "is empty"),
+    ('cases = ["paper-cube"]\n[axes]\nnu = [0.1, 0.1]', "repeats a value"),
+    ('cases = ["paper-cube"]\n[axes]\nnu = {from = 0, to = 1}', "a range is"),
+    ('cases = ["paper-cube"]\n[axes]\nE = {from = 0, to = 1, num = 3, log = true}',
+     "log range needs"),
+    ('cases = ["paper-cube"]\n[axes]\nresolution = [4.5]', "whole number"),
+    ('cases = ["modes"]\n[axes]\nload = [1.0]', "has no load setting"),
+    ('cases = ["modes"]\nstatic_only = true', "has no static problem"),
+    ('cases = ["paper-cube"]\n[axes]\nmesh = ["hex"]', "has no mesh hex"),
+    ('cases = ["paper-cube"]\n[axes]\nbc = ["free"]', "has no bc free"),
+    ('cases = ["paper-cube"]\n[axes]\nmodel = ["shear(c=auto) + nosuchterm"]', "nosuchterm"),
+    ('cases = ["paper-cube"]\n[fixed]\nnu = 0.3\n[axes]\nnu = [0.1]', "both fixed and swept"),
+    ('cases = ["paper-cube"]\n[fixed]\nspacing_mm = 2.0', "not a setting of case paper-cube"),
+    ('cases = ["paper-cube"]\n[fixed]\nmeshes = ["five"]', "the selection is swept"),
+    ('cases = ["paper-cube"]\ntable = "xlsx"', "table must be one of"),
+    ('cases = ["paper-cube"]\nquick = "yes"', "quick must be true or false"),
+])
+def test_a_bad_spec_is_refused_naming_what_is_wrong(text, says):
+    with pytest.raises(specs.SpecError) as err:
+        _parse(text)
+    assert says in str(err.value)
+
+
+def test_a_bad_argument_fails_before_any_computing(tmp_path, capsys):
+    assert main(["sweep", str(tmp_path / "none.toml")]) == 2
+    assert "does not exist" in capsys.readouterr().err
+    path = _spec(tmp_path, 'cases = ["paper-cube"]\n[axes]\nnu = [0.7')
+    assert main(["sweep", str(path)]) == 2
+    assert "not valid TOML" in capsys.readouterr().err
+    (tmp_path / "mine").mkdir()
+    (tmp_path / "mine" / "notes.txt").write_text("keep")
+    good = _spec(tmp_path)
+    assert main(["sweep", str(good), "--out", str(tmp_path / "mine")]) == 2
+    assert "not a sweep's" in capsys.readouterr().err
+    assert main(["sweep", str(good), "--scheduler", "tcp://127.0.0.1:1", "--workers", "2",
+                 "--out", str(tmp_path / "o")]) == 2
+    assert "drop --workers" in capsys.readouterr().err
+    assert not (tmp_path / "o").exists()
+    assert main(["sweep", str(good), "--scheduler", "tcp://127.0.0.1:9", "--out",
+                 str(tmp_path / "o2")]) == 2
+    assert "no Dask scheduler answers" in capsys.readouterr().err
+    assert not (tmp_path / "o2" / "runs").exists()
+
+
+# ------------------------------------------------------------------ runs, table, report
+def test_every_run_is_a_row_and_a_metrics_json(serial):
+    _, out = serial
+    rows = table.read(out / "table.csv")
+    assert len(rows) == 3 * 2
+    assert [(r["nu"], r["model"]) for r in rows] == [
+        (0.0, "pbcm-variational"), (0.0, "fem-linear"), (0.3, "pbcm-variational"),
+        (0.3, "fem-linear"), (0.5, "pbcm-variational"), (0.5, "fem-linear")]
+    for r in rows:
+        stored = json.loads((out / "runs" / r["run_key"] / "metrics.json").read_text())
+        assert stored["model"] == r["model"] and stored["nu"] == r["nu"]
+        for k in ("case", "mesh", "bc", "E", "rho", "resolution", "load", "p2_levels"):
+            assert r[k] is not None, k
+        assert r["resolution"] == 5 and r["load"] == 1.7 and r["E"] == 1e4
+
+
+def test_a_failing_point_is_a_row_with_its_error(serial):
+    rows = table.read(serial[1] / "table.csv")
+    bad = [r for r in rows if r["nu"] == 0.5]
+    assert all(r["status"] == "failed" and "nu" in r["error"] and r["reaction_ratio"] is None
+               for r in bad)
+    assert all(r["status"] == "ok" and r["error"] is None for r in rows if r["nu"] != 0.5)
+    text = (serial[1] / "report.md").read_text()
+    assert "## Failed runs" in text and text.count("| paper-cube | five | sliding |") == 2
+
+
+def test_apparent_poisson_of_linear_fem_on_the_sliding_base_is_nu(serial):
+    """Uniaxial stress: the lateral strain is -nu times the axial one, exactly for P1 and
+    P2 (the solution is linear), so the FEM reference and the fem-linear model show nu."""
+    for r in table.read(serial[1] / "table.csv"):
+        if r["status"] == "ok":
+            assert r["apparent_poisson_fem"] == pytest.approx(r["nu"], abs=1e-7)
+            if r["model"] == "fem-linear":
+                assert r["apparent_poisson"] == pytest.approx(r["nu"], abs=1e-7)
+                assert r["reaction_ratio"] == pytest.approx(1.0, abs=1e-7)
+
+
+def test_report_draws_each_metric_against_each_axis(serial):
+    out = serial[1]
+    text = (out / "report.md").read_text()
+    for metric in ("reaction_ratio", "apparent_poisson"):
+        assert (out / f"sweep_{metric}_vs_nu.png").is_file()
+        assert f"![{metric} against nu](sweep_{metric}_vs_nu.png)" in text
+    assert "apparent_poisson: closest to FEM P2 over the sweep fem-linear" in text
+
+
+def test_a_rerun_resumes_and_rewrites_the_same_files(serial, tmp_path):
+    path, out = serial
+    before = {p.name: p.read_bytes() for p in out.iterdir() if p.is_file()}
+    stored = {p: p.stat().st_mtime_ns for p in (out / "runs").glob("*/metrics.json")}
+    outcome = engine.run(specs.load(path, CASES), CASES, out, serial=True, log=False)
+    assert outcome.computed == 0 and outcome.found == 6
+    assert main(["sweep", str(path), "--serial", "--out", str(out)]) == 0
+    assert {p.name: p.read_bytes() for p in out.iterdir() if p.is_file()} == before
+    assert {p: p.stat().st_mtime_ns for p in stored} == stored    # nothing recomputed
+    # --retry-failed computes the failed points again, and only them
+    again = engine.run(specs.load(path, CASES), CASES, out, serial=True, log=False,
+                       retry_failed=True)
+    assert again.computed == 2 and again.found == 4
+
+
+def test_an_interrupted_sweep_resumes_where_it_stopped(serial, tmp_path):
+    path, done = serial
+    out = tmp_path / "cut"
+    (out / "runs").mkdir(parents=True)
+    keep = sorted((done / "runs").iterdir())[:3]      # as if stopped after three runs
+    for k in keep:
+        (out / "runs" / k.name).mkdir()
+        (out / "runs" / k.name / "metrics.json").write_bytes((k / "metrics.json").read_bytes())
+    outcome = engine.run(specs.load(path, CASES), CASES, out, serial=True, log=False)
+    assert outcome.found == 3 and outcome.computed == 3
+    now = table.read(table.write(outcome.rows, out, "csv", engine.PARAMS))
+    assert _values(now) == _values(table.read(done / "table.csv"))
+
+
+def test_parquet_and_csv_hold_the_same_rows(serial, tmp_path):
+    pytest.importorskip("pyarrow")
+    rows = table.read(serial[1] / "table.csv")
+    path = table.write(rows, tmp_path, "parquet", engine.PARAMS)
+    back = table.read(path)
+    assert [list(r) for r in back][0][:4] == ["case", "mesh", "bc", "model"]
+    for a, b in zip(rows, back):
+        assert a.keys() == b.keys()
+        for k in a:
+            if isinstance(a[k], float) and isinstance(b[k], float):
+                assert a[k] == b[k], k
+            else:
+                assert a[k] == b[k] or (isinstance(a[k], int) and a[k] == b[k]), k
+
+
+def test_table_columns_take_one_type_each(tmp_path):
+    pytest.importorskip("pyarrow")
+    rows = [{"a": 1, "b": None, "c": [1, 2], "d": True, "e": "x"},
+            {"a": 2.5, "b": 3, "c": None, "d": None, "e": 1}]
+    back = table.read(table.write(rows, tmp_path, "parquet"))
+    assert back == [{"a": 1.0, "b": None, "c": "[1, 2]", "d": True, "e": "x"},
+                    {"a": 2.5, "b": 3, "c": None, "d": None, "e": "1"}]
+    csv_back = table.read(table.write(rows, tmp_path, "csv"))
+    assert csv_back[0] == {"a": 1, "b": None, "c": "[1, 2]", "d": True, "e": "x"}
+    assert csv_back[1]["a"] == 2.5
+
+
+# ------------------------------------------------------------------ what the report computes
+def test_findings_measure_each_model_against_its_target():
+    spec = _parse('cases = ["paper-cube"]\n[axes]\nnu = [0.0, 0.4]\nmodel = ["a", "b"]'
+                  .replace('["a", "b"]', '["msm", "fem-linear"]'))
+    rows = [{"case": "paper-cube", "model": m, "nu": nu, "reaction_ratio": v}
+            for m, nu, v in [("msm", 0.0, 1.1), ("msm", 0.4, 0.6), ("fem-linear", 0.0, 1.0),
+                             ("fem-linear", 0.4, 1.02)]]
+    sentences, header, body = report.findings("reaction_ratio", rows, spec,
+                                              ["msm", "fem-linear"])
+    # msm: |1.1 - 1| = 0.1 and |0.6 - 1| = 0.4, mean 0.25, worst 0.4 at nu 0.4; grows 4x
+    assert body[0] == ["msm", 2, "0.25", "0.4", "nu 0.4", "0.1", "0.4"]
+    assert body[1][:4] == ["fem-linear", 2, "0.01", "0.02"]
+    assert sentences[0].startswith("reaction_ratio: closest to 1 (FEM P2) over the sweep "
+                                   "fem-linear (mean |deviation| 0.01), farthest msm (0.25)")
+    assert "grows by more than 1.25x from nu = 0 to nu = 0.4 for msm, fem-linear" in sentences[1]
+    # with an FEM column the target is FEM's value, row by row
+    rows = [{"case": "paper-cube", "model": "msm", "nu": 0.4, "apparent_poisson": 0.16,
+             "apparent_poisson_fem": 0.4}]
+    assert report.deviations("apparent_poisson", rows)["msm"][0][0] == pytest.approx(0.24)
+
+
+# ------------------------------------------------------------------ on Dask
+def test_distributed_runs_equal_serial_runs(serial, tmp_path):
+    """The same spec on a LocalCluster of two worker processes gives the same rows, every
+    non-timing value equal."""
+    path, out = serial
+    dist = tmp_path / "dist"
+    assert main(["sweep", str(path), "--workers", "2", "--out", str(dist)]) == 0
+    a, b = table.read(out / "table.csv"), table.read(dist / "table.csv")
+    assert _values(a) == _values(b)
+    assert (out / "report.md").read_text() == (dist / "report.md").read_text()
+
+
+def test_a_killed_workers_task_runs_again(serial, tmp_path):
+    """SIGKILL a worker process while it runs a task: the scheduler gives the task to a
+    worker again and the sweep ends with every run, equal to the serial ones."""
+    from distributed import Client, LocalCluster
+    path, out = serial
+    spec = specs.load(path, CASES)
+    with LocalCluster(n_workers=2, threads_per_worker=1, processes=True,
+                      dashboard_address=":0") as cluster, Client(cluster) as watcher:
+        killed = {}
+
+        def kill_a_busy_worker():
+            deadline = time.time() + 120
+            while time.time() < deadline:
+                busy = {w: t for w, t in watcher.processing().items() if t}
+                if busy:
+                    worker = sorted(busy)[0]
+                    pid = watcher.run(os.getpid, workers=[worker])[worker]
+                    os.kill(pid, signal.SIGKILL)
+                    killed.update(worker=worker, pid=pid, tasks=busy[worker])
+                    return
+                time.sleep(0.05)
+
+        killer = threading.Thread(target=kill_a_busy_worker)
+        killer.start()
+        outcome = engine.run(spec, CASES, tmp_path / "k", scheduler=cluster.scheduler_address,
+                             log=False)
+        killer.join()
+        assert killed["tasks"], "the killed worker was running a task"
+        # the nanny started a new process in its place
+        watcher.wait_for_workers(2, timeout=60)
+        assert killed["pid"] not in watcher.run(os.getpid).values()
+    assert outcome.lost == 0 and outcome.computed == 6
+    now = table.read(table.write(outcome.rows, tmp_path, "csv", engine.PARAMS))
+    assert _values(now) == _values(table.read(out / "table.csv"))
+
+
+def test_the_shipped_spec_parses_and_names_every_model():
+    s = specs.load(Path(__file__).resolve().parents[1] / "cases" / "sweeps" / "nu.toml", CASES)
+    assert s.axes["nu"] == [0.0, 0.1, 0.2, 0.3, 0.4, 0.45, 0.49]
+    assert s.axes["model"] == list(CASES["paper-cube"].models)
+    assert {"reaction_ratio", "apparent_poisson"} <= set(s.metrics)
+    assert len(s.units(CASES)) == 7 * 2 * 2
+
+
+def test_case_knobs_name_settings_the_case_reads():
+    """Each declared knob is a field of the case's settings and changes its problem: twice
+    the paper cube's push gives twice fem-linear's reaction (a linear model)."""
+    for case in CASES.values():
+        for knob in (case.resolution, case.load):
+            if knob is not None:
+                v = getattr(case.settings(), knob.field)
+                turned = case.settings(**{knob.field: 2 * v}).problem()
+                assert turned != case.settings().problem(), (case.name, knob.field)
+    from cases import runner
+    case = CASES["paper-cube"]
+    force = []
+    for push in (1.7, 3.4):
+        s = case.settings(quick=True, meshes=("five",), bcs=("sliding",),
+                          models=("fem-linear",), push_mm=push, static_only=True, p2_levels=1)
+        runs, _ = runner.unit(case, s, "five", "sliding")
+        force.append(runs[0]["reaction_n"])
+    assert force[1] == pytest.approx(2 * force[0], rel=1e-9)
+    s = case.settings(quick=True, nodes_per_side=4, static_only=True)
+    assert case.mesh("five", s).n_nodes == 4 ** 3
+    assert np.allclose(s.problem()["layers_mm"], [0, 32 / 3, 64 / 3, 32])
