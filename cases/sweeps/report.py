@@ -24,6 +24,9 @@ MAX_FAILURES = 40     # failed runs listed one by one; the rest counted
 CHANGE = 1.25         # "grows" / "shrinks" along an axis: a change by this factor or more
 RATIOS = {"reaction_ratio"}   # model over FEM: the target is 1
 ERRORS = ("_rel_err", "_rel_l2", "_rel_l2_p1", "_rel_l2_p2", "_max_rel_p1", "_max_rel_p2")
+LOG_SPAN = 5.0        # a ratio or error spanning this factor is drawn on a log scale
+FLAT = 0.1            # a model "does not follow" an axis that moves FEM's value 10x more
+SIGN_FLOOR = 1e-3     # FEM values below this fraction of their largest are zero for the sign
 PREFIX = "sweep_"     # every figure's file name starts so (earlier ones are cleaned up)
 
 
@@ -91,7 +94,8 @@ def findings(metric, rows, spec, models):
     ends = {a: _ends(a, rows, spec) for a in numeric}
     header = ["model", "runs", f"mean abs dev from {t[0]}", "worst", "at"]
     for a in numeric:
-        header += [f"mean at {a} = {fmt(ends[a][0])}", f"mean at {a} = {fmt(ends[a][1])}"]
+        header += [f"mean abs dev at {a} = {fmt(ends[a][0])}",
+                   f"mean abs dev at {a} = {fmt(ends[a][1])}"]
     body, trend = [], {a: ([], []) for a in numeric}
     for m in models:
         d = dev.get(m)
@@ -103,10 +107,11 @@ def findings(metric, rows, spec, models):
             at = [_mean([x for x, r in d if r[a] == v]) for v in ends[a]]
             line += [fmt(at[0]), fmt(at[1])]
             if None not in at:
+                said = f"{m} {fmt(at[0])} -> {fmt(at[1])}"
                 if at[1] > CHANGE * at[0] and at[1] > 1e-12:
-                    trend[a][0].append(m)
+                    trend[a][0].append(said)
                 elif at[1] * CHANGE < at[0]:
-                    trend[a][1].append(m)
+                    trend[a][1].append(said)
         body.append(line)
     ranked = sorted((_mean([x for x, _ in d]), m) for m, d in dev.items())
     out = []
@@ -118,12 +123,65 @@ def findings(metric, rows, spec, models):
         grows, shrinks = trend[a]
         first, last = map(fmt, ends[a])
         if grows:
-            out.append(f"{metric}: the deviation grows by more than {CHANGE:g}x from {a} = "
-                       f"{first} to {a} = {last} for {', '.join(grows)}.")
+            out.append(f"{metric}: the mean |deviation| grows by more than {CHANGE:g}x from "
+                       f"{a} = {first} to {a} = {last}: " + ", ".join(grows) + ".")
         if shrinks:
-            out.append(f"{metric}: it shrinks by more than {CHANGE:g}x for "
-                       f"{', '.join(shrinks)}.")
+            out.append(f"{metric}: it shrinks by more than {CHANGE:g}x from {a} = {first} to "
+                       f"{a} = {last}: " + ", ".join(shrinks) + ".")
+    if t[0] == "FEM P2":
+        fem = ref_name(metric)
+        out += [f"{metric}: {m} {text}" for m in models
+                for text in _unfollowed(metric, fem, rows, spec, m, numeric)
+                + _opposite(metric, fem, rows, m, axes)]
     return out, header, body
+
+
+def _unfollowed(metric, fem, rows, spec, model, numeric):
+    """Sentences for each numeric axis along which FEM P2's value moves and the model's does
+    not (by less than FLAT of FEM's move, in every panel of the other axes)."""
+    out = []
+    for a in numeric:
+        spans = []
+        for panel in _groups(rows, spec, a, model):
+            mv = [_value(r.get(metric)) for r in panel]
+            fv = [_value(r.get(fem)) for r in panel]
+            if None in mv or None in fv or len(panel) < 2:
+                break
+            spans.append((float(np.ptp(mv)), float(np.ptp(fv))))
+        else:
+            if spans and all(f > 0 and m < FLAT * f for m, f in spans):
+                out.append(f"does not follow {a}: it moves by at most "
+                           f"{fmt(max(m for m, _ in spans))} across {a} in every panel, where "
+                           f"FEM P2's moves by {fmt(min(f for _, f in spans))} to "
+                           f"{fmt(max(f for _, f in spans))}.")
+    return out
+
+
+def _opposite(metric, fem, rows, model, axes):
+    """A sentence when the model's value has the sign opposite to FEM P2's (where FEM's is
+    clearly not zero)."""
+    pairs = [(_value(r.get(metric)), _value(r.get(fem)), r) for r in rows if r["model"] == model]
+    pairs = [(v, f, r) for v, f, r in pairs if v is not None and f is not None]
+    scale = max((abs(f) for _, f, _ in pairs), default=0.0)
+    bad = [(v, r) for v, f, r in pairs if v * f < 0 and abs(f) > SIGN_FLOOR * scale]
+    if not bad:
+        return []
+    v, r = max(bad, key=lambda p: abs(p[0]))
+    return [f"has the sign opposite to FEM P2's in {len(bad)} of {len(pairs)} runs (as far as "
+            f"{fmt(v)} at {_where(r, axes)})."]
+
+
+def _groups(rows, spec, axis, model):
+    """The model's rows grouped by the values of every swept axis but ``axis`` and model
+    (and by case), each group ordered along ``axis``."""
+    others = ["case"] + [a for a in spec.swept() if a not in (axis, "model")]
+    groups = {}
+    for r in rows:
+        if r["model"] == model:
+            groups.setdefault(tuple(r.get(a) for a in others), []).append(r)
+    order = {v: i for i, v in enumerate(spec.axes[axis])}
+    return [sorted(g, key=lambda r: order.get(r[axis], 0)) for _, g in sorted(
+        groups.items(), key=lambda kv: repr(kv[0]))]
 
 
 def _ends(axis, rows, spec):
@@ -134,21 +192,30 @@ def _ends(axis, rows, spec):
 
 
 def _panels(spec, axis):
-    """The combinations of the other swept axes (not ``axis``, not model), as dicts."""
+    """The panels of a figure against ``axis``: the combinations of the other swept axes
+    (not model) as dicts, and the numeric axes cut down to their two ends when there would be
+    more than MAX_PANELS."""
     others = [a for a in spec.swept() if a not in (axis, "model")]
-    combos = [{}]
-    for a in others:
-        combos = [{**c, a: v} for c in combos for v in spec.axes[a]]
-    if len(spec.cases) > 1:
-        combos = [{"case": c, **k} for c in spec.cases for k in combos]
-    return combos
+
+    def combos(values):
+        out = [{}]
+        for a in others:
+            out = [{**c, a: v} for c in out for v in values(a)]
+        return [{"case": c, **k} for c in spec.cases for k in out] if len(spec.cases) > 1 \
+            else out
+    every = combos(lambda a: spec.axes[a])
+    if len(every) <= MAX_PANELS:
+        return every, []
+    ends = [a for a in others if a in NUMERIC_AXES and len(spec.axes[a]) > 2]
+    return combos(lambda a: [spec.axes[a][0], spec.axes[a][-1]] if a in ends
+                  else spec.axes[a]), ends
 
 
 def figure(metric, axis, rows, spec, models, label):
     """PNG bytes of ``metric`` against ``axis``: a panel per combination of the other swept
-    axes (at most MAX_PANELS), a line per model, FEM P2 dashed where the rows carry it; and
-    the number of panels left out."""
-    panels = _panels(spec, axis)
+    axes (at most MAX_PANELS), a line per model, FEM P2 dashed where the rows carry it; the
+    number of panels left out; and the axes drawn at their two ends only."""
+    panels, ends = _panels(spec, axis)
     shown = panels[:MAX_PANELS]
     xs = spec.axes[axis]
     numeric = axis in NUMERIC_AXES
@@ -171,6 +238,12 @@ def figure(metric, axis, rows, spec, models, label):
             ax.plot(x, [np.nan if v is None else v for v in y], "k--", lw=1.5, label="FEM P2")
         if metric in RATIOS:
             ax.axhline(1.0, color="0.5", lw=0.8)
+        drawn = [v for line in ax.get_lines() for v in line.get_ydata() if np.isfinite(v)]
+        if (metric in RATIOS or metric.endswith(ERRORS)) and drawn and min(drawn) > 0 \
+                and max(drawn) >= LOG_SPAN * min(drawn):
+            ax.set_yscale("log")     # a ratio or an error spanning decades
+            for set_formatter in (ax.yaxis.set_major_formatter, ax.yaxis.set_minor_formatter):
+                set_formatter(matplotlib.ticker.FormatStrFormatter("%g"))
         if not numeric:
             ax.set_xticks(x, [str(v) for v in xs])
         elif min(xs) > 0 and max(xs) / min(xs) >= 100:
@@ -194,7 +267,7 @@ def figure(metric, axis, rows, spec, models, label):
     buf = io.BytesIO()
     fig.savefig(buf, format="png", dpi=80, metadata={"Software": None})
     plt.close(fig)
-    return buf.getvalue(), len(panels) - len(shown)
+    return buf.getvalue(), len(panels) - len(shown), ends
 
 
 def _pick(rows, model, axis, value, metric):
@@ -240,11 +313,15 @@ def write(spec, rows, out, registry, table_path):
         doc.h(2, metric)
         doc.table(header, body)
         for axis in [a for a in spec.swept() if a != "model"]:
-            png, left = figure(metric, axis, ok, spec, models, spec.label(axis, case))
+            png, left, ends = figure(metric, axis, ok, spec, models, spec.label(axis, case))
             name = f"{PREFIX}{metric}_vs_{axis}.png"
             atomic_write(out / name, png)
             names.append(name)
             doc.img(name, f"{metric} against {spec.label(axis, case)}")
+            if ends:
+                doc.p("Panels at the two ends of " + ", ".join(
+                    f"{a} ({fmt(spec.axes[a][0])} and {fmt(spec.axes[a][-1])})" for a in ends)
+                    + " only; the table has every value.")
             if left:
                 doc.p(f"{left} more panels (other combinations of the swept axes) are not "
                       f"drawn; the table has them.")
