@@ -18,6 +18,9 @@ from . import stop
 
 # a folder the suite may replace: empty, or written by it before (it always holds this file)
 OWNED_MARK = "metrics.json"
+# a sweep's folder (``pbcm sweep``): its runs/<key>/metrics.json are rows of a table, not
+# case metrics, so the gate does not read them
+SWEEP_MARK = "sweep.json"
 TMP_TAG = ".pbcm-tmp-"
 
 

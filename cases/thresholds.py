@@ -14,6 +14,8 @@ import math
 from pathlib import Path
 import tomllib
 
+from .output import SWEEP_MARK
+
 # the gated metrics and their direction; correlations must stay above, errors below
 GATED = {"disp_rel_l2_p1": "max", "disp_rel_l2_p2": "max", "disp_max_rel_p2": "max",
          "reaction_rel_err": "max", "stress_corr": "min", "stress_rel_err": "max",
@@ -149,13 +151,21 @@ def load(path, hint=None):
 
 
 
+def _in_sweep(path, root):
+    """True when ``path`` lies in a sweep's folder under ``root`` (the gate reads cases and
+    studies, not the runs of a sweep)."""
+    return any((d / SWEEP_MARK).is_file() for d in path.parents
+               if d == root or root in d.parents)
+
+
 def measured(metrics_dir):
     """The Measurements of every metrics.json under a folder (or of one file)."""
     p = Path(metrics_dir)
     if not p.exists():
         raise CheckError(f"--metrics {p} does not exist; run `pbcm run CASE --out {p}/CASE` "
                          "first, or give the folder that holds the metrics.json files")
-    files = [p] if p.is_file() else sorted(p.glob("**/metrics.json"))
+    files = [p] if p.is_file() else [f for f in sorted(p.glob("**/metrics.json"))
+                                      if not _in_sweep(f, p)]
     if not files:
         raise CheckError(f"no metrics.json under {p}; run `pbcm run CASE` first")
     values, problems, directions = {}, {}, {}

@@ -265,12 +265,14 @@ def test_findings_measure_each_model_against_its_target():
 
 
 # ------------------------------------------------------------------ on Dask
-def test_distributed_runs_equal_serial_runs(serial, tmp_path):
+def test_distributed_runs_equal_serial_runs(serial, tmp_path, capsys):
     """The same spec on a LocalCluster of two worker processes gives the same rows, every
     non-timing value equal."""
     path, out = serial
     dist = tmp_path / "dist"
     assert main(["sweep", str(path), "--workers", "2", "--out", str(dist)]) == 0
+    said = capsys.readouterr().err
+    assert "Dask dashboard: http://" in said and "sweep: 6/6 runs in" in said
     a, b = table.read(out / "table.csv"), table.read(dist / "table.csv")
     assert _values(a) == _values(b)
     assert (out / "report.md").read_text() == (dist / "report.md").read_text()
@@ -341,3 +343,49 @@ def test_case_knobs_name_settings_the_case_reads():
     s = case.settings(quick=True, nodes_per_side=4, static_only=True)
     assert case.mesh("five", s).n_nodes == 4 ** 3
     assert np.allclose(s.problem()["layers_mm"], [0, 32 / 3, 64 / 3, 32])
+
+
+def test_a_task_no_worker_finishes_is_lost_for_this_sweep_only(serial, tmp_path):
+    """With no retry allowed, a killed worker's task ends as KilledWorker: its runs are
+    failed rows that are not stored, and a rerun computes exactly them."""
+    import dask
+    from distributed import Client, LocalCluster
+    path, out = serial
+    spec = specs.load(path, CASES)
+    with dask.config.set({"distributed.scheduler.allowed-failures": 0}), \
+            LocalCluster(n_workers=1, threads_per_worker=1, processes=True,
+                         dashboard_address=":0") as cluster, Client(cluster) as watcher:
+        def kill_when_busy():
+            deadline = time.time() + 120
+            while time.time() < deadline:
+                busy = [w for w, t in watcher.processing().items() if t]
+                if busy:
+                    os.kill(watcher.run(os.getpid, workers=busy)[busy[0]], signal.SIGKILL)
+                    return
+                time.sleep(0.05)
+
+        killer = threading.Thread(target=kill_when_busy)
+        killer.start()
+        outcome = engine.run(spec, CASES, tmp_path / "l", scheduler=cluster.scheduler_address,
+                             log=False)
+        killer.join()
+    lost = [r for r in outcome.rows if r["error"] and r["error"].startswith("worker:")]
+    assert outcome.lost == len(lost) >= 2      # a task holds both models of its point
+    assert all(r["status"] == "failed" and "rerun the sweep" in r["error"] for r in lost)
+    assert not any((tmp_path / "l" / "runs" / r["run_key"]).exists() for r in lost)
+    again = engine.run(spec, CASES, tmp_path / "l", serial=True, log=False)
+    assert again.computed == outcome.lost and again.lost == 0
+    now = table.read(table.write(again.rows, tmp_path, "csv", engine.PARAMS))
+    assert _values(now) == _values(table.read(out / "table.csv"))
+
+
+def test_the_gate_does_not_read_a_sweeps_runs(serial, tmp_path):
+    """A sweep folder under reports/ holds runs/<key>/metrics.json: rows, not case metrics."""
+    from cases import thresholds
+    root = tmp_path / "reports"
+    import shutil
+    shutil.copytree(serial[1], root / "sweeps" / "small")
+    assert list(root.glob("**/metrics.json"))
+    with pytest.raises(thresholds.CheckError, match="no metrics.json under"):
+        thresholds.measured(root)
+

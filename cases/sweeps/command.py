@@ -5,12 +5,11 @@ import json
 from pathlib import Path
 
 from model import PbcmError
-from ..output import OutputError, owned, writable_folder
+from ..output import SWEEP_MARK as MARK, OutputError, owned, writable_folder
 from ..registry import CASES
 from . import SHIPPED
 from . import engine, report, spec as specs, table
 
-MARK = "sweep.json"     # a folder holding it is a sweep's: a rerun may resume and rewrite it
 
 
 class SweepUsageError(PbcmError):

@@ -12,6 +12,7 @@ rerun tries it again.
 """
 import logging
 import sys
+import time
 from dataclasses import dataclass, field
 
 from rich.console import Console
@@ -99,10 +100,16 @@ def run(spec, registry, out, scheduler=None, workers=None, serial=False, retry_f
     lost = {}
     outcome = Outcome(rows=[])
     console = Console(stderr=True)
+    tty = sys.stderr.isatty()
+    if log:
+        n = sum(len(u.models) for u in units)
+        console.print(f"sweep: {n} runs: {total} to compute, {n - total} found in "
+                      f"{store.folder}")
+    t0, said = time.perf_counter(), [0]
     with Progress(TextColumn("{task.description:<48}"), BarColumn(),
                   TextColumn("{task.completed}/{task.total} runs"), TimeElapsedColumn(),
                   TextColumn("left"), TimeRemainingColumn(), console=console,
-                  disable=not (log and sys.stderr.isatty())) as bar:
+                  disable=not (log and tty)) as bar:
         task = bar.add_task("sweep", total=total)
 
         def finished(unit, result):
@@ -115,6 +122,12 @@ def run(spec, registry, out, scheduler=None, workers=None, serial=False, retry_f
             bar.update(task, advance=len(runs),
                        description=f"{unit.case} {unit.mesh}/{unit.bc} "
                        + " ".join(f"{k}={v:g}" for k, v in unit.point.items()))
+            done = outcome.computed
+            if log and not tty and 10 * done // total > said[0]:   # a log: every tenth
+                said[0] = 10 * done // total
+                spent = time.perf_counter() - t0
+                console.print(f"sweep: {done}/{total} runs in {spent:.0f} s, about "
+                              f"{spent / done * (total - done):.0f} s left")
 
         if todo and serial:
             for u in todo:
