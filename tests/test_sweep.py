@@ -278,6 +278,33 @@ def test_distributed_runs_equal_serial_runs(serial, tmp_path, capsys):
     assert (out / "report.md").read_text() == (dist / "report.md").read_text()
 
 
+def _sweep_killing_a_busy_worker(spec, cluster, watcher, out):
+    """Run ``spec`` on ``cluster`` into ``out`` while a thread SIGKILLs the first worker
+    seen executing a task; return (outcome, {worker, pid, tasks executing} of the kill)."""
+    killed = {}
+
+    def executing(dask_worker):    # local, so that cloudpickle sends it by value
+        return len(dask_worker.state.executing)
+
+    def kill():
+        deadline = time.time() + 120
+        while time.time() < deadline:
+            busy = {w: n for w, n in watcher.run(executing).items() if n}
+            if busy:
+                worker = sorted(busy)[0]
+                pid = watcher.run(os.getpid, workers=[worker])[worker]
+                os.kill(pid, signal.SIGKILL)
+                killed.update(worker=worker, pid=pid, tasks=busy[worker])
+                return
+            time.sleep(0.05)
+
+    killer = threading.Thread(target=kill)
+    killer.start()
+    outcome = engine.run(spec, CASES, out, scheduler=cluster.scheduler_address, log=False)
+    killer.join()
+    return outcome, killed
+
+
 def test_a_killed_workers_task_runs_again(serial, tmp_path):
     """SIGKILL a worker process while it runs a task: the scheduler gives the task to a
     worker again and the sweep ends with every run, equal to the serial ones."""
@@ -286,25 +313,7 @@ def test_a_killed_workers_task_runs_again(serial, tmp_path):
     spec = specs.load(path, CASES)
     with LocalCluster(n_workers=2, threads_per_worker=1, processes=True,
                       dashboard_address=":0") as cluster, Client(cluster) as watcher:
-        killed = {}
-
-        def kill_a_busy_worker():
-            deadline = time.time() + 120
-            while time.time() < deadline:
-                busy = {w: t for w, t in watcher.processing().items() if t}
-                if busy:
-                    worker = sorted(busy)[0]
-                    pid = watcher.run(os.getpid, workers=[worker])[worker]
-                    os.kill(pid, signal.SIGKILL)
-                    killed.update(worker=worker, pid=pid, tasks=busy[worker])
-                    return
-                time.sleep(0.05)
-
-        killer = threading.Thread(target=kill_a_busy_worker)
-        killer.start()
-        outcome = engine.run(spec, CASES, tmp_path / "k", scheduler=cluster.scheduler_address,
-                             log=False)
-        killer.join()
+        outcome, killed = _sweep_killing_a_busy_worker(spec, cluster, watcher, tmp_path / "k")
         assert killed["tasks"], "the killed worker was running a task"
         # the nanny started a new process in its place
         watcher.wait_for_workers(2, timeout=60)
@@ -355,20 +364,8 @@ def test_a_task_no_worker_finishes_is_lost_for_this_sweep_only(serial, tmp_path)
     with dask.config.set({"distributed.scheduler.allowed-failures": 0}), \
             LocalCluster(n_workers=1, threads_per_worker=1, processes=True,
                          dashboard_address=":0") as cluster, Client(cluster) as watcher:
-        def kill_when_busy():
-            deadline = time.time() + 120
-            while time.time() < deadline:
-                busy = [w for w, t in watcher.processing().items() if t]
-                if busy:
-                    os.kill(watcher.run(os.getpid, workers=busy)[busy[0]], signal.SIGKILL)
-                    return
-                time.sleep(0.05)
-
-        killer = threading.Thread(target=kill_when_busy)
-        killer.start()
-        outcome = engine.run(spec, CASES, tmp_path / "l", scheduler=cluster.scheduler_address,
-                             log=False)
-        killer.join()
+        outcome, killed = _sweep_killing_a_busy_worker(spec, cluster, watcher, tmp_path / "l")
+    assert killed["tasks"]
     lost = [r for r in outcome.rows if r["error"] and r["error"].startswith("worker:")]
     assert outcome.lost == len(lost) >= 2      # a task holds both models of its point
     assert all(r["status"] == "failed" and "rerun the sweep" in r["error"] for r in lost)
