@@ -386,3 +386,45 @@ def test_the_gate_does_not_read_a_sweeps_runs(serial, tmp_path):
     with pytest.raises(thresholds.CheckError, match="no metrics.json under"):
         thresholds.measured(root)
 
+
+def test_a_sweep_on_a_cluster_started_as_the_readme_says(serial, tmp_path):
+    """`dask scheduler` and `dask worker ADDRESS --nworkers 2 --nthreads 1` in their own
+    processes (as on other machines), then `pbcm sweep --scheduler ADDRESS`: the same rows."""
+    import subprocess
+    path, out = serial
+    info = tmp_path / "scheduler.json"
+    procs = [subprocess.Popen(["dask", "scheduler", "--port", "0", "--dashboard-address", ":0",
+                               "--scheduler-file", str(info)], stdout=subprocess.DEVNULL,
+                              stderr=subprocess.DEVNULL)]
+    try:
+        deadline = time.time() + 60
+        while not info.is_file() and time.time() < deadline:
+            time.sleep(0.1)
+        time.sleep(0.2)
+        address = json.loads(info.read_text())["address"]
+        procs.append(subprocess.Popen(["dask", "worker", address, "--nworkers", "2",
+                                       "--nthreads", "1"], stdout=subprocess.DEVNULL,
+                                      stderr=subprocess.DEVNULL))
+        from distributed import Client
+        with Client(address) as c:
+            c.wait_for_workers(2, timeout=60)
+        assert main(["sweep", str(path), "--scheduler", address, "--out",
+                     str(tmp_path / "c")]) == 0
+    finally:
+        for p in reversed(procs):
+            p.terminate()
+            p.wait(timeout=60)
+    assert _values(table.read(tmp_path / "c" / "table.csv")) == _values(
+        table.read(out / "table.csv"))
+
+
+def test_the_table_is_parquet_with_pyarrow_and_csv_without(tmp_path, monkeypatch):
+    pytest.importorskip("pyarrow")
+    assert table.write([{"a": 1.5}], tmp_path, "auto").name == "table.parquet"
+    monkeypatch.setattr(table, "parquet_available", lambda: False)
+    assert table.write([{"a": 1.5}], tmp_path, "auto").name == "table.csv"
+    # a spec that asks for Parquet where there is no pyarrow: refused before computing
+    assert main(["sweep", str(_spec(tmp_path, table="parquet")), "--out",
+                 str(tmp_path / "p")]) == 2
+    assert not (tmp_path / "p").exists()
+
