@@ -192,7 +192,9 @@ def richardson(increments):
     """(observed order, estimated error of the finest level) from the relative changes
     between successive levels of a sequence halving h."""
     inc = increments
-    rate = float(np.log2(inc[-2] / inc[-1])) if len(inc) > 1 and inc[-1] > 0 else float("nan")
+    # no rate from a change that is exactly zero (an exact solution: the uniform sliding cube)
+    rate = float(np.log2(inc[-2] / inc[-1])) if len(inc) > 1 and inc[-1] > 0 and inc[-2] > 0 \
+        else float("nan")
     est = inc[-1] / (2**rate - 1) if np.isfinite(rate) and rate > 0.5 else inc[-1]
     return rate, float(est)
 

@@ -209,6 +209,19 @@ def test_converged_reference_reports_its_error():
     assert np.linalg.norm(p1.u - c.result.u) / np.linalg.norm(c.result.u) > 10 * c.error_estimate
 
 
+def test_richardson_of_an_exact_solution_has_no_rate():
+    """An increment of exactly zero (a uniform strain that P2 reproduces at every level)
+    gives no observed order, and the last increment stands as the error, without a warning
+    (log2 of zero)."""
+    import warnings
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        rate, est = linear.richardson([0.0, 3e-16])
+    assert np.isnan(rate) and est == 3e-16
+    rate, est = linear.richardson([4e-3, 1e-3])       # order 2: the error is 1e-3 / 3
+    assert rate == pytest.approx(2.0) and est == pytest.approx(1e-3 / 3)
+
+
 def test_amg_and_direct_agree():
     mesh = cube(6, L, "six")
     bc = sliding_bc(mesh, -1e-3)
