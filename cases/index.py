@@ -6,6 +6,7 @@ from pathlib import Path
 import numpy as np
 
 from .document import Cell, Document, Link
+from .output import SWEEP_MARK
 
 # headline error bands of the scorecard: within 5 %, within 20 %, beyond
 BANDS = ((0.05, "#c8e6c9", "within 5 %"), (0.20, "#fff59d", "within 20 %"),
@@ -115,4 +116,11 @@ def index_documents(root, cases, studies=()):
     doc.table(["case", "headline"] + models, rows)
     doc.p("Each case folder holds metrics.json, report.md, report.html and the figures; "
           "regenerate with `pbcm report`.")
+    sweeps = sorted((root / "sweeps").glob(f"*/{SWEEP_MARK}"))
+    if sweeps:
+        doc.h(2, "Sweeps")
+        doc.table(["sweep", "spec"], [
+            [Link(json.loads(m.read_text())["title"], f"sweeps/{m.parent.name}/report.md"),
+             json.loads(m.read_text())["spec"]] for m in sweeps])
+        doc.p("Each is written by `pbcm sweep SPEC` (not by `pbcm report`).")
     return doc.markdown() + "\n", doc.html(root) + "\n"
