@@ -165,6 +165,21 @@ def test_a_failing_point_is_a_row_with_its_error(serial):
     assert all(r["status"] == "ok" and r["error"] is None for r in rows if r["nu"] != 0.5)
     text = (serial[1] / "report.md").read_text()
     assert "## Failed runs" in text and text.count("| paper-cube | five | sliding |") == 2
+    assert "0 partial" in text
+
+
+def test_a_blown_up_dynamic_run_is_a_partial_row():
+    params = {"case": "paper-cube", "mesh": "five", "bc": "clamped"}
+    r = engine.row(params, {"model": "m", "failed": None, "static_failed": None,
+                            "dyn_failed": "time integration blew up at step 12",
+                            "dyn_failed_dt4": None, "reaction_ratio": 1.2}, "k", 1.0)
+    assert r["status"] == "partial" and r["reaction_ratio"] == 1.2
+    assert r["error"] == "dyn_failed: time integration blew up at step 12"
+    r = engine.row(params, {"model": "m", "failed": None, "static_failed": "no equilibrium",
+                            "dyn_failed": "blew up"}, "k", 1.0)
+    assert r["status"] == "failed" and r["error"] == "no equilibrium"
+    assert engine.row(params, {"model": "m", "failed": None, "static_failed": None,
+                               "dyn_failed": None}, "k", 1.0)["status"] == "ok"
 
 
 def test_apparent_poisson_of_linear_fem_on_the_sliding_base_is_nu(serial):

@@ -53,23 +53,28 @@ def parameters(unit, registry):
     values laid over them, so that a point whose settings fail still names them all."""
     case = registry[unit.case]
     default = case.settings(quick=unit.settings.get("quick", False))
-    field = {"E": "E", "nu": "nu", "rho": "rho"}
+    setting = {"E": "E", "nu": "nu", "rho": "rho"}      # axis -> the case's settings field
     for axis in ("resolution", "load"):
         knob = getattr(case, axis)
-        field[axis] = None if knob is None else knob.field
+        setting[axis] = None if knob is None else knob.field
     out = {"case": unit.case, "mesh": unit.mesh, "bc": unit.bc}
     out.update({a: None if f is None else unit.settings.get(f, getattr(default, f))
-                for a, f in field.items()})
-    out.update({k: v for k, v in unit.settings.items() if k not in field.values()})
+                for a, f in setting.items()})
+    out.update({k: v for k, v in unit.settings.items() if k not in setting.values()})
     return out
 
 
 def row(params, run, key, wall):
     """One table row: the parameters, the run key, status and error, the run's metrics and
-    the task's wall time."""
+    the task's wall time. Status ``failed``: the run has no static result (``error`` says
+    why); ``partial``: it has, but a later phase failed (a dynamic run blew up: ``error``
+    names the phase); ``ok``: every phase ran."""
     error = run.get("failed") or run.get("static_failed")
-    out = {**params, "model": run["model"], "run_key": key,
-           "status": "failed" if error else "ok", "error": error}
+    phases = {k: v for k, v in run.items()
+              if k.endswith("_failed") and k not in ("failed", "static_failed") and v}
+    status = "failed" if error else "partial" if phases else "ok"
+    error = error or "; ".join(f"{k}: {v}" for k, v in sorted(phases.items())) or None
+    out = {**params, "model": run["model"], "run_key": key, "status": status, "error": error}
     out.update({k: v for k, v in run.items() if k not in RUN_SKIP})
     out["task_wall_s"] = wall
     return out

@@ -285,10 +285,11 @@ def write(spec, rows, out, registry, table_path):
     """Write ``report.md`` and its figures into ``out``; return the figure names. Raises
     MissingMetric (after writing) when a metric of the spec has no value in any run."""
     models = list(dict.fromkeys(r["model"] for r in rows))
-    ok = [r for r in rows if r["status"] == "ok"]
+    ok = [r for r in rows if r["status"] != "failed"]      # partial runs have statics
     doc = Document(spec.title)
     doc.p(f"Drawn by `pbcm sweep {spec.source}` from its {len(rows)} runs "
-          f"({len(rows) - len(ok)} failed). Every parameter and metric of every run is in "
+          f"({len(rows) - len(ok)} failed, "
+          f"{sum(r['status'] == 'partial' for r in rows)} partial). Every parameter and metric of every run is in "
           f"[{table_path.name}]({table_path.name}); each run's metrics.json is under "
           "runs/<run key>/.")
     doc.h(2, "What was run")
@@ -329,15 +330,18 @@ def write(spec, rows, out, registry, table_path):
         doc.h(2, "Metrics without values")
         doc.p(f"No finished run has {', '.join(missing)}: check the names against the "
               f"columns of {table_path.name}.")
-    failed = [r for r in rows if r["status"] == "failed"]
+    failed = [r for r in rows if r["status"] != "ok"]
     if failed:
         doc.h(2, "Failed runs")
-        doc.table(["case", "mesh", "bc", "model", "point", "error"],
-                  [[r["case"], r["mesh"], r["bc"], r["model"],
+        doc.p("failed: no static result; partial: the static result is plotted, a later "
+              "phase (dynamics) failed.")
+        doc.table(["case", "mesh", "bc", "model", "status", "point", "error"],
+                  [[r["case"], r["mesh"], r["bc"], r["model"], r["status"],
                     ", ".join(f"{a} {fmt(r[a])}" for a in NUMERIC_AXES if a in spec.axes),
                     str(r["error"]).replace("|", "/")] for r in failed[:MAX_FAILURES]])
         if len(failed) > MAX_FAILURES:
-            doc.p(f"... and {len(failed) - MAX_FAILURES} more (status = failed in the table).")
+            doc.p(f"... and {len(failed) - MAX_FAILURES} more (status failed or partial in the "
+                  "table).")
     for old in out.glob(f"{PREFIX}*.png"):
         if old.name not in names:
             old.unlink()
