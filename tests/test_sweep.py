@@ -85,6 +85,8 @@ def test_units_map_generic_axes_to_each_cases_settings():
     assert units[3].settings["spacing_mm"] == 8 and units[3].settings["load_N"] == 2.0
     # a run key is the run's definition: another model, another key; the same, the same
     assert units[0].run_key("msm") != units[0].run_key("fem-linear")
+    # and a case default the spec does not name is part of the run too
+    assert units[0].problem["p2_levels"] == CASES["paper-cube"].settings().p2_levels
     assert units[0].run_key("msm") == _parse(
         'cases = ["paper-cube"]\nstatic_only = true\n[axes]\nresolution = [4]\nload = [2.0]\n'
         'mesh = ["five"]\nbc = ["clamped"]\nmodel = ["msm"]').units(CASES)[0].run_key("msm")

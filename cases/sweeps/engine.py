@@ -13,7 +13,7 @@ rerun tries it again.
 import logging
 import sys
 import time
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 from rich.console import Console
 from rich.progress import BarColumn, Progress, TextColumn, TimeElapsedColumn, TimeRemainingColumn
@@ -92,7 +92,7 @@ def plan(spec, registry, store, retry_failed=False):
             if stored is None or (retry_failed and stored["status"] == "failed"):
                 missing.append(m)
         if missing:
-            todo.append(type(u)(u.case, u.mesh, u.bc, tuple(missing), u.point, u.settings))
+            todo.append(replace(u, models=tuple(missing)))
     return units, todo
 
 

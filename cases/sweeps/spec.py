@@ -68,12 +68,15 @@ class Unit:
     models: tuple
     point: dict
     settings: dict
+    problem: object = None   # the case's problem() at these settings (or why they fail)
 
     def run_key(self, model):
-        """The run's identity: a hash of everything that defines it (a rerun of the same
-        spec finds it; a changed value makes a new run)."""
+        """The run's identity: a hash of everything that defines it, the case's whole problem
+        included (a rerun of the same spec finds it; a changed value, here or in a case's
+        defaults, makes a new run)."""
         text = json.dumps({"case": self.case, "mesh": self.mesh, "bc": self.bc,
-                           "model": model, "settings": self.settings}, sort_keys=True)
+                           "model": model, "settings": self.settings,
+                           "problem": self.problem}, sort_keys=True)
         return hashlib.sha256(text.encode()).hexdigest()[:16]
 
 
@@ -110,8 +113,12 @@ class Spec:
                 point = dict(zip(numeric, values))
                 kw = {**self.fixed, **point}
                 settings = _settings_keywords(case, kw, self)
+                try:
+                    problem = case.settings(**settings).problem()
+                except Exception as exc:    # the runs of this point will fail and say why
+                    problem = f"settings refused: {exc}"
                 for mesh, bc in itertools.product(meshes, bcs):
-                    out.append(Unit(name, mesh, bc, models, point, settings))
+                    out.append(Unit(name, mesh, bc, models, point, settings, problem))
         return out
 
     def label(self, axis, case):
