@@ -113,6 +113,8 @@ def test_units_map_generic_axes_to_each_cases_settings():
     ('cases = ["paper-cube"]\n[fixed]\nnu = 0.3\n[axes]\nnu = [0.1]', "both fixed and swept"),
     ('cases = ["paper-cube"]\n[fixed]\nspacing_mm = 2.0', "not a setting of case paper-cube"),
     ('cases = ["paper-cube"]\n[fixed]\nmeshes = ["five"]', "the selection is swept"),
+    ('cases = ["paper-cube"]\n[fixed]\np2_levels = 1.5', "takes a whole number, got 1.5"),
+    ('cases = ["paper-cube"]\n[fixed]\ndamping = "high"', "takes a number, got 'high'"),
     ('cases = ["paper-cube"]\ntable = "xlsx"', "table must be one of"),
     ('cases = ["paper-cube"]\nquick = "yes"', "quick must be true or false"),
 ])

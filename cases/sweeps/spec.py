@@ -46,6 +46,11 @@ NUMERIC_AXES = ("E", "nu", "rho", "resolution", "load")
 CHOICE_AXES = ("mesh", "bc", "model")
 AXES = NUMERIC_AXES + CHOICE_AXES
 PLURAL = {"mesh": "meshes", "bc": "bcs"}    # the Case attribute listing an axis' choices
+# a settings field's type: the TOML values it takes, and how to say so
+KINDS = {int: (lambda v: isinstance(v, int) and not isinstance(v, bool), "a whole number"),
+         float: (lambda v: isinstance(v, (int, float)) and not isinstance(v, bool), "a number"),
+         bool: (lambda v: isinstance(v, bool), "true or false"),
+         str: (lambda v: isinstance(v, str), "a string")}
 TABLES = ("auto", "csv", "parquet")
 TOP_KEYS = {"title", "cases", "quick", "static_only", "table", "fixed", "axes", "report"}
 UNITS = {"E": "E [Pa]", "nu": "nu", "rho": "rho [kg/m^3]", "mesh": "mesh", "bc": "bc",
@@ -291,8 +296,8 @@ def _axes(table, cases, registry, where):
 def _field_type(case, name):
     for f in fields(case.settings_class):
         if f.name == name:
-            return f.type if isinstance(f.type, type) else {"int": int, "float": float}.get(
-                f.type, float)
+            return f.type if isinstance(f.type, type) else {
+                "int": int, "float": float, "bool": bool, "str": str}.get(f.type, object)
     raise SpecError(f"case {case.name} names the setting {name}, which its settings lack")
 
 
@@ -340,6 +345,10 @@ def _fixed(table, cases, registry, axes, where):
                                 f"settings: " + ", ".join(sorted(names - selection)))
             if isinstance(value, (dict, list)):
                 raise SpecError(f"{where}: fixed.{key} takes one value, got {value!r}")
+            kind = _field_type(case, target)
+            if kind in KINDS and not KINDS[kind][0](value):
+                raise SpecError(f"{where}: fixed.{key} of case {name} takes "
+                                f"{KINDS[kind][1]}, got {value!r}")
     return dict(table)
 
 
