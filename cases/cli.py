@@ -610,7 +610,16 @@ def main(argv=None):
         return _main(argv)
 
 
+def _kept(args):
+    """What an interrupted command leaves behind, for its last line."""
+    if getattr(args, "command", None) == "sweep":
+        return ("every run finished is kept in the sweep's runs/ folder: rerun the same "
+                "command to resume")
+    return "output folders hold what they held before the unfinished one"
+
+
 def _main(argv):
+    args = None
     try:
         try:
             args = parser().parse_args(argv)
@@ -625,12 +634,10 @@ def _main(argv):
         print(f"pbcm: error: {exc}", file=sys.stderr)
         return 2
     except KeyboardInterrupt:
-        print("\npbcm: interrupted; output folders hold what they held before the unfinished "
-              "one", file=sys.stderr)
+        print(f"\npbcm: interrupted; {_kept(args)}", file=sys.stderr)
         return 130
     except stop.Terminated:
-        print("\npbcm: terminated; output folders hold what they held before the unfinished "
-              "one", file=sys.stderr)
+        print(f"\npbcm: terminated; {_kept(args)}", file=sys.stderr)
         return 143
     except BrokenPipeError:   # `pbcm check | head`: the reader left; say nothing more
         os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())

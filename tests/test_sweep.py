@@ -448,3 +448,31 @@ def test_the_table_is_parquet_with_pyarrow_and_csv_without(tmp_path, monkeypatch
                  str(tmp_path / "p")]) == 2
     assert not (tmp_path / "p").exists()
 
+
+@pytest.mark.parametrize("sig,status,word", [(signal.SIGINT, 130, "interrupted"),
+                                             (signal.SIGTERM, 143, "terminated")])
+def test_a_stopped_sweep_says_how_to_resume_and_resumes(sig, status, word, tmp_path):
+    """Ctrl-C or SIGTERM while a LocalCluster computes: one line, exit 130 / 143, the runs
+    finished are on disk, and the same command then computes only the rest."""
+    import subprocess
+    import sys
+    path = _spec(tmp_path, SMALL.replace('nu = [0.0, 0.3, 0.5]', 'nu = [0.0, 0.1, 0.2, 0.3]'))
+    out = tmp_path / "out"
+    proc = subprocess.Popen([sys.executable, "-m", "cases.cli", "sweep", str(path),
+                             "--workers", "2", "--out", str(out)], stdout=subprocess.PIPE,
+                            stderr=subprocess.PIPE, text=True, cwd=tmp_path)
+    deadline = time.monotonic() + 180
+    while len(list(out.glob("runs/*/metrics.json"))) < 2:
+        assert proc.poll() is None and time.monotonic() < deadline
+        time.sleep(0.05)
+    proc.send_signal(sig)
+    _, err = proc.communicate(timeout=120)
+    assert proc.returncode == status, err
+    last = [line for line in err.splitlines() if line.strip()][-1]
+    assert last == f"pbcm: {word}; every run finished is kept in the sweep's runs/ folder: " \
+                  "rerun the same command to resume"
+    kept = len(list(out.glob("runs/*/metrics.json")))
+    assert 2 <= kept < 8
+    again = engine.run(specs.load(path, CASES), CASES, out, serial=True, log=False)
+    assert again.found == kept and again.computed == 8 - kept
+
