@@ -196,9 +196,18 @@ def _list_command(args):
         print(f"  meshes: {', '.join(case.meshes)} (quick: {', '.join(case.quick_meshes)})")
         print(f"  bcs:    {', '.join(case.bcs)}")
         print(f"  models: {', '.join(case.models)}")
+        knobs = [f"{axis}: {knob.label} ({knob.field})" for axis, knob in
+                 (("resolution", case.resolution), ("load", case.load)) if knob is not None]
+        if knobs:
+            print(f"  sweep axes: {'; '.join(knobs)}")
     for name, study in studies().items():
         print(textwrap.fill(f"{name} (study): {_summary(study)}", width=96,
                             subsequent_indent="  "))
+    from .sweeps import SHIPPED
+    from .sweeps.spec import load
+    from .registry import CASES as cases
+    for path in sorted(SHIPPED.glob("*.toml")):
+        print(f"{path.stem} (sweep, pbcm sweep {path.stem}): {load(path, cases).title}")
     print("force terms (compose them with '+' in --models):")
     for name, cls in sorted(model.terms.registered().items()):
         params = ", ".join(f"{k}={v}" for k, v in cls.params.items())
