@@ -89,7 +89,7 @@ def plan(spec, registry, store, retry_failed=False):
         missing = []
         for m in u.models:
             stored = store.get(u.run_key(m))
-            if stored is None or (retry_failed and stored["status"] == "failed"):
+            if stored is None or (retry_failed and stored.get("status") == "failed"):
                 missing.append(m)
         if missing:
             todo.append(replace(u, models=tuple(missing)))
