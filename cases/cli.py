@@ -587,6 +587,9 @@ def parser():
                     help="run every task in this process, without Dask (same results)")
     sw.add_argument("--retry-failed", action="store_true",
                     help="compute again the runs an earlier sweep recorded as failed")
+    sw.add_argument("--plan", action="store_true",
+                    help="print the tasks and runs the sweep would compute (and those already "
+                         "in --out), then stop: nothing is computed or written")
     _term_files(sw)
     sw.set_defaults(func=_sweep_command)
     b = sub.add_parser(

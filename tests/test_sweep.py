@@ -124,6 +124,18 @@ def test_a_bad_spec_is_refused_naming_what_is_wrong(text, says):
     assert says in str(err.value)
 
 
+def test_plan_counts_without_computing(serial, tmp_path, capsys):
+    path, out = serial
+    assert main(["sweep", str(path), "--plan", "--out", str(tmp_path / "new")]) == 0
+    said = capsys.readouterr().out.splitlines()
+    assert said == [f"paper-cube: 3 tasks, 6 runs, 6 to compute (0 found in "
+                    f"{tmp_path / 'new' / 'runs'})",
+                    "in all: 3 tasks to run, 6 runs; swept: nu (3), model (2)"]
+    assert not (tmp_path / "new").exists()
+    assert main(["sweep", str(path), "--plan", "--out", str(out), "--retry-failed"]) == 0
+    assert "6 runs, 2 to compute (4 found" in capsys.readouterr().out
+
+
 def test_a_bad_argument_fails_before_any_computing(tmp_path, capsys):
     assert main(["sweep", str(tmp_path / "none.toml")]) == 2
     assert "does not exist" in capsys.readouterr().err

@@ -45,6 +45,9 @@ def run(args):
     if spec.table == "parquet" and not table.parquet_available():
         raise SweepUsageError(f"{path} asks for table = \"parquet\" but pyarrow is not "
                               "installed; pip install pyarrow, or set table = \"csv\"")
+    if args.plan:
+        return _plan(spec, Path(args.out) if args.out else
+                     Path("reports") / "sweeps" / path.stem, args.retry_failed)
     out = output_folder(args.out, path)
     table.atomic_write(out / MARK, json.dumps(
         {"spec": spec.source, "title": spec.title, "cases": list(spec.cases),
@@ -65,6 +68,20 @@ def run(args):
         print(f"pbcm: {outcome.lost} runs were lost with their workers; rerun the same command "
               "to compute them")
         return 1
+    return 0
+
+
+def _plan(spec, out, retry_failed):
+    """Print what the sweep would compute, per case, without computing or writing."""
+    units, todo = engine.plan(spec, CASES, table.RunStore(out), retry_failed)
+    for name in spec.cases:
+        mine = [u for u in units if u.case == name]
+        runs = sum(len(u.models) for u in mine)
+        left = sum(len(u.models) for u in todo if u.case == name)
+        print(f"{name}: {len(mine)} tasks, {runs} runs, {left} to compute "
+              f"({runs - left} found in {out / 'runs'})")
+    print(f"in all: {len(todo)} tasks to run, {sum(len(u.models) for u in todo)} runs; swept: "
+          + (", ".join(f"{a} ({len(spec.axes[a])})" for a in spec.swept()) or "nothing"))
     return 0
 
 
