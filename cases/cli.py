@@ -116,9 +116,6 @@ class UsageError(Exception):
     pass
 
 
-CHECKOUT_BENCH = Path(__file__).resolve().parents[1] / "reports" / "bench" / "bench.json"
-
-
 def _case(name):
     from .registry import CASES, STUDY_MODULES
     if name not in CASES:
@@ -140,9 +137,8 @@ def _study_config(study, args):
 def _run_study_into(study, cfg, folder, workers=None):
     """Run ``study`` and write its files into ``folder``; the step costs come from the bench
     beside the folder (reports/bench), or the checkout's."""
-    from . import bench
-    here = Path(folder).parent / "bench" / "bench.json"
-    data = bench.load(here if here.is_file() else CHECKOUT_BENCH)
+    from . import costs
+    data = costs.load(Path(folder).parent)
     study.write(folder, cfg, study.run(cfg, workers=workers, bench=data))
 
 
@@ -203,8 +199,8 @@ def _list_command(args):
     for name, study in studies().items():
         print(textwrap.fill(f"{name} (study): {_summary(study)}", width=96,
                             subsequent_indent="  "))
-    from .sweeps import SHIPPED
-    from .sweeps.spec import load
+    from .studies.sweeps import SHIPPED
+    from .studies.sweeps.spec import load
     from .registry import CASES as cases
     for path in sorted(SHIPPED.glob("*.toml")):
         print(f"{path.stem} (sweep, pbcm sweep {path.stem}): {load(path, cases).title}")
@@ -271,7 +267,8 @@ def _rewrite_study(study, folder):
 
 
 def _bench_command(args):
-    from . import bench
+    from . import costs
+    from .tools import bench
     models = _models(args.models, list(model.PRESETS))
     sizes = args.sizes or (bench.QUICK_SIZES if args.quick else bench.SIZES)
     # checked before any timing starts
@@ -280,13 +277,13 @@ def _bench_command(args):
         if not models:
             raise UsageError("--merge adds the rows of the --models given to a bench.json: "
                              "name the models to time")
-        where = Path(args.out) / "bench.json"
+        where = Path(args.out) / costs.FILE
         if not where.is_file():
             raise UsageError(f"--merge needs an existing {where}; run `pbcm bench` first or "
                              "drop --merge")
-        old = bench.load(where)
+        old = costs.read(where)
         models = tuple(m for m in models if m not in bench.BASELINES)
-    with StagedFolder(Path(args.out), mark="bench.json") as out:
+    with StagedFolder(Path(args.out), mark=costs.FILE) as out:
         data = bench.run(sizes=sizes, models=models, rounds=3 if args.quick else args.rounds,
                          with_engines=old is None)
         bench.write(bench.merge(old, data) if old else data, out.path)
@@ -337,7 +334,7 @@ def _index_command(args):
 
 
 def _check_command(args):
-    from .thresholds import NEW, CheckError, check, load, measured
+    from .gate import NEW, CheckError, check, load, measured
     try:
         rows, status, new = check(load(args.thresholds, hint="--thresholds"),
                                   measured(args.metrics))
@@ -370,7 +367,7 @@ def _bless_command(args):
     ``--prune``; each existing bound's tolerances unless ``--margin`` is given."""
     import tempfile
     from .registry import CASES, studies
-    from .thresholds import CheckError, bless, dumps, load, measured
+    from .gate import CheckError, bless, dumps, load, measured
     path = Path(args.thresholds)
     try:   # every check before the run: the old file must load and the new one be writable
         writable_folder(path.parent if str(path.parent) else Path("."), flag="--thresholds")
@@ -410,7 +407,7 @@ def _fit_command(args):
     import json
     from model.compose import label, slug
     from .registry import CASES
-    from . import fit
+    from .studies import fit
     name = label(args.model)
     fit.fitted_terms(name)                       # a model with nothing to fit: refused now
     train = [_case(c) for c in args.cases]
@@ -438,7 +435,7 @@ def _fit_command(args):
 
 
 def _sweep_command(args):
-    from .sweeps import command
+    from .studies.sweeps import command
     return command.run(args)
 
 
@@ -570,7 +567,7 @@ def parser():
     sw = sub.add_parser(
         "sweep", help="run a parameter sweep (TOML spec) on Dask: table, runs and report",
         description="Run every point of a sweep spec (cases, fixed settings, axes over E, nu, "
-                    "rho, resolution, load, mesh, bc and model; see cases/sweeps/nu.toml) as "
+                    "rho, resolution, load, mesh, bc and model; see cases/studies/sweeps/nu.toml) as "
                     "tasks on dask.distributed: a LocalCluster of --workers processes, or the "
                     "cluster at --scheduler. Finished runs are kept (runs/<key>/metrics.json) "
                     "and skipped on a rerun; a failing run is a row with its error. Writes "

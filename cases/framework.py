@@ -4,7 +4,7 @@ with it.
 A case is a module that declares one :class:`Case` subclass: its geometry and mesh family,
 boundary conditions and loads, quantities of interest, closed form, quick and full settings and
 any case-specific metric, finding or figure. It does not loop, solve the FEM references, compute
-the standard metrics, write files or gate: the runner, ``cases.report`` and ``cases.thresholds``
+the standard metrics, write files or gate: the runner, ``cases.report`` and ``cases.gate``
 do that for every case alike. Millimetres stop at the case module's edge: everything a case
 hands the runner is in SI units, except the quantities it names ``*_mm`` for its report.
 """

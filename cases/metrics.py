@@ -1,4 +1,4 @@
-"""Metrics comparing a model's state with a reference (MODEL.md "What is compared").
+"""Metrics comparing a model's state with a reference (docs/model.md "What is compared").
 
 Every function returns plain floats or arrays and raises MetricError rather than return NaN.
 """

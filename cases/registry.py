@@ -13,8 +13,8 @@ MODULES = {
     "modes": "cases.library.modes",
 }
 STUDY_MODULES = {
-    "convergence": "cases.convergence",
-    "extensions": "cases.extensions",
+    "convergence": "cases.studies.convergence",
+    "extensions": "cases.studies.extensions",
 }
 
 CASES = {name: importlib.import_module(module).CASE for name, module in MODULES.items()}

@@ -12,7 +12,7 @@ import numpy as np
 
 from model.compose import slug
 from model.mesh import write as write_mesh
-from . import bench, figures
+from . import costs, figures
 from .document import Document, fmt
 from .framework import STANDARD_GATED
 from .runner import jsonable
@@ -140,8 +140,8 @@ def build_report(case, s, runs, fields, out):
     failed = [r for r in runs if r.get("failed")]
     groups = dict(case.findings(s, [r for r in runs if not r.get("failed")]))
     tets = [r["tets"] for r in runs if r.get("tets")]
-    groups["Cost"] = groups.get("Cost", []) + bench.cost_sentences(
-        bench.load(Path(out).parent / "bench" / "bench.json"), s.models,
+    groups["Cost"] = groups.get("Cost", []) + costs.cost_sentences(
+        costs.load(Path(out).parent), s.models,
         float(np.median(tets)) if tets else 1e3)
     if failed:
         groups["Runs that could not start"] = sorted({f"{r['mesh']}/{r['bc']}: {r['failed']}"

@@ -66,7 +66,7 @@ def reference(case, mesh, bc, s, probe, extra=True):
 
 
 def static_metrics(case, pm, st, mesh, bc, s, ref):
-    """The standard metrics of a static solution against the references (MODEL.md "What is
+    """The standard metrics of a static solution against the references (docs/model.md "What is
     compared"), then the case's quantities of interest and their errors."""
     stress = pm.tet_stress(st.x)
     out = {"disp_rel_l2_p1": M.rel_l2(st.u, ref.p1.u),

@@ -11,25 +11,10 @@ True
 from .material import Material
 from .errors import (PbcmError, MeshError, MaterialError, ModelError, DegenerateTetError,
                      BlowUpError, ConvergenceError)
+from .presets import PRESETS
 from .system import ParticleModel
 
 __version__ = "0.1.0"
-
-# name -> list of (term, parameters); MODEL.md "Shear force" and "Mass-spring baseline"
-PRESETS = {
-    "pbcm-corner": [("shear", {"reading": "corner"}), ("volume", {})],
-    "pbcm-balanced": [("shear", {"reading": "balanced"}), ("volume", {})],
-    "pbcm-variational": [("shear", {"reading": "variational", "c": "auto"}), ("volume", {})],
-    "pbcm-variational+normal": [("shear", {"reading": "variational", "c": "auto"}),
-                                ("normal", {"c": "auto"}), ("volume", {})],
-    "msm": [("springs", {})],
-    "msm+volume": [("springs", {}), ("volume", {})],
-    # MODEL.md "Explicit FEM baselines": what a user would pick instead of a particle model
-    "fem-linear": [("fem_linear", {})],
-    "fem-corotated": [("fem_corotated", {})],
-    "fem-neohookean": [("fem_neohookean", {})],
-}
-
 
 def build(model, mesh, material, threads=1, **term_params):
     """A :class:`ParticleModel` from a preset name, a composed spec such as

@@ -20,7 +20,7 @@ _NUMBER = re.compile(r"[+-]?(\d+\.?\d*|\.\d+)([eE][+-]?\d+)?$")
 
 
 def _presets():
-    from . import PRESETS
+    from .presets import PRESETS
     return PRESETS
 
 

@@ -1,4 +1,4 @@
-"""Effective elasticity of a model on a lattice (MODEL.md "Convergence and effective
+"""Effective elasticity of a model on a lattice (docs/model.md "Convergence and effective
 elasticity"): the 6 x 6 tensor C_eff a patch of the lattice answers a homogeneous strain with,
 and what it says: engineering constants per axis, the universal anisotropy index and the
 directional Young's modulus.

@@ -5,7 +5,7 @@
 integrated with Newmark's average acceleration (beta = 1/4, gamma = 1/2): unconditionally
 stable, second order, and energy conserving without damping; or, for a ramped boundary
 motion, solved exactly in time by superposing every mode (``method="modal"``). ``zeta`` is
-the mass-proportional damping rate [1/s] of the particle runs (MODEL.md "Time integration"):
+the mass-proportional damping rate [1/s] of the particle runs (docs/model.md "Time integration"):
 every mode decays as exp(-zeta t / 2).
 """
 from dataclasses import dataclass

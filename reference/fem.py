@@ -20,7 +20,7 @@ from .assembly import elasticity_matrix
 ELEMENTS = {"P1": ElementTetP1, "P2": ElementTetP2}
 INTORDER = {"P1": 1, "P2": 2}  # exact for the stiffness, and for a constant body force
 # "auto" uses scipy's direct solver up to this many unknowns and AMG-CG beyond: where the two
-# cost the same on the P1 and P2 cubes of `python -m cases.fem_scaling --solvers` (direct/AMG
+# cost the same on the P1 and P2 cubes of `python -m cases.tools.fem_scaling --solvers` (direct/AMG
 # time 0.9-1.3 at 2 200-4 000 unknowns, 1.6 at 6 600, 3 at 14 700, 12-16 at 47 000; README)
 DIRECT_MAX_DOFS = 4_000
 # peak memory of that direct solve of a P2 cube with 101 277 unknowns, measured: 5.8 GiB (245 s)

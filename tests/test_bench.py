@@ -6,7 +6,8 @@ import numba
 import pytest
 import numpy as np
 
-from cases import bench
+from cases import costs
+from cases.tools import bench
 from cases.cli import main
 
 
@@ -35,7 +36,7 @@ def test_bench_writes_table_figure_and_in_round_ratios(tmp_path):
     assert (two is None) == (numba.config.NUMBA_NUM_THREADS < 2)
     assert two is None or (np.isfinite(two) and two > 0)
     # optional engines: "not installed", or timed beside fem-neohookean in the same rounds
-    from cases.engines import ENGINES
+    from cases.tools.engines import ENGINES
     assert set(data["engines"]) == {"newton", "warp-lang"}
     md = (out / "bench.md").read_text()
     for name, engine in ENGINES.items():
@@ -78,9 +79,9 @@ def test_cost_sentences_come_from_the_nearest_bench_size():
     data = {"rows": [{"model": m, "tets": t, "rounds": 5, "step_vs_msm": r,
                       "step_vs_fem-linear": r / 2}
                      for t, r in ((135, 3.0), (1080, 7.0), (10985, 9.0)) for m in ("a", "msm")]}
-    line = bench.cost_sentences(data, ["a"], 500)[0]
+    line = costs.cost_sentences(data, ["a"], 500)[0]
     assert "1080 tetrahedra" in line and "a takes 7x the msm step and 3.5x the fem-linear" in line
-    assert "run `pbcm bench`" in bench.cost_sentences(None, ["a"], 500)[0]
+    assert "run `pbcm bench`" in costs.cost_sentences(None, ["a"], 500)[0]
 
 
 def test_bench_mesh_is_the_closest_five_cube():
@@ -110,7 +111,7 @@ def test_warp_engine_computes_our_neohookean_forces():
     pytest.importorskip("warp")
     from model import Material, build
     from model.mesh import cube
-    from cases.warp_neohookean import WarpNeoHookean
+    from cases.tools.warp_neohookean import WarpNeoHookean
     mesh = cube(4, 0.02, "six")
     pm = build("fem-neohookean", mesh, Material(1e4, 0.4))
     x = mesh.points * (1.0, 0.97, 1.01) + 1e-4 * np.sin(mesh.points * 300)

@@ -11,8 +11,9 @@ import pytest
 from conftest import floats_in
 
 from cases.cli import main
-from cases.convergence.cost import pareto, step_cost_us
-from cases.convergence.fit import EXACT, extrapolate, fit, observed_order
+from cases.costs import step_cost_us
+from cases.studies.convergence.cost import pareto
+from cases.studies.convergence.fit import EXACT, extrapolate, fit, observed_order
 from model.mesh import cube
 from reference import linear
 
@@ -152,7 +153,7 @@ def test_quick_study_passes_the_committed_bounds(study, capsys):
 
 def test_study_progress_says_the_time_left(study, capsys):
     """A log (not a terminal) gets one line per finished unit with the time left."""
-    from cases.convergence.study import Tracker
+    from cases.studies.convergence.study import Tracker
     with Tracker(True, 10.0) as t:
         t.advance(4.0, "paper-cube clamped")
     err = capsys.readouterr().err
@@ -195,7 +196,7 @@ def test_index_leads_with_the_study_headline(study, tmp_path, capsys):
 
 
 def test_study_bad_arguments_fail_before_computing(tmp_path, capsys, monkeypatch):
-    from cases.convergence import Convergence
+    from cases.studies.convergence import Convergence
 
     def refuse(self, *a, **k):
         raise AssertionError("the study started computing")

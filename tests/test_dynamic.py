@@ -117,7 +117,7 @@ def test_model_frequencies_of_one_spring_node_by_hand():
     four nodes leave exactly the six rigid modes."""
     from model import Material, build
     from model.mesh import TetMesh
-    from cases.transient import model_frequencies
+    from cases.library.transient import model_frequencies
     X = 0.01 * np.array([[0.0, 0, 0], [1, 0, 0], [0, 1, 0], [0.2, 0.3, 1]])
     mesh = TetMesh(X, np.array([[0, 1, 2, 3]]))
     mat = Material(E=E, nu=0.25, rho=RHO)

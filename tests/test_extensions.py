@@ -6,9 +6,9 @@ import numpy as np
 import pytest
 
 from cases.cli import main
-from cases.extensions import STUDY
-from cases.extensions import report as R
-from cases.extensions.study import BASE, CANDIDATES, YARDSTICK, short
+from cases.studies.extensions import STUDY
+from cases.studies.extensions import report as R
+from cases.studies.extensions.study import BASE, CANDIDATES, YARDSTICK, short
 from cases.registry import CASES
 from cases.runner import reaction_along, reference
 from model import build

@@ -22,7 +22,7 @@ def sheared():
 
 def hand_strains(x, X):
     """Every (corner a, tip j, in-plane edge m, other base vertex l): gamma, S_F, e, written
-    out from MODEL.md with loops and an explicit orientation test."""
+    out from docs/model.md with loops and an explicit orientation test."""
     out = []
     for a, j in itertools.permutations(range(4), 2):
         base = [i for i in range(4) if i not in (a, j)]

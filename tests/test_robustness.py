@@ -305,7 +305,7 @@ def test_bless_refuses_a_bad_margin(margin, small_run, tmp_path, capsys):
 def test_bless_keeps_unseen_bounds_and_tolerances_unless_told(small_run, tmp_path, capsys,
                                                              monkeypatch):
     import tempfile
-    from cases.thresholds import load
+    from cases.gate import load
     monkeypatch.setattr(tempfile, "tempdir", str(tmp_path / "tmp"))
     (tmp_path / "tmp").mkdir()
     t = tmp_path / "t.toml"

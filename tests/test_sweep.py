@@ -13,7 +13,7 @@ import pytest
 
 from cases.cli import main
 from cases.registry import CASES
-from cases.sweeps import engine, report, spec as specs, table
+from cases.studies.sweeps import engine, report, spec as specs, table
 
 SMALL = """
 title = "small"

@@ -98,7 +98,7 @@ def test_malformed_or_missing_thresholds_exit_2(blessed, tmp_path, text, word, c
 
 
 def test_the_band_is_two_sided_for_either_sign():
-    from cases.thresholds import Bound
+    from cases.gate import Bound
     for value in (-0.6, 0.6):
         for direction in ("min", "max"):
             b = Bound("c", "quick", "m", "b", "x", "zigzag", value, 0.1, 0.0, direction)

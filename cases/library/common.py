@@ -2,8 +2,32 @@
 that rank the models and compare FEM with a closed form, computed from the runs."""
 import numpy as np
 
+from model import ModelError
+from model.bc import merge
 from model.mesh import box
 from ..framework import MM
+
+CUBE_BCS = ("clamped", "sliding")    # the compressed cube's bases
+
+
+def cube_boundary_sets(mesh, bc, size):
+    """(driven, lateral, held) of a cube [0, size]^3 [m] pushed down on its top: the top
+    nodes, moved in y; what the top holds laterally; and the mapping that holds the rest.
+
+    ``clamped``: bottom fully fixed, top fully prescribed. ``sliding``: only y prescribed at top
+    and bottom; the origin pinned and the node at (size, 0, 0) held in z remove rigid
+    motions."""
+    top, bottom = mesh.nodes_on_plane("y", size), mesh.nodes_on_plane("y", 0.0)
+    if bc == "clamped":
+        return top, (0.0, None, 0.0), {int(i): (0.0, 0.0, 0.0) for i in bottom}
+    if bc != "sliding":
+        raise ModelError(f"unknown boundary condition {bc!r}; choose from {', '.join(CUBE_BCS)}")
+    held = [(int(i), (None, 0.0, None)) for i in bottom]
+    origin = mesh.nodes_where(lambda p: np.all(np.abs(p) < 1e-9, axis=1))[0]
+    corner_x = mesh.nodes_where(lambda p: (np.abs(p[:, 0] - size) < 1e-9)
+                                & (np.abs(p[:, 1]) < 1e-9) & (np.abs(p[:, 2]) < 1e-9))[0]
+    held += [(int(origin), (0.0, 0.0, 0.0)), (int(corner_x), (None, 0.0, 0.0))]
+    return top, (None, None, None), merge(held)
 
 
 def bar(family, length_mm, height_mm, width_mm, spacing_mm):

@@ -12,7 +12,6 @@ from .. import metrics as M
 from ..document import fmt
 from ..framework import Case, Headline, Knob, MM, Reference, Settings
 from . import common
-from .paper_cube import boundary_sets
 
 SIZE_MM, NODES = 32.0, 5
 PUSH_MM, STEPS = 9.6, 6
@@ -31,7 +30,7 @@ class LargeCompressionSettings(Settings):
 
 def dirichlet_at(mesh, push):
     """The sliding cube with its top pushed down ``push`` [m]."""
-    top, _, held = boundary_sets(mesh, "sliding")
+    top, _, held = common.cube_boundary_sets(mesh, "sliding", SIZE_MM * MM)
     out = dict(held)
     out.update({int(i): (None, -push, None) for i in top})
     return out
@@ -45,7 +44,7 @@ def lateral_strain(mesh, u):
 
 
 def top_force(mesh, reaction):
-    top = boundary_sets(mesh, "sliding")[0]
+    top = common.cube_boundary_sets(mesh, "sliding", SIZE_MM * MM)[0]
     return float(-reaction[top, 1].sum())
 
 
@@ -90,7 +89,7 @@ class LargeCompression(Case):
         return dirichlet_at(mesh, s.push_mm * MM)
 
     def driven(self, mesh, bc, s):
-        return boundary_sets(mesh, "sliding")[0], 1
+        return common.cube_boundary_sets(mesh, "sliding", SIZE_MM * MM)[0], 1
 
     def solve_reference(self, mesh, bc, s, probe):
         dirichlet = self.dirichlet(mesh, bc, s)

@@ -7,7 +7,7 @@ import numpy as np
 from model.mesh import cube
 from reference import modal
 from .. import metrics as M
-from .. import transient
+from . import transient
 from ..document import fmt
 from ..framework import MM, Case, Headline, Reference, Settings
 from . import common

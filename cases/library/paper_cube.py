@@ -8,12 +8,13 @@ import time
 
 import numpy as np
 
-from model import BlowUpError, ModelError
-from model.bc import Ramp, bc_arrays, merge
+from model import BlowUpError
+from model.bc import Ramp, bc_arrays
 from model.mesh import cube
 from .. import metrics as M
-from .. import transient
+from . import transient
 from ..framework import Case, Headline, Knob, MESH_FAMILIES, Settings
+from . import common
 from . import paper_cube_report as report
 
 SIZE_MM = 32.0
@@ -21,7 +22,7 @@ NODES_PER_SIDE = 5
 PUSH_MM = 1.7
 SPEED_MM_S = 1.7
 LAYERS_MM = (0.0, 8.0, 16.0, 24.0, 32.0)
-BCS = ("clamped", "sliding")
+BCS = common.CUBE_BCS
 
 MM = 1e-3
 
@@ -29,7 +30,7 @@ MM = 1e-3
 @dataclass
 class Config(Settings):
     """What one run of the case does. Defaults follow the paper where it says something and
-    MODEL.md where it does not (E, nu, rho: the paper gives none)."""
+    docs/model.md where it does not (E, nu, rho: the paper gives none)."""
 
     p2_levels: int = 2            # refinements of the converged P2 reference
     transient_element: str = "P2"  # element of the FEM transient (quick: P1, 10x cheaper)
@@ -69,22 +70,9 @@ def apparent_poisson(profile, push_mm):
 
 
 def boundary_sets(mesh, bc):
-    """(driven, held): the top nodes, moved in y; and the mapping that holds the rest.
-
-    ``clamped``: bottom fully fixed, top fully prescribed. ``sliding``: only y prescribed at top
-    and bottom; the origin pinned and the node at (L, 0, 0) held in z remove rigid motions."""
-    L = SIZE_MM * MM
-    top, bottom = mesh.nodes_on_plane("y", L), mesh.nodes_on_plane("y", 0.0)
-    if bc == "clamped":
-        return top, (0.0, None, 0.0), {int(i): (0.0, 0.0, 0.0) for i in bottom}
-    if bc != "sliding":
-        raise ModelError(f"unknown boundary condition {bc!r}; choose from {', '.join(BCS)}")
-    held = [(int(i), (None, 0.0, None)) for i in bottom]
-    origin = mesh.nodes_where(lambda p: np.all(np.abs(p) < 1e-9, axis=1))[0]
-    corner_x = mesh.nodes_where(lambda p: (np.abs(p[:, 0] - L) < 1e-9) & (np.abs(p[:, 1]) < 1e-9)
-                                & (np.abs(p[:, 2]) < 1e-9))[0]
-    held += [(int(origin), (0.0, 0.0, 0.0)), (int(corner_x), (None, 0.0, 0.0))]
-    return top, (None, None, None), merge(held)
+    """(driven, lateral, held) of the cube's boundary condition ``bc`` (see
+    ``common.cube_boundary_sets``)."""
+    return common.cube_boundary_sets(mesh, bc, SIZE_MM * MM)
 
 
 def static_bc(mesh, bc, push_mm=PUSH_MM):

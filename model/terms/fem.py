@@ -1,4 +1,4 @@
-"""Explicit FEM baselines (MODEL.md "Explicit FEM baselines"): constant-strain tetrahedra with
+"""Explicit FEM baselines (docs/model.md "Explicit FEM baselines"): constant-strain tetrahedra with
 F = Ds Dm^-1 and nodal forces f = -V0 P(F) Dm^-T, driven by the same RK4 as the particle
 model. What a simulation engineer would pick instead, at the same cost budget.
 

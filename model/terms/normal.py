@@ -1,4 +1,4 @@
-"""Deviatoric normal-stress extension of MODEL.md: the per-corner edge-strain deviation.
+"""Deviatoric normal-stress extension of docs/model.md: the per-corner edge-strain deviation.
 
 The shear strains see no stretch along an edge. Per corner a, the three edge strains
 eps_j = (|d_j| - |D_j|) / |D_j| (d_j = x_j - x_a, D_j at rest) and their mean eps_a give
@@ -105,7 +105,7 @@ class Normal(CalibratedTerm):
 
 @register
 class NormalEdge(Normal):
-    """MODEL.md's per-corner edge-strain deviation (the term ``normal``) by its candidate
+    """docs/model.md's per-corner edge-strain deviation (the term ``normal``) by its candidate
     name."""
 
     name = "normal_edge"

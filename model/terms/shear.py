@@ -1,4 +1,4 @@
-"""Shear term, the paper's equations 4 and 5 (MODEL.md "Shear strain" and "Shear force").
+"""Shear term, the paper's equations 4 and 5 (docs/model.md "Shear strain" and "Shear force").
 
 At corner a of a tetrahedron, tip j, base face F = (a, m, l) with in-plane edge m:
 

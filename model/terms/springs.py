@@ -1,8 +1,8 @@
-"""Mass-spring baseline (MODEL.md "Mass-spring baseline").
+"""Mass-spring baseline (docs/model.md "Mass-spring baseline").
 
 Linear springs on the mesh edges with the stiffness rule of A. van Gelder, "Approximate
 simulation of elastic membranes by triangulated spring meshes", J. Graphics Tools 3(2), 1998,
-extended to tetrahedra as in MODEL.md:
+extended to tetrahedra as in docs/model.md:
 
     k_e = E * sum_{T at e} V0_T / L_e^2.
 

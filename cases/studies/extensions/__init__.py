@@ -6,7 +6,7 @@ its effective elasticity from the isotropic target.
 """
 from dataclasses import fields
 
-from ..framework import Study
+from ...framework import Study
 from . import report
 from .study import RUN_KEYS, ExtensionSettings, run
 

@@ -5,10 +5,10 @@ from pathlib import Path
 
 import numpy as np
 
-from ..document import Document, fmt
-from .. import figures
-from ..report import environment, write_study
-from ..runner import jsonable
+from ...document import Document, fmt
+from ... import figures
+from ...report import environment, write_study
+from ...runner import jsonable
 from .study import BASE, COST_TETS, TWIN, YARDSTICK, CANDIDATES, short
 
 GATED = {"error": "max", "zigzag": "max", "e_inf": "max", "distance": "max"}
@@ -294,7 +294,7 @@ def build(out, study, s, doc):
         "the step costs, which are `pbcm bench`'s (reports/bench/bench.json).")
     d.h(2, "What was run")
     d.ul([study.title + ".",
-          f"The paper's model: {BASE} (MODEL.md's variational reading, c fitted). Each "
+          f"The paper's model: {BASE} (the variational reading of docs/model.md, c fitted). Each "
           "candidate adds one deviatoric normal-stress term with c_n = auto (fitted with the "
           "shear c against the isotropic deviatoric energy): "
           + "; ".join(f"{short(m)} = `{m}`" for m in models if short(m) != m) + ". "

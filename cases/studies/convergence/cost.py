@@ -1,31 +1,10 @@
 """Accuracy per cost: each run's displacement error against what one RK4 step of its model
-costs on its mesh, from `pbcm bench` (reports/bench/bench.json), and the Pareto front of the
-models: for a given cost budget, the least error any model reaches.
-
-The cost of a step on a mesh of T tetrahedra is fem-linear's step time interpolated in T
-(log-log between the bench sizes) times the model's step ratio to fem-linear at T, itself
-interpolated: the ratios are medians of interleaved rounds (one process), steadier than
-either time alone. Outside the bench sizes the nearest size's values are used.
+costs on its mesh (``cases.costs``, from `pbcm bench`), and the Pareto front of the models: for
+a given cost budget, the least error any model reaches.
 """
 import numpy as np
 
-BASE = "fem-linear"
-
-
-def step_cost_us(bench, model, tets):
-    """Microseconds per RK4 step of ``model`` on ``tets`` tetrahedra, or None when the bench
-    lacks the model."""
-    rows = [r for r in bench["rows"] if r["model"] == model]
-    base = [r for r in bench["rows"] if r["model"] == BASE]
-    if not rows or not base:
-        return None
-    rows, base = sorted(rows, key=lambda r: r["tets"]), sorted(base, key=lambda r: r["tets"])
-    lt = np.log(tets)
-    t_base = np.exp(np.interp(lt, np.log([r["tets"] for r in base]),
-                              np.log([r["us_per_step"] for r in base])))
-    ratio = np.exp(np.interp(lt, np.log([r["tets"] for r in rows]),
-                             np.log([r[f"step_vs_{BASE}"] for r in rows])))
-    return float(t_base * ratio)
+from ...costs import SOURCE, step_cost_us
 
 
 def pareto(points):
@@ -61,8 +40,8 @@ def accuracy_per_cost(runs, bench, exact=0.0):
         for i in front:
             counts[pts[i]["model"]] = counts.get(pts[i]["model"], 0) + 1
         groups.append({"case": case, "bc": bc, "points": pts, "front": front})
-    return {"source": "reports/bench/bench.json", "groups": groups,
+    return {"source": SOURCE, "groups": groups,
             "front_counts": dict(sorted(counts.items(), key=lambda kv: -kv[1]))}
 
 
-__all__ = ["step_cost_us", "pareto", "accuracy_per_cost"]
+__all__ = ["pareto", "accuracy_per_cost"]

@@ -20,11 +20,13 @@ from model import Material, PRESETS, build
 from model.bc import Ramp
 from model.calibrate import calibrate
 from model.integrate import STEP_BUFFERS, rk4_ramp, total_forces
+from model.candidates import CANDIDATES
 from model.mesh import cube
 
-from . import figures, stop
+from .. import figures, stop
 from .engines import ENGINES
-from .document import Document, fmt
+from ..costs import FILE
+from ..document import Document, fmt
 
 SIZES = (1e2, 1e3, 1e4, 1e5, 1e6)
 QUICK_SIZES = (1e2, 1e3)
@@ -160,7 +162,6 @@ def run(sizes=SIZES, models=None, rounds=7, progress=print, with_engines=True):
     baselines (msm, fem-linear) are always timed, for the ratios; the other engines only with
     ``with_engines``."""
     if not models:      # every preset and the normal-stress candidates of `pbcm run extensions`
-        from .extensions.study import CANDIDATES
         models = [*PRESETS, *CANDIDATES]
     models = list(models)
     timed_models = models + [b for b in BASELINES if b not in models]
@@ -243,7 +244,7 @@ def _machine():
 def write(data, out):
     """bench.json, bench.md (+ html) and step_time.png into the folder ``out``."""
     out.mkdir(parents=True, exist_ok=True)
-    (out / "bench.json").write_text(json.dumps(data, indent=1) + "\n")
+    (out / FILE).write_text(json.dumps(data, indent=1) + "\n")
     rows = data["rows"]
     models = list(dict.fromkeys(r["model"] for r in rows))
     figures.loglog(out / "step_time.png",
@@ -290,26 +291,3 @@ def summary(data):
     return [f"At {top} tetrahedra: " + "; ".join(
         f"{r['model']} {fmt(r['ns_per_tet'])} ns/tet, step {fmt(r['step_vs_msm'])}x msm and "
         f"{fmt(r['step_vs_fem-linear'])}x fem-linear" for r in at) + "."]
-
-
-def load(path):
-    """The bench document at ``path``, or None when there is none."""
-    try:
-        return json.loads(path.read_text())
-    except (OSError, ValueError):
-        return None
-
-
-def cost_sentences(data, models, tets):
-    """The cost of each model's RK4 step against msm and fem-linear, from the bench size
-    closest to ``tets``: the sentences a case report states about cost."""
-    if not data:
-        return ["No benchmark found beside this report (reports/bench/bench.json): run "
-                "`pbcm bench` for the cost of each model."]
-    sizes = sorted({r["tets"] for r in data["rows"]}, key=lambda n: abs(np.log(n / tets)))
-    near = [r for r in data["rows"] if r["tets"] == sizes[0] and r["model"] in models]
-    return [f"Cost, from `pbcm bench` at {sizes[0]} tetrahedra (median of "
-            f"{near[0]['rounds']} interleaved rounds): one RK4 step of " + "; ".join(
-                f"{r['model']} takes {fmt(r['step_vs_msm'])}x the msm step and "
-                f"{fmt(r['step_vs_fem-linear'])}x the fem-linear step" for r in near)
-            + ". The paper reports more than 10x msm."] if near else []

@@ -3,26 +3,14 @@ candidate models, reduced to what the rankings read."""
 from dataclasses import dataclass, field
 
 from model import Material
-from model.compose import label
-from ..convergence import STUDY as CONVERGENCE
-from ..convergence.cost import step_cost_us
-from ..runner import jsonable, run as run_case
+from model.candidates import BASE, CANDIDATES, NORMAL_FORMS, short  # noqa: F401 (the study's names)
+from ...costs import step_cost_us
+from ...registry import studies
+from ...runner import jsonable, run as run_case
 
-BASE = "pbcm-variational"    # the paper's model: its best reading (MODEL.md "variational")
 YARDSTICK = "fem-linear"     # what the same tetrahedra give as constant-strain FEM
-# the normal-stress forms added to the paper's model, one candidate each
-NORMAL_FORMS = ("normal_edge", "normal_tet", "normal_corotated", "normal_sbd")
-CANDIDATES = tuple(label(f"{BASE} + {form}(c=auto)") for form in NORMAL_FORMS)
 COST_TETS = 1e4              # the mesh size at which costs are compared
 TWIN = "pbcm-variational+normal"   # the preset whose terms are +normal_edge's
-
-
-def short(model):
-    """The name the report's tables use: the added term of a candidate, else the preset."""
-    for form in NORMAL_FORMS:
-        if model == label(f"{BASE} + {form}(c=auto)"):
-            return f"+{form}"
-    return model
 
 
 @dataclass
@@ -47,13 +35,13 @@ class ExtensionSettings:
                              f"keep {BASE} among --models")
 
     def case_settings(self):
-        from ..registry import CASES
+        from ...registry import CASES
         return {name: case.settings(quick=self.quick, models=self.models, E=self.E, nu=self.nu,
                                     rho=self.rho) for name, case in CASES.items()
                 if self.cases is None or name in self.cases}
 
     def convergence_settings(self):
-        return CONVERGENCE.settings(quick=self.quick, models=self.models, E=self.E, nu=self.nu,
+        return studies()["convergence"].settings(quick=self.quick, models=self.models, E=self.E, nu=self.nu,
                                     rho=self.rho, problems=self.problems)
 
     def problem(self):
@@ -100,12 +88,12 @@ RUN_KEYS = ("case_runs", "fits", "elasticity", "cost_vs_fem_linear", "cost_same_
 
 def run(s, workers=None, log=True, bench=None):
     """Every case with the study's models, then the convergence study with them."""
-    from ..registry import CASES
+    from ...registry import CASES
     rows = []
     for name, cfg in s.case_settings().items():
         runs, _ = run_case(CASES[name], cfg, workers=workers)
         rows += [case_row(CASES[name], r) for r in runs]
-    conv = CONVERGENCE.run(s.convergence_settings(), workers=workers, log=log, bench=None)
+    conv = studies()["convergence"].run(s.convergence_settings(), workers=workers, log=log, bench=None)
     return jsonable({"case_runs": rows, "fits": conv["fits"], "elasticity": [
         {k: e.get(k) for k in ("model", "mesh", "distance", "anisotropy_AU", "E_x", "nu_xy",
                                "G_xy", "failed")} for e in conv["elasticity"]],

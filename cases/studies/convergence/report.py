@@ -3,9 +3,9 @@ accuracy per cost, and the rows the gate reads), report.md/.html and the figures
 sentence is computed from the data it is written with."""
 import numpy as np
 
-from ..document import Document, fmt
-from ..report import environment, write_study
-from ..runner import jsonable
+from ...document import Document, fmt
+from ...report import environment, write_study
+from ...runner import jsonable
 from . import plots
 from .elasticity import ANGLES_DEG, PATCH_MM
 from .problems import PROBLEMS

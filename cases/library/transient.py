@@ -7,7 +7,7 @@ import numpy as np
 
 from model.bc import bc_arrays
 from reference import dynamic, modal
-from . import metrics as M
+from .. import metrics as M
 
 N_MODES = 10            # non-rigid frequencies compared
 RIGID_TOL = 1e-8        # |lambda| below this fraction of the largest is a rigid (zero) mode

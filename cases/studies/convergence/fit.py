@@ -1,5 +1,5 @@
 """What a sequence of errors at falling mesh sizes says: the observed order, the limit e_inf of
-e(h) = e_inf + C h^p (MODEL.md "Convergence and effective elasticity") with its uncertainty,
+e(h) = e_inf + C h^p (docs/model.md "Convergence and effective elasticity") with its uncertainty,
 and a verdict.
 
 The limit is Richardson's extrapolation from the three finest levels, its uncertainty Roache's

@@ -7,8 +7,8 @@ from model import build
 from model.homogenize import (anisotropy_index, asymmetry, directional_young, distance,
                               effective_stiffness, engineering_constants, isotropic_stiffness)
 from model.mesh import cube
-from .. import stop
-from ..runner import FINDINGS
+from ... import stop
+from ...runner import FINDINGS
 
 PATCH_MM = 32.0
 # directions of the directional Young's modulus figure: the x-y plane, every 5 degrees

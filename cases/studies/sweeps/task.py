@@ -4,9 +4,9 @@ becomes the ``failed`` entry of the runs it touched.
 """
 import time
 
-from .. import runner
-from ..registry import CASES
-from ..workers import one_blas_thread
+from ... import runner
+from ...registry import CASES
+from ...workers import one_blas_thread
 
 
 def run_unit(unit):

@@ -1,6 +1,6 @@
 """The fem-neohookean tetrahedron (model/terms/fem.py) as a Warp kernel, run on the CPU: the
 same law in float64, so that `pbcm bench` compares two compilers on one computation. Imported
-only where warp-lang is installed (cases.engines)."""
+only where warp-lang is installed (cases.tools.engines)."""
 import numpy as np
 import warp as wp
 

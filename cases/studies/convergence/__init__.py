@@ -7,7 +7,7 @@ RK4 step, with the models on the Pareto front.
 """
 from dataclasses import fields
 
-from ..framework import Study
+from ...framework import Study
 from . import report
 from .study import ConvergenceSettings, run
 

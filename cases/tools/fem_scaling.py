@@ -1,8 +1,8 @@
 """Time and peak memory of a large P1 reference solve, and the direct/AMG crossover that
 sets ``reference.fem.DIRECT_MAX_DOFS`` (the README quotes both outputs).
 
-    python -m cases.fem_scaling [--n 70]    # n nodes per side of the unit cube: 3 n^3 unknowns
-    python -m cases.fem_scaling --solvers   # direct and AMG-CG on the same P1 and P2 systems
+    python -m cases.tools.fem_scaling [--n 70]    # n nodes per side of the unit cube: 3 n^3 unknowns
+    python -m cases.tools.fem_scaling --solvers   # direct and AMG-CG on the same P1 and P2 systems
 """
 import argparse
 import resource

@@ -14,8 +14,8 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
 from model import PbcmError  # noqa: E402
-from ..document import Document, fmt  # noqa: E402
-from ..framework import ref_name  # noqa: E402
+from ...document import Document, fmt  # noqa: E402
+from ...framework import ref_name  # noqa: E402
 from .spec import NUMERIC_AXES  # noqa: E402
 from .table import atomic_write  # noqa: E402
 

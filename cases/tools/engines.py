@@ -4,7 +4,7 @@ Each is used only where its package is installed (``pip install "pbcm[engines]"`
 bench row says "not installed" otherwise. What is timed is one evaluation of the
 tetrahedral forces on the CPU, as pbcm's force kernels are timed.
 
-* ``warp-lang``: pbcm's fem-neohookean law written as a Warp kernel (cases.warp_neohookean),
+* ``warp-lang``: pbcm's fem-neohookean law written as a Warp kernel (cases.tools.warp_neohookean),
   float64: the same computation through another compiler (its forces equal ours; tested).
 * ``newton``: the Newton engine's own tetrahedral FEM forces (its semi-implicit solver's
   ``eval_tetrahedra``: the stable neo-Hookean of Smith et al. 2018, float32, on a model built

@@ -12,10 +12,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..framework import MM, Loads, Traction
-from ..library import common
-from ..registry import CASES
-from ..runner import reaction_along
+from ...framework import MM, Loads, Traction
+from ...library import common
+from ...registry import CASES
+from ...runner import reaction_along
 
 
 @dataclass(frozen=True)

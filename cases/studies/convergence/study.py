@@ -13,11 +13,11 @@ from rich.progress import BarColumn, Progress, TextColumn, TimeElapsedColumn, Ti
 
 from model import PRESETS, Material, build
 from reference import linear
-from .. import metrics as M
-from .. import stop
-from ..framework import MESH_FAMILIES
-from ..runner import FINDINGS, jsonable
-from ..workers import one_blas_thread
+from ... import metrics as M
+from ... import stop
+from ...framework import MESH_FAMILIES
+from ...runner import FINDINGS, jsonable
+from ...workers import one_blas_thread
 from . import cost, elasticity
 from .fit import EXACT, extrapolate, fit, observed_order
 from .problems import PROBLEMS
@@ -114,7 +114,7 @@ def solve_reference(problem, bc, s):
     """P2 on the 'five' mesh at each spacing of the problem's ladder (8, 4, 2 mm; the
     torsion bar adds 1.33 mm). The relative L2 changes of the displacement at the coarsest
     mesh's nodes between the three finest levels give the observed order p
-    (``cases.convergence.fit.observed_order``) and the finest level's error, its last change
+    (``cases.studies.convergence.fit.observed_order``) and the finest level's error, its last change
     times h_f^p / (h_c^p - h_f^p). Richardson's extrapolation of the field from the two finest
     levels, u_f + (u_f - u_c) h_f^p / (h_c^p - h_f^p), has as error estimate its distance to
     the same extrapolation one level coarser (an upper estimate: what is left when the error

@@ -19,7 +19,7 @@ from rich.console import Console
 from rich.progress import BarColumn, Progress, TextColumn, TimeElapsedColumn, TimeRemainingColumn
 
 from model import PbcmError
-from ..workers import available_cores
+from ...workers import available_cores
 from .spec import NUMERIC_AXES
 from .table import RunStore
 from .task import run_unit

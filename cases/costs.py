@@ -1,0 +1,72 @@
+"""What a model costs, as `pbcm bench` measured it: the one reader of ``bench.json``.
+
+The bench (``cases.tools.bench``) writes ``reports/bench/bench.json``; cases and studies never
+time anything themselves, they read their cost sentences and step costs from here. The cost of
+a step on a mesh of T tetrahedra is fem-linear's step time interpolated in T (log-log between
+the bench sizes) times the model's step ratio to fem-linear at T, itself interpolated: the
+ratios are medians of interleaved rounds (one process), steadier than either time alone.
+Outside the bench sizes the nearest size's values are used.
+"""
+import json
+from pathlib import Path
+
+import numpy as np
+
+from .document import fmt
+
+FILE = "bench.json"
+FOLDER = "bench"                 # beside the case folders: reports/bench/bench.json
+SOURCE = f"reports/{FOLDER}/{FILE}"
+BASE = "fem-linear"              # the baseline every ratio is taken against
+CHECKOUT = Path(__file__).resolve().parents[1] / "reports" / FOLDER / FILE
+
+
+def read(path):
+    """The bench document at ``path``, or None when there is none (or it is not JSON)."""
+    try:
+        return json.loads(Path(path).read_text())
+    except (OSError, ValueError):
+        return None
+
+
+def load(root=None):
+    """The bench document of the reports folder ``root`` (``root/bench/bench.json``), else the
+    checkout's, else None."""
+    here = Path(root) / FOLDER / FILE if root is not None else None
+    return read(here) if here is not None and here.is_file() else read(CHECKOUT)
+
+
+def step_cost_us(bench, model, tets):
+    """Microseconds per RK4 step of ``model`` on ``tets`` tetrahedra, or None when the bench
+    lacks the model (or there is no bench)."""
+    if not bench:
+        return None
+    rows = [r for r in bench["rows"] if r["model"] == model]
+    base = [r for r in bench["rows"] if r["model"] == BASE]
+    if not rows or not base:
+        return None
+    rows, base = sorted(rows, key=lambda r: r["tets"]), sorted(base, key=lambda r: r["tets"])
+    lt = np.log(tets)
+    t_base = np.exp(np.interp(lt, np.log([r["tets"] for r in base]),
+                              np.log([r["us_per_step"] for r in base])))
+    ratio = np.exp(np.interp(lt, np.log([r["tets"] for r in rows]),
+                             np.log([r[f"step_vs_{BASE}"] for r in rows])))
+    return float(t_base * ratio)
+
+
+def cost_sentences(data, models, tets):
+    """The cost of each model's RK4 step against msm and fem-linear, from the bench size
+    closest to ``tets``: the sentences a case report states about cost."""
+    if not data:
+        return [f"No benchmark found beside this report ({SOURCE}): run `pbcm bench` for "
+                "the cost of each model."]
+    sizes = sorted({r["tets"] for r in data["rows"]}, key=lambda n: abs(np.log(n / tets)))
+    near = [r for r in data["rows"] if r["tets"] == sizes[0] and r["model"] in models]
+    return [f"Cost, from `pbcm bench` at {sizes[0]} tetrahedra (median of "
+            f"{near[0]['rounds']} interleaved rounds): one RK4 step of " + "; ".join(
+                f"{r['model']} takes {fmt(r['step_vs_msm'])}x the msm step and "
+                f"{fmt(r['step_vs_fem-linear'])}x the fem-linear step" for r in near)
+            + ". The paper reports more than 10x msm."] if near else []
+
+
+__all__ = ["FILE", "FOLDER", "SOURCE", "read", "load", "step_cost_us", "cost_sentences"]
