@@ -20,7 +20,7 @@ from .output import StagedFolder, writable_folder, write_text_atomic
 
 DESCRIPTION = """\
 pbcm measures how far the particle soft-body model of Nakagawa et al. is from the continuum:
-it runs cases against FEM references, writes reports, and gates CI on error bounds."""
+it runs cases against FEM references, writes reports, and gates CI on gold values."""
 
 
 class Parser(argparse.ArgumentParser):
@@ -334,46 +334,52 @@ def _index_command(args):
 
 
 def _check_command(args):
-    from .gate import NEW, CheckError, check, load, measured
+    from .gate import NEW, CheckError, check, flip_message, load, measured
     try:
-        rows, status, new = check(load(args.thresholds, hint="--thresholds"),
-                                  measured(args.metrics))
+        v = check(load(args.gold, hint="--gold"), measured(args.metrics))
     except CheckError as exc:
         print(f"pbcm check: error: {exc}", file=sys.stderr)
         return 2
     print(f"{'metric':<66} {'measured':>11} {'band':>23} {'margin':>8}  result")
-    for b, v, ok in rows:
+    for b, value, ok in v.rows:
         name = f"{b.case}/{b.mesh}/{b.bc}/{b.model}/{b.metric}"
         low, high = b.band
-        print(f"{name:<66} {v:>11.5g} [{low:>10.5g},{high:>10.5g}] {b.margin(v):>8.1%}  "
-              f"{'PASS' if ok else 'FAIL'}")
-    failed = [r for r in rows if not r[2]]
-    print(f"{len(rows) - len(failed)} passed, {len(failed)} failed")
-    for b, v, _ in failed:
+        print(f"{name:<66} {value:>11.5g} [{low:>10.5g},{high:>10.5g}] "
+              f"{b.margin(value):>8.1%}  {'PASS' if ok else 'FAIL'}")
+    failed = [r for r in v.rows if not r[2]]
+    print(f"{len(v.rows) - len(failed)} passed, {len(failed) + len(v.flips)} failed")
+    for b, value, _ in failed:
         low, high = b.band
-        print(f"FAIL {b.metric} of {b.case}/{b.mesh}/{b.bc}/{b.model}: {v:.6g} outside "
-              f"[{low:.6g}, {high:.6g}] ({b.verdict(v)})")
-    for case, mode, name, n in new:
-        print(f"NEW  {case} ({mode}) {name}: new, not gated yet ({n} metrics without a bound; "
+        print(f"FAIL {b.metric} of {b.case}/{b.mesh}/{b.bc}/{b.model}: {value:.6g} outside "
+              f"[{low:.6g}, {high:.6g}] ({b.verdict(value)})")
+    for key, gold, now in v.flips:
+        print(flip_message(key, gold, now))
+    for case, mode, name, n in v.new:
+        print(f"NEW  {case} ({mode}) {name}: new, not gated yet ({n} metrics without gold; "
               "`pbcm bless` gates them)")
-    if new:
-        print(f"{len(new)} model(s) new, not gated yet")
-    return 0 if status == NEW and args.allow_new else status
+    if v.new:
+        print(f"{len(v.new)} model(s) new, not gated yet")
+    return 0 if v.status == NEW and args.allow_new else v.status
 
 
 def _bless_command(args):
-    """Bounds from a folder of metrics (``--metrics``) or from a fresh run of every case. What
-    it keeps: bounds of runs it did not see (other modes, meshes, models...) unless
-    ``--prune``; each existing bound's tolerances unless ``--margin`` is given."""
+    """Gold from a folder of metrics (``--metrics``) or from a fresh run of every case: the
+    compact files of quick mode, and for full mode the case folders installed where the
+    policy keeps the full-mode gold. What it keeps: gold rows of runs it did not see (other
+    modes, meshes, models...) unless ``--prune``."""
     import tempfile
+    from .gate import (COMPACT_MODES, POLICY, CheckError, Gold, Policy, bless, compact_files,
+                       load, measured, policy_text)
     from .registry import CASES, studies
-    from .gate import CheckError, bless, dumps, load, measured
-    path = Path(args.thresholds)
-    try:   # every check before the run: the old file must load and the new one be writable
-        writable_folder(path.parent if str(path.parent) else Path("."), flag="--thresholds")
-        old = load(path) if path.exists() else []
+    folder = Path(args.gold)
+    try:   # every check before the run: the old gold must load and the folder be writable
+        writable_folder(folder, flag="--gold")
+        old = load(folder) if (folder / POLICY).is_file() and any(
+            folder.glob("*.jsonl")) else Gold(Policy(atol_of=dict(ATOL_OF)), {}, {}, folder)
         if args.metrics:
             values = measured(args.metrics)
+            new, changes = bless(values, old, rtol=args.margin, prune=args.prune)
+            _write_gold(folder, old, new, values, changes, Path(args.metrics))
         else:
             cfgs = _configs(CASES, args)
             study_cfgs = {name: _study_config(st, args) for name, st in studies().items()}
@@ -386,15 +392,50 @@ def _bless_command(args):
                     (Path(tmp) / name).mkdir()
                     _run_study_into(studies()[name], cfg, Path(tmp) / name, workers)
                 values = measured(tmp)
-        new, changes = bless(values, old, rtol=args.margin, prune=args.prune)
+                new, changes = bless(values, old, rtol=args.margin, prune=args.prune)
+                _write_gold(folder, old, new, values, changes, Path(tmp))
     except CheckError as exc:
         print(f"pbcm bless: error: {exc}", file=sys.stderr)
         return 2
-    write_text_atomic(path, dumps(new))
     for line in changes or ["no change"]:
         print(line)
-    print(f"{len(new.bounds)} bounds written to {path}")
+    n = sum(len(r) for k, r in new.rows.items() if k[1] in COMPACT_MODES)
+    print(f"{n} gold values of {', '.join(COMPACT_MODES)} mode in {folder}")
     return 0
+
+
+# absolute floors of a new gold folder: static displacements are solved to a residual of
+# 1e-9 (model.static), so their differences below 1e-8 are the solver's
+ATOL_OF = {"disp_rel_l2_p1": 1e-8, "disp_rel_l2_p2": 1e-8, "disp_max_rel_p2": 1e-8}
+
+
+def _write_gold(folder, old, new, values, changes, root):
+    """Write the compact gold files (atomically, each), the policy when it changed, and
+    install the case folders of full-mode metrics where the full-mode gold lives."""
+    import shutil
+    from .gate import COMPACT_MODES, POLICY, compact_files, policy_text
+    files = compact_files(new)
+    for name, text in files.items():
+        path = folder / name
+        if not path.is_file() or path.read_text() != text:
+            write_text_atomic(path, text)
+    for path in folder.glob("*.jsonl"):
+        if path.name not in files:
+            path.unlink()
+    if not (folder / POLICY).is_file() or new.policy != old.policy:
+        write_text_atomic(folder / POLICY, policy_text(new.policy))
+    full = new.full_root
+    for (case, mode), source in sorted((values.sources or {}).items()):
+        if mode in COMPACT_MODES:
+            continue
+        target = full / case
+        if source.parent.resolve() == target.resolve():
+            changes.append(f"full    {case}: the gold is {target / 'metrics.json'} itself")
+            continue
+        with StagedFolder(target) as out:
+            shutil.copytree(source.parent, out.path, dirs_exist_ok=True)
+            out.commit()
+        changes.append(f"full    {case}: {source.parent} installed as the gold {target}")
 
 
 def _term_files(p):
@@ -545,23 +586,27 @@ def parser():
     ix.add_argument("--out", default="reports", help="the reports folder (default reports)")
     ix.set_defaults(func=_index_command)
 
-    c = sub.add_parser("check", help="compare the latest metrics with thresholds.toml "
+    c = sub.add_parser("check", help="compare the latest metrics with the gold values "
                        "(exit 0 pass, 1 fail, 2 missing or malformed, 3 pass with new models)",
-                       description="Compare every metrics.json under --metrics with the bounds "
-                                   "of --thresholds. Exit status 0: every bound holds; 1: some "
-                                   "metric left its bound; 2: a bound without a metric, a metric "
-                                   "without a bound for a model that has bounds, a NaN, a "
-                                   "malformed or missing file, or metrics run at other problem "
-                                   "parameters than the bounds'; 3: every bound holds, and some "
-                                   "model (a new preset or composed model) has no bound at all "
-                                   "in that case and mode: listed as 'new, not gated yet' "
-                                   "(--allow-new turns 3 into 0).")
+                       description="Compare every metrics.json under --metrics with the gold "
+                                   "values of --gold (quick mode: gold/CASE.quick.jsonl; full "
+                                   "mode: the committed reports/CASE/metrics.json), two-sided, "
+                                   "with the tolerance policy of gold/policy.toml. Exit status "
+                                   "0: every value holds; 1: some metric left its band, or was "
+                                   "n/a in the gold and is a number now (or the reverse); 2: "
+                                   "gold without a metric, a metric without gold for a model "
+                                   "that has gold, a NaN, a malformed or missing file, or "
+                                   "metrics run at other problem parameters than the gold's; "
+                                   "3: every value holds, and some model (a new preset or "
+                                   "composed model) has no gold at all in that case and mode: "
+                                   "listed as 'new, not gated yet' (--allow-new turns 3 into "
+                                   "0).")
     c.add_argument("--allow-new", action="store_true",
-                   help="exit 0 rather than 3 when the only news is models without bounds")
+                   help="exit 0 rather than 3 when the only news is models without gold")
     c.add_argument("--metrics", default="reports", help="a metrics.json or a folder of them "
                    "(default reports)")
-    c.add_argument("--thresholds", default="thresholds.toml",
-                   help="the bounds file (default thresholds.toml in the current folder: the "
+    c.add_argument("--gold", default="gold",
+                   help="the gold folder (default gold in the current folder: the "
                         "repository's own when run from a checkout)")
     c.set_defaults(func=_check_command)
     sw = sub.add_parser(
@@ -590,21 +635,23 @@ def parser():
     _term_files(sw)
     sw.set_defaults(func=_sweep_command)
     b = sub.add_parser(
-        "bless", help="rewrite the bounds from measured metrics and print what changed",
-        description="Set the bounds of thresholds.toml from measured metrics. Without --metrics "
-                    "it first runs every case and study: in full mode (about 75 minutes on 2 "
-                    "cores) unless --quick is given. It keeps the bounds of runs it did not see (other modes, "
-                    "meshes, models) unless --prune is given, and each existing bound's "
-                    "tolerances unless --margin is given; new bounds get --margin or 0.1. It "
-                    "prints every bound it adds, changes or removes.")
+        "bless", help="rewrite the gold values from measured metrics and print what changed",
+        description="Set the gold values from measured metrics: quick mode into the compact "
+                    "files gold/CASE.quick.jsonl (6 significant digits; a value that agrees "
+                    "to that precision is kept as it is), full mode by installing the case "
+                    "folder as the committed reports/CASE. Without --metrics it first runs "
+                    "every case and study: in full mode (about 75 minutes on 2 cores) unless "
+                    "--quick is given. It keeps the gold rows of runs it did not see (other "
+                    "modes, meshes, models) unless --prune is given; --margin sets the "
+                    "policy's rtol. It prints every value it adds, changes or removes.")
     b.add_argument("--margin", type=_number("--margin", "a relative tolerance, a number > 0",
                                             low=0), default=None,
-                   help="relative tolerance rtol of every bound written (default: keep each "
-                        "existing bound's, 0.1 for new ones)")
+                   help="relative tolerance rtol of the policy (default: keep the policy's, "
+                        "0.1 for a new gold folder)")
     b.add_argument("--prune", action="store_true",
-                   help="remove (and list) bounds of runs or metrics not in the metrics blessed")
-    b.add_argument("--thresholds", default="thresholds.toml",
-                   help="the bounds file to rewrite (default thresholds.toml)")
+                   help="remove (and list) gold rows of runs not in the metrics blessed")
+    b.add_argument("--gold", default="gold",
+                   help="the gold folder to rewrite (default gold)")
     b.add_argument("--metrics", help="bless the metrics.json files under this folder instead "
                                      "of a fresh run")
     _selection(b)

@@ -1,14 +1,25 @@
-"""Error bounds for CI, declared as data (thresholds.toml) in the style of verification
-harnesses: a stored value with a relative tolerance and an absolute floor. The gate is
-two-sided: every change of result fails until it is blessed on purpose,
+"""The CI gate: measured metrics against gold values, declared as data in the style of
+verification harnesses (a small gold file per test, one tolerance policy).
 
-    |measured - value| <= rtol |value| + atol,
+Where the gold lives (``gold/`` of the checkout):
 
-and ``direction`` only says which way is worse (max: an error, min: a correlation), so that a
-failure reads as a regression or as an improvement to bless.
+* ``policy.toml``: the tolerance policy, declared once for every value: ``rtol``, the default
+  ``atol`` and the metrics whose ``atol`` differs; and where the full-mode gold is.
+* ``CASE.quick.jsonl``: one small file per case (or study) in quick mode, what CI runs: a first
+  line with the problem parameters and the metric columns, then one line per (mesh, bc, model)
+  with each value to 6 significant digits, or null where the run could not give it.
+* Full mode: the gold is the committed ``reports/CASE/metrics.json`` itself (nothing stores a
+  number twice); ``pbcm bless`` of full-mode metrics installs their case folder there.
+
+The gate is two-sided: every change of result fails until it is blessed on purpose,
+
+    |measured - gold| <= rtol |gold| + atol,
+
+and the metric's direction (max: an error, min: a correlation) only says whether a failure is a
+regression or an improvement. A metric that was null and is now a number, or the reverse, is a
+failure too: a run that failed now succeeds, or the reverse.
 """
-from dataclasses import dataclass
-import datetime
+from dataclasses import dataclass, field
 import json
 import math
 from pathlib import Path
@@ -16,17 +27,17 @@ import tomllib
 
 from .output import SWEEP_MARK
 
-# the gated metrics and their direction; correlations must stay above, errors below
+POLICY = "policy.toml"
+SUFFIX = ".jsonl"
+COMPACT_MODES = ("quick",)        # modes whose gold is a compact file; full: the reports
+DIGITS = 6                        # significant digits of a compact gold value
+KEY = ("mesh", "bc", "model")     # what names a row of a gold file
+# directions of metrics written before a metrics.json carried its own ``gated``
 GATED = {"disp_rel_l2_p1": "max", "disp_rel_l2_p2": "max", "disp_max_rel_p2": "max",
          "reaction_rel_err": "max", "stress_corr": "min", "stress_rel_err": "max",
          "pressure_rel_err": "max", "zigzag": "max", "net_force_rel": "max",
          "reaction_time_rel_l2": "max", "disp_end_push_rel_l2": "max", "rest_time_s": "max",
          "modal_rel_err": "max", "modal_rel_err_free": "max", "rigid_modes_free": "max"}
-ATOL = 1e-9  # floor: metrics near zero (momentum residuals, zig-zag of FEM) never fail on noise
-# static displacements are solved to a residual of 1e-9 (model.static), so differences below
-# about 1e-8 are the solver's, not the model's: fem-linear equals P1 to that level
-FLOORS = {"disp_rel_l2_p1": 1e-8, "disp_rel_l2_p2": 1e-8, "disp_max_rel_p2": 1e-8}
-RTOL = 0.1   # default margin of bless
 
 
 class CheckError(Exception):
@@ -34,7 +45,24 @@ class CheckError(Exception):
 
 
 @dataclass
+class Policy:
+    """The tolerance policy: ``rtol`` and ``atol`` for every value, ``atol_of`` per metric
+    where the absolute floor differs, ``full``: the folder of the full-mode gold (relative to
+    the gold folder)."""
+
+    rtol: float = 0.1
+    atol: float = 1e-9
+    atol_of: dict = field(default_factory=dict)
+    full: str = "../reports"
+
+    def tolerance(self, metric):
+        return self.rtol, self.atol_of.get(metric, self.atol)
+
+
+@dataclass
 class Bound:
+    """One gold value with its tolerances: the band a measured value must stay inside."""
+
     case: str
     mode: str
     mesh: str
@@ -45,7 +73,6 @@ class Bound:
     rtol: float
     atol: float
     direction: str
-    measured_on: str = ""
 
     @property
     def key(self):
@@ -79,76 +106,120 @@ class Bound:
                 "better: bless it on purpose if the change is meant")
 
 
-FIELDS = ("case", "mode", "mesh", "bc", "model", "metric", "value", "rtol", "atol", "direction")
-HEADER = """\
-# pbcm error bounds, read by `pbcm check` and rewritten only by `pbcm bless`.
-# Two-sided: |measured - value| <= rtol |value| + atol; direction says which way is worse.
-# mode: the run mode the bound belongs to (quick runs in CI). The problem tables at the end
-# hold the parameters each case and mode was measured at; `pbcm check` refuses other ones.
-"""
+@dataclass
+class Gold:
+    """The gold values: ``rows`` {(case, mode, mesh, bc, model): {metric: value or None}},
+    ``problems`` {(case, mode): parameters}, the ``policy`` and the folder it came from."""
+
+    policy: Policy
+    rows: dict
+    problems: dict
+    folder: Path = None
+
+    @property
+    def full_root(self):
+        return (self.folder / self.policy.full).resolve() if self.folder else None
 
 
 @dataclass
 class Measurements:
     """What a folder of metrics.json holds for the gate: ``values`` {(case, mode, mesh, bc,
-    model, metric): value or None} and ``problems`` {(case, mode): parameters of the problem}."""
+    model, metric): value or None}, ``rows`` {(case, mode, mesh, bc, model)}, ``problems``
+    {(case, mode): parameters}, ``directions`` {metric: 'max' or 'min'} and ``sources``
+    {(case, mode): the metrics.json}."""
 
     values: dict
     problems: dict
     directions: dict = None
+    rows: set = None
+    sources: dict = None
 
 
-@dataclass
-class Thresholds:
-    """A thresholds file: ``bounds`` (Bound list) and ``problems`` {(case, mode): parameters}."""
-
-    bounds: list
-    problems: dict
+def _rounded(v):
+    return None if v is None else float(f"{v:.{DIGITS}g}")
 
 
-def load(path, hint=None):
-    """The bounds and problem parameters of a thresholds file (a ``Thresholds``)."""
-    path = Path(path)
+def _load_policy(folder, hint):
+    path = folder / POLICY
     if not path.is_file():
-        where = (f"pass {hint} PATH (e.g. the thresholds.toml of a pbcm checkout)"
-                 if hint else "give its path")
-        raise CheckError(f"thresholds file {path} is missing: {where}, or create one from "
-                         "measured metrics with `pbcm bless --metrics DIR`")
+        where = (f"pass {hint} DIR (e.g. the gold/ folder of a pbcm checkout)" if hint
+                 else "give the gold folder")
+        raise CheckError(f"gold folder {folder} has no {POLICY}: {where}, or create one from "
+                         "measured metrics with `pbcm bless --metrics DIR --gold DIR`")
     try:
         data = tomllib.loads(path.read_text())
     except (tomllib.TOMLDecodeError, UnicodeDecodeError) as exc:
-        raise CheckError(f"thresholds file {path} is malformed: {exc}") from None
-    bounds, seen = [], {}
-    for i, b in enumerate(data.get("bound", [])):
-        missing = [f for f in FIELDS if f not in b]
-        if missing:
-            raise CheckError(f"{path}: bound {i + 1} lacks {', '.join(missing)}")
-        if b["direction"] not in ("max", "min"):
-            raise CheckError(f"{path}: bound {i + 1} has direction {b['direction']!r}; "
-                             "use 'max' (stay below) or 'min' (stay above)")
-        nums = [b[k] for k in ("value", "rtol", "atol")]
-        if not all(isinstance(v, (int, float)) and math.isfinite(v) for v in nums) \
-                or b["rtol"] < 0 or b["atol"] < 0:
-            raise CheckError(f"{path}: bound {i + 1} needs finite value and non-negative "
-                             "rtol, atol")
-        bound = Bound(**{f: b[f] for f in FIELDS}, measured_on=b.get("measured_on", ""))
-        if bound.key in seen:
-            raise CheckError(f"{path}: bounds {seen[bound.key] + 1} and {i + 1} are both for "
-                             f"{'/'.join(bound.key)}; keep one")
-        seen[bound.key] = i
-        bounds.append(bound)
-    if not bounds:
-        raise CheckError(f"thresholds file {path} holds no [[bound]]; run `pbcm bless`")
-    problems = {}
-    for i, p in enumerate(data.get("problem", [])):
-        if not {"case", "mode"} <= set(p):
-            raise CheckError(f"{path}: [[problem]] {i + 1} lacks case or mode")
-        key = (p["case"], p["mode"])
-        if key in problems:
-            raise CheckError(f"{path}: two [[problem]] tables for {'/'.join(key)}; keep one")
-        problems[key] = {k: v for k, v in p.items() if k not in ("case", "mode")}
-    return Thresholds(bounds, problems)
+        raise CheckError(f"{path} is malformed: {exc}") from None
+    unknown = set(data) - {"rtol", "atol", "atol_of", "full"}
+    if unknown:
+        raise CheckError(f"{path}: unknown key(s) {', '.join(sorted(unknown))}; the policy "
+                         "takes rtol, atol, atol_of and full")
+    policy = Policy(**data)
+    nums = [policy.rtol, policy.atol, *policy.atol_of.values()]
+    if not all(isinstance(v, (int, float)) and math.isfinite(v) and v >= 0 for v in nums):
+        raise CheckError(f"{path}: rtol, atol and atol_of need finite non-negative numbers")
+    return policy
 
+
+def load(folder, hint=None):
+    """The gold of a gold folder: its policy, every compact file and the full-mode gold of
+    the reports folder the policy names."""
+    folder = Path(folder)
+    if not folder.is_dir():
+        where = (f"pass {hint} DIR (e.g. the gold/ folder of a pbcm checkout)" if hint
+                 else "give its path")
+        raise CheckError(f"gold folder {folder} is missing: {where}, or create one from "
+                         "measured metrics with `pbcm bless --metrics DIR --gold DIR`")
+    policy = _load_policy(folder, hint)
+    gold = Gold(policy, {}, {}, folder)
+    for path in sorted(folder.glob(f"*{SUFFIX}")):
+        _read_compact(path, gold)
+    full = gold.full_root
+    if full is not None and full.is_dir() and any(full.glob("*/metrics.json")):
+        m = measured(full)
+        for (case, mode), problem in m.problems.items():
+            if mode in COMPACT_MODES:
+                continue
+            gold.problems[(case, mode)] = problem
+        for key, v in m.values.items():
+            if key[1] not in COMPACT_MODES:
+                gold.rows.setdefault(key[:5], {})[key[5]] = v
+    if not gold.rows:
+        raise CheckError(f"gold folder {folder} holds no gold value; run `pbcm bless`")
+    return gold
+
+
+def _read_compact(path, gold):
+    try:
+        lines = path.read_text().splitlines()
+        head = json.loads(lines[0])
+        case, mode, columns = head["case"], head["mode"], head["columns"]
+        problem = head["problem"]
+    except (IndexError, ValueError, KeyError, TypeError, UnicodeDecodeError) as exc:
+        raise CheckError(f"gold file {path} is malformed (its first line must name case, mode, "
+                         f"problem and columns: {exc})") from None
+    if (case, mode) in gold.problems:
+        raise CheckError(f"two gold files for {case} ({mode} mode): keep one")
+    gold.problems[(case, mode)] = problem
+    seen = {}
+    for i, line in enumerate(lines[1:], start=2):
+        try:
+            row = json.loads(line)
+        except ValueError as exc:
+            raise CheckError(f"{path}, line {i}: {exc}") from None
+        if not (isinstance(row, list) and len(row) == len(KEY) + len(columns)):
+            raise CheckError(f"{path}, line {i}: expected [mesh, bc, model] and "
+                             f"{len(columns)} values")
+        key = (case, mode, *row[:len(KEY)])
+        values = row[len(KEY):]
+        if not all(v is None or (isinstance(v, (int, float)) and math.isfinite(v))
+                   for v in values):
+            raise CheckError(f"{path}, line {i}: values must be finite numbers or null")
+        if key in seen:
+            raise CheckError(f"{path}: lines {seen[key]} and {i} are both for "
+                             f"{'/'.join(key[2:])}; keep one")
+        seen[key] = i
+        gold.rows[key] = dict(zip(columns, values))
 
 
 def _in_sweep(path, root):
@@ -168,7 +239,7 @@ def measured(metrics_dir):
                                       if not _in_sweep(f, p)]
     if not files:
         raise CheckError(f"no metrics.json under {p}; run `pbcm run CASE` first")
-    values, problems, directions = {}, {}, {}
+    values, problems, directions, rows, sources = {}, {}, {}, set(), {}
     for f in files:
         try:
             data = json.loads(f.read_text())
@@ -184,140 +255,210 @@ def measured(metrics_dir):
             raise CheckError(f"two metrics files of {case} ({mode} mode) under {p} were run at "
                              "different parameters; check them one at a time")
         problems[(case, mode)] = problem
+        sources[(case, mode)] = f
         directions.update(gated)
         for r in runs:
+            rows.add((case, mode, r["mesh"], r["bc"], r["model"]))
             for metric in gated:
                 values[(case, mode, r["mesh"], r["bc"], r["model"], metric)] = r.get(metric)
-    return Measurements(values, problems, directions)
+    return Measurements(values, problems, directions, rows, sources)
 
 
 def _same_problem(case, mode, recorded, ran):
-    """CheckError naming the first parameter in which a run differs from the bounds."""
+    """CheckError naming the first parameter in which a run differs from the gold."""
     for k in sorted(set(recorded) | set(ran)):
         if recorded.get(k) != ran.get(k):
             raise CheckError(
                 f"parameter {k} of {case} ({mode} mode) is {ran.get(k, 'absent')!r} in the "
-                f"metrics but the bounds were measured at {recorded.get(k, 'absent')!r}: run "
-                "the case with the bounds' parameters, or bless these metrics on purpose")
+                f"metrics but the gold was measured at {recorded.get(k, 'absent')!r}: run "
+                "the case with the gold's parameters, or bless these metrics on purpose")
 
 
-NEW = 3   # exit status: every bound holds, but some models ran that no bound covers yet
+def _finite(v):
+    return isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v)
 
 
-def check(thresholds, measurements):
-    """Rows (bound, measured, passed), the exit status and the new models.
+NEW = 3   # exit status: every value holds, but some models ran that the gold does not cover
 
-    Status 0: every bound holds; 1: a metric left its bound; NEW (3): every bound holds but
-    some (case, mode, model) has no bound at all: "new, not gated yet" (a preset or user term
-    nobody has blessed), listed as ``new`` [(case, mode, model, n_metrics)]. Bounds of a case
-    and mode that were not run are set aside; metrics run at other problem parameters than the
-    bounds', a bound without a measured value, a value that is not finite, or a measured metric
-    without a bound for a model that has bounds raise CheckError (exit 2): a missing reference
-    never passes."""
-    values = measurements.values
-    rows, status = [], 0
-    runs = {k[:2] for k in values}            # (case, mode) pairs that were measured
-    bounds = [b for b in thresholds.bounds if b.key[:2] in runs]
-    if not bounds:
-        raise CheckError(f"no bound for the measured {', '.join('/'.join(r) for r in sorted(runs))}"
-                         "; run in a mode the thresholds cover, or bless this one")
-    for case, mode in sorted(runs):
-        if (case, mode) not in thresholds.problems:
-            raise CheckError(f"the thresholds do not record the parameters of {case} ({mode} "
-                             "mode) their bounds were measured at; bless them again")
-        _same_problem(case, mode, thresholds.problems[(case, mode)],
+
+@dataclass
+class Verdict:
+    """What ``check`` found: ``rows`` (bound, measured, passed) of every value compared,
+    ``flips`` (key, gold, measured) where one of the two is null, ``new`` (case, mode, model,
+    n_metrics) of models without gold, and the exit ``status``."""
+
+    rows: list
+    flips: list
+    new: list
+    status: int
+
+
+def check(gold, measurements):
+    """Every measured metric against its gold value (``Verdict``).
+
+    Status 0: every value holds; 1: a metric left its band, or was null in the gold and is a
+    number now (or the reverse); NEW (3): every value holds but some (case, mode, model) has
+    no gold at all: "new, not gated yet". The gold of a case and mode that was not run is set
+    aside. Metrics run at other problem parameters than the gold's, a gold row that was not
+    measured, a metric or row the gold lacks for a model it has, or a value that is not
+    finite raise CheckError (exit 2): a missing reference never passes."""
+    values, policy = measurements.values, gold.policy
+    ran = {k[:2] for k in values} | {k[:2] for k in (measurements.rows or ())}
+    rows = {k: v for k, v in gold.rows.items() if k[:2] in ran}
+    if not rows:
+        raise CheckError(f"no gold for the measured {', '.join('/'.join(r) for r in sorted(ran))}"
+                         "; run in a mode the gold covers, or bless this one")
+    for case, mode in sorted(ran):
+        if (case, mode) not in gold.problems:
+            raise CheckError(f"the gold does not record the parameters of {case} ({mode} "
+                             "mode) it was measured at; bless it again")
+        _same_problem(case, mode, gold.problems[(case, mode)],
                       measurements.problems[(case, mode)])
-    keys = {b.key for b in bounds}
-    gated_models = {(b.case, b.mode, b.model) for b in bounds}
-    unbounded = [k for k in values if k not in keys and values[k] is not None]
+    gated_models = {k[:2] + (k[4],) for k in rows}
+    measured_rows = set(measurements.rows or {k[:5] for k in values})
     new = {}
-    for k in unbounded:
-        if (k[0], k[1], k[4]) not in gated_models:
-            new[(k[0], k[1], k[4])] = new.get((k[0], k[1], k[4]), 0) + 1
-    unbounded = [k for k in unbounded if (k[0], k[1], k[4]) in gated_models]
-    if unbounded:
-        raise CheckError(f"no bound for {len(unbounded)} measured metric(s), e.g. "
-                         f"{'/'.join(unbounded[0])}: run `pbcm bless` to set them")
-    for b in bounds:
-        if b.key not in values or values[b.key] is None:
-            raise CheckError(f"metric {b.metric} of {b.case}/{b.mesh}/{b.bc}/{b.model} "
-                             f"({b.mode} mode) has a bound but no measured value: run the "
-                             "case in that mode, or remove the bound")
-        v = values[b.key]
-        if not (isinstance(v, (int, float)) and math.isfinite(v)):
-            raise CheckError(f"metric {b.metric} of {b.case}/{b.mesh}/{b.bc}/{b.model} is "
-                             f"{v!r}, not a finite number")
-        ok = b.passes(v)
-        rows.append((b, v, ok))
-        status = max(status, 0 if ok else 1)
-    for k in values:           # a new model's metrics must be numbers too
-        if (k[0], k[1], k[4]) in new and values[k] is not None and not (
-                isinstance(values[k], (int, float)) and math.isfinite(values[k])):
-            raise CheckError(f"metric {k[5]} of {'/'.join(k[:5])} is {values[k]!r}, not a "
-                             "finite number")
+    for k, v in values.items():
+        if not (k[:2] + (k[4],) in gated_models):
+            if v is not None and not _finite(v):
+                raise CheckError(f"metric {k[5]} of {'/'.join(k[:5])} is {v!r}, not a "
+                                 "finite number")
+            if v is not None:
+                new[k[:2] + (k[4],)] = new.get(k[:2] + (k[4],), 0) + 1
+            continue
+        if k[:5] not in rows:
+            if v is not None:
+                raise CheckError(f"the gold has no row {'/'.join(k[2:5])} of {k[0]} ({k[1]} "
+                                 f"mode), measured here: run the gold's selection, or bless "
+                                 "this one on purpose")
+            continue
+        if k[5] not in rows[k[:5]] and v is not None:
+            raise CheckError(f"metric {k[5]} of {'/'.join(k[:5])} has no gold value: a "
+                             "metric gated since the last bless; bless it on purpose")
+    out, flips, status = [], [], 0
+    directions = {**GATED, **(measurements.directions or {})}
+    for key5, metrics in sorted(rows.items()):
+        if key5 not in measured_rows:
+            raise CheckError(f"{'/'.join(key5[2:])} of {key5[0]} ({key5[1]} mode) has gold "
+                             "values but was not measured: run the case in that mode, or "
+                             "bless without it (--prune)")
+        for metric, g in sorted(metrics.items()):
+            v = values.get((*key5, metric))
+            if v is not None and not _finite(v):
+                raise CheckError(f"metric {metric} of {'/'.join(key5)} is {v!r}, not a "
+                                 "finite number")
+            if g is None and v is None:
+                continue
+            if g is None or v is None:
+                flips.append(((*key5, metric), g, v))
+                status = 1
+                continue
+            b = Bound(*key5, metric, g, *policy.tolerance(metric),
+                      directions.get(metric, "max"))
+            ok = b.passes(v)
+            out.append((b, v, ok))
+            status = max(status, 0 if ok else 1)
     if new and status == 0:
         status = NEW
-    return rows, status, [(*k, n) for k, n in sorted(new.items())]
+    return Verdict(out, flips, [(*k, n) for k, n in sorted(new.items())], status)
 
 
-def bless(measurements, old=None, rtol=None, prune=False, today=None):
-    """New thresholds from ``measurements`` and the lines saying what changed.
+def flip_message(key, gold, now):
+    """The failure line of a metric that was null and is a number, or the reverse."""
+    def show(v):
+        return "n/a" if v is None else f"{v:.6g}"
+    return (f"FAIL {key[5]} of {'/'.join(key[:5])}: was {show(gold)}, now {show(now)}: a run "
+            "that failed now succeeds, or the reverse: bless on purpose if intended")
 
-    Every gated metric measured gets a bound at its value (metrics that are None, e.g. an
-    undefined correlation, get none) with ``rtol`` when given, else the old bound's
-    tolerances, else RTOL and ATOL. Bounds that were not measured are kept, unless ``prune``
-    (then they are removed and listed); keeping them is refused when the problem parameters of
-    their case and mode changed, since they would then gate another problem.
-    """
+
+def bless(measurements, gold, rtol=None, prune=False):
+    """The gold of the compact modes updated from ``measurements`` and the lines saying what
+    changed: ``(Gold, changes)``.
+
+    Every gated metric measured gets its value to 6 significant digits, or null where the run
+    could not give it; a gold value the measurement agrees with to that precision is kept as
+    it is, so a re-bless that moves only the last digits changes no line. Rows that were not
+    measured are kept, unless ``prune`` (then they are removed and listed); keeping them is
+    refused when the problem parameters of their case and mode changed. ``rtol`` replaces the
+    policy's. Full-mode metrics are not written here: their gold is their case folder
+    (``cases.cli`` installs it)."""
     if rtol is not None and not (math.isfinite(rtol) and rtol > 0):
         raise CheckError(f"the margin must be a finite number > 0, got {rtol!r}")
-    today = today or datetime.date.today().isoformat()
-    old = old or Thresholds([], {})
-    values = measurements.values
-    prev = {b.key: b for b in old.bounds}
-    bounds, changes = [], []
-    for key in sorted(values):
-        v = values[key]
-        if v is None:
+    policy = Policy(**{**gold.policy.__dict__, **({"rtol": rtol} if rtol is not None else {})})
+    changes = []
+    if rtol is not None and rtol != gold.policy.rtol:
+        changes.append(f"policy  rtol {gold.policy.rtol:g} -> {rtol:g}")
+    old = {k: v for k, v in gold.rows.items() if k[1] in COMPACT_MODES}
+    rows = {}
+    measured_rows = set(measurements.rows or {k[:5] for k in measurements.values})
+    for key in sorted(measurements.values):
+        if key[1] not in COMPACT_MODES or key[:5] not in measured_rows:
             continue
-        if not math.isfinite(v):
+        v = measurements.values[key]
+        if v is not None and not _finite(v):
             raise CheckError(f"cannot bless {'/'.join(key)}: measured {v!r}")
-        o = prev.get(key)
-        floor = FLOORS.get(key[-1], ATOL)
-        tol = (rtol if rtol is not None else o.rtol if o else RTOL, max(o.atol, floor) if o else floor)
-        direction = {**GATED, **(measurements.directions or {})}[key[-1]]
-        b = Bound(*key, float(v), *tol, direction, today)
-        if o is None:
-            changes.append(f"new     {'/'.join(key)}: {v:.6g}")
-        elif o.value != b.value or (o.rtol, o.atol) != tol:
-            changes.append(f"changed {'/'.join(key)}: {o.value:.6g} -> {v:.6g}"
-                           + (f" (rtol {o.rtol:g} -> {tol[0]:g})" if o.rtol != tol[0] else ""))
-        bounds.append(b)
-    problems = {**old.problems, **measurements.problems}
-    unseen = sorted(set(prev) - {b.key for b in bounds})
+        before = old.get(key[:5], {})
+        o = before.get(key[5])
+        value = _rounded(v)
+        if o is not None and value is not None and abs(v - o) <= 10 ** -DIGITS * abs(o):
+            value = o                  # the same to the gold's precision: no line changes
+        rows.setdefault(key[:5], {})[key[5]] = value
+        name = "/".join(key)
+        if key[:5] not in old or key[5] not in before:
+            changes.append(f"new     {name}: {_show(value)}")
+        elif o != value:
+            changes.append(f"changed {name}: {_show(o)} -> {_show(value)}")
+    problems = {k: v for k, v in gold.problems.items() if k[1] in COMPACT_MODES}
+    problems.update({k: v for k, v in measurements.problems.items() if k[1] in COMPACT_MODES})
+    unseen = sorted(set(old) - set(rows))
     if prune:
-        changes += [f"removed {'/'.join(key)} (not in the metrics blessed)" for key in unseen]
-        live = {b.key[:2] for b in bounds}
-        problems = {k: v for k, v in problems.items() if k in live}
+        changes += [f"removed {'/'.join(k)} (not in the metrics blessed)" for k in unseen]
+        problems = {k: v for k, v in problems.items() if k in {r[:2] for r in rows}}
     else:
         moved = sorted({k[:2] for k in unseen if k[:2] in measurements.problems
-                        and old.problems.get(k[:2]) != measurements.problems[k[:2]]})
+                        and gold.problems.get(k[:2]) != measurements.problems[k[:2]]})
         if moved:
             raise CheckError(f"the parameters of {', '.join('/'.join(k) for k in moved)} differ "
-                             "from those of bounds these metrics do not cover; bless a complete "
-                             "run, or pass --prune to drop the bounds not measured")
-        bounds += [prev[key] for key in unseen]
+                             "from those of gold rows these metrics do not cover; bless a "
+                             "complete run, or pass --prune to drop the rows not measured")
+        rows.update({k: old[k] for k in unseen})
         if unseen:
-            changes.append(f"kept    {len(unseen)} bounds of runs or metrics not in the metrics "
+            changes.append(f"kept    {len(unseen)} gold rows of runs not in the metrics "
                            "blessed (--prune removes them)")
-    return Thresholds(sorted(bounds, key=lambda b: b.key), problems), changes
+    return Gold(policy, rows, problems, gold.folder), changes
 
 
-def dumps(thresholds):
-    """TOML text of ``thresholds`` (bounds sorted by key, then the problem parameters)."""
+def _show(v):
+    return "n/a" if v is None else f"{v:.6g}"
+
+
+def compact_files(gold):
+    """{file name: text} of the compact gold files of ``gold`` (one per case and mode)."""
+    out = {}
+    for case, mode in sorted(gold.problems):
+        if mode not in COMPACT_MODES:
+            continue
+        keys = sorted(k for k in gold.rows if k[:2] == (case, mode))
+        columns = sorted({m for k in keys for m in gold.rows[k]})
+        head = {"case": case, "mode": mode, "problem": gold.problems[(case, mode)],
+                "columns": columns}
+        lines = [json.dumps(head)] + [json.dumps([*k[2:], *(gold.rows[k].get(c)
+                                                             for c in columns)])
+                                      for k in keys]
+        out[f"{case}.{mode}{SUFFIX}"] = "\n".join(lines) + "\n"
+    return out
+
+
+def policy_text(policy):
+    """policy.toml: the tolerance policy, with what each entry means."""
     import tomli_w
-    data = {"bound": [{**{f: getattr(b, f) for f in FIELDS}, "measured_on": b.measured_on}
-                      for b in sorted(thresholds.bounds, key=lambda b: b.key)],
-            "problem": [{"case": c, "mode": m, **p}
-                        for (c, m), p in sorted(thresholds.problems.items())]}
-    return HEADER + "\n" + tomli_w.dumps(data)
+    return ("# The gate's tolerance policy, for every gold value (`pbcm check`):\n"
+            "#   |measured - gold| <= rtol |gold| + atol, atol = atol_of[metric] or atol.\n"
+            "# atol keeps metrics near zero (momentum residuals, a zig-zag of FEM) from failing\n"
+            "# on noise; static displacements are solved to a residual of 1e-9, so their\n"
+            "# differences below 1e-8 are the solver's. full: where the full-mode gold is\n"
+            "# (the committed reports/CASE/metrics.json). Rewritten by `pbcm bless --margin`.\n"
+            + tomli_w.dumps(policy.__dict__))
+
+
+__all__ = ["Policy", "Bound", "Gold", "Measurements", "Verdict", "CheckError", "NEW", "load",
+           "measured", "check", "bless", "compact_files", "policy_text", "flip_message"]

@@ -146,8 +146,8 @@ def test_sliding_cube_reaction_ratio_is_the_lattice_young_modulus(study):
 
 
 def test_quick_study_passes_the_committed_bounds(study, capsys):
-    status = main(["check", "--metrics", str(study), "--thresholds",
-                   str(ROOT / "thresholds.toml"), "--allow-new"])
+    status = main(["check", "--metrics", str(study), "--gold",
+                   str(ROOT / "gold"), "--allow-new"])
     assert status == 0, capsys.readouterr().out[-3000:]
 
 

@@ -74,8 +74,8 @@ def test_quick_case_writes_report_and_finite_metrics(library, name):
 
 def test_quick_library_passes_the_committed_bounds(library, capsys):
     # --allow-new: a preset or term added since the bounds were blessed is new, not failed
-    status = main(["check", "--metrics", str(library), "--thresholds",
-                   str(ROOT / "thresholds.toml"), "--allow-new"])
+    status = main(["check", "--metrics", str(library), "--gold",
+                   str(ROOT / "gold"), "--allow-new"])
     out = capsys.readouterr().out
     assert status == 0, out[-3000:]
 
@@ -97,7 +97,7 @@ def test_paper_cube_on_the_framework_matches_the_landed_case(quick):
     metrics measured against the FEM transient and FEM modes are left out since those
     references changed on purpose (mass matrices integrated exactly, the transient exact in
     time): the model's own series (reactions, frequencies) must still match, and those metrics
-    are gated by thresholds.toml."""
+    are gated by the gold values (gold/)."""
     before = json.loads(BASELINE.read_text())
     now = {(r["mesh"], r["bc"], r["model"]): r
            for r in json.loads((quick / "metrics.json").read_text())["runs"]}

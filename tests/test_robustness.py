@@ -239,7 +239,7 @@ def test_a_reader_that_leaves_early_gets_no_traceback(quick):
     """`pbcm check | head -0`: the pipe is closed before the table is written; exit 141
     (SIGPIPE's status), nothing on stderr."""
     proc = subprocess.Popen([sys.executable, "-m", "cases.cli", "check", "--metrics",
-                             str(quick), "--thresholds", str(ROOT / "thresholds.toml")],
+                             str(quick), "--gold", str(ROOT / "gold")],
                             stdout=subprocess.PIPE, stderr=subprocess.PIPE, cwd=ROOT)
     proc.stdout.close()
     err = proc.stderr.read().decode()
@@ -297,44 +297,44 @@ def small_run(tmp_path_factory):
 @pytest.mark.parametrize("margin", ["-1", "0", "nan", "inf"])
 def test_bless_refuses_a_bad_margin(margin, small_run, tmp_path, capsys):
     assert main(["bless", "--metrics", str(small_run), "--margin", margin,
-                 "--thresholds", str(tmp_path / "t.toml")]) == 2
+                 "--gold", str(tmp_path / "g")]) == 2
     assert "--margin" in one_error_line(capsys)
-    assert not (tmp_path / "t.toml").exists()
+    assert not (tmp_path / "g").exists()
 
 
-def test_bless_keeps_unseen_bounds_and_tolerances_unless_told(small_run, tmp_path, capsys,
-                                                             monkeypatch):
+def test_bless_keeps_unseen_rows_and_the_policy_unless_told(small_run, tmp_path, capsys,
+                                                           monkeypatch):
     import tempfile
     from cases.gate import load
     monkeypatch.setattr(tempfile, "tempdir", str(tmp_path / "tmp"))
     (tmp_path / "tmp").mkdir()
-    t = tmp_path / "t.toml"
-    shutil.copy(ROOT / "thresholds.toml", t)
-    before = load(t)
-    text = t.read_text().replace("rtol = 0.1", "rtol = 0.25")
-    t.write_text(text)
-    assert main(["bless", "--metrics", str(small_run), "--thresholds", str(t)]) == 0
+    g = tmp_path / "g"
+    shutil.copytree(ROOT / "gold", g)
+    before = load(g)
+    policy = g / "policy.toml"
+    policy.write_text(policy.read_text().replace("rtol = 0.1", "rtol = 0.25"))
+    assert main(["bless", "--metrics", str(small_run), "--gold", str(g)]) == 0
     out = capsys.readouterr().out
-    after = load(t)
-    assert len(after.bounds) == len(before.bounds)          # nothing dropped
-    assert {b.rtol for b in after.bounds} == {0.25}          # tolerances kept
+    after = load(g)
+    assert set(after.rows) == set(before.rows)               # nothing dropped
+    assert after.policy.rtol == 0.25                         # the policy kept
     assert "kept" in out and "--prune" in out
-    assert main(["bless", "--metrics", str(small_run), "--thresholds", str(t), "--prune",
+    assert main(["bless", "--metrics", str(small_run), "--gold", str(g), "--prune",
                  "--margin", "0.2"]) == 0
     out = capsys.readouterr().out
-    pruned = load(t)
-    assert {b.key[:5] for b in pruned.bounds} == {("paper-cube", "quick", "five", "clamped",
-                                                    "msm")}
-    assert {b.rtol for b in pruned.bounds} == {0.2}
-    assert out.count("removed ") == len(before.bounds) - len(pruned.bounds)
+    pruned = load(g)
+    assert set(pruned.rows) == {("paper-cube", "quick", "five", "clamped", "msm")}
+    assert pruned.policy.rtol == 0.2
+    assert out.count("removed ") == len(before.rows) - len(pruned.rows)
+    assert sorted(p.name for p in g.iterdir()) == ["paper-cube.quick.jsonl", "policy.toml"]
     assert list((tmp_path / "tmp").iterdir()) == []          # no temporary files left
-    assert sorted(p.name for p in tmp_path.iterdir()) == ["t.toml", "tmp"]
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["g", "tmp"]
 
 
 def test_check_refuses_metrics_run_at_other_parameters(small_run, tmp_path, capsys):
-    t = tmp_path / "t.toml"
-    assert main(["bless", "--metrics", str(small_run), "--thresholds", str(t)]) == 0
-    assert main(["check", "--metrics", str(small_run), "--thresholds", str(t)]) == 0
+    g = tmp_path / "g"
+    assert main(["bless", "--metrics", str(small_run), "--gold", str(g)]) == 0
+    assert main(["check", "--metrics", str(small_run), "--gold", str(g)]) == 0
     capsys.readouterr()
     for key, value in (("E_Pa", 20e3), ("nu", 0.3), ("push_mm", 2.0)):
         other = tmp_path / key / "paper-cube"
@@ -342,27 +342,27 @@ def test_check_refuses_metrics_run_at_other_parameters(small_run, tmp_path, caps
         data = json.loads((other / "metrics.json").read_text())
         data["problem"][key] = value
         (other / "metrics.json").write_text(json.dumps(data))
-        assert main(["check", "--metrics", str(other.parent), "--thresholds", str(t)]) == 2
+        assert main(["check", "--metrics", str(other.parent), "--gold", str(g)]) == 2
         err = capsys.readouterr().err
         assert f"parameter {key}" in err and repr(value) in err
 
 
-def test_check_refuses_duplicate_bounds(small_run, tmp_path, capsys):
-    t = tmp_path / "t.toml"
-    assert main(["bless", "--metrics", str(small_run), "--thresholds", str(t)]) == 0
-    text = t.read_text()
-    first = "[[bound]]" + text.split("[[bound]]")[1]
-    t.write_text(text + "\n" + first)
-    assert main(["check", "--metrics", str(small_run), "--thresholds", str(t)]) == 2
+def test_check_refuses_duplicate_rows(small_run, tmp_path, capsys):
+    g = tmp_path / "g"
+    assert main(["bless", "--metrics", str(small_run), "--gold", str(g)]) == 0
+    f = g / "paper-cube.quick.jsonl"
+    lines = f.read_text().splitlines()
+    f.write_text("\n".join(lines + [lines[1]]) + "\n")
+    assert main(["check", "--metrics", str(small_run), "--gold", str(g)]) == 2
     assert "both for" in capsys.readouterr().err
 
 
-def test_check_outside_a_checkout_points_to_thresholds_flag(small_run, tmp_path, capsys,
-                                                            monkeypatch):
+def test_check_outside_a_checkout_points_to_the_gold_flag(small_run, tmp_path, capsys,
+                                                          monkeypatch):
     monkeypatch.chdir(tmp_path)
     assert main(["check", "--metrics", str(small_run)]) == 2
     err = capsys.readouterr().err
-    assert "--thresholds" in err and "14" not in err
+    assert "--gold" in err and "14" not in err
 
 
 # ------------------------------------------------------------ help speaks the user's terms
@@ -375,7 +375,7 @@ def test_help_and_list(capsys):
     assert main(["bless", "--help"]) == 0
     assert "full mode" in " ".join(capsys.readouterr().out.split())
     assert main(["check", "--help"]) == 0
-    assert "thresholds.toml in the current folder" in " ".join(capsys.readouterr().out.split())
+    assert "gold in the current folder" in " ".join(capsys.readouterr().out.split())
     assert main(["list"]) == 0
     first = capsys.readouterr().out.split("  meshes:")[0]
     assert " ".join(first.split()).endswith("boundary condition and model.")

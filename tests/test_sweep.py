@@ -415,13 +415,13 @@ def test_a_task_no_worker_finishes_is_lost_for_this_sweep_only(serial, tmp_path)
 
 def test_the_gate_does_not_read_a_sweeps_runs(serial, tmp_path):
     """A sweep folder under reports/ holds runs/<key>/metrics.json: rows, not case metrics."""
-    from cases import thresholds
+    from cases import gate
     root = tmp_path / "reports"
     import shutil
     shutil.copytree(serial[1], root / "sweeps" / "small")
     assert list(root.glob("**/metrics.json"))
-    with pytest.raises(thresholds.CheckError, match="no metrics.json under"):
-        thresholds.measured(root)
+    with pytest.raises(gate.CheckError, match="no metrics.json under"):
+        gate.measured(root)
 
 
 def test_a_sweep_on_a_cluster_started_as_the_readme_says(serial, tmp_path):

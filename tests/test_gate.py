@@ -1,0 +1,263 @@
+"""The CI gate: the gold folder (gold/policy.toml, gold/CASE.quick.jsonl, the committed
+full-mode reports), pbcm check and pbcm bless."""
+import json
+import re
+import shutil
+from pathlib import Path
+
+import pytest
+
+from cases.cli import main
+
+ROOT = Path(__file__).resolve().parents[1]
+SMALL = ["--quick", "--meshes", "five", "--models", "pbcm-variational", "msm"]
+
+
+def test_committed_bounds_hold_for_the_quick_run(quick, capsys):
+    """The gate CI runs: every gold value against this run's metrics."""
+    status = main(["check", "--metrics", str(quick), "--gold",
+                   str(ROOT / "gold"), "--allow-new"])
+    out = capsys.readouterr().out
+    assert status == 0, out
+    assert re.search(r"^\d+ passed, 0 failed$", out, re.M)
+
+
+@pytest.fixture(scope="module")
+def blessed(tmp_path_factory):
+    d = tmp_path_factory.mktemp("gate")
+    assert main(["run", "paper-cube", *SMALL, "--out", str(d / "good" / "paper-cube")]) == 0
+    assert main(["bless", "--metrics", str(d / "good"), "--gold", str(d / "g")]) == 0
+    return d
+
+
+def check(metrics, gold):
+    return main(["check", "--metrics", str(metrics), "--gold", str(gold)])
+
+
+def edit_gold(src, dst, model, metric, change):
+    """Copy the gold folder ``src`` to ``dst`` with ``change(value)`` applied to ``metric`` of
+    the first row of ``model``."""
+    shutil.copytree(src, dst)
+    f = dst / "paper-cube.quick.jsonl"
+    lines = f.read_text().splitlines()
+    columns = json.loads(lines[0])["columns"]
+    i = next(k for k, line in enumerate(lines[1:], 1) if json.loads(line)[2] == model)
+    row = json.loads(lines[i])
+    row[3 + columns.index(metric)] = change(row[3 + columns.index(metric)])
+    lines[i] = json.dumps(row)
+    f.write_text("\n".join(lines) + "\n")
+
+
+def test_bless_then_check_passes(blessed, capsys):
+    assert check(blessed / "good", blessed / "g") == 0
+    assert sorted(p.name for p in (blessed / "g").iterdir()) == ["paper-cube.quick.jsonl",
+                                                                "policy.toml"]
+    head = json.loads((blessed / "g" / "paper-cube.quick.jsonl").read_text().splitlines()[0])
+    assert head["case"] == "paper-cube" and head["mode"] == "quick" and "nu" in head["problem"]
+    assert "stress_corr" in head["columns"] and "disp_rel_l2_p2" in head["columns"]
+
+
+def test_gold_values_carry_six_digits_and_a_rebless_of_the_last_digits_changes_nothing(
+        blessed, tmp_path, capsys):
+    """Every compact value has at most 6 significant digits; metrics that moved in their
+    10th digit bless to the same bytes."""
+    text = (blessed / "g" / "paper-cube.quick.jsonl").read_text()
+    for line in text.splitlines()[1:]:
+        for v in json.loads(line)[3:]:
+            assert v is None or float(f"{v:.6g}") == v
+    shutil.copytree(blessed / "good", tmp_path / "m")
+    f = tmp_path / "m" / "paper-cube" / "metrics.json"
+    data = json.loads(f.read_text())
+    for r in data["runs"]:
+        for k in data["gated"]:
+            if isinstance(r.get(k), float):
+                r[k] *= 1 + 3e-10
+    f.write_text(json.dumps(data))
+    shutil.copytree(blessed / "g", tmp_path / "g")
+    assert main(["bless", "--metrics", str(tmp_path / "m"), "--gold", str(tmp_path / "g")]) == 0
+    assert "no change" in capsys.readouterr().out
+    assert (tmp_path / "g" / "paper-cube.quick.jsonl").read_text() == text
+
+
+def test_the_committed_gold_is_compact():
+    """All the gate's files together: under 5 % of the 79 741 lines thresholds.toml had."""
+    lines = sum(len(p.read_text().splitlines()) for p in (ROOT / "gold").iterdir())
+    assert lines < 0.05 * 79741
+    assert not (ROOT / "thresholds.toml").exists()
+
+
+def test_worse_model_fails_and_names_the_metric(blessed, tmp_path, capsys):
+    worse = tmp_path / "worse" / "paper-cube"
+    assert main(["run", "paper-cube", *SMALL, "--shear-scale", "0.5", "--out", str(worse)]) == 0
+    capsys.readouterr()
+    assert check(worse.parent, blessed / "g") == 1
+    out = capsys.readouterr().out
+    assert "FAIL disp_rel_l2_p2 of paper-cube/five/clamped/pbcm-variational" in out
+    assert "msm/" not in "".join(l for l in out.splitlines() if l.startswith("FAIL"))
+
+
+def test_hand_tightened_gold_fails(blessed, tmp_path, capsys):
+    edit_gold(blessed / "g", tmp_path / "g", "pbcm-variational", "disp_rel_l2_p2",
+              lambda v: v / 2)
+    assert check(blessed / "good", tmp_path / "g") == 1
+    assert "FAIL disp_rel_l2_p2" in capsys.readouterr().out
+
+
+def test_a_null_that_becomes_a_number_fails_and_says_what_changed(blessed, tmp_path, capsys):
+    """Gold n/a and a number now, or the reverse: exit 1 naming both, never an invitation
+    to bless."""
+    edit_gold(blessed / "g", tmp_path / "g", "pbcm-variational", "disp_rel_l2_p2",
+              lambda v: None)
+    assert check(blessed / "good", tmp_path / "g") == 1
+    out = capsys.readouterr().out
+    line = next(l for l in out.splitlines() if l.startswith("FAIL disp_rel_l2_p2"))
+    assert "was n/a, now 0." in line and "a run that failed now succeeds, or the reverse" in line
+    assert "bless on purpose if intended" in line
+    shutil.copytree(blessed / "good", tmp_path / "m")
+    f = tmp_path / "m" / "paper-cube" / "metrics.json"
+    data = json.loads(f.read_text())
+    r = next(r for r in data["runs"] if r["model"] == "pbcm-variational")
+    was = r["disp_rel_l2_p2"]
+    r["disp_rel_l2_p2"] = None
+    f.write_text(json.dumps(data))
+    assert check(tmp_path / "m", blessed / "g") == 1
+    assert f"was {was:.6g}, now n/a" in capsys.readouterr().out
+
+
+def test_missing_gold_row_exits_2(blessed, tmp_path, capsys):
+    shutil.copytree(blessed / "g", tmp_path / "g")
+    f = tmp_path / "g" / "paper-cube.quick.jsonl"
+    lines = [l for l in f.read_text().splitlines() if '"msm"' not in l]
+    f.write_text("\n".join(lines) + "\n")
+    capsys.readouterr()
+    assert check(blessed / "good", tmp_path / "g") == 3     # msm is now a model without gold
+    assert "NEW  paper-cube (quick) msm" in capsys.readouterr().out
+    shutil.copytree(blessed / "g", tmp_path / "h")
+    f = tmp_path / "h" / "paper-cube.quick.jsonl"
+    lines = [l for l in f.read_text().splitlines()
+             if not l.startswith('["five", "sliding", "pbcm-variational"')]
+    f.write_text("\n".join(lines) + "\n")       # one row of a model with gold left out
+    assert check(blessed / "good", tmp_path / "h") == 2
+    assert "the gold has no row" in capsys.readouterr().err
+
+
+def test_missing_metrics_file_exits_2(blessed, tmp_path, capsys):
+    assert check(tmp_path / "absent", blessed / "g") == 2
+    assert "absent does not exist" in capsys.readouterr().err
+    (tmp_path / "empty").mkdir()
+    assert check(tmp_path / "empty", blessed / "g") == 2
+    assert "no metrics.json" in capsys.readouterr().err
+
+
+def test_nan_metric_exits_2(blessed, tmp_path, capsys):
+    shutil.copytree(blessed / "good", tmp_path / "nan")
+    f = tmp_path / "nan" / "paper-cube" / "metrics.json"
+    data = json.loads(f.read_text())
+    data["runs"][0]["zigzag"] = float("nan")
+    f.write_text(json.dumps(data))
+    assert check(tmp_path / "nan", blessed / "g") == 2
+    err = capsys.readouterr().err
+    assert "zigzag" in err and "not a finite number" in err
+
+
+@pytest.mark.parametrize("name,text,word", [
+    ("policy.toml", "rtol = \n", "malformed"),
+    ("policy.toml", "rtol = -1\n", "non-negative"),
+    ("policy.toml", "margin = 1\n", "unknown key"),
+    ("paper-cube.quick.jsonl", "not json\n", "malformed"),
+    ("paper-cube.quick.jsonl", None, "no gold value"),
+    ("policy.toml", None, "has no policy.toml")])
+def test_malformed_or_missing_gold_exits_2(blessed, tmp_path, name, text, word, capsys):
+    shutil.copytree(blessed / "g", tmp_path / "g")
+    if text is None:
+        (tmp_path / "g" / name).unlink()
+    else:
+        (tmp_path / "g" / name).write_text(text)
+    assert check(blessed / "good", tmp_path / "g") == 2
+    assert word in capsys.readouterr().err
+    assert check(blessed / "good", tmp_path / "absent") == 2
+
+
+def test_the_band_is_two_sided_for_either_sign():
+    from cases.gate import Bound
+    for value in (-0.6, 0.6):
+        for direction in ("min", "max"):
+            b = Bound("c", "quick", "m", "b", "x", "zigzag", value, 0.1, 0.0, direction)
+            low, high = b.band
+            assert low == pytest.approx(value - 0.06) and high == pytest.approx(value + 0.06)
+            assert b.passes(value) and b.margin(value) == 1.0
+            assert not b.passes(value - 0.07) and not b.passes(value + 0.07)
+    error = Bound("c", "quick", "m", "b", "x", "zigzag", 0.5, 0.1, 0.0, "max")
+    assert "worse" in error.verdict(0.6) and "better" in error.verdict(0.4)
+    corr = Bound("c", "quick", "m", "b", "x", "stress_corr", 0.5, 0.1, 0.0, "min")
+    assert "better" in corr.verdict(0.6) and "worse" in corr.verdict(0.4)
+
+
+def test_a_better_result_fails_until_blessed(blessed, tmp_path, capsys):
+    """A gold value loosened by hand (doubled) sees the measured error as an improvement
+    outside the band: that fails too, until blessed."""
+    edit_gold(blessed / "g", tmp_path / "g", "pbcm-variational", "disp_rel_l2_p2",
+              lambda v: 2 * v)
+    assert check(blessed / "good", tmp_path / "g") == 1
+    assert "better: bless it on purpose" in capsys.readouterr().out
+
+
+def test_committed_full_mode_gold_holds_for_the_committed_reports(capsys):
+    """`pbcm check` with its defaults on a clean checkout: the committed full-mode report."""
+    assert main(["check", "--metrics", str(ROOT / "reports"), "--gold",
+                 str(ROOT / "gold"), "--allow-new"]) == 0
+    assert "0 failed" in capsys.readouterr().out
+
+
+def test_a_model_without_bounds_is_new_not_gated_yet(blessed, tmp_path, capsys):
+    """A preset or composed model nobody has blessed: its metrics are listed as new (exit 3,
+    or 0 with --allow-new), while every blessed bound is still checked; a bounded model's
+    metric without a bound stays an error."""
+    data = json.loads((blessed / "good" / "paper-cube" / "metrics.json").read_text())
+    extra = "shear(reading=variational, c=auto) + normal_tet(c=auto) + volume"
+    data["runs"] += [{**r, "model": extra} for r in data["runs"] if r["model"] == "msm"]
+    (tmp_path / "m").mkdir()
+    (tmp_path / "m" / "metrics.json").write_text(json.dumps(data))
+    assert check(tmp_path / "m", blessed / "g") == 3
+    out = capsys.readouterr().out
+    assert f"NEW  paper-cube (quick) {extra}: new, not gated yet" in out
+    assert re.search(r"^\d+ passed, 0 failed$", out, re.M)
+    assert main(["check", "--metrics", str(tmp_path / "m"), "--gold",
+                 str(blessed / "g"), "--allow-new"]) == 0
+    # a failing bound still fails (1), new models or not
+    worse = [dict(r) for r in data["runs"]]
+    for r in worse:
+        if r["model"] == "msm" and r.get("disp_rel_l2_p2") is not None:
+            r["disp_rel_l2_p2"] *= 2
+    (tmp_path / "m" / "metrics.json").write_text(json.dumps({**data, "runs": worse}))
+    assert main(["check", "--metrics", str(tmp_path / "m"), "--gold",
+                 str(blessed / "g"), "--allow-new"]) == 1
+    # a new model's NaN is an error, not news
+    nan = [dict(r) for r in data["runs"]]
+    for r in nan:
+        if r["model"] == extra:
+            r["disp_rel_l2_p2"] = float("nan")
+    (tmp_path / "m" / "metrics.json").write_text(json.dumps({**data, "runs": nan}))
+    assert check(tmp_path / "m", blessed / "g") == 2
+
+
+def test_a_regression_that_turns_a_null_into_a_number_fails(tmp_path, monkeypatch, capsys):
+    """The lumped mass doubled (in this process: --workers 1) on the quick paper cube: runs
+    that blew up now finish, or the reverse. The gate fails (exit 1) and says what changed;
+    it never answers 'run pbcm bless'."""
+    from model.system import ParticleModel
+    init = ParticleModel.__init__
+
+    def heavy(self, *a, **kw):
+        init(self, *a, **kw)
+        self.mass = 2 * self.mass
+    monkeypatch.setattr(ParticleModel, "__init__", heavy)
+    out = tmp_path / "paper-cube"
+    assert main(["run", "paper-cube", "--quick", "--workers", "1", "--out", str(out)]) == 0
+    capsys.readouterr()
+    assert check(tmp_path, ROOT / "gold") == 1
+    text = capsys.readouterr()
+    flips = [l for l in text.out.splitlines() if "a run that failed now succeeds" in l]
+    assert flips, text.out[-2000:]
+    assert all(("was n/a, now " in l) != (", now n/a:" in l) for l in flips)
+    assert "pbcm bless` to set" not in text.out + text.err
