@@ -41,7 +41,7 @@ class Settings:
     models: tuple = ()
     p2_levels: int = 1          # refinements of the converged P2 reference
     quick: bool = False
-    shear_scale: float = 1.0    # testing knob: scales every shear term (1 = the model)
+    shear_scale: float = 1.0    # for tests, in the API only: scales every shear term (1 = the model)
     # True: the standard static metrics and quantities only; the case's extra reference work
     # and metrics (reference_extra, reference_entries, run_extra: dynamics, modes) are skipped
     static_only: bool = False

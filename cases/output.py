@@ -117,13 +117,16 @@ class StagedFolder:
         return self.target
 
 
-def write_text_atomic(path, text):
-    """Write ``text`` to ``path`` through a temporary file in the same folder and a rename."""
+def write_atomic(path, data):
+    """Write ``data`` (str or bytes) to ``path`` through a temporary file in the same folder
+    (created if need be) and a rename: a reader sees the old file or the new one, never a
+    part; a run killed while writing leaves only a hidden temporary file."""
     path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
     fd, tmp = tempfile.mkstemp(prefix=f".{path.name}{TMP_TAG}", dir=path.parent)
     try:
-        with os.fdopen(fd, "w") as f:
-            f.write(text)
+        with os.fdopen(fd, "wb") as f:
+            f.write(data.encode() if isinstance(data, str) else data)
         os.chmod(tmp, 0o666 & ~_umask())
         with no_interrupt():
             os.replace(tmp, path)

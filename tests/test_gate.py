@@ -1,5 +1,6 @@
 """The CI gate: the gold folder (gold/policy.toml, gold/CASE.quick.jsonl, the committed
 full-mode reports), pbcm check and pbcm bless."""
+import dataclasses
 import json
 import re
 import shutil
@@ -86,9 +87,14 @@ def test_the_committed_gold_is_compact():
     assert not (ROOT / "thresholds.toml").exists()
 
 
-def test_worse_model_fails_and_names_the_metric(blessed, tmp_path, capsys):
+def test_worse_model_fails_and_names_the_metric(blessed, tmp_path, capsys, monkeypatch):
+    """Every shear term at half its stiffness (in this process: one mesh, no workers)."""
+    from cases.framework import Case
+    build = Case.build_model
+    monkeypatch.setattr(Case, "build_model", lambda self, name, mesh, s: build(
+        self, name, mesh, dataclasses.replace(s, shear_scale=0.5)))
     worse = tmp_path / "worse" / "paper-cube"
-    assert main(["run", "paper-cube", *SMALL, "--shear-scale", "0.5", "--out", str(worse)]) == 0
+    assert main(["run", "paper-cube", *SMALL, "--out", str(worse)]) == 0
     capsys.readouterr()
     assert check(worse.parent, blessed / "g") == 1
     out = capsys.readouterr().out

@@ -5,7 +5,7 @@ import json
 from pathlib import Path
 
 from model import PbcmError
-from ...output import SWEEP_MARK as MARK, OutputError, owned, writable_folder
+from ...output import SWEEP_MARK as MARK, OutputError, owned, writable_folder, write_atomic
 from ...registry import CASES
 from . import SHIPPED
 from . import engine, report, spec as specs, table
@@ -49,7 +49,7 @@ def run(args):
         return _plan(spec, Path(args.out) if args.out else
                      Path("reports") / "sweeps" / path.stem, args.retry_failed)
     out = output_folder(args.out, path)
-    table.atomic_write(out / MARK, json.dumps(
+    write_atomic(out / MARK, json.dumps(
         {"spec": spec.source, "title": spec.title, "cases": list(spec.cases),
          "quick": spec.quick, "static_only": spec.static_only, "fixed": spec.fixed,
          "axes": spec.axes, "metrics": list(spec.metrics)}, indent=1) + "\n")

@@ -17,7 +17,7 @@ from model import PbcmError  # noqa: E402
 from ...document import Document, fmt  # noqa: E402
 from ...framework import ref_name  # noqa: E402
 from .spec import NUMERIC_AXES  # noqa: E402
-from .table import atomic_write  # noqa: E402
+from ...output import write_atomic  # noqa: E402
 
 MAX_PANELS = 12       # more combinations of the other axes than this: the first ones drawn
 MAX_FAILURES = 40     # failed runs listed one by one; the rest counted
@@ -316,7 +316,7 @@ def write(spec, rows, out, registry, table_path):
         for axis in [a for a in spec.swept() if a != "model"]:
             png, left, ends = figure(metric, axis, ok, spec, models, spec.label(axis, case))
             name = f"{PREFIX}{metric}_vs_{axis}.png"
-            atomic_write(out / name, png)
+            write_atomic(out / name, png)
             names.append(name)
             doc.img(name, f"{metric} against {spec.label(axis, case)}")
             if ends:
@@ -345,7 +345,7 @@ def write(spec, rows, out, registry, table_path):
     for old in out.glob(f"{PREFIX}*.png"):
         if old.name not in names:
             old.unlink()
-    atomic_write(out / "report.md", doc.markdown() + "\n")
+    write_atomic(out / "report.md", doc.markdown() + "\n")
     if missing:
         raise MissingMetric(f"no finished run has metric(s) {', '.join(missing)} named in "
                             f"[report] metrics of {spec.source}; valid names are the columns "

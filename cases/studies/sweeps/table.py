@@ -5,25 +5,11 @@ otherwise). Every file is written atomically: beside its target, then renamed ov
 import csv
 import io
 import json
-import os
-import tempfile
 from pathlib import Path
 
+from ...output import write_atomic
+
 RUNS = "runs"
-
-
-def atomic_write(path, data):
-    """Write ``data`` (str or bytes) to ``path`` through a temporary file in its folder."""
-    path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
-    try:
-        with os.fdopen(fd, "wb") as f:
-            f.write(data.encode() if isinstance(data, str) else data)
-        os.replace(tmp, path)
-    except BaseException:
-        Path(tmp).unlink(missing_ok=True)
-        raise
 
 
 class RunStore:
@@ -43,7 +29,7 @@ class RunStore:
             return None
 
     def put(self, key, row):
-        atomic_write(self.path(key), json.dumps(row, indent=1, sort_keys=True) + "\n")
+        write_atomic(self.path(key), json.dumps(row, indent=1, sort_keys=True) + "\n")
 
 
 def parquet_available():
@@ -77,7 +63,7 @@ def write(rows, folder, kind, first=()):
     table = [[cell(r.get(c)) for c in cols] for r in rows]
     if kind == "parquet":
         path = Path(folder) / "table.parquet"
-        atomic_write(path, _parquet(cols, table))
+        write_atomic(path, _parquet(cols, table))
     else:
         path = Path(folder) / "table.csv"
         buf = io.StringIO()
@@ -85,7 +71,7 @@ def write(rows, folder, kind, first=()):
         w.writerow(cols)
         w.writerows([["" if v is None else repr(v) if isinstance(v, float) else v
                       for v in row] for row in table])
-        atomic_write(path, buf.getvalue())
+        write_atomic(path, buf.getvalue())
     return path
 
 
@@ -137,4 +123,4 @@ def _parse(text):
     return text
 
 
-__all__ = ["RunStore", "write", "read", "atomic_write", "parquet_available"]
+__all__ = ["RunStore", "write", "read", "parquet_available"]

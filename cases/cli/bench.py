@@ -1,0 +1,57 @@
+"""`pbcm bench`: what every model costs."""
+from pathlib import Path
+
+from ..output import StagedFolder
+from .common import UsageError, add_term_files, chosen_models, number
+import model
+
+def add(sub):
+    """The command's parser."""
+    bn = sub.add_parser(
+        "bench", help="time every model: force evaluation, RK4 step, calibration, memory",
+        description="Time every preset on cubes of about 1e2 to 1e6 tetrahedra (--quick: 1e2 "
+                    "and 1e3): ns per tetrahedron per force evaluation, microseconds per RK4 "
+                    "step, calibration seconds, memory, and the step ratios to msm and "
+                    "fem-linear as medians of per-round ratios (models timed round-robin). "
+                    "Writes bench.json, bench.md and step_time.png (the paper's Figure 2).")
+    bn.add_argument("--out", default="reports/bench", help="output folder (default reports/bench)")
+    bn.add_argument("--quick", action="store_true", help="sizes 1e2 and 1e3, three rounds")
+    bn.add_argument("--sizes", nargs="+",
+                    type=number("--sizes", "tetrahedron counts, numbers >= 5", low=4),
+                    help="approximate tetrahedron counts (default 1e2 1e3 1e4 1e5 1e6)")
+    bn.add_argument("--rounds", type=number("--rounds", "an integer >= 1", low=0, integer=True),
+                    default=7, help="timing rounds (default 7)")
+    bn.add_argument("--models", nargs="+", help="model presets or composed models "
+                                                "(default: every preset)")
+    bn.add_argument("--merge", action="store_true",
+                    help="add the rows of --models to the bench.json in --out (timed against "
+                         "the baselines in this process) and keep every other row")
+    add_term_files(bn)
+    bn.set_defaults(func=run)
+
+
+def run(args):
+    from .. import costs
+    from ..tools import bench
+    models = chosen_models(args.models, list(model.PRESETS))
+    sizes = args.sizes or (bench.QUICK_SIZES if args.quick else bench.SIZES)
+    # checked before any timing starts
+    old = None
+    if args.merge:
+        if not models:
+            raise UsageError("--merge adds the rows of the --models given to a bench.json: "
+                             "name the models to time")
+        where = Path(args.out) / costs.FILE
+        if not where.is_file():
+            raise UsageError(f"--merge needs an existing {where}; run `pbcm bench` first or "
+                             "drop --merge")
+        old = costs.read(where)
+        models = tuple(m for m in models if m not in bench.BASELINES)
+    with StagedFolder(Path(args.out), mark=costs.FILE) as out:
+        data = bench.run(sizes=sizes, models=models, rounds=3 if args.quick else args.rounds,
+                         with_engines=old is None)
+        bench.write(bench.merge(old, data) if old else data, out.path)
+        path = out.commit()
+    print(f"bench written to {path}")
+    return 0
+

@@ -1,0 +1,58 @@
+"""`pbcm check`: measured metrics against the gold values (cases.gate)."""
+import sys
+
+def add(sub):
+    """The command's parser."""
+    c = sub.add_parser("check", help="compare the latest metrics with the gold values "
+                       "(exit 0 pass, 1 fail, 2 missing or malformed, 3 pass with new models)",
+                       description="Compare every metrics.json under --metrics with the gold "
+                                   "values of --gold (quick mode: gold/CASE.quick.jsonl; full "
+                                   "mode: the committed reports/CASE/metrics.json), two-sided, "
+                                   "with the tolerance policy of gold/policy.toml. Exit status "
+                                   "0: every value holds; 1: some metric left its band, or was "
+                                   "n/a in the gold and is a number now (or the reverse); 2: "
+                                   "gold without a metric, a metric without gold for a model "
+                                   "that has gold, a NaN, a malformed or missing file, or "
+                                   "metrics run at other problem parameters than the gold's; "
+                                   "3: every value holds, and some model (a new preset or "
+                                   "composed model) has no gold at all in that case and mode: "
+                                   "listed as 'new, not gated yet' (--allow-new turns 3 into "
+                                   "0).")
+    c.add_argument("--allow-new", action="store_true",
+                   help="exit 0 rather than 3 when the only news is models without gold")
+    c.add_argument("--metrics", default="reports", help="a metrics.json or a folder of them "
+                   "(default reports)")
+    c.add_argument("--gold", default="gold",
+                   help="the gold folder (default gold in the current folder: the "
+                        "repository's own when run from a checkout)")
+    c.set_defaults(func=run)
+
+
+def run(args):
+    from ..gate import NEW, CheckError, check, flip_message, load, measured
+    try:
+        v = check(load(args.gold, hint="--gold"), measured(args.metrics))
+    except CheckError as exc:
+        print(f"pbcm check: error: {exc}", file=sys.stderr)
+        return 2
+    print(f"{'metric':<66} {'measured':>11} {'band':>23} {'margin':>8}  result")
+    for b, value, ok in v.rows:
+        name = f"{b.case}/{b.mesh}/{b.bc}/{b.model}/{b.metric}"
+        low, high = b.band
+        print(f"{name:<66} {value:>11.5g} [{low:>10.5g},{high:>10.5g}] "
+              f"{b.margin(value):>8.1%}  {'PASS' if ok else 'FAIL'}")
+    failed = [r for r in v.rows if not r[2]]
+    print(f"{len(v.rows) - len(failed)} passed, {len(failed) + len(v.flips)} failed")
+    for b, value, _ in failed:
+        low, high = b.band
+        print(f"FAIL {b.metric} of {b.case}/{b.mesh}/{b.bc}/{b.model}: {value:.6g} outside "
+              f"[{low:.6g}, {high:.6g}] ({b.verdict(value)})")
+    for key, gold, now in v.flips:
+        print(flip_message(key, gold, now))
+    for case, mode, name, n in v.new:
+        print(f"NEW  {case} ({mode}) {name}: new, not gated yet ({n} metrics without gold; "
+              "`pbcm bless` gates them)")
+    if v.new:
+        print(f"{len(v.new)} model(s) new, not gated yet")
+    return 0 if v.status == NEW and args.allow_new else v.status
+

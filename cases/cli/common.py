@@ -1,0 +1,167 @@
+"""What the commands share: one-line argument errors, numbers checked in the user's units,
+the selection of cases, meshes, bcs and models, worker pools, and running one case or study
+into a folder."""
+import argparse
+import math
+import re
+from pathlib import Path
+
+import model
+from ..output import StagedFolder  # noqa: F401 (the commands' staging)
+
+
+class Parser(argparse.ArgumentParser):
+    """argparse with one-line errors: ``pbcm: error: ...`` and exit status 2."""
+
+    def error(self, message):
+        message = re.sub(r"^argument (\S+): (?=\1 )", "", message)  # the flag is said already
+        self.exit(2, f"pbcm: error: {message} (see `{self.prog} --help`)\n")
+
+
+def number(flag, what, low=None, high=None, integer=False, open_low=True):
+    """An argparse type: a finite number in (low, high), in the user's units, or an error
+    naming the flag."""
+    def parse(text):
+        try:
+            v = int(text) if integer else float(text)
+        except ValueError:
+            raise argparse.ArgumentTypeError(f"{flag} takes {what}, got {text!r}") from None
+        ok = math.isfinite(v) and (low is None or (v > low if open_low else v >= low)) \
+            and (high is None or v < high)
+        if not ok:
+            raise argparse.ArgumentTypeError(f"{flag} takes {what}, got {text}")
+        return v
+    return parse
+
+
+def poisson(text):
+    v = number("--nu", "Poisson's ratio, a number between -1 and 0.5")(text)
+    if v >= 0.5:
+        raise argparse.ArgumentTypeError(
+            f"--nu must be below 0.5, got {text} (0.5 is incompressible, which the volume "
+            "term cannot represent: use 0.49 at most)")
+    if v <= -1:
+        raise argparse.ArgumentTypeError(f"--nu must be above -1, got {text} (at -1 the bulk "
+                                         "modulus vanishes)")
+    return v
+
+
+def choose(kind, given, valid):
+    """The names asked for (None when not given: the case's default), or a one-line error
+    listing the valid ones (exit status 2)."""
+    if given is None:
+        return None
+    bad = [g for g in given if g not in valid]
+    if bad:
+        raise UsageError(f"unknown {kind} {', '.join(bad)}; valid: {', '.join(valid)}")
+    return tuple(given)
+
+
+def chosen_models(given, presets):
+    """The models asked for as canonical labels (None when not given): presets among
+    ``presets``, or composed specs (``model.compose``) checked against the term registry."""
+    if given is None:
+        return None
+    from model.compose import checked
+    out = []
+    for g in given:
+        name = checked(g)      # a ModelError names the unknown term, parameter or value
+        if name in model.PRESETS and name not in presets:
+            raise UsageError(f"model {name} is not run by this case; valid presets: "
+                             f"{', '.join(presets)} (or terms composed with '+')")
+        out.append(name)
+    return tuple(dict.fromkeys(out))
+
+
+class UsageError(Exception):
+    pass
+
+
+def case_named(name):
+    from ..registry import CASES, STUDY_MODULES
+    if name not in CASES:
+        raise UsageError(f"unknown case {name}; valid: {', '.join([*CASES, *STUDY_MODULES])}")
+    return CASES[name]
+
+
+def study_config(study, args):
+    """A study's settings from the command line, checked before anything runs."""
+    from model.mesh import SCHEMES
+    if getattr(args, "bcs", None):
+        raise UsageError(f"--bcs does not apply to the {study.name} study: it runs each "
+                         "problem's own boundary conditions; leave --bcs out")
+    return study.settings(quick=args.quick, meshes=choose("mesh", args.meshes, SCHEMES),
+                          models=chosen_models(args.models, list(model.PRESETS)),
+                          E=args.E, nu=args.nu, rho=args.rho)
+
+
+def run_study_into(study, cfg, folder, workers=None):
+    """Run ``study`` and write its files into ``folder``; the step costs come from the bench
+    beside the folder (reports/bench), or the checkout's."""
+    from .. import costs
+    data = costs.load(Path(folder).parent)
+    study.write(folder, cfg, study.run(cfg, workers=workers, bench=data))
+
+
+def case_config(case, args):
+    return case.settings(quick=args.quick,
+                         meshes=choose("mesh", args.meshes, case.meshes),
+                         bcs=choose("boundary condition", args.bcs, case.bcs),
+                         models=chosen_models(args.models, case.models),
+                         E=args.E, nu=args.nu, rho=args.rho)
+
+
+def run_case_into(name, cfg, folder, workers=None):
+    """Run case ``name`` with ``cfg`` (on ``workers``, a started Workers, when given) and
+    write its files into the existing ``folder``."""
+    from ..report import write_case
+    from ..runner import run
+    case = case_named(name)
+    runs, fields = run(case, cfg, workers=workers)
+    write_case(folder, case, cfg, runs, fields)
+    return runs
+
+
+def worker_pool(args, cfgs):
+    """The worker pool of a command (a context; nothing to start for one worker or one unit
+    in every case: a worker runs one mesh of a case with all its bcs, or one problem and bc
+    of a study)."""
+    from contextlib import nullcontext
+    from ..workers import Workers, available_cores
+    units = max(c.units for c in cfgs.values())
+    n = min(args.workers or available_cores(), units)
+    return Workers(n) if n > 1 else nullcontext()
+
+
+def case_configs(names, args):
+    """Every case's configuration, built (and so checked) before anything runs."""
+    return {name: case_config(case_named(name), args) for name in names}
+
+
+def add_selection(p):
+    p.add_argument("--models", nargs="+",
+                   help="model presets, or terms composed with '+', e.g. \"shear(reading="
+                        "variational, c=auto) + normal_edge(c=auto) + volume\" (default: "
+                        "every preset)")
+    add_term_files(p)
+    p.add_argument("--meshes", nargs="+", help="meshes (default: all; --quick: five six)")
+    p.add_argument("--bcs", nargs="+", help="boundary conditions (default: all)")
+    p.add_argument("--quick", action="store_true",
+                   help="each case's quick settings (fewer meshes, coarser references; "
+                        "what CI runs)")
+    p.add_argument("--E", type=number("--E", "Young's modulus in Pa, a number > 0", low=0),
+                   help="Young's modulus [Pa] (default 10e3)")
+    p.add_argument("--nu", type=poisson, help="Poisson's ratio, -1 < nu < 0.5 (default 0.45)")
+    p.add_argument("--rho", type=number("--rho", "a density in kg/m^3, a number > 0", low=0),
+                   help="density [kg/m^3] (default 1000)")
+    p.add_argument("--workers", type=number("--workers", "an integer >= 1", low=0,
+                                             integer=True),
+                   help="processes running a case's meshes side by side (default: the cores "
+                        "available); the metrics do not depend on it")
+
+
+def add_term_files(p):
+    p.add_argument("--term", action="append", default=[], metavar="FILE",
+                   help="a Python file that registers force terms (repeatable); its terms can "
+                        "then be composed in --models")
+

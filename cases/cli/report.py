@@ -1,0 +1,32 @@
+"""`pbcm report`: every case and study, written with the index."""
+from contextlib import ExitStack
+
+from ..output import StagedFolder, writable_folder, write_atomic
+from .common import add_selection
+from .pipeline import configs, run_everything
+
+def add(sub):
+    """The command's parser."""
+    rep = sub.add_parser("report", help="run every case and write reports/ with its index")
+    rep.add_argument("--out", help="output folder (default reports)")
+    add_selection(rep)
+    rep.set_defaults(func=run)
+
+
+def run(args):
+    from ..index import index_documents
+    from ..registry import CASES
+    cfgs = configs(args)
+    root = writable_folder(args.out or "reports")
+    with ExitStack() as stack:   # every case folder checked and staged before any computing
+        staged = {name: stack.enter_context(StagedFolder(root / name)) for name in cfgs}
+
+        def done(name, runs):
+            what = "" if runs is None else f"{len(runs)} runs "
+            print(f"{name}: {what}written to {staged[name].commit()}")
+        run_everything(args, cfgs, lambda name: staged[name].path, done)
+    md, html = index_documents(root, list(CASES), [n for n in cfgs if n not in CASES])
+    write_atomic(root / "index.md", md)
+    write_atomic(root / "index.html", html)
+    print(f"index written to {root / 'index.md'} and {root / 'index.html'}")
+    return 0
