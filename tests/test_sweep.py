@@ -361,7 +361,8 @@ def test_the_shipped_spec_parses_and_names_every_model(capsys):
     assert "nu (sweep, pbcm sweep nu): Every model on the paper cube over Poisson's ratio" \
         in listed
     assert "sweep axes: resolution: nodes per side (nodes_per_side); load: push [mm]" in listed
-    s = specs.load(Path(__file__).resolve().parents[1] / "cases" / "sweeps" / "nu.toml", CASES)
+    s = specs.load(Path(__file__).resolve().parents[1] / "cases" / "studies" / "sweeps"
+                   / "nu.toml", CASES)
     assert s.axes["nu"] == [0.0, 0.1, 0.2, 0.3, 0.4, 0.45, 0.49]
     assert s.axes["model"] == list(CASES["paper-cube"].models)
     assert {"reaction_ratio", "apparent_poisson"} <= set(s.metrics)
