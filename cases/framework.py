@@ -18,12 +18,10 @@ from model import PRESETS, Material, build
 from model.compose import parse
 from model.mesh import SCHEMES
 from model.loads import body_forces, traction_forces
+from . import catalogue
 
 MM = 1e-3
 MESH_FAMILIES = SCHEMES          # five, six, bcc, unstructured
-STANDARD_GATED = {"disp_rel_l2_p1": "max", "disp_rel_l2_p2": "max", "disp_max_rel_p2": "max",
-                  "reaction_rel_err": "max", "stress_corr": "min", "stress_rel_err": "max",
-                  "pressure_rel_err": "max", "net_force_rel": "max"}
 
 
 @dataclass
@@ -125,15 +123,6 @@ class Knob:
     label: str
 
 
-@dataclass(frozen=True)
-class Headline:
-    """The metric that sums a case up in the scorecard: ``metric`` (an error, smaller is
-    better, per run) and how the index names it."""
-
-    metric: str
-    label: str
-
-
 @dataclass
 class Reference:
     """The FEM side of one (mesh, bc), as the runner computes it by default: P1 on the mesh,
@@ -166,10 +155,15 @@ class Case(abc.ABC):
     bcs, quick_bcs : boundary-condition names (quick_bcs None: all of them in quick mode).
     models : model presets (default every preset).
     quick : settings that ``--quick`` changes (e.g. ``{"p2_levels": 1}``).
-    headline : the scorecard's metric.
-    gated : case metrics the CI gate bounds beside the standard ones, {metric: "max"/"min"}.
+    headline : the metric (a catalogue name) that sums the case up in the scorecard: an
+        error, smaller is better, per run.
+    gated : case metrics the CI gate bounds beside the standard ones (catalogue names; the
+        catalogue gives their direction).
+    columns : case metrics shown in the per-(mesh, bc) table after the standard ones
+        (catalogue names: the catalogue gives header, unit and digits; ``cell`` the text).
     qoi_errors : scalar quantities of interest that get ``<name>_rel_err`` = |model / FEM - 1|.
-    definitions : report lines defining the case's own metrics.
+    notes : report lines on how the case is set up; the metrics' definitions come from the
+        catalogue.
     fem_solver : the linear FEM solver ("auto", "direct", "amg").
     draws_stress, magnify : whether the case draws its own stress panels; the magnification
         of the standard ones.
@@ -187,16 +181,27 @@ class Case(abc.ABC):
     quick_bcs: ClassVar[tuple] = None
     models: ClassVar[tuple] = tuple(PRESETS)
     quick: ClassVar[dict] = {}
-    headline: ClassVar[Headline] = Headline("disp_rel_l2_p2", "displacement error vs FEM P2")
-    gated: ClassVar[dict] = {}
+    headline: ClassVar[str] = "disp_rel_l2_p2"
+    gated: ClassVar[tuple] = ()
+    columns: ClassVar[tuple] = ()
     qoi_errors: ClassVar[tuple] = ()
-    definitions: ClassVar[tuple] = ()
+    notes: ClassVar[tuple] = ()
     fem_solver: ClassVar[str] = "auto"    # the linear FEM solver (reference.fem.linear_solve)
     draws_stress: ClassVar[bool] = False   # True: the case draws its own max |tau| panels
     magnify: ClassVar[float] = 5.0         # displacement magnification of the panels
     static: ClassVar[bool] = True          # False: no static displacement (modes)
     resolution: ClassVar[Knob] = None      # what a sweep's resolution axis turns
     load: ClassVar[Knob] = None            # what a sweep's load axis turns
+
+    def __init_subclass__(cls, **kw):
+        """A declaration error shows when the case is imported, not in its report."""
+        super().__init_subclass__(**kw)
+        for attr in ("gated", "columns", "qoi_errors", "notes"):
+            if not isinstance(getattr(cls, attr), tuple):
+                raise TypeError(f"{cls.__name__}.{attr} must be a tuple (a one-element tuple "
+                                "needs its trailing comma)")
+        for name in (cls.headline, *cls.gated, *cls.columns):
+            catalogue.metric(name)      # a KeyError naming where to declare it
 
     # ------------------------------------------------------------------ settings
     def settings(self, quick=False, **kw):
@@ -296,9 +301,10 @@ class Case(abc.ABC):
         """{group title: [sentences]} computed from the runs."""
         return {}
 
-    def columns(self):
-        """Extra columns of the per-(mesh, bc) table: [(header, run -> text)]."""
-        return []
+    def cell(self, metric, run):
+        """The table text of ``metric`` (a catalogue Metric) in ``run``; a case overrides it
+        where a cell says more than the number (a run that blew up)."""
+        return metric.cell(run.get(metric.name))
 
     def sections(self, doc, s, runs, fields, out):
         """Case-specific sections and figures, written into ``out`` and added to ``doc``."""
@@ -343,23 +349,5 @@ class Study(abc.ABC):
         return None
 
 
-def ref_name(name):
-    """The run key of the FEM value of quantity ``name``: '_fem' before a unit suffix
-    (bulge_profile_mm -> bulge_profile_fem_mm, zigzag -> zigzag_fem)."""
-    for unit in ("_mm", "_n", "_nm", "_hz", "_s", "_pa"):
-        if name.endswith(unit):
-            return name[:-len(unit)] + "_fem" + unit
-    return name + "_fem"
-
-
-def err_name(name):
-    """The run key of the relative error of quantity ``name`` (tip_deflection_mm ->
-    tip_deflection_rel_err)."""
-    for unit in ("_mm", "_n", "_nm", "_hz", "_s", "_pa"):
-        if name.endswith(unit):
-            return name[:-len(unit)] + "_rel_err"
-    return name + "_rel_err"
-
-
-__all__ = ["Case", "Study", "Settings", "Loads", "Traction", "Headline", "Knob", "Reference",
-           "MM", "MESH_FAMILIES", "STANDARD_GATED", "ref_name", "err_name"]
+__all__ = ["Case", "Study", "Settings", "Loads", "Traction", "Knob", "Reference",
+           "MM", "MESH_FAMILIES"]

@@ -25,6 +25,7 @@ import math
 from pathlib import Path
 import tomllib
 
+from . import catalogue
 from .output import SWEEP_MARK
 
 POLICY = "policy.toml"
@@ -32,12 +33,6 @@ SUFFIX = ".jsonl"
 COMPACT_MODES = ("quick",)        # modes whose gold is a compact file; full: the reports
 DIGITS = 6                        # significant digits of a compact gold value
 KEY = ("mesh", "bc", "model")     # what names a row of a gold file
-# directions of metrics written before a metrics.json carried its own ``gated``
-GATED = {"disp_rel_l2_p1": "max", "disp_rel_l2_p2": "max", "disp_max_rel_p2": "max",
-         "reaction_rel_err": "max", "stress_corr": "min", "stress_rel_err": "max",
-         "pressure_rel_err": "max", "zigzag": "max", "net_force_rel": "max",
-         "reaction_time_rel_l2": "max", "disp_end_push_rel_l2": "max", "rest_time_s": "max",
-         "modal_rel_err": "max", "modal_rel_err_free": "max", "rigid_modes_free": "max"}
 
 
 class CheckError(Exception):
@@ -247,7 +242,7 @@ def measured(metrics_dir):
             # a study's rows for the gate (e.g. one per case, bc and mesh size) are its own
             runs = data["gate_runs"] if "gate_runs" in data else data["runs"]
             problem = data["problem"]
-            gated = data.get("gated", GATED)
+            gated = list(data["gated"])
         except (ValueError, KeyError, TypeError) as exc:
             raise CheckError(f"{f} is not a pbcm metrics file of this version (lacks {exc}); "
                              "rerun the case") from None
@@ -256,7 +251,11 @@ def measured(metrics_dir):
                              "different parameters; check them one at a time")
         problems[(case, mode)] = problem
         sources[(case, mode)] = f
-        directions.update(gated)
+        # the file says which metrics are gated; the catalogue says which way
+        try:
+            directions.update({m: catalogue.metric(m).direction for m in gated})
+        except KeyError as exc:
+            raise CheckError(f"{f} gates {exc.args[0]}") from None
         for r in runs:
             rows.add((case, mode, r["mesh"], r["bc"], r["model"]))
             for metric in gated:
@@ -335,7 +334,7 @@ def check(gold, measurements):
             raise CheckError(f"metric {k[5]} of {'/'.join(k[:5])} has no gold value: a "
                              "metric gated since the last bless; bless it on purpose")
     out, flips, status = [], [], 0
-    directions = {**GATED, **(measurements.directions or {})}
+    directions = measurements.directions or {}
     for key5, metrics in sorted(rows.items()):
         if key5 not in measured_rows:
             raise CheckError(f"{'/'.join(key5[2:])} of {key5[0]} ({key5[1]} mode) has gold "
@@ -353,7 +352,7 @@ def check(gold, measurements):
                 status = 1
                 continue
             b = Bound(*key5, metric, g, *policy.tolerance(metric),
-                      directions.get(metric, "max"))
+                      directions.get(metric) or catalogue.metric(metric).direction)
             ok = b.passes(v)
             out.append((b, v, ok))
             status = max(status, 0 if ok else 1)

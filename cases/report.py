@@ -14,26 +14,10 @@ from model.compose import slug
 from model.mesh import write as write_mesh
 from . import costs, figures
 from .document import Document, fmt
-from .framework import STANDARD_GATED
+from . import catalogue
 from .runner import jsonable
 
 TIMING_KEYS = ("dyn_wall_s",)   # wall times: in run.json, never in metrics.json
-
-STANDARD_DEFINITIONS = (
-    "disp L2 P1 / P2: ||u_model - u_ref|| / ||u_ref|| over all nodes and components, against "
-    "FEM P1 on the same mesh and the converged P2 reference; disp max P2: "
-    "max_i |u_model,i - u_ref,i| / max_i |u_ref,i|.",
-    "reaction ratio: the force on the driven nodes along the driven axis, model over FEM P2 "
-    "(n/a in a load-controlled case, where it is the load).",
-    "stress corr / err: the paper's Figure 1 measure, max |tau| = G max |gamma| over the 24 "
-    "corner shear strains of each tetrahedron, computed on the model's and on the FEM P2 "
-    "displacement; Pearson correlation and relative L2 error (n/a where the reference field is "
-    "uniform).",
-    "pressure corr / err: model p = -K (V - V0)/V against the FEM P2 pressure -tr(sigma)/3 "
-    "averaged over each tetrahedron.",
-    "net F / net T: |sum f| / sum |f| and |sum x x f| / sum |x||f| of the model's internal "
-    "forces at the FEM P2 deformed state (zero for a momentum-conserving model).")
-
 
 def environment():
     import numba
@@ -76,8 +60,9 @@ def metrics_document(case, s, runs, extra=None):
     """The metrics.json content of a case run: the parameters, the problem the gate compares,
     the gated metrics with their direction, the runs, and what the case adds (``extra``)."""
     return jsonable({"case": case.name, "parameters": s.describe(), "problem": s.problem(),
-                     "params": case.params(s), "gated": {**STANDARD_GATED, **case.gated},
-                     "headline": case.headline.metric, **(extra or {}),
+                     "params": case.params(s), "gated": {**catalogue.STANDARD_GATED,
+                                                          **catalogue.gated(*case.gated)},
+                     "headline": case.headline, **(extra or {}),
                      "environment": environment(),
                      "runs": [{k: v for k, v in r.items() if k not in TIMING_KEYS} for r in runs]})
 
@@ -136,7 +121,8 @@ def build_report(case, s, runs, fields, out):
         case.references_line(s),
         "Quick mode." if s.quick else "Full mode."])
     doc.h(2, "Definitions")
-    doc.ul(list(STANDARD_DEFINITIONS) + list(case.definitions))
+    doc.ul(catalogue.definitions(catalogue.TABLE + case.columns + case.gated
+                                 + (case.headline,)) + list(case.notes))
     failed = [r for r in runs if r.get("failed")]
     groups = dict(case.findings(s, [r for r in runs if not r.get("failed")]))
     tets = [r["tets"] for r in runs if r.get("tets")]
@@ -158,7 +144,7 @@ def build_report(case, s, runs, fields, out):
 
 
 def _tables(doc, case, s, runs):
-    extra = case.columns()
+    shown = [catalogue.metric(n) for n in catalogue.TABLE + case.columns]
     for mesh in s.meshes:
         for bc in s.bcs:
             rs = [r for r in _runs(runs, mesh=mesh, bc=bc) if not r.get("failed")]
@@ -169,14 +155,8 @@ def _tables(doc, case, s, runs):
             if rs[0].get("reaction_fem_p2_n") is not None:
                 line += f"; FEM P2 reaction {fmt(rs[0]['reaction_fem_p2_n'], 4)} N"
             doc.p(line + f"; P2 reference error estimate {fmt(rs[0]['p2_error_estimate'], 2)}.")
-            doc.table(["model", "disp L2 P1", "disp L2 P2", "disp max P2", "reaction ratio",
-                       "stress corr", "stress err", "pressure corr", "net F", "net T"]
-                      + [h for h, _ in extra],
-                      [[r["model"], fmt(r["disp_rel_l2_p1"]), fmt(r["disp_rel_l2_p2"]),
-                        fmt(r["disp_max_rel_p2"]), fmt(r["reaction_ratio"]),
-                        fmt(r["stress_corr"]), fmt(r["stress_rel_err"]),
-                        fmt(r["pressure_corr"]), fmt(r["net_force_rel"], 2),
-                        fmt(r["net_torque_rel"], 2)] + [f(r) for _, f in extra] for r in rs])
+            doc.table(["model"] + [m.header for m in shown],
+                      [[r["model"]] + [case.cell(m, r) for m in shown] for r in rs])
             bad = [r for r in rs if r["static_failed"]]
             if bad:
                 doc.p("Static solve failed (its metrics are n/a): " + "; ".join(
@@ -190,12 +170,12 @@ def _standard_figures(doc, case, s, runs, fields, out):
             if any(not r.get("failed") for r in _runs(runs, mesh=m, bc=b))]
     if not keys:
         return
-    metric = case.headline.metric
+    metric = case.headline
     doc.h(2, "Headline error")
     figures.grouped_bars(out / "errors.png", [f"{m}/{b}" for m, b in keys], s.models,
                          [[_chart_value(runs, m, b, mo, metric) for mo in s.models]
-                          for m, b in keys], f"{metric}", case.headline.label, log=True)
-    doc.img("errors.png", f"{case.headline.label} ({metric}) per run")
+                          for m, b in keys], f"{metric}", catalogue.metric(metric).label, log=True)
+    doc.img("errors.png", f"{catalogue.metric(metric).label} ({metric}) per run")
     for m, b in [k for k in keys if (*k, "fem-p2") in fields][:1]:
         if case.draws_stress:
             break

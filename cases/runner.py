@@ -14,17 +14,14 @@ from model.terms.shear import Shear
 from reference import linear
 from . import metrics as M
 from . import stop
-from .framework import Reference, err_name, ref_name
+from .catalogue import STATIC, err_name, ref_name
+from .framework import Reference
 from .workers import one_blas_thread
 
 # a reference field that varies by less than this fraction of its size is uniform: its
 # variation is the iterative solver's (relative residual 1e-10 gives about 1e-9 here), and a
 # correlation with it would correlate with solver noise (the sliding cube's pressure)
 UNIFORM_TOL = 1e-6
-# the standard metrics of a static solution; None when the static solve failed
-STATIC_KEYS = ("disp_rel_l2_p1", "disp_max_rel_p1", "disp_rel_l2_p2", "disp_max_rel_p2",
-               "reaction_n", "reaction_ratio", "reaction_rel_err", "stress_corr",
-               "stress_rel_err", "pressure_corr", "pressure_rel_err", "static_residual_n")
 # what a run may fail with and still be a finding: the suite's own errors and numerical ones
 FINDINGS = (PbcmError, ArithmeticError, np.linalg.LinAlgError)
 
@@ -118,7 +115,7 @@ def model_run(case, mesh_name, mesh, bc, model_name, s, ref):
         r.update(case.reference_entries(ref))
     pm = case.build_model(model_name, mesh, s)
     st, fields = None, None
-    blank = {k: None for k in STATIC_KEYS + tuple(ref.quantities)
+    blank = {k: None for k in STATIC + tuple(ref.quantities)
              + tuple(err_name(q) for q in case.qoi_errors)}
     try:
         st = case.solve_static(pm, mesh, bc, s, ref)
@@ -266,4 +263,4 @@ def jsonable(d):
     return d
 
 
-__all__ = ["run", "unit", "reference", "model_run", "uniform", "jsonable", "STATIC_KEYS"]
+__all__ = ["run", "unit", "reference", "model_run", "uniform", "jsonable"]

@@ -12,7 +12,8 @@ import pytest
 from conftest import floats_in
 
 from cases.cli import main
-from cases.framework import Case, Headline, Settings
+from cases import catalogue
+from cases.framework import Case, Settings
 from cases.registry import CASES
 from cases.report import TIMING_KEYS
 from model.errors import MeshError
@@ -39,10 +40,14 @@ def test_every_case_declares_the_contract():
     for name, case in CASES.items():
         assert isinstance(case, Case) and case.name == name
         assert issubclass(case.settings_class, Settings)
-        assert isinstance(case.headline, Headline)
+        assert catalogue.metric(case.headline).direction == "max"   # an error
+        assert all(isinstance(t, tuple) for t in (case.gated, case.columns, case.notes))
+        assert all(isinstance(line, str) for line in case.notes)
+        for name in case.gated + case.columns:
+            catalogue.metric(name)
         s = case.settings(quick=True)
         assert s.quick and set(s.meshes) <= set(case.meshes)
-        assert set(case.gated.values()) <= {"max", "min"}
+        assert set(catalogue.gated(*case.gated).values()) <= {"max", "min"}
 
 
 @pytest.mark.parametrize("name", LIBRARY)

@@ -15,7 +15,7 @@ import numpy as np  # noqa: E402
 
 from model import PbcmError  # noqa: E402
 from ...document import Document, fmt  # noqa: E402
-from ...framework import ref_name  # noqa: E402
+from ...catalogue import ref_name  # noqa: E402
 from .spec import NUMERIC_AXES  # noqa: E402
 from ...output import write_atomic  # noqa: E402
 

@@ -1,0 +1,332 @@
+"""The metric catalogue: every metric the suite writes, declared once.
+
+A :class:`Metric` says what a run key means: its unit, the gate's direction (``"max"``: the
+value is an error, smaller is better, and the gate bounds it; ``"min"``: larger is better;
+None: reported, not gated), its short label (table headers) and a one-line definition (the
+reports' definition lists). Tables, definition lists, gated sets, charts and the gate read
+these declarations; nothing else writes a metric's label, unit or direction.
+
+A quantity of interest declared here brings two derived keys with it: its FEM value
+(``ref_name``: ``tip_deflection_mm`` -> ``tip_deflection_fem_mm``) and its relative error
+(``err_name``: ``tip_deflection_rel_err``, direction "max"), unless those are declared
+themselves. To add a metric: one ``declare(...)`` line below (in the group it belongs to),
+then compute it under that name; a case kept outside the package declares its own with
+``catalogue.declare`` in its module.
+
+Keys of a run that are not metrics (what identifies a run, a failure message, a run
+parameter) are listed in ``DESCRIPTORS``; a test checks that every key of every committed
+metrics.json is one or the other.
+"""
+from dataclasses import dataclass
+
+from .document import fmt
+
+UNIT_SUFFIXES = ("_mm", "_n", "_nm", "_hz", "_s", "_pa")
+
+
+@dataclass(frozen=True)
+class Metric:
+    """One metric: ``name`` (its run key), ``unit`` ("1" for a ratio; SI but for names
+    ending in _mm), ``label`` (table header), ``definition`` (one line), ``direction``
+    ("max", "min" or None), and how a table shows it: ``shown`` = (unit text, factor) when
+    shown in another unit than stored (e.g. ("mN", 1e3)), ``digits`` significant."""
+
+    name: str
+    unit: str
+    label: str
+    definition: str
+    direction: str = None
+    shown: tuple = None
+    digits: int = 3
+
+    def __post_init__(self):
+        if self.direction not in (None, "max", "min"):
+            raise ValueError(f"metric {self.name}: direction {self.direction!r} is not "
+                             "'max', 'min' or None")
+
+    @property
+    def header(self):
+        """The table header: the label with the unit shown (none for a ratio)."""
+        unit = self.shown[0] if self.shown else self.unit
+        return self.label if unit == "1" else f"{self.label} [{unit}]"
+
+    def cell(self, value):
+        """``value`` as a table shows it (n/a for None)."""
+        if value is None or isinstance(value, (list, dict, str, bool)):
+            return fmt(value) if not isinstance(value, (list, dict)) else "n/a"
+        if isinstance(value, int) and self.unit == "count":
+            return str(value)
+        return fmt(value * (self.shown[1] if self.shown else 1), self.digits)
+
+    def line(self):
+        """The definition-list line: ``label (name): definition``."""
+        return f"{self.label} ({self.name}): {self.definition}"
+
+
+CATALOGUE = {}
+
+
+def declare(name, unit, label, definition, direction=None, shown=None, digits=3):
+    """Declare metric ``name`` (see :class:`Metric`); declaring a name again differently is an
+    error (the same declaration again, a module imported twice, is not)."""
+    m = Metric(name, unit, label, definition, direction, shown, digits)
+    if CATALOGUE.get(name, m) != m:
+        raise ValueError(f"metric {name} declared twice, differently: {CATALOGUE[name]} and {m}")
+    CATALOGUE[name] = m
+
+
+def ref_name(name):
+    """The run key of the FEM value of quantity ``name``: '_fem' before a unit suffix
+    (bulge_profile_mm -> bulge_profile_fem_mm, zigzag -> zigzag_fem)."""
+    for unit in UNIT_SUFFIXES:
+        if name.endswith(unit):
+            return name[:-len(unit)] + "_fem" + unit
+    return name + "_fem"
+
+
+def err_name(name):
+    """The run key of the relative error of quantity ``name`` (tip_deflection_mm ->
+    tip_deflection_rel_err)."""
+    for unit in UNIT_SUFFIXES:
+        if name.endswith(unit):
+            return name[:-len(unit)] + "_rel_err"
+    return name + "_rel_err"
+
+
+def _derived(name):
+    """The Metric of a FEM twin or a relative error of a declared quantity, or None."""
+    for q, m in CATALOGUE.items():
+        if ref_name(q) == name != q:
+            return Metric(name, m.unit, f"FEM {m.label}",
+                          f"the {m.label} of the FEM reference's solution.", None, m.shown,
+                          m.digits)
+        if err_name(q) == name != q:
+            return Metric(name, "1", f"{m.label} err",
+                          f"|model / FEM - 1| of the {m.label}.", "max")
+    return None
+
+
+def metric(name):
+    """The Metric of run key ``name``; a KeyError naming where to declare it otherwise."""
+    m = CATALOGUE.get(name) or _derived(name)
+    if m is None:
+        raise KeyError(f"{name!r} is not a metric of the catalogue: declare it in "
+                       "cases/catalogue.py")
+    return m
+
+
+def known(name):
+    """True when ``name`` is a declared metric or derived from one."""
+    return name in CATALOGUE or _derived(name) is not None
+
+
+def gated(*names):
+    """{name: direction} of metrics the gate bounds, in the order given; a metric without a
+    direction cannot be gated."""
+    out = {}
+    for n in names:
+        d = metric(n).direction
+        if d is None:
+            raise ValueError(f"metric {n} has no gate direction in the catalogue")
+        out[n] = d
+    return out
+
+
+def definitions(names):
+    """The definition lines of ``names`` (each once, in order)."""
+    return [metric(n).line() for n in dict.fromkeys(names)]
+
+
+# keys of a run (or a study's row) that are not metrics: what identifies it, why it failed,
+# what it was run with
+DESCRIPTORS = frozenset({
+    "case", "mesh", "bc", "model", "failed", "static_failed", "dyn_failed", "dyn_failed_dt4",
+    "model_info", "nodes", "tets", "h_mm", "dyn_dt_s", "dyn_steps", "dyn_t_end_s", "label",
+    "why", "verdict", "levels", "metric", "dropped", "dyn_reaction_t_s"})
+
+# ---------------------------------------------------------------- the standard static metrics
+declare("disp_rel_l2_p1", "1", "disp L2 P1",
+         "||u_model - u_ref|| / ||u_ref|| over all nodes and components, against linear FEM "
+         "P1 on the same mesh.", "max")
+declare("disp_max_rel_p1", "1", "disp max P1",
+         "max_i |u_model,i - u_ref,i| / max_i |u_ref,i| against FEM P1 on the same mesh.")
+declare("disp_rel_l2_p2", "1", "disp L2 P2",
+         "||u_model - u_ref|| / ||u_ref|| against the converged P2 reference at the "
+         "particle nodes.", "max")
+declare("disp_max_rel_p2", "1", "disp max P2",
+         "max_i |u_model,i - u_ref,i| / max_i |u_ref,i| against the converged P2 reference.",
+         "max")
+declare("reaction_n", "N", "reaction",
+         "the force the supports exert on the driven nodes along the driven axis (n/a in a "
+         "load-controlled case).", shown=("mN", 1e3), digits=4)
+declare("reaction_ratio", "1", "reaction ratio",
+         "the reaction of the model over that of FEM P2.")
+declare("reaction_rel_err", "1", "reaction err",
+         "|reaction ratio - 1|.", "max")
+declare("reaction_fem_p2_n", "N", "FEM P2 reaction",
+         "the reaction of the converged P2 reference.", shown=("mN", 1e3), digits=4)
+declare("stress_corr", "1", "stress corr",
+         "Pearson correlation of the paper's max |tau| = G max |gamma| over the 24 corner shear "
+         "strains of each tetrahedron, on the model's and on the FEM P2 displacement (n/a "
+         "where the reference field is uniform).", "min")
+declare("stress_rel_err", "1", "stress err",
+         "relative L2 error of that max |tau| field against FEM P2's.", "max")
+declare("pressure_corr", "1", "pressure corr",
+         "Pearson correlation of the model's p = -K (V - V0)/V per tetrahedron with the FEM P2 "
+         "pressure -tr(sigma)/3 averaged over it (n/a where the reference is uniform).")
+declare("pressure_rel_err", "1", "pressure err",
+         "relative L2 error of that pressure against FEM P2's.", "max")
+declare("static_residual_n", "N", "residual",
+         "the largest free-node force left by the model's static solve.")
+declare("net_force_rel", "1", "net F",
+         "|sum f| / sum |f| of the model's internal forces at the FEM P2 deformed state (zero "
+         "for a momentum-conserving model).", "max", digits=2)
+declare("net_torque_rel", "1", "net T",
+         "|sum x x f| / sum |x||f| of those forces.", digits=2)
+declare("p2_error_estimate", "1", "P2 error estimate",
+         "the P2 reference's own error estimate: its change over the last refinement.")
+
+# ---------------------------------------------------------------- paper cube: the artefact
+declare("bulge_profile_mm", "mm", "layer profile",
+         "for each y-layer (0, 8, 16, 24, 32 mm) the mean outward lateral displacement of the "
+         "side-face nodes.")
+declare("zigzag", "1", "zig-zag",
+         "RMS residual of a least-squares quadratic fit to the five-layer profile over its "
+         "largest |value|: 0 for a barrel or uniform expansion, about 0.86 for pure "
+         "alternation.", "max")
+declare("paper_pattern", "1", "paper pattern",
+         "1 when the middle and end layers bulge relative to their neighbours while the 8 and "
+         "24 mm layers neck (second differences +, -, +), as the paper reports, else 0.")
+declare("apparent_poisson", "1", "apparent nu",
+         "the mean of the layer profile over the half side, divided by the axial compression "
+         "push / size (exactly nu for linear FEM on the sliding base).")
+declare("growth_rate_1_s", "1/s", "growth",
+         "the largest exponential growth rate of the undamped model linearised at rest (max Re "
+         "sqrt(eig(M^-1 df/dx))); above zero the force field flutters.")
+declare("verdict_changes_dt4", "1", "dt/4 changes verdict",
+         "whether the dynamic run repeated at a quarter of the step changes whether it blew "
+         "up.")
+
+# ---------------------------------------------------------------- paper cube: dynamics
+declare("dyn_vs_static_rel_l2", "1", "dyn vs static",
+         "relative L2 distance between the end of the dynamic run and the static "
+         "equilibrium.", digits=2)
+declare("dyn_at_rest", "1", "at rest",
+         "whether the dynamic run came to rest before its end.")
+declare("dyn_reaction_n", "N", "reaction(t)",
+         "the top reaction over push and hold of the dynamic run.")
+declare("reaction_time_rel_l2", "1", "reaction(t) err",
+         "relative L2 of the top reaction over push and hold against the FEM transient on the "
+         "same boundary motion (all modes superposed, consistent mass, the same damping).",
+         "max")
+declare("disp_end_push_rel_l2", "1", "disp end push err",
+         "relative L2 of the displacement at the end of the push against the FEM transient.",
+         "max")
+declare("rest_time_s", "s", "rest",
+         "when every node is slower than the rest speed (checked every 0.1 s of hold).", "max",
+         digits=2)
+
+# ---------------------------------------------------------------- modes
+declare("frequencies_hz", "Hz", "frequencies",
+         "the first 10 non-rigid frequencies of the model linearised at rest (coloured "
+         "finite-difference Jacobian, lumped mass; |Re sqrt(lambda)| / 2 pi).")
+declare("modal_rel_err", "1", "modal err",
+         "the largest relative error of the first 10 non-rigid frequencies (sorted) against "
+         "FEM P2 (consistent mass), with the case's constraints.", "max")
+declare("modal_rel_err_median", "1", "median err",
+         "the median of those relative errors.", "max")
+declare("modal_rel_err_free", "1", "modal err free",
+         "the modal error free-free, after the rigid modes.", "max")
+declare("rigid_modes", "count", "rigid modes",
+         "zero eigenvalues (below 1e-8 of the largest): 6 free-free, 0 clamped expected.",
+         "max")
+declare("rigid_modes_free", "count", "rigid modes free",
+         "zero eigenvalues free-free (6 expected).", "max")
+declare("rest_time_fem_s", "s", "FEM rest",
+         "when the FEM transient comes to rest.", digits=2)
+
+# ---------------------------------------------------------------- case quantities
+declare("tip_deflection_mm", "mm", "tip deflection",
+         "the mean -u_y over the nodes of the loaded face x = L.", digits=4)
+declare("top_settlement_mm", "mm", "settlement",
+         "the mean -u_y over the top-face nodes.", digits=4)
+declare("top_settlement_cf_mm", "mm", "closed form",
+         "the closed-form settlement at this mesh's top nodes (sliding base only).", digits=4)
+declare("top_settlement_cf_rel_err", "1", "err vs closed form",
+         "|model / closed form - 1| of the top settlement.", "max")
+declare("torque_nm", "N m", "torque",
+         "the moment about the bar's axis of the forces the supports exert on the turned end "
+         "face, sum (y - y_c) R_z - (z - z_c) R_y with rest positions as arms.",
+         shown=("uN m", 1e6), digits=4)
+declare("warping_mm", "mm", "warping",
+         "the RMS over the end face of the axial displacement u_x about its mean.")
+declare("surface_profile_mm", "mm", "surface profile",
+         "u_y of the top nodes on the centre line z = 16 mm, by x.")
+declare("profile_rel_err", "1", "profile err",
+         "relative L2 error of the surface profile against FEM P2.", "max")
+declare("edge_shear_pa", "Pa", "edge shear",
+         "the peak of the paper's max |tau| over the tetrahedra touching the punch's edge "
+         "nodes (singular in the continuum: a mesh-level comparison).", digits=4)
+declare("force_n_steps", "N", "force(steps)",
+         "the top force at each compression step.")
+declare("force_fem_n_steps", "N", "neo-Hookean force(steps)",
+         "the top force of the neo-Hookean P2 reference at each step.")
+declare("force_linear_n_steps", "N", "linear FEM force(steps)",
+         "the top force of linear FEM P2 at each step.")
+declare("lateral_strain_steps", "1", "lateral strain(steps)",
+         "the mean outward displacement of the side-face nodes over the half side, per step.")
+declare("lateral_strain_fem_steps", "1", "neo-Hookean lateral strain(steps)",
+         "the lateral strain of the neo-Hookean P2 reference per step.")
+declare("lateral_strain_linear_steps", "1", "linear FEM lateral strain(steps)",
+         "the lateral strain of linear FEM P2 per step.")
+declare("force_rel_err_max", "1", "force err max",
+         "the largest |F_model / F_neo-Hookean - 1| of the top force over the steps.", "max")
+declare("lateral_rel_err_max", "1", "lateral err max",
+         "the largest relative error of the lateral strain over the steps.", "max")
+declare("linear_force_rel_err_max", "1", "linear FEM force err",
+         "the force err max of linear FEM P2 against neo-Hookean (the linear reference's own "
+         "error at this strain).")
+declare("linear_lateral_rel_err_max", "1", "linear FEM lateral err",
+         "the lateral err max of linear FEM P2 against neo-Hookean.")
+
+# ---------------------------------------------------------------- convergence and extensions
+declare("response", "1", "response",
+         "the problem's scalar response (its reaction or displacement measure) in SI units.")
+declare("disp_rel_l2", "1", "disp L2",
+         "||u_model - u_ref|| / ||u_ref|| against the problem's finest reference.", "max")
+declare("e_inf", "1", "e_inf",
+         "the error extrapolated to h -> 0 by the fit of error against mesh size.", "max")
+declare("e_inf_err", "1", "e_inf uncertainty", "the fit's uncertainty of e_inf.")
+declare("ratio_inf", "1", "ratio_inf",
+         "the response ratio model / reference extrapolated to h -> 0.")
+declare("ratio_inf_err", "1", "ratio_inf uncertainty", "the fit's uncertainty of ratio_inf.")
+declare("order", "1", "order", "the fitted order of convergence of the error in h.")
+declare("C_eff_Pa", "Pa", "C_eff",
+         "the lattice's effective elasticity tensor (Voigt 6 x 6) from six homogeneous "
+         "strains.")
+for _n in ("E_x", "E_y", "E_z", "E_110", "E_111", "E_xy_plane"):
+    declare(_n, "Pa", _n, f"the effective Young's modulus {_n[2:]} of C_eff.")
+for _n in ("G_xy", "G_xz", "G_yz"):
+    declare(_n, "Pa", _n, f"the effective shear modulus {_n[2:]} of C_eff.")
+for _n in ("nu_xy", "nu_xz", "nu_yx", "nu_yz", "nu_zx", "nu_zy"):
+    declare(_n, "1", _n, f"the effective Poisson ratio {_n[3:]} of C_eff.")
+declare("distance", "1", "distance",
+         "||C_eff - C|| / ||C||: how far the lattice answers from the isotropic target.",
+         "max")
+declare("anisotropy_AU", "1", "A^U",
+         "the universal anisotropy index of C_eff (0 for an isotropic material).", "max")
+declare("asymmetry", "1", "asymmetry",
+         "||C_eff - C_eff^T|| / ||C_eff|| (zero for a model with an energy).")
+declare("error", "1", "case error",
+         "the case's headline metric for one run (the extensions study's ranking unit).",
+         "max")
+del _n
+
+# the standard metrics of a static solution (None when the static solve failed), the ones the
+# gate bounds in every case, and the columns of every case's table
+STATIC = ("disp_rel_l2_p1", "disp_max_rel_p1", "disp_rel_l2_p2", "disp_max_rel_p2",
+          "reaction_n", "reaction_ratio", "reaction_rel_err", "stress_corr", "stress_rel_err",
+          "pressure_corr", "pressure_rel_err", "static_residual_n")
+STANDARD_GATED = gated(*(n for n in STATIC + ("net_force_rel",) if CATALOGUE[n].direction))
+TABLE = ("disp_rel_l2_p1", "disp_rel_l2_p2", "disp_max_rel_p2", "reaction_ratio",
+         "stress_corr", "stress_rel_err", "pressure_corr", "net_force_rel", "net_torque_rel")

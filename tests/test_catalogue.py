@@ -1,0 +1,96 @@
+"""The metric catalogue (issue 24): every metric the suite writes is declared once, with a
+unit, a gate direction, a label and a definition; what the reports and the gate say about a
+metric comes from there."""
+import json
+from pathlib import Path
+
+import pytest
+
+from cases import catalogue
+from cases.catalogue import CATALOGUE, DESCRIPTORS, err_name, metric, ref_name
+from cases.registry import CASES, studies
+
+ROOT = Path(__file__).resolve().parents[1]
+# the sections of a metrics.json whose rows carry metrics
+ROW_SECTIONS = ("runs", "gate_runs", "case_runs", "fits", "elasticity")
+
+
+def _rows(data):
+    for section in ROW_SECTIONS:
+        rows = data.get(section)
+        if isinstance(rows, list):
+            yield from (r for r in rows if isinstance(r, dict))
+
+
+def undeclared(data):
+    """The keys of a metrics document's rows and gated set that are neither metrics of the
+    catalogue nor descriptors."""
+    keys = {k for r in _rows(data) for k in r} | set(data.get("gated", {}))
+    return sorted(k for k in keys if k not in DESCRIPTORS and not catalogue.known(k))
+
+
+@pytest.mark.parametrize("path", sorted(ROOT.glob("reports/*/metrics.json")),
+                         ids=lambda p: p.parent.name)
+def test_every_committed_metric_is_declared(path):
+    data = json.loads(path.read_text())
+    assert undeclared(data) == []
+    for name, direction in data.get("gated", {}).items():
+        assert metric(name).direction == direction, name
+
+
+def test_an_undeclared_key_is_caught():
+    data = {"runs": [{"mesh": "five", "model": "x", "disp_rel_l2_p2": 0.1,
+                      "wobble_index": 3.0}], "gated": {"disp_rel_l2_p2": "max"}}
+    assert undeclared(data) == ["wobble_index"]
+    with pytest.raises(KeyError, match="declare it in cases/catalogue.py"):
+        metric("wobble_index")
+
+
+def test_twins_and_errors_are_derived_from_a_quantity():
+    assert ref_name("bulge_profile_mm") == "bulge_profile_fem_mm"
+    assert ref_name("zigzag") == "zigzag_fem"
+    assert err_name("tip_deflection_mm") == "tip_deflection_rel_err"
+    assert err_name("torque_nm") == "torque_rel_err"
+    twin = metric("tip_deflection_fem_mm")
+    assert twin.unit == "mm" and twin.direction is None
+    err = metric("warping_rel_err")
+    assert err.unit == "1" and err.direction == "max"
+
+
+def test_every_declaration_is_complete():
+    for name, m in CATALOGUE.items():
+        assert m.name == name and m.unit and m.label and m.definition.endswith("."), name
+        assert m.direction in (None, "max", "min")
+        assert name not in DESCRIPTORS
+    with pytest.raises(ValueError, match="direction"):
+        catalogue.Metric("x", "1", "x", "x.", direction="up")
+    with pytest.raises(ValueError, match="declared twice, differently"):
+        catalogue.declare("zigzag", "1", "zig-zag", "another meaning.")
+    with pytest.raises(ValueError, match="no gate direction"):
+        catalogue.gated("disp_max_rel_p1")
+
+
+def test_correlations_are_gated_from_below_and_errors_from_above():
+    # the one metric gated from below: a correlation falls when the model gets worse
+    assert catalogue.STANDARD_GATED["stress_corr"] == "min"
+    assert {d for n, d in catalogue.STANDARD_GATED.items() if n != "stress_corr"} == {"max"}
+
+
+def test_headers_show_units_where_they_are_not_ratios():
+    assert metric("reaction_n").header == "reaction [mN]"
+    assert metric("reaction_n").cell(0.0123) == "12.3"
+    assert metric("disp_rel_l2_p2").header == "disp L2 P2"
+    assert metric("rigid_modes").cell(6) == "6"
+    assert metric("zigzag").cell(None) == "n/a"
+
+
+def test_cases_and_studies_gate_declared_metrics():
+    for case in CASES.values():
+        for name in (case.headline, *case.gated, *case.columns, *case.qoi_errors):
+            metric(name)
+    from cases.studies.convergence.report import GATED as CONVERGENCE
+    from cases.studies.extensions.report import GATED as EXTENSIONS
+    assert set(studies()) == {"convergence", "extensions"}
+    for gated in (CONVERGENCE, EXTENSIONS):
+        for name, direction in gated.items():
+            assert metric(name).direction == direction
