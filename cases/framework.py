@@ -329,9 +329,10 @@ class Study(abc.ABC):
         ignored). Settings have ``problem()`` (what the gate compares) and ``describe()``."""
 
     @abc.abstractmethod
-    def run(self, s, workers=None, log=True, bench=None):
+    def run(self, s, workers=None, log=True, bench=None, store=None):
         """Compute everything; return the data its ``write`` takes. ``bench`` is the
-        `pbcm bench` document (cost), or None."""
+        `pbcm bench` document (cost), or None; ``store`` a ``cases.store.RunStore`` to take
+        stored results from and keep computed ones in (None: none)."""
 
     @abc.abstractmethod
     def write(self, out, s, data):

@@ -3,11 +3,7 @@ model its run with the standard metrics, the case's quantities of interest and i
 metrics. A failure (a mesh that cannot be built, a reference that does not converge, a model
 without equilibrium) is recorded in the runs it touches and the case goes on.
 """
-import sys
-
 import numpy as np
-from rich.console import Console
-from rich.progress import BarColumn, Progress, TextColumn, TimeElapsedColumn, TimeRemainingColumn
 
 from model import PbcmError
 from model.terms.shear import Shear
@@ -16,6 +12,8 @@ from . import metrics as M
 from . import stop
 from .catalogue import STATIC, err_name, ref_name
 from .framework import Reference
+from .progress import Progress
+from .store import OFF, key
 from .workers import one_blas_thread
 
 # a reference field that varies by less than this fraction of its size is uniform: its
@@ -147,18 +145,69 @@ def failed_runs(mesh_name, bc, models, phase, exc):
             for m in models]
 
 
-def unit(case, s, mesh_name, bc, mesh_of=None, step=None):
+def what(case, s, mesh_name, bc, static_only=None):
+    """What determines the results of one (mesh, bc) of ``case`` beside the model: the case,
+    mesh, bc and every setting but the selection (the run store's key, ``cases.store``)."""
+    d = {k: v for k, v in s.describe().items() if k not in ("meshes", "bcs", "models")}
+    return {"case": case.name, "mesh": mesh_name, "bc": bc, **d,
+            "static_only": s.static_only if static_only is None else static_only}
+
+
+def _stored(store, kind, case, s, mesh_name, bc, reuse_full, **more):
+    """A stored entry of this (mesh, bc), or None; ``reuse_full``: a static-only request
+    accepts the entry of a full run (a superset of it)."""
+    found = store.get(key(kind=kind, **what(case, s, mesh_name, bc), **more))
+    if found is None and reuse_full and s.static_only:
+        found = store.get(key(kind=kind, **what(case, s, mesh_name, bc, False), **more))
+    return found
+
+
+def unit(case, s, mesh_name, bc, mesh_of=None, step=None, store=OFF, reuse_full=False):
     """The runs and figure fields of one (mesh, bc): its references, then every model.
     ``mesh_of(name)`` builds (or recalls) the mesh; ``step(text, done)`` reports progress
-    (``done`` items of the case's total finished since the last call)."""
+    (``done`` items of the case's total finished since the last call). The references and
+    each model's run are taken from ``store`` (a ``cases.store.RunStore``) where it has them,
+    and kept there when computed."""
     step = step or (lambda text, done: None)
     mesh_of = mesh_of or (lambda name: case.mesh(name, s))
+    base = what(case, s, mesh_name, bc)
+    stored = {m: _stored(store, "run", case, s, mesh_name, bc, reuse_full, model=m)
+              for m in s.models}
+    ref_fields = _stored(store, "reference-fields", case, s, mesh_name, bc, reuse_full)
+    if ref_fields is not None and all(v is not None for v in stored.values()):
+        step(f"{case.name} {mesh_name}/{bc}: stored", len(s.models) + 1)
+        return _assemble(mesh_name, bc, s.models, stored, ref_fields)
+    computed = _compute(case, s, mesh_name, bc, mesh_of, step,
+                        [m for m in s.models if stored[m] is None])
+    for m, value in computed["runs"].items():
+        stored[m] = store.put(key(kind="run", **base, model=m), value)
+    ref_fields = store.put(key(kind="reference-fields", **base), computed["ref_fields"])
+    return _assemble(mesh_name, bc, s.models, stored, ref_fields)
+
+
+def _assemble(mesh_name, bc, models, stored, ref_fields):
     runs, fields = [], {}
+    if ref_fields:
+        fields[(mesh_name, bc, "fem-p2")] = ref_fields
+    for m in models:
+        r, f = stored[m]
+        runs.append(r)
+        if f is not None:
+            fields[(mesh_name, bc, m)] = f
+    return runs, fields
+
+
+def _compute(case, s, mesh_name, bc, mesh_of, step, models):
+    """The references of one (mesh, bc) and the runs of ``models`` on it: {"runs": {model:
+    (run, fields or None)}, "ref_fields": the FEM P2 fields or {}}."""
+    out = {"runs": {}, "ref_fields": {}}
     try:
         mesh = mesh_of(mesh_name)
     except FINDINGS as exc:
         step(f"{case.name} {mesh_name}/{bc}: mesh failed", len(s.models) + 1)
-        return failed_runs(mesh_name, bc, s.models, "mesh", exc), fields
+        out["runs"] = {r["model"]: (r, None)
+                       for r in failed_runs(mesh_name, bc, models, "mesh", exc)}
+        return out
     probe = Shear(mesh, s.material, reading="corner")  # the paper's max |tau| measure
     step(f"{case.name} {mesh_name}/{bc}: FEM references", 0)
     try:
@@ -166,34 +215,34 @@ def unit(case, s, mesh_name, bc, mesh_of=None, step=None):
                or reference(case, mesh, bc, s, probe, extra=not s.static_only))
     except FINDINGS as exc:
         step(f"{case.name} {mesh_name}/{bc}: references failed", len(s.models) + 1)
-        return failed_runs(mesh_name, bc, s.models, "reference", exc), fields
+        out["runs"] = {r["model"]: (r, None)
+                       for r in failed_runs(mesh_name, bc, models, "reference", exc)}
+        return out
     if ref.p2 is not None:
-        fields[(mesh_name, bc, "fem-p2")] = {
-            "mesh": mesh, "u": ref.p2.u, "max_tau": ref.tau, "pressure": ref.p2.pressure,
-            **ref.extra}
-    step(f"{case.name} {mesh_name}/{bc}", 1)
-    for model_name in s.models:
+        out["ref_fields"] = {"mesh": mesh, "u": ref.p2.u, "max_tau": ref.tau,
+                             "pressure": ref.p2.pressure, **ref.extra}
+    step(f"{case.name} {mesh_name}/{bc}", 1 + len(s.models) - len(models))
+    for model_name in models:
         stop.checkpoint()
         step(f"{case.name} {mesh_name}/{bc}/{model_name}", 0)
         try:
             r, f = model_run(case, mesh_name, mesh, bc, model_name, s, ref)
         except FINDINGS as exc:   # the model cannot be built on this mesh (calibration)
             [r], f = failed_runs(mesh_name, bc, [model_name], "model", exc), None
-        runs.append(r)
-        if f is not None:
-            fields[(mesh_name, bc, model_name)] = f
+        out["runs"][model_name] = (r, f)
         step(f"{case.name} {mesh_name}/{bc}/{model_name}", 1)
-    return runs, fields
+    return out
 
 
 def _mesh_in_worker(job):
     """Every bc of one mesh, in one worker: the bcs share the mesh and the FEM stiffness
     matrices (reference.fem keeps the last ones assembled), which a (mesh, bc) per worker
     would assemble twice."""
-    case, s, mesh_name = job
+    case, s, mesh_name, store, reuse_full = job
     mesh_of = _built_once(case, s)
     with one_blas_thread():
-        return mesh_name, [unit(case, s, mesh_name, bc, mesh_of) for bc in s.bcs]
+        return mesh_name, [unit(case, s, mesh_name, bc, mesh_of, store=store,
+                                reuse_full=reuse_full) for bc in s.bcs]
 
 
 def _built_once(case, s):
@@ -208,41 +257,34 @@ def _built_once(case, s):
     return mesh_of
 
 
-def run(case, s, log=True, workers=None):
+def run(case, s, log=True, workers=None, store=OFF, reuse_full=False):
     """Run every (mesh, bc, model) of ``case`` with settings ``s``; return the runs (metrics)
     and the fields for the figures ({(mesh, bc, model or 'fem-p2'): arrays}). The (mesh, bc)
     units run in this process, or on ``workers`` (a started ``cases.workers.Workers``), one
     mesh with all its bcs per task; the results are the same either way and come in the
-    declared order."""
+    declared order. ``store`` (a ``cases.store.RunStore``) gives what it has and keeps what
+    is computed; ``reuse_full``: a static-only run takes a full run's stored rows."""
     units = [(mesh_name, bc) for mesh_name in s.meshes for bc in s.bcs]
     per_unit = len(s.models) + 1
     results = [None] * len(units)
-    with Progress(TextColumn("{task.description:<56}"), BarColumn(),
-                  TextColumn("{task.completed}/{task.total}"), TimeElapsedColumn(),
-                  TextColumn("left"), TimeRemainingColumn(), console=Console(stderr=True),
-                  disable=not (log and sys.stderr.isatty())) as bar:
-        task = bar.add_task(case.name, total=len(units) * per_unit)
+    with Progress(case.name, len(units) * per_unit, log=log, width=56) as bar:
         if workers is None or len(s.meshes) < 2:
             mesh_of = _built_once(case, s)
-
-            def step(text, done):
-                bar.update(task, description=text, advance=done)
-
             with one_blas_thread():
                 for i, (mesh_name, bc) in enumerate(units):
                     stop.checkpoint()
-                    results[i] = unit(case, s, mesh_name, bc, mesh_of, step)
+                    results[i] = unit(case, s, mesh_name, bc, mesh_of,
+                                      lambda text, done: bar.advance(done, text), store,
+                                      reuse_full)
         else:
-            bar.update(task, description=f"{case.name}: {len(s.meshes)} meshes on "
-                       f"{workers.n} workers")
-            jobs = [(case, s, mesh_name) for mesh_name in s.meshes]
+            bar.advance(0, f"{case.name}: {len(s.meshes)} meshes on {workers.n} workers")
+            jobs = [(case, s, mesh_name, store, reuse_full) for mesh_name in s.meshes]
             for mesh_name, done in workers.unordered(_mesh_in_worker, jobs):
                 stop.checkpoint()
                 for bc, result in zip(s.bcs, done):
                     results[units.index((mesh_name, bc))] = result
-                bar.update(task, description=f"{case.name} {mesh_name}: done",
-                           advance=per_unit * len(s.bcs))
-        bar.update(task, description=f"{case.name}: done")
+                bar.advance(per_unit * len(s.bcs), f"{case.name} {mesh_name}: done")
+        bar.advance(0, f"{case.name}: done")
     runs, fields = [], {}
     for r, f in results:
         runs += r

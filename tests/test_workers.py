@@ -10,7 +10,7 @@ from pathlib import Path
 import pytest
 
 from cases.cli import main
-from cases.workers import Workers
+from cases.workers import Cluster, Workers, WorkerLost, RETRIES
 
 UNITS = ["--quick", "--meshes", "five", "six", "--models", "msm", "fem-linear"]
 
@@ -22,6 +22,67 @@ def test_workers_write_the_metrics_of_one_process(tmp_path):
     one, two = ((tmp_path / n / "metrics.json").read_bytes() for n in ("1", "2"))
     assert one == two
     assert one.index(b'"mesh": "five"') < one.index(b'"mesh": "six"')   # declared order
+
+
+def test_a_dask_cluster_writes_the_metrics_of_one_process(tmp_path):
+    """`--scheduler ADDRESS`: the same units on a Dask cluster, the same bytes."""
+    from distributed import LocalCluster
+    assert main(["run", "cantilever", *UNITS, "--workers", "1",
+                 "--out", str(tmp_path / "one")]) == 0
+    with LocalCluster(n_workers=2, threads_per_worker=1, processes=True,
+                      dashboard_address=":0") as cluster:
+        assert main(["run", "cantilever", *UNITS, "--scheduler", cluster.scheduler_address,
+                     "--out", str(tmp_path / "dask")]) == 0
+    assert (tmp_path / "one" / "metrics.json").read_bytes() == \
+        (tmp_path / "dask" / "metrics.json").read_bytes()
+
+
+def test_scheduler_and_workers_together_are_refused_before_computing(capsys, tmp_path):
+    assert main(["run", "cantilever", "--scheduler", "tcp://127.0.0.1:1", "--workers", "2",
+                 "--out", str(tmp_path / "c")]) == 2
+    assert "drop --workers" in capsys.readouterr().err
+    assert not (tmp_path / "c").exists()
+
+
+def test_an_unreachable_scheduler_is_one_line(capsys, tmp_path):
+    assert main(["run", "cantilever", "--quick", "--scheduler", "tcp://127.0.0.1:9",
+                 "--out", str(tmp_path / "c")]) == 2
+    err = capsys.readouterr().err
+    assert "no Dask scheduler answers there" in err and len(err.strip().splitlines()) == 1
+
+
+def die_once(item):
+    """Kill this worker the first time ``item`` runs here (a marker file says it did)."""
+    marker, value = item
+    if marker is not None and not os.path.exists(marker):
+        open(marker, "w").close()
+        os.kill(os.getpid(), signal.SIGKILL)
+    return value * 10
+
+
+def die_always(item):
+    os.kill(os.getpid(), signal.SIGKILL)
+
+
+def test_a_killed_local_workers_unit_runs_again(tmp_path):
+    items = [(None, 1), (str(tmp_path / "killed"), 2), (None, 3)]
+    with Workers(2) as pool:
+        got = sorted(pool.unordered(die_once, items))
+    assert got == [10, 20, 30] and (tmp_path / "killed").exists()
+
+
+def test_a_unit_that_kills_every_worker_is_lost_after_the_retries():
+    with Workers(1) as pool:
+        outcomes = list(pool.outcomes(die_always, [0]))
+    [(i, error, result)] = outcomes
+    assert i == 0 and result is None and isinstance(error, WorkerLost)
+    assert f"died {RETRIES + 1} times" in str(error)
+
+
+def test_the_cluster_executor_is_the_same_interface():
+    with Cluster(None, 1) as cluster:
+        assert sorted(cluster.unordered(die_once, [(None, 4), (None, 5)])) == [40, 50]
+        assert cluster.dashboard
 
 
 @pytest.mark.parametrize("n", [0, -1, 1.5, "2"])

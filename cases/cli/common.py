@@ -87,6 +87,7 @@ def case_named(name):
 def study_config(study, args):
     """A study's settings from the command line, checked before anything runs."""
     from model.mesh import SCHEMES
+    check_executor(args)
     if getattr(args, "bcs", None):
         raise UsageError(f"--bcs does not apply to the {study.name} study: it runs each "
                          "problem's own boundary conditions; leave --bcs out")
@@ -95,12 +96,13 @@ def study_config(study, args):
                           E=args.E, nu=args.nu, rho=args.rho)
 
 
-def run_study_into(study, cfg, folder, workers=None):
+def run_study_into(study, cfg, folder, workers=None, store=None):
     """Run ``study`` and write its files into ``folder``; the step costs come from the bench
     beside the folder (reports/bench), or the checkout's."""
     from .. import costs
+    from ..store import OFF
     data = costs.load(Path(folder).parent)
-    study.write(folder, cfg, study.run(cfg, workers=workers, bench=data))
+    study.write(folder, cfg, study.run(cfg, workers=workers, bench=data, store=store or OFF))
 
 
 def case_config(case, args):
@@ -111,30 +113,61 @@ def case_config(case, args):
                          E=args.E, nu=args.nu, rho=args.rho)
 
 
-def run_case_into(name, cfg, folder, workers=None):
-    """Run case ``name`` with ``cfg`` (on ``workers``, a started Workers, when given) and
-    write its files into the existing ``folder``."""
+def run_case_into(name, cfg, folder, workers=None, store=None):
+    """Run case ``name`` with ``cfg`` (on ``workers``, a started Workers, when given; from
+    and into ``store``, a RunStore) and write its files into the existing ``folder``."""
     from ..report import write_case
     from ..runner import run
+    from ..store import OFF
     case = case_named(name)
-    runs, fields = run(case, cfg, workers=workers)
+    runs, fields = run(case, cfg, workers=workers, store=store or OFF)
     write_case(folder, case, cfg, runs, fields)
     return runs
 
 
 def worker_pool(args, cfgs):
-    """The worker pool of a command (a context; nothing to start for one worker or one unit
-    in every case: a worker runs one mesh of a case with all its bcs, or one problem and bc
-    of a study)."""
+    """The executor of a command (a context): the Dask cluster at ``--scheduler``, else
+    ``--workers`` local processes; nothing to start for one worker or one unit in every case
+    (a worker runs one mesh of a case with all its bcs, or one problem and bc of a study)."""
     from contextlib import nullcontext
-    from ..workers import Workers, available_cores
+    from ..workers import executor
     units = max(c.units for c in cfgs.values())
-    n = min(args.workers or available_cores(), units)
-    return Workers(n) if n > 1 else nullcontext()
+    return executor(getattr(args, "scheduler", None), args.workers, units) or nullcontext()
+
+
+def add_executor(p):
+    """--workers and --scheduler: where the units of a command run."""
+    p.add_argument("--workers", type=number("--workers", "an integer >= 1", low=0,
+                                             integer=True),
+                   help="local worker processes running units side by side (default: the "
+                        "cores available); the metrics do not depend on it")
+    p.add_argument("--scheduler", metavar="ADDRESS",
+                   help="run the units on the Dask cluster whose scheduler is at ADDRESS, "
+                        "e.g. tcp://host:8786, instead of local processes (same metrics)")
+
+
+def check_executor(args):
+    """--scheduler and --workers cannot both be honoured: say so before computing."""
+    if getattr(args, "scheduler", None) and (args.workers or getattr(args, "serial", False)):
+        raise UsageError("--scheduler runs on that cluster's workers: drop --workers and "
+                         "--serial (start more workers with `dask worker ADDRESS`)")
+
+
+def run_store(args):
+    """The run store a command reads and fills (``--no-cache``: none)."""
+    from ..store import RunStore
+    return RunStore(enabled=not getattr(args, "no_cache", False))
+
+
+def add_store(p):
+    p.add_argument("--no-cache", action="store_true",
+                   help="compute everything, neither reading nor filling the run store "
+                        "($PBCM_CACHE, default the user cache directory)")
 
 
 def case_configs(names, args):
     """Every case's configuration, built (and so checked) before anything runs."""
+    check_executor(args)
     return {name: case_config(case_named(name), args) for name in names}
 
 
@@ -154,10 +187,8 @@ def add_selection(p):
     p.add_argument("--nu", type=poisson, help="Poisson's ratio, -1 < nu < 0.5 (default 0.45)")
     p.add_argument("--rho", type=number("--rho", "a density in kg/m^3, a number > 0", low=0),
                    help="density [kg/m^3] (default 1000)")
-    p.add_argument("--workers", type=number("--workers", "an integer >= 1", low=0,
-                                             integer=True),
-                   help="processes running a case's meshes side by side (default: the cores "
-                        "available); the metrics do not depend on it")
+    add_executor(p)
+    add_store(p)
 
 
 def add_term_files(p):

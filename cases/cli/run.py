@@ -2,8 +2,8 @@
 from pathlib import Path
 
 from ..output import StagedFolder
-from .common import (UsageError, add_selection, case_configs, run_case_into, run_study_into,
-                     study_config, worker_pool)
+from .common import (UsageError, add_selection, case_configs, run_case_into, run_store,
+                     run_study_into, study_config, worker_pool)
 
 def add(sub):
     """The command's parser."""
@@ -31,14 +31,14 @@ def run(args):
         cfg = study_config(study, args)
         with StagedFolder(Path(args.out) if args.out else Path("reports") / args.case) as out, \
                 worker_pool(args, {args.case: cfg}) as workers:
-            run_study_into(study, cfg, out.path, workers)
+            run_study_into(study, cfg, out.path, workers, run_store(args))
             path = out.commit()
         print(f"{args.case}: written to {path}")
         return 0
     cfgs = case_configs([args.case], args)
     with StagedFolder(Path(args.out) if args.out else Path("reports") / args.case) as out, \
             worker_pool(args, cfgs) as workers:
-        runs = run_case_into(args.case, cfgs[args.case], out.path, workers)
+        runs = run_case_into(args.case, cfgs[args.case], out.path, workers, run_store(args))
         path = out.commit()
     print(f"{args.case}: {len(runs)} runs written to {path}")
     return 0

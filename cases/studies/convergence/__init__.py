@@ -8,6 +8,7 @@ RK4 step, with the models on the Pareto front.
 from dataclasses import fields
 
 from ...framework import Study
+from ...store import OFF
 from . import report
 from .study import ConvergenceSettings, run
 
@@ -25,8 +26,8 @@ class Convergence(Study):
         base = {**(self.quick if quick else {}), "quick": quick}
         return ConvergenceSettings(**{k: v for k, v in {**base, **kw}.items() if k in names})
 
-    def run(self, s, workers=None, log=True, bench=None):
-        return run(s, workers=workers, log=log, bench=bench)
+    def run(self, s, workers=None, log=True, bench=None, store=None):
+        return run(s, workers=workers, log=log, bench=bench, store=store or OFF)
 
     def write(self, out, s, data):
         return report.write(out, self, s, data)

@@ -4,17 +4,15 @@ reference per problem; then the fits, the effective elasticity of every model on
 and the accuracy per cost.
 """
 from dataclasses import dataclass, field
-import sys
-import time
 
 import numpy as np
-from rich.console import Console
-from rich.progress import BarColumn, Progress, TextColumn, TimeElapsedColumn, TimeRemainingColumn
 
 from model import PRESETS, Material, build
 from reference import linear
 from ... import metrics as M
 from ... import stop
+from ...progress import Progress
+from ...store import OFF, key
 from ...framework import MESH_FAMILIES
 from ...runner import FINDINGS, jsonable
 from ...workers import one_blas_thread
@@ -265,29 +263,39 @@ def fits(runs):
     return out
 
 
-def run(s, workers=None, log=True, bench=None):
+def run(s, workers=None, log=True, bench=None, store=OFF):
     """Run the study with settings ``s``: the metrics document (runs, fits, references,
     effective elasticity, accuracy per cost from the ``bench`` document). ``workers`` (a
     started cases.workers.Workers) runs the (problem, bc) units side by side; the results do
-    not depend on it (one BLAS thread everywhere)."""
+    not depend on it (one BLAS thread everywhere). ``store`` gives the (problem, bc) units
+    and the elasticity table it has, and keeps those computed."""
     jobs = [(name, bc, s) for name in s.problems for bc in PROBLEMS[name].bcs]
+    keys = [key(kind="convergence", problem=name, bc=bc, **s.describe()) for name, bc, _ in jobs]
     weights = [_weights(name, s) for name, _, _ in jobs]
     elastic_weight = 0.05 * sum(sum(w.values()) for w in weights)
-    results = [None] * len(jobs)
-    with Tracker(log, sum(sum(w.values()) for w in weights) + elastic_weight) as track:
+    results = [store.get(k) for k in keys]
+    todo = [i for i, r in enumerate(results) if r is None]
+    with Progress("convergence", sum(sum(w.values()) for w in weights) + elastic_weight,
+                  log=log, width=36) as track:
+        for i in set(range(len(jobs))) - set(todo):
+            track.advance(sum(weights[i].values()), f"{jobs[i][0]} {jobs[i][1]}: stored")
         if workers is None:
             with one_blas_thread():
-                for i, job in enumerate(jobs):
+                for i in todo:
                     stop.checkpoint()
-                    results[i] = problem_unit(job, lambda fam, i=i: track.advance(
-                        weights[i][fam], f"{jobs[i][0]} {jobs[i][1]} {fam}"))
+                    results[i] = store.put(keys[i], problem_unit(
+                        jobs[i], lambda fam, i=i: track.advance(
+                            weights[i][fam], f"{jobs[i][0]} {jobs[i][1]} {fam}")))
         else:
-            for i, result in workers.unordered(_unit_in_worker, list(enumerate(jobs))):
+            for i, result in workers.unordered(_unit_in_worker, [(i, jobs[i]) for i in todo]):
                 stop.checkpoint()
-                results[i] = result
+                results[i] = store.put(keys[i], result)
                 track.advance(sum(weights[i].values()), f"{jobs[i][0]} {jobs[i][1]}")
-        with one_blas_thread():
-            eff = elasticity.table(s)
+        elastic_key = key(kind="convergence-elasticity", **s.describe())
+        eff = store.get(elastic_key)
+        if eff is None:
+            with one_blas_thread():
+                eff = store.put(elastic_key, elasticity.table(s))
         track.advance(elastic_weight, "effective elasticity")
     runs = [r for _, rows in results for r in rows]
     data = {"runs": runs, "fits": fits(runs), "references": [ref for ref, _ in results],
@@ -295,37 +303,5 @@ def run(s, workers=None, log=True, bench=None):
     return jsonable(data)
 
 
-class Tracker:
-    """Progress with the time left: a rich bar on a terminal, else one line per finished
-    unit on stderr (a log, CI). The time left assumes the rest goes at the pace so far,
-    measured in expected work (``advance``'s weights), not in units."""
-
-    def __init__(self, log, total):
-        self.log, self.total, self.done = log, float(total), 0.0
-        self.tty = log and sys.stderr.isatty()
-        self.bar = Progress(TextColumn("{task.description:<36}"), BarColumn(),
-                            TextColumn("{task.percentage:>3.0f}%"), TimeElapsedColumn(),
-                            TextColumn("left"), TimeRemainingColumn(),
-                            console=Console(stderr=True), disable=not self.tty)
-
-    def __enter__(self):
-        self.t0 = time.perf_counter()
-        self.bar.__enter__()
-        self.task = self.bar.add_task("convergence", total=self.total)
-        return self
-
-    def __exit__(self, *exc):
-        return self.bar.__exit__(*exc)
-
-    def advance(self, work, text):
-        self.done += work
-        self.bar.update(self.task, completed=self.done, description=text)
-        if self.log and not self.tty:
-            elapsed = time.perf_counter() - self.t0
-            left = elapsed * (self.total - self.done) / max(self.done, 1e-12)
-            print(f"convergence: {text} done; {self.done / self.total:.0%} after "
-                  f"{elapsed:.0f} s, about {left:.0f} s left", file=sys.stderr, flush=True)
-
-
 __all__ = ["ConvergenceSettings", "run", "fits", "levels", "solve_reference", "family_runs",
-           "problem_unit", "FEM_P1", "Tracker"]
+           "problem_unit", "FEM_P1"]

@@ -7,6 +7,7 @@ its effective elasticity from the isotropic target.
 from dataclasses import fields
 
 from ...framework import Study
+from ...store import OFF
 from . import report
 from .study import RUN_KEYS, ExtensionSettings, run
 
@@ -22,8 +23,8 @@ class Extensions(Study):
         return ExtensionSettings(**{k: v for k, v in {**kw, "quick": quick}.items()
                                     if k in names})
 
-    def run(self, s, workers=None, log=True, bench=None):
-        return run(s, workers=workers, log=log, bench=bench)
+    def run(self, s, workers=None, log=True, bench=None, store=None):
+        return run(s, workers=workers, log=log, bench=bench, store=store or OFF)
 
     def write(self, out, s, data):
         return report.write(out, self, s, data)

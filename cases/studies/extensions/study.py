@@ -1,10 +1,12 @@
 """The extensions study's runs: the library's cases and the convergence study with the
 candidate models, reduced to what the rankings read."""
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 from model import Material
 from model.candidates import BASE, CANDIDATES, NORMAL_FORMS, short  # noqa: F401 (the study's names)
+from ...catalogue import STATIC, err_name
 from ...costs import step_cost_us
+from ...store import OFF
 from ...registry import studies
 from ...runner import jsonable, run as run_case
 
@@ -60,13 +62,19 @@ class ExtensionSettings:
                 "cases": list(self.case_settings())}
 
 
+def static_headline(case):
+    """True when the case's headline comes from its static problem (a standard metric or the
+    error of a quantity of interest), so that the dynamics and modes can be skipped."""
+    return case.headline in STATIC or case.headline in {err_name(q) for q in case.qoi_errors}
+
+
 def case_row(case, r):
     """What the rankings read of one case run."""
     failed = r.get("failed") or r.get("static_failed")
     info = r.get("model_info") or {}
     return {"case": case.name, "mesh": r["mesh"], "bc": r["bc"], "model": r["model"],
-            "metric": case.headline.metric, "error": None if failed else r.get(
-                case.headline.metric), "failed": failed,
+            "metric": case.headline, "error": None if failed else r.get(case.headline),
+            "failed": failed,
             "zigzag": r.get("zigzag"), "zigzag_fem": r.get("zigzag_fem"),
             "dropped": info.get("calibration_dropped", [])}
 
@@ -86,14 +94,19 @@ def costs(bench, models):
 RUN_KEYS = ("case_runs", "fits", "elasticity", "cost_vs_fem_linear", "cost_same_terms")
 
 
-def run(s, workers=None, log=True, bench=None):
-    """Every case with the study's models, then the convergence study with them."""
+def run(s, workers=None, log=True, bench=None, store=OFF):
+    """Every case with the study's models, then the convergence study with them. The models
+    the cases ran already (the paper's model, fem-linear) come from ``store``; a case whose
+    headline is a static metric runs its static problem only (no dynamics, no modes: no
+    ranking reads them)."""
     from ...registry import CASES
     rows = []
     for name, cfg in s.case_settings().items():
-        runs, _ = run_case(CASES[name], cfg, workers=workers)
+        cfg = replace(cfg, static_only=static_headline(CASES[name]))
+        runs, _ = run_case(CASES[name], cfg, workers=workers, store=store, reuse_full=True)
         rows += [case_row(CASES[name], r) for r in runs]
-    conv = studies()["convergence"].run(s.convergence_settings(), workers=workers, log=log, bench=None)
+    conv = studies()["convergence"].run(s.convergence_settings(), workers=workers, log=log,
+                                        bench=None, store=store)
     return jsonable({"case_runs": rows, "fits": conv["fits"], "elasticity": [
         {k: e.get(k) for k in ("model", "mesh", "distance", "anisotropy_AU", "E_x", "nu_xy",
                                "G_xy", "failed")} for e in conv["elasticity"]],

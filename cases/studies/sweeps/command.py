@@ -7,6 +7,7 @@ from pathlib import Path
 from model import PbcmError
 from ...output import SWEEP_MARK as MARK, OutputError, owned, writable_folder, write_atomic
 from ...registry import CASES
+from ...store import RunStore
 from . import SHIPPED
 from . import engine, report, spec as specs, table
 
@@ -54,7 +55,8 @@ def run(args):
          "quick": spec.quick, "static_only": spec.static_only, "fixed": spec.fixed,
          "axes": spec.axes, "metrics": list(spec.metrics)}, indent=1) + "\n")
     outcome = engine.run(spec, CASES, out, scheduler=args.scheduler, workers=args.workers,
-                         serial=args.serial, retry_failed=args.retry_failed)
+                         serial=args.serial, retry_failed=args.retry_failed,
+                         store=RunStore(enabled=not args.no_cache))
     first = engine.PARAMS + ("run_key", "status", "error") + tuple(spec.fixed)
     path_table = table.write(outcome.rows, out, spec.table, first)
     for other in ("table.csv", "table.parquet"):      # one table: the other is an old one

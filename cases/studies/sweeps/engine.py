@@ -1,25 +1,21 @@
-"""Running a sweep: every unit not yet finished goes to dask.distributed as one task (a
-LocalCluster by default, or the cluster at ``scheduler``), or runs in this process
+"""Running a sweep: every unit not yet finished goes to the one executor as one task (local
+worker processes by default, or the Dask cluster at ``scheduler``), or runs in this process
 (``serial``). The parent alone writes files, so remote workers need no shared disk: each
 finished run is stored at once (a sweep stopped anywhere resumes where it stopped), and the
 table and report are drawn from the stored runs in the spec's order (so they do not depend on
 which worker finished first).
 
-A worker that dies mid-task (killed, out of memory) loses its tasks to the scheduler, which
-runs them again elsewhere (up to ``distributed.scheduler.allowed-failures`` times, 3 by
-default). A task that exhausts them is recorded as failed for this sweep but not stored: a
+A worker that dies mid-task (killed, out of memory) does not lose its task: it runs again
+on another worker (Dask: up to ``distributed.scheduler.allowed-failures`` times, 3 by default;
+local: ``cases.workers.RETRIES``). A task that exhausts them is recorded as failed for this sweep but not stored: a
 rerun tries it again.
 """
-import logging
-import sys
-import time
 from dataclasses import dataclass, field, replace
+from functools import partial
 
-from rich.console import Console
-from rich.progress import BarColumn, Progress, TextColumn, TimeElapsedColumn, TimeRemainingColumn
-
-from model import PbcmError
-from ...workers import available_cores
+from ...progress import Progress
+from ...store import OFF
+from ...workers import SchedulerError, executor
 from .spec import NUMERIC_AXES
 from .table import RunStore
 from .task import run_unit
@@ -27,11 +23,6 @@ from .task import run_unit
 PARAMS = ("case", "mesh", "bc", "model") + NUMERIC_AXES
 # run entries that are the row's parameters already, or folded into status and error
 RUN_SKIP = {"mesh", "bc", "model", "failed", "static_failed"}
-CONNECT_TIMEOUT_S = 10
-
-
-class SchedulerError(PbcmError):
-    """The scheduler given cannot be reached: it names the address and what to do."""
 
 
 @dataclass
@@ -97,57 +88,52 @@ def plan(spec, registry, store, retry_failed=False):
 
 
 def run(spec, registry, out, scheduler=None, workers=None, serial=False, retry_failed=False,
-        log=True):
-    """Run the sweep ``spec`` into the folder ``out``; return its Outcome."""
-    store = RunStore(out)
-    units, todo = plan(spec, registry, store, retry_failed)
+        log=True, store=OFF):
+    """Run the sweep ``spec`` into the folder ``out``; return its Outcome. The units go to
+    the one executor (``cases.workers``): local processes, the Dask cluster at
+    ``scheduler``, or this process (``serial``); each model's run is taken from ``store`` (the
+    run store) where a case or an earlier sweep computed it."""
+    table = RunStore(out)
+    units, todo = plan(spec, registry, table, retry_failed)
     total = sum(len(u.models) for u in todo)
     lost = {}
     outcome = Outcome(rows=[])
-    console = Console(stderr=True)
-    tty = sys.stderr.isatty()
-    if log:
+    with Progress("sweep", total, log=log) as bar:
         n = sum(len(u.models) for u in units)
-        console.print(f"sweep: {n} runs: {total} to compute, {n - total} found in "
-                      f"{store.folder}")
-    t0, said = time.perf_counter(), [0]
-    with Progress(TextColumn("{task.description:<48}"), BarColumn(),
-                  TextColumn("{task.completed}/{task.total} runs"), TimeElapsedColumn(),
-                  TextColumn("left"), TimeRemainingColumn(), console=console,
-                  disable=not (log and tty)) as bar:
-        task = bar.add_task("sweep", total=total)
+        bar.say(f"sweep: {n} runs: {total} to compute, {n - total} found in {table.folder}")
 
         def finished(unit, result):
             runs, wall = result
             params = parameters(unit, registry)
             for r in runs:
                 key = unit.run_key(r["model"])
-                store.put(key, row(params, r, key, wall))
+                table.put(key, row(params, r, key, wall))
             outcome.computed += len(runs)
-            bar.update(task, advance=len(runs),
-                       description=f"{unit.case} {unit.mesh}/{unit.bc} "
-                       + " ".join(f"{k}={v:g}" for k, v in unit.point.items()))
-            done = outcome.computed
-            if log and not tty and 10 * done // total > said[0]:   # a log: every tenth
-                said[0] = 10 * done // total
-                spent = time.perf_counter() - t0
-                console.print(f"sweep: {done}/{total} runs in {spent:.0f} s, about "
-                              f"{spent / done * (total - done):.0f} s left")
+            bar.advance(len(runs), f"{unit.case} {unit.mesh}/{unit.bc} "
+                        + " ".join(f"{k}={v:g}" for k, v in unit.point.items()))
 
-        if todo and serial:
+        ex = None if serial or not todo else executor(scheduler, workers, len(todo))
+        if ex is None:
             for u in todo:
-                finished(u, run_unit(u))
-        elif todo:
-            with _client(scheduler, workers, log) as client:
-                outcome.dashboard = client.dashboard_link
-                if log:
-                    console.print(f"Dask dashboard: {client.dashboard_link}")
-                _distribute(client, todo, finished, lost)
+                finished(u, run_unit(u, store))
+        else:
+            with ex:
+                outcome.dashboard = ex.dashboard
+                if ex.dashboard:
+                    bar.say(f"Dask dashboard: {ex.dashboard}")
+                for i, error, result in ex.outcomes(partial(run_unit, store=store), todo):
+                    if error is None:
+                        finished(todo[i], result)
+                        continue
+                    for m in todo[i].models:   # the task, not the run, failed: no worker
+                        lost[todo[i].run_key(m)] = (  # could finish it
+                            f"worker: the task could not be finished ({type(error).__name__}: "
+                            f"{error}); rerun the sweep to try it again")
     for u in units:
         params = parameters(u, registry)
         for m in u.models:
             key = u.run_key(m)
-            r = store.get(key)
+            r = table.get(key)
             if r is None:
                 r = row(params, {"model": m, "failed": lost[key]}, key, None)
                 outcome.lost += 1
@@ -155,63 +141,6 @@ def run(spec, registry, out, scheduler=None, workers=None, serial=False, retry_f
     outcome.found = len(outcome.rows) - outcome.computed - outcome.lost
     outcome.failed = [r for r in outcome.rows if r["status"] == "failed"]
     return outcome
-
-
-def _distribute(client, todo, finished, lost):
-    """Every unit of ``todo`` as a task on ``client``; ``finished(unit, result)`` as each
-    comes back. A task no worker could finish (KilledWorker) is noted in ``lost``."""
-    from distributed import as_completed
-    futures = {}
-    for i, u in enumerate(todo):
-        key = f"pbcm-sweep-{i}-{u.run_key(u.models[0])}"
-        futures[client.submit(run_unit, u, key=key, pure=False)] = u
-    try:
-        for fut in as_completed(futures):
-            u = futures[fut]
-            try:
-                result = fut.result()
-            except Exception as exc:   # the task, not the run, failed: a worker died
-                for m in u.models:
-                    lost[u.run_key(m)] = (f"worker: the task could not be finished "
-                                          f"({type(exc).__name__}: {exc}); rerun the sweep "
-                                          "to try it again")
-                continue
-            finished(u, result)
-    finally:
-        for fut in futures:
-            fut.cancel()
-
-
-class _client:
-    """A dask.distributed Client: on the scheduler at ``address``, or on a LocalCluster of
-    ``workers`` processes (one thread each), closed on leaving the block."""
-
-    def __init__(self, address, workers, log):
-        self.address, self.workers, self.log = address, workers, log
-        self.cluster = self.client = None
-
-    def __enter__(self):
-        from distributed import Client, LocalCluster
-        if self.address:
-            try:
-                self.client = Client(self.address, timeout=f"{CONNECT_TIMEOUT_S}s")
-            except (OSError, TimeoutError) as exc:
-                raise SchedulerError(
-                    f"--scheduler {self.address}: no Dask scheduler answers there ({exc}); "
-                    "start one with `dask scheduler` and workers with `dask worker "
-                    f"{self.address}` (README, 'Sweeps on a cluster')") from None
-            return self.client
-        self.cluster = LocalCluster(n_workers=self.workers or available_cores(),
-                                    threads_per_worker=1, processes=True,
-                                    silence_logs=logging.ERROR)
-        self.client = Client(self.cluster)
-        return self.client
-
-    def __exit__(self, *exc):
-        if self.client is not None:
-            self.client.close()
-        if self.cluster is not None:
-            self.cluster.close()
 
 
 __all__ = ["run", "plan", "row", "parameters", "Outcome", "SchedulerError", "PARAMS"]

@@ -6,12 +6,13 @@ import time
 
 from ... import runner
 from ...registry import CASES
+from ...store import OFF
 from ...workers import one_blas_thread
 
 
-def run_unit(unit):
+def run_unit(unit, store=OFF):
     """``(runs, wall)``: the runner's run dicts of ``unit`` (one per model, failures
-    included) and the task's wall time [s]."""
+    included; from the run store ``store`` where it has them) and the task's wall time [s]."""
     t0 = time.perf_counter()
     case = CASES[unit.case]
     try:
@@ -22,7 +23,7 @@ def run_unit(unit):
     else:
         with one_blas_thread():
             try:
-                runs, _ = runner.unit(case, s, unit.mesh, unit.bc)
+                runs, _ = runner.unit(case, s, unit.mesh, unit.bc, store=store)
             except Exception as exc:  # beyond the runner's findings: recorded all the same
                 runs = runner.failed_runs(unit.mesh, unit.bc, unit.models, "error",
                                           f"{type(exc).__name__}: {exc}")

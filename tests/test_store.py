@@ -1,0 +1,163 @@
+"""The run store (issue 24): a second run on an unchanged checkout computes nothing and writes
+the same files; a change to any source file of the package misses every entry; a run killed
+while writing leaves no entry a later run trusts; a static-only study run takes the rows of
+the cases' full runs."""
+import filecmp
+import os
+import shutil
+import subprocess
+import sys
+import textwrap
+from pathlib import Path
+
+import pytest
+
+from cases import runner, store as S
+from cases.cli import main
+from cases.registry import CASES
+
+ROOT = Path(__file__).resolve().parents[1]
+SMALL = ["--quick", "--meshes", "five", "--bcs", "clamped", "--models", "pbcm-variational",
+         "msm"]
+
+
+@pytest.fixture
+def cache(tmp_path, monkeypatch):
+    """The store on, in a folder of this test's own."""
+    monkeypatch.delenv(S.ENV_OFF, raising=False)
+    monkeypatch.setenv(S.ENV, str(tmp_path / "cache"))
+    return tmp_path / "cache"
+
+
+def _refuse(*args, **kw):
+    raise AssertionError("computed although every result is stored")
+
+
+def test_a_second_run_computes_nothing_and_writes_the_same_files(cache, tmp_path,
+                                                                 monkeypatch):
+    assert main(["run", "cantilever", *SMALL, "--out", str(tmp_path / "first")]) == 0
+    assert any(cache.iterdir())
+    monkeypatch.setattr(runner, "_compute", _refuse)
+    assert main(["run", "cantilever", *SMALL, "--out", str(tmp_path / "second")]) == 0
+    monkeypatch.undo()
+    # and a run that computes everything afresh writes the same bytes
+    monkeypatch.setenv(S.ENV_OFF, "1")
+    assert main(["run", "cantilever", *SMALL, "--out", str(tmp_path / "fresh"),
+                 "--no-cache"]) == 0
+    for name in ("metrics.json", "report.md", "errors.png"):
+        assert filecmp.cmp(tmp_path / "first" / name, tmp_path / "second" / name,
+                           shallow=False), name
+        assert filecmp.cmp(tmp_path / "fresh" / name, tmp_path / "second" / name,
+                           shallow=False), name
+
+
+def test_no_cache_neither_reads_nor_fills_the_store(cache, tmp_path, monkeypatch):
+    assert main(["run", "cantilever", *SMALL, "--out", str(tmp_path / "a"), "--no-cache"]) == 0
+    assert not cache.exists() or not any(cache.iterdir())
+    s = CASES["cantilever"].settings(quick=True, meshes=("five",), bcs=("clamped",),
+                                     models=("msm",))
+    store = S.RunStore(cache)
+    runner.run(CASES["cantilever"], s, log=False, store=store)
+    assert store.kept == 2 and store.found == 0            # the run and the references
+    calls = []
+    monkeypatch.setattr(runner, "_compute", lambda *a, **k: calls.append(a) or _refuse())
+    with pytest.raises(AssertionError, match="computed"):
+        runner.run(CASES["cantilever"], s, log=False, store=S.RunStore(cache, enabled=False))
+    assert calls
+
+
+def test_a_static_only_run_reuses_the_full_runs_and_computes_only_the_new_model(
+        cache, monkeypatch):
+    case = CASES["cantilever"]
+    full = case.settings(quick=True, meshes=("five",), bcs=("clamped",),
+                         models=("pbcm-variational",))
+    store = S.RunStore(cache)
+    [done], _ = runner.run(case, full, log=False, store=store)
+    ran = []
+    real = runner.model_run
+    monkeypatch.setattr(runner, "model_run",
+                        lambda case, mesh_name, mesh, bc, model, s, ref:
+                        ran.append(model) or real(case, mesh_name, mesh, bc, model, s, ref))
+    static = case.settings(quick=True, meshes=("five",), bcs=("clamped",),
+                           models=("pbcm-variational", "msm"), static_only=True)
+    runs, _ = runner.run(case, static, log=False, store=store, reuse_full=True)
+    assert ran == ["msm"]
+    assert runs[0] == done
+    # without reuse_full a static-only run is its own result
+    ran.clear()
+    runner.run(case, static, log=False, store=S.RunStore(cache), reuse_full=False)
+    assert ran == ["pbcm-variational"]
+
+
+def _tree(tmp_path):
+    root = tmp_path / "checkout"
+    for package in S.PACKAGES:
+        shutil.copytree(ROOT / package, root / package,
+                        ignore=shutil.ignore_patterns("__pycache__"))
+    return root
+
+
+@pytest.mark.parametrize("edited", ["model/terms/shear.py", "reference/linear.py",
+                                    "cases/runner.py", "cases/studies/sweeps/nu.toml"])
+def test_a_change_to_any_source_file_misses_every_entry(tmp_path, edited):
+    root = _tree(tmp_path)
+    before = S.source_hash(root)
+    path = root / edited
+    path.write_text(path.read_text() + "\n# an edit\n")
+    assert S.source_hash(root) != before
+    path.write_text(path.read_text().removesuffix("\n# an edit\n"))
+    assert S.source_hash(root) == before          # the same source, the same key
+
+
+def test_keys_depend_on_what_determines_a_result():
+    base = dict(kind="run", case="cantilever", mesh="five", bc="clamped", model="msm",
+                E_Pa=10e3)
+    k = S.key(**base)
+    assert S.key(**base) == k
+    for change in ({"mesh": "six"}, {"bc": "sliding"}, {"model": "pbcm-variational"},
+                   {"E_Pa": 11e3}, {"kind": "reference-fields"}):
+        assert S.key(**{**base, **change}) != k, change
+
+
+KILLED = textwrap.dedent("""
+    import sys, time
+    import diskcache.core
+    from cases.store import RunStore
+    real = diskcache.core.Disk.store
+    def store_then_hang(self, value, read, key=diskcache.core.UNKNOWN):
+        out = real(self, value, read, key)      # the value's file is on disk ...
+        print("written", flush=True)
+        time.sleep(600)                         # ... and the entry not committed yet
+        return out
+    diskcache.core.Disk.store = store_then_hang
+    RunStore(sys.argv[1]).put("the-key", {"rows": list(range(100000))})
+""")
+
+
+def test_a_run_killed_while_writing_leaves_no_entry(cache):
+    folder = cache
+    env = {k: v for k, v in os.environ.items() if k != S.ENV_OFF}
+    env["PYTHONPATH"] = str(ROOT)
+    p = subprocess.Popen([sys.executable, "-c", KILLED, str(folder)], stdout=subprocess.PIPE,
+                         env=env, text=True)
+    try:
+        assert p.stdout.readline().strip() == "written"
+    finally:
+        p.kill()
+        p.wait()
+    assert p.returncode != 0
+    assert any(f.is_file() for f in folder.rglob("*.val"))   # the orphaned value's file
+    s = S.RunStore(folder)
+    assert s.enabled
+    assert s.get("the-key") is None                           # ... is trusted by no one
+    s.put("the-key", [1, 2])
+    assert S.RunStore(folder).get("the-key") == [1, 2]
+
+
+def test_the_store_folder_follows_the_environment(monkeypatch, tmp_path):
+    monkeypatch.setenv(S.ENV, str(tmp_path / "here"))
+    assert S.default_folder() == tmp_path / "here"
+    monkeypatch.delenv(S.ENV)
+    assert "pbcm" in str(S.default_folder())
+    monkeypatch.setenv(S.ENV_OFF, "1")
+    assert not S.RunStore(tmp_path).enabled
