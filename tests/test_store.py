@@ -37,9 +37,9 @@ def test_a_second_run_computes_nothing_and_writes_the_same_files(cache, tmp_path
                                                                  monkeypatch):
     assert main(["run", "cantilever", *SMALL, "--out", str(tmp_path / "first")]) == 0
     assert any(cache.iterdir())
-    monkeypatch.setattr(runner, "_compute", _refuse)
-    assert main(["run", "cantilever", *SMALL, "--out", str(tmp_path / "second")]) == 0
-    monkeypatch.undo()
+    with monkeypatch.context() as m:
+        m.setattr(runner, "_compute", _refuse)
+        assert main(["run", "cantilever", *SMALL, "--out", str(tmp_path / "second")]) == 0
     # and a run that computes everything afresh writes the same bytes
     monkeypatch.setenv(S.ENV_OFF, "1")
     assert main(["run", "cantilever", *SMALL, "--out", str(tmp_path / "fresh"),
@@ -161,3 +161,34 @@ def test_the_store_folder_follows_the_environment(monkeypatch, tmp_path):
     assert "pbcm" in str(S.default_folder())
     monkeypatch.setenv(S.ENV_OFF, "1")
     assert not S.RunStore(tmp_path).enabled
+
+
+def test_a_study_run_again_computes_nothing(cache, monkeypatch):
+    """The convergence study's runs, its reference and its elasticity entries come from the
+    store the second time, equal to the first; a model added later is the only thing
+    computed (the extensions study's case: the P2 reference ladder is not solved again)."""
+    from cases.registry import studies
+    from cases.studies.convergence import elasticity, study as conv
+    st = studies()["convergence"]
+    s = st.settings(quick=True, problems=("cantilever",), meshes=("five",), models=("msm",),
+                    h_mm=(8.0, 4.0), patch_n=3)
+    first = st.run(s, log=False, store=S.RunStore(cache))
+    with monkeypatch.context() as m:
+        m.setattr(conv, "solve_reference", _refuse)
+        m.setattr(conv, "build", _refuse)
+        m.setattr(conv.linear, "solve", _refuse)
+        m.setattr(elasticity, "entry", _refuse)
+        again = S.RunStore(cache)
+        assert st.run(s, log=False, store=again) == first
+    assert again.kept == 0
+    assert again.found == len(first["runs"]) + 1 + len(first["elasticity"])
+    monkeypatch.setattr(conv, "solve_reference", _refuse)
+    built = []
+    real = conv.build
+    monkeypatch.setattr(conv, "build", lambda name, *a: built.append(name) or real(name, *a))
+    more = st.run(st.settings(quick=True, problems=("cantilever",), meshes=("five",),
+                              models=("msm", "pbcm-variational"), h_mm=(8.0, 4.0), patch_n=3),
+                  log=False, store=S.RunStore(cache))
+    assert set(built) == {"pbcm-variational"}
+    old = [r for r in more["runs"] if r["model"] != "pbcm-variational"]
+    assert old == first["runs"]

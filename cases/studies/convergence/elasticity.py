@@ -9,6 +9,7 @@ from model.homogenize import (anisotropy_index, asymmetry, directional_young, di
 from model.mesh import cube
 from ... import stop
 from ...runner import FINDINGS
+from ...store import OFF, key
 
 PATCH_MM = 32.0
 # directions of the directional Young's modulus figure: the x-y plane, every 5 degrees
@@ -40,17 +41,24 @@ def entry(model_name, family, s):
                 C, np.column_stack([np.cos(theta), np.sin(theta), 0 * theta])).tolist()}
 
 
-def table(s):
-    """Every (model, lattice) entry; a model whose patch stiffness is singular (no interior
-    equilibrium) is recorded with the reason."""
+def table(s, store=OFF):
+    """Every (model, lattice) entry, each from the run store ``store`` where kept; a model
+    whose patch stiffness is singular (no interior equilibrium) is recorded with the
+    reason."""
     out = []
     for family in s.meshes:
         for name in s.models:
             stop.checkpoint()
-            try:
-                out.append(entry(name, family, s))
-            except FINDINGS as exc:
-                out.append({"model": name, "mesh": family, "failed": str(exc)})
+            k = key(kind="elasticity", model=name, mesh=family, E_Pa=s.E, nu=s.nu,
+                    rho_kg_m3=s.rho, patch_n=s.patch_n)
+            found = store.get(k)
+            if found is None:
+                try:
+                    found = entry(name, family, s)
+                except FINDINGS as exc:
+                    found = {"model": name, "mesh": family, "failed": str(exc)}
+                store.put(k, found)
+            out.append(found)
     return out
 
 

@@ -157,27 +157,37 @@ def solve_reference(problem, bc, s):
 
 
 # ---------------------------------------------------------------------- one (problem, bc, family)
-def family_runs(problem, bc, family, s, ref, hs):
-    """The runs of every model and of FEM P1 on ``family`` at each of ``hs``."""
+def family_runs(problem, bc, family, s, ref, hs, store=OFF):
+    """The runs of every model and of FEM P1 on ``family`` at each of ``hs``; each row taken
+    from ``store`` where it is kept, the mesh and the reference touched only for the rest."""
     rows = []
     ps = problem.settings(s.E, s.nu)
+    names = (FEM_P1,) + tuple(s.models)
     for h in hs:
         stop.checkpoint()
+        keys = {m: key(kind="convergence-run", **ref.what, mesh=family, level_mm=float(h), model=m)
+                for m in names}
+        found = {m: store.get(k) for m, k in keys.items()}
+        if all(v is not None for v in found.values()):
+            rows += [found[m] for m in names]
+            continue
         mesh = problem.mesh(family, h)
         dirichlet = problem.dirichlet(mesh, bc, ps, s.load_scale)
         loads = problem.loads(mesh, bc, ps, s.load_scale)
-        u_ref = ref.at(mesh.points)
+        u_ref = ref.at_mesh(family, h, mesh.points)
         fem = (ref.response if problem.reference_on_reference_mesh()
                else problem.response_value(mesh, u_ref, None, bc, ps))
         base = {"case": problem.case, "mesh": family, "bc": bc, "h_mm": float(h),
                 "nodes": mesh.n_nodes, "tets": mesh.n_tets, "response_fem": fem}
-        p1 = linear.solve(mesh, s.E, s.nu, dirichlet, element="P1",
-                          solver=problem.spec.fem_solver,
-                          **_fem_loads(loads, mesh))
-        rows.append({**base, "model": FEM_P1, **_metrics(problem, mesh, bc, ps, p1.u,
-                                                         p1.reaction, u_ref, fem)})
+        if found[FEM_P1] is None:
+            p1 = linear.solve(mesh, s.E, s.nu, dirichlet, element="P1",
+                              solver=problem.spec.fem_solver, **_fem_loads(loads, mesh))
+            found[FEM_P1] = store.put(keys[FEM_P1], {**base, "model": FEM_P1, **_metrics(
+                problem, mesh, bc, ps, p1.u, p1.reaction, u_ref, fem)})
         f_ext = loads.nodal_forces(mesh)
         for name in s.models:
+            if found[name] is not None:
+                continue
             stop.checkpoint()
             row = {**base, "model": name, "failed": None}
             try:
@@ -187,8 +197,47 @@ def family_runs(problem, bc, family, s, ref, hs):
             except FINDINGS as exc:     # a model without equilibrium here: a finding
                 row.update(failed=str(exc), disp_rel_l2=None, reaction_ratio=None,
                            reaction_rel_err=None, response=None)
-            rows.append(row)
+            found[name] = store.put(keys[name], row)
+        rows += [found[m] for m in names]
     return rows
+
+
+class StoredReference:
+    """The reference of one (problem, bc) as the runs read it: its values at a family mesh's
+    nodes (``at_mesh``), its ``response`` and ``summary()``, each taken from ``store`` where
+    kept; the P2 ladder is solved only when something asked for is not (its solutions are
+    too large to keep: 150 MB for the cantilever)."""
+
+    def __init__(self, problem, bc, s, store=OFF):
+        self.problem, self.bc, self.s, self.store = problem, bc, s, store
+        self.what = {"problem": problem.case, "bc": bc,
+                     **{k: v for k, v in s.problem().items()}}
+        self._solved = self._meta = None
+
+    def solved(self):
+        if self._solved is None:
+            self._solved = solve_reference(self.problem, self.bc, self.s)
+        return self._solved
+
+    def _kept(self):
+        if self._meta is None:
+            k = key(kind="convergence-reference", **self.what)
+            self._meta = self.store.get(k) or self.store.put(k, {
+                "summary": self.solved().summary(), "response": self.solved().response})
+        return self._meta
+
+    @property
+    def response(self):
+        return self._kept()["response"]
+
+    def summary(self):
+        return self._kept()["summary"]
+
+    def at_mesh(self, family, h, points):
+        """The reference at the nodes ``points`` of the ``family`` mesh of size ``h``."""
+        k = key(kind="convergence-reference-at", **self.what, mesh=family, level_mm=float(h))
+        found = self.store.get(k)
+        return found if found is not None else self.store.put(k, self.solved().at(points))
 
 
 def _fem_loads(loads, mesh):
@@ -206,15 +255,16 @@ def _metrics(problem, mesh, bc, ps, u, reaction, u_ref, fem):
 
 
 def problem_unit(job, step=None):
-    """One (problem, bc): its reference, then every family at its levels. ``step(family)`` is
-    called as each family finishes. Returns (reference summary, runs)."""
-    name, bc, s = job
+    """One (problem, bc): its reference, then every family at its levels, each piece from
+    the run store where kept. ``step(family)`` is called as each family finishes. Returns
+    (reference summary, runs)."""
+    name, bc, s, store = job
     problem = PROBLEMS[name]
     hs = {fam: levels(problem, fam, s) for fam in s.meshes}
-    ref = solve_reference(problem, bc, s)
+    ref = StoredReference(problem, bc, s, store)
     rows = []
     for fam in s.meshes:
-        rows += family_runs(problem, bc, fam, s, ref, hs[fam])
+        rows += family_runs(problem, bc, fam, s, ref, hs[fam], store)
         if step:
             step(fam)
     return ref.summary(), rows
@@ -269,33 +319,25 @@ def run(s, workers=None, log=True, bench=None, store=OFF):
     started cases.workers.Workers) runs the (problem, bc) units side by side; the results do
     not depend on it (one BLAS thread everywhere). ``store`` gives the (problem, bc) units
     and the elasticity table it has, and keeps those computed."""
-    jobs = [(name, bc, s) for name in s.problems for bc in PROBLEMS[name].bcs]
-    keys = [key(kind="convergence", problem=name, bc=bc, **s.describe()) for name, bc, _ in jobs]
-    weights = [_weights(name, s) for name, _, _ in jobs]
+    jobs = [(name, bc, s, store) for name in s.problems for bc in PROBLEMS[name].bcs]
+    weights = [_weights(name, s) for name, *_ in jobs]
     elastic_weight = 0.05 * sum(sum(w.values()) for w in weights)
-    results = [store.get(k) for k in keys]
-    todo = [i for i, r in enumerate(results) if r is None]
+    results = [None] * len(jobs)
     with Progress("convergence", sum(sum(w.values()) for w in weights) + elastic_weight,
                   log=log, width=36) as track:
-        for i in set(range(len(jobs))) - set(todo):
-            track.advance(sum(weights[i].values()), f"{jobs[i][0]} {jobs[i][1]}: stored")
         if workers is None:
             with one_blas_thread():
-                for i in todo:
+                for i, job in enumerate(jobs):
                     stop.checkpoint()
-                    results[i] = store.put(keys[i], problem_unit(
-                        jobs[i], lambda fam, i=i: track.advance(
-                            weights[i][fam], f"{jobs[i][0]} {jobs[i][1]} {fam}")))
+                    results[i] = problem_unit(job, lambda fam, i=i: track.advance(
+                        weights[i][fam], f"{jobs[i][0]} {jobs[i][1]} {fam}"))
         else:
-            for i, result in workers.unordered(_unit_in_worker, [(i, jobs[i]) for i in todo]):
+            for i, result in workers.unordered(_unit_in_worker, list(enumerate(jobs))):
                 stop.checkpoint()
-                results[i] = store.put(keys[i], result)
+                results[i] = result
                 track.advance(sum(weights[i].values()), f"{jobs[i][0]} {jobs[i][1]}")
-        elastic_key = key(kind="convergence-elasticity", **s.describe())
-        eff = store.get(elastic_key)
-        if eff is None:
-            with one_blas_thread():
-                eff = store.put(elastic_key, elasticity.table(s))
+        with one_blas_thread():
+            eff = elasticity.table(s, store)
         track.advance(elastic_weight, "effective elasticity")
     runs = [r for _, rows in results for r in rows]
     data = {"runs": runs, "fits": fits(runs), "references": [ref for ref, _ in results],
@@ -304,4 +346,4 @@ def run(s, workers=None, log=True, bench=None, store=OFF):
 
 
 __all__ = ["ConvergenceSettings", "run", "fits", "levels", "solve_reference", "family_runs",
-           "problem_unit", "FEM_P1"]
+           "problem_unit", "StoredReference", "FEM_P1"]
