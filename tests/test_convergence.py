@@ -151,13 +151,20 @@ def test_quick_study_passes_the_committed_bounds(study, capsys):
     assert status == 0, capsys.readouterr().out[-3000:]
 
 
-def test_study_progress_says_the_time_left(study, capsys):
-    """A log (not a terminal) gets one line per finished unit with the time left."""
-    from cases.studies.convergence.study import Tracker
-    with Tracker(True, 10.0) as t:
+def test_progress_says_the_time_left_on_a_log(capsys):
+    """The one progress display (every command's): a log (not a terminal) gets a line at
+    every tenth of the work with the time left, and nothing when told not to log."""
+    from cases.progress import Progress
+    with Progress("convergence", 10.0) as t:
         t.advance(4.0, "paper-cube clamped")
+        t.advance(0.5, "cantilever clamped")       # within the same tenth: no new line
     err = capsys.readouterr().err
-    assert "paper-cube clamped done; 40%" in err and "s left" in err
+    assert err.count("convergence: 40% after") == 1 and "s left" in err
+    assert "45%" not in err
+    with Progress("quiet", 1.0, log=False) as t:
+        t.advance(1.0)
+        t.say("not shown")
+    assert capsys.readouterr().err == ""
 
 
 def test_study_refuses_bcs_before_computing(capsys):
