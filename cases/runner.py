@@ -3,6 +3,8 @@ model its run with the standard metrics, the case's quantities of interest and i
 metrics. A failure (a mesh that cannot be built, a reference that does not converge, a model
 without equilibrium) is recorded in the runs it touches and the case goes on.
 """
+import dataclasses
+
 import numpy as np
 
 from model import PbcmError
@@ -178,7 +180,8 @@ def unit(case, s, mesh_name, bc, mesh_of=None, step=None, store=OFF, reuse_full=
         step(f"{case.name} {mesh_name}/{bc}: stored", len(s.models) + 1)
         return _assemble(mesh_name, bc, s.models, stored, ref_fields)
     computed = _compute(case, s, mesh_name, bc, mesh_of, step,
-                        [m for m in s.models if stored[m] is None])
+                        [m for m in s.models if stored[m] is None],
+                        _ReferenceStore(store, case, s, mesh_name, bc, reuse_full))
     for m, value in computed["runs"].items():
         stored[m] = store.put(key(kind="run", **base, model=m), value)
     ref_fields = store.put(key(kind="reference-fields", **base), computed["ref_fields"])
@@ -197,9 +200,39 @@ def _assemble(mesh_name, bc, models, stored, ref_fields):
     return runs, fields
 
 
-def _compute(case, s, mesh_name, bc, mesh_of, step, models):
+class _ReferenceStore:
+    """The FEM references of one (mesh, bc) in the run store, so that a run of more models
+    (the extensions study's candidates) does not solve them again: kept without the bases
+    (``at()`` is the convergence study's, never a case's), taken from a full run's entry
+    when only the static problem is asked."""
+
+    def __init__(self, store, case, s, mesh_name, bc, reuse_full):
+        self.args = (store, "reference", case, s, mesh_name, bc, reuse_full)
+        self.key = key(kind="reference", **what(case, s, mesh_name, bc))
+
+    def get(self):
+        return _stored(*self.args)
+
+    def put(self, ref):
+        lean = [_without_basis(r) for r in (ref.p1, ref.p2)]
+        conv = None if ref.conv is None else dataclasses.replace(ref.conv, result=lean[1])
+        self.args[0].put(self.key, dataclasses.replace(ref, p1=lean[0], p2=lean[1], conv=conv))
+        return ref
+
+
+def _without_basis(result):
+    """A FEM result without its basis and dof vector (the refined P2 basis is most of its
+    size and only ``at()`` reads it)."""
+    if not dataclasses.is_dataclass(result):
+        return result
+    heavy = {f.name for f in dataclasses.fields(result)} & {"basis", "dofs"}
+    return dataclasses.replace(result, **dict.fromkeys(heavy))
+
+
+def _compute(case, s, mesh_name, bc, mesh_of, step, models, refs=None):
     """The references of one (mesh, bc) and the runs of ``models`` on it: {"runs": {model:
-    (run, fields or None)}, "ref_fields": the FEM P2 fields or {}}."""
+    (run, fields or None)}, "ref_fields": the FEM P2 fields or {}}. ``refs`` (a
+    ``_ReferenceStore``) gives the references where kept and keeps those solved."""
     out = {"runs": {}, "ref_fields": {}}
     try:
         mesh = mesh_of(mesh_name)
@@ -211,8 +244,12 @@ def _compute(case, s, mesh_name, bc, mesh_of, step, models):
     probe = Shear(mesh, s.material, reading="corner")  # the paper's max |tau| measure
     step(f"{case.name} {mesh_name}/{bc}: FEM references", 0)
     try:
-        ref = (case.solve_reference(mesh, bc, s, probe)
-               or reference(case, mesh, bc, s, probe, extra=not s.static_only))
+        ref = refs.get() if refs is not None else None
+        if ref is None:
+            ref = (case.solve_reference(mesh, bc, s, probe)
+                   or reference(case, mesh, bc, s, probe, extra=not s.static_only))
+            if refs is not None:
+                refs.put(ref)
     except FINDINGS as exc:
         step(f"{case.name} {mesh_name}/{bc}: references failed", len(s.models) + 1)
         out["runs"] = {r["model"]: (r, None)

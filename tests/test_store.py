@@ -58,7 +58,7 @@ def test_no_cache_neither_reads_nor_fills_the_store(cache, tmp_path, monkeypatch
                                      models=("msm",))
     store = S.RunStore(cache)
     runner.run(CASES["cantilever"], s, log=False, store=store)
-    assert store.kept == 2 and store.found == 0            # the run and the references
+    assert store.kept == 3 and store.found == 0    # the run, the reference fields and references
     calls = []
     monkeypatch.setattr(runner, "_compute", lambda *a, **k: calls.append(a) or _refuse())
     with pytest.raises(AssertionError, match="computed"):
@@ -80,9 +80,14 @@ def test_a_static_only_run_reuses_the_full_runs_and_computes_only_the_new_model(
                         ran.append(model) or real(case, mesh_name, mesh, bc, model, s, ref))
     static = case.settings(quick=True, meshes=("five",), bcs=("clamped",),
                            models=("pbcm-variational", "msm"), static_only=True)
-    runs, _ = runner.run(case, static, log=False, store=store, reuse_full=True)
+    with monkeypatch.context() as m:     # the full run's references serve the new model
+        m.setattr(runner, "reference", _refuse)
+        runs, _ = runner.run(case, static, log=False, store=store, reuse_full=True)
     assert ran == ["msm"]
     assert runs[0] == done
+    # the stored references give the new model the metrics that solving them gives
+    fresh, _ = runner.run(case, static, log=False)
+    assert runs[1] == fresh[1]
     # without reuse_full a static-only run is its own result
     ran.clear()
     runner.run(case, static, log=False, store=S.RunStore(cache), reuse_full=False)
