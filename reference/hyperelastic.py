@@ -1,60 +1,33 @@
-"""Static compressible neo-Hookean elasticity with Newton iterations and load steps.
+"""Static compressible neo-Hookean elasticity: Newton in load steps, P1 or P2 on the mesh
+refined uniformly, in displacement form or mixed (Taylor-Hood P2/P1, u and p), and a
+converged reference with its error estimate (as ``reference.linear.converged``).
 
 W = mu/2 (tr C - 3) - mu ln J + lam/2 (ln J)^2, the first Piola-Kirchhoff stress
 P = mu (F - F^-T) + lam ln J F^-T; for large deformation and rotation, where linear FEM is
-wrong by construction.
+wrong by construction. The mixed form carries p = lam ln J as a field of its own
+(``reference._neohookean``), which keeps P2 accurate up to nu = 0.499.
 """
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
-from skfem import BilinearForm, LinearForm, asm, condense
-from skfem.helpers import ddot, det, eye, grad, inv, mul, transpose
+import scipy.sparse as sp
+from skfem import Basis, ElementTetP1
 
 from model.bc import bc_arrays
 from model.errors import ConvergenceError, ModelError
-from .fem import (cell_average, dirichlet_dofs, element_basis, lame, linear_solve,
-                  refine_with_data, skfem_mesh, stress_measures)
-from .linear import body_load, dof_component, transfer_to_nodes
-
-
-def _kinematics(w):
-    H = grad(w["u"])
-    F = H + eye(np.ones_like(H[0, 0]), 3)
-    J = det(F)
-    if np.any(J <= 0):
-        raise ConvergenceError("neo-Hookean: an element inverted (det F <= 0); use more load "
-                               "steps")
-    return F, J, transpose(inv(F))
-
-
-def first_piola(lam, mu):
-    def P(F, J, FinvT):
-        return mu * (F - FinvT) + lam * np.log(J) * FinvT
-    return P
-
-
-def forms(lam, mu):
-    P = first_piola(lam, mu)
-
-    @LinearForm
-    def internal(v, w):
-        return ddot(P(*_kinematics(w)), grad(v))
-
-    @BilinearForm
-    def tangent(du, v, w):
-        F, J, FinvT = _kinematics(w)
-        dF = grad(du)
-        dP = (mu * dF + (mu - lam * np.log(J)) * mul(FinvT, mul(transpose(dF), FinvT))
-              + lam * ddot(FinvT, dF) * FinvT)
-        return ddot(dP, grad(v))
-
-    return internal, tangent, P
+from ._neohookean import neohookean
+from .assembly import scalar_gradients
+from .fem import (check_finite, dirichlet_dofs, element_basis, lame, linear_solve, probe,
+                  refine_with_data, saddle_solve, skfem_mesh, stress_measures, stress_on_input)
+from .linear import ConvergedResult, body_load, dof_component, richardson, transfer_to_nodes
 
 
 @dataclass
 class HyperelasticResult:
-    """``u`` (n, 3) [m]; ``stress`` (m, 3, 3) Cauchy stress per tetrahedron (volume average);
-    ``von_mises``, ``max_shear``, ``pressure`` (m,); ``reaction`` (n, 3) [N]; ``iterations``."""
+    """``u`` (n, 3) [m] at the input nodes; ``stress`` (m, 3, 3) Cauchy stress per input
+    tetrahedron (volume average); ``von_mises``, ``max_shear``, ``pressure`` (m,); ``reaction``
+    (n, 3) [N]; ``energy`` the stored energy [J]; ``iterations`` Newton iterations in all;
+    ``info`` element, formulation, refinement, dofs, load steps."""
 
     u: np.ndarray
     stress: np.ndarray
@@ -64,66 +37,180 @@ class HyperelasticResult:
     reaction: np.ndarray
     iterations: int
     info: dict
+    energy: float = 0.0
+    basis: object = field(default=None, repr=False)
+    dofs: np.ndarray = field(default=None, repr=False)
+
+    def at(self, points):
+        """The displacement (k, 3) at arbitrary ``points`` (k, 3) inside the mesh, by the
+        solution's own basis (what compares it with results on another mesh)."""
+        return probe(self.basis, self.dofs, points)
+
+
+class Discretisation:
+    """The bases of one solve and the assembly of the neo-Hookean residual and tangent from
+    the element kernel: the vector basis ``ub`` (P1 or P2) and, for the mixed form, the P1
+    pressure basis ``pb`` on the same quadrature; unknowns [u dofs, p dofs]."""
+
+    def __init__(self, m, element, mixed, lam, mu):
+        self.ub = element_basis(m, element)
+        self.mixed = bool(mixed)
+        self.pb = Basis(m, ElementTetP1(), quadrature=self.ub.quadrature) if mixed else None
+        self.lam, self.mu = float(lam), float(mu)
+        self.grad, self.comp = scalar_gradients(self.ub)
+        self.dx = np.ascontiguousarray(self.ub.dx)
+        self.udofs = np.ascontiguousarray(self.ub.element_dofs.T)          # (nel, nb)
+        nel, nq = self.dx.shape
+        if mixed:
+            self.psi = np.ascontiguousarray(np.stack(
+                [f[0].value for f in self.pb.basis], axis=-1))            # (nel, nq, 4)
+            self.pdofs = np.ascontiguousarray(self.pb.element_dofs.T) + self.ub.N
+        else:
+            self.psi = np.zeros((nel, nq, 0))
+            self.pdofs = np.zeros((nel, 0), dtype=np.int64)
+        self.N = self.ub.N + (self.pb.N if mixed else 0)
+        dofs = np.hstack([self.udofs, self.pdofs])                          # (nel, nb + np)
+        self.rows = np.repeat(dofs, dofs.shape[1], axis=1).ravel()
+        self.cols = np.tile(dofs, (1, dofs.shape[1])).ravel()
+        self.dofs = dofs
+
+    def evaluate(self, x, tangent=True):
+        """(residual (N,), tangent (CSR) or None, energy) at the unknowns ``x``."""
+        nel, nb = self.udofs.shape
+        npb = self.pdofs.shape[1]
+        r_u, r_p = np.empty((nel, nb)), np.empty((nel, npb))
+        shape = (nel, nb, nb), (nel, nb, npb), (nel, npb, npb)
+        k_uu, k_up, k_pp = (np.empty(s) if tangent else np.empty((0, 0, 0)) for s in shape)
+        energy, bad = neohookean(self.grad, self.comp, self.dx, x[self.udofs], self.psi,
+                                 x[self.pdofs], self.lam, self.mu, self.mixed, tangent,
+                                 r_u, r_p, k_uu, k_up, k_pp)
+        if bad >= 0:
+            raise ConvergenceError(f"neo-Hookean: element {bad} inverted (det F <= 0); use "
+                                   "more load steps")
+        res = np.bincount(self.dofs.ravel(), weights=np.hstack([r_u, r_p]).ravel(),
+                          minlength=self.N)
+        if not tangent:
+            return res, None, energy
+        local = np.concatenate([np.concatenate([k_uu, k_up], axis=2),
+                                np.concatenate([np.transpose(k_up, (0, 2, 1)), k_pp], axis=2)],
+                               axis=1)
+        K = sp.csr_matrix((local.ravel(), (self.rows, self.cols)), shape=(self.N, self.N))
+        return res, K, energy
+
+    def cauchy(self, x):
+        """The Cauchy stress (3, 3, nel, nq) of the unknowns ``x``: (mu (F F^T - I) + p I) / J
+        with p = lam ln J, or the pressure field in the mixed form."""
+        w = self.ub.interpolate(x[:self.ub.N])
+        F = w.grad + np.eye(3)[:, :, None, None]
+        J = np.linalg.det(np.moveaxis(F, (0, 1), (-2, -1)))
+        p = (self.pb.interpolate(x[self.ub.N:]).value if self.mixed
+             else self.lam * np.log(J))
+        FFt = np.einsum("ik...,jk...->ij...", F, F)
+        return (self.mu * (FFt - np.eye(3)[:, :, None, None])
+                + p * np.eye(3)[:, :, None, None]) / J
 
 
 def solve(mesh, E, nu, dirichlet, body_force=None, element="P1", refine=0, dirichlet_fn=None,
-          load_steps=1, rtol=1e-10, max_iter=30, on_step=None):
-    """Neo-Hookean equilibrium: Newton in ``load_steps`` equal increments of the prescribed
-    displacement and body force, each converged to max |residual| <= rtol * E h^2 (h the mean
-    edge). Raises ConvergenceError otherwise. ``on_step(step, u, reaction)``, when given, is
-    called after every converged step with the nodal displacement (n, 3) and reaction (n, 3)
-    at that load (a force-displacement curve in one solve)."""
+          load_steps=1, rtol=1e-10, max_iter=30, on_step=None, mixed=False):
+    """Neo-Hookean equilibrium on ``mesh`` (a model.mesh.TetMesh) refined ``refine`` times.
+
+    Newton in ``load_steps`` equal increments of the prescribed displacement and body force,
+    each converged to max |residual| <= rtol * E h^2 (h the mean edge of the solved mesh; the
+    pressure equations of the mixed form to rtol * h^3). Raises ConvergenceError otherwise.
+    ``element`` "P1" or "P2"; ``mixed`` solves the Taylor-Hood P2/P1 (u, p) form (P2 only).
+    ``dirichlet`` and ``dirichlet_fn`` as ``reference.linear.solve`` takes them.
+    ``on_step(step, u, reaction)``, when given, is called after every converged step with the
+    nodal displacement (n, 3) and reaction (n, 3) at that load (a force-displacement curve in
+    one solve)."""
     lam, mu = lame(E, nu)
+    if mixed and element != "P2":
+        raise ModelError(f"the mixed (u, p) form is Taylor-Hood P2/P1: pass element='P2', got "
+                         f"{element!r}")
+    if int(refine) != refine or refine < 0:
+        raise ModelError(f"refine must be a non-negative integer, got {refine!r}")
+    if int(load_steps) != load_steps or load_steps < 1:
+        raise ModelError(f"load_steps must be a positive integer, got {load_steps!r}")
     mask, vals = bc_arrays(dirichlet, mesh.n_nodes)
     if not mask.any():
         raise ModelError("no Dirichlet condition: the problem is singular; prescribe nodes")
-    coarse = skfem_mesh(mesh)
-    if refine:
-        raise ModelError("the neo-Hookean reference solves on the input mesh (refine=0); "
-                         "pass a refined mesh instead")
-    m, mask_f, vals_f, W = refine_with_data(coarse, mask, vals, dirichlet_fn, 0)
-    basis = element_basis(m, element)
-    D, x_D = dirichlet_dofs(basis, mask_f, vals_f, dirichlet_fn)
-    internal, tangent, P = forms(lam, mu)
-    f_body = body_load(basis, body_force) if body_force is not None else np.zeros(basis.N)
-    comp = dof_component(basis)
-    I = np.setdiff1d(np.arange(basis.N), D)
+    m, mask_f, vals_f, W = refine_with_data(skfem_mesh(mesh), mask, vals, dirichlet_fn,
+                                            int(refine))
+    d = Discretisation(m, element, mixed, lam, mu)
+    ub = d.ub
+    D, x_D = dirichlet_dofs(ub, mask_f, vals_f, dirichlet_fn)
+    f_body = np.zeros(d.N)
+    if body_force is not None:
+        f_body[:ub.N] = body_load(ub, body_force)
+    comp = dof_component(ub)
+    prescribed = np.zeros(d.N, dtype=bool)
+    prescribed[D] = True
+    I = np.flatnonzero(~prescribed)
+    Iu, Ip = I[I < ub.N], I[I >= ub.N]
     h = np.linalg.norm(np.diff(m.p[:, m.edges], axis=1), axis=0).mean()
-    floor = rtol * E * h * h
-    u = np.zeros(basis.N)
+    floor_u, floor_p = rtol * E * h * h, rtol * h ** 3
+    x = np.zeros(d.N)
+    target = np.zeros(d.N)
+    target[D] = x_D[D]
     iters = 0
     for step in range(1, load_steps + 1):
         s = step / load_steps
         for _ in range(max_iter):
-            w = {"u": basis.interpolate(u)}
-            res = asm(internal, basis, **w) - s * f_body
-            rn = np.abs(res[I]).max(initial=0.0)
-            if rn <= floor and np.array_equal(u[D], s * x_D[D]):
+            res, K, _ = d.evaluate(x)
+            res -= s * f_body
+            rn = np.abs(res[Iu]).max(initial=0.0)
+            rp = np.abs(res[Ip]).max(initial=0.0)
+            if rn <= floor_u and rp <= floor_p and np.array_equal(x[D], s * target[D]):
                 break
-            # Newton step; its prescribed part carries the load increment (a tangent predictor,
-            # so that the interior follows the boundary instead of inverting next to it)
-            K = asm(tangent, basis, **w)
-            A, b, du, II = condense(K, -res, x=np.where(np.isin(np.arange(basis.N), D),
-                                                        s * x_D - u, 0.0), D=D)
-            du[II], _ = linear_solve(A, b, basis.doflocs.T[II], comp[II])
-            u = u + du
-            u[D] = s * x_D[D]
+            # Newton step; its prescribed part carries the load increment (a tangent
+            # predictor, so that the interior follows the boundary instead of inverting)
+            dx = np.zeros(d.N)
+            dx[D] = s * target[D] - x[D]
+            b = -res[I] - K[I][:, D] @ dx[D]
+            A = K[I][:, I]
+            dx[I] = (saddle_solve(A, b) if mixed else
+                     linear_solve(A, b, ub.doflocs.T[I], comp[I])[0])
+            x = x + dx
+            x[D] = s * target[D]
             iters += 1
         else:
             raise ConvergenceError(f"neo-Hookean Newton did not converge in {max_iter} "
                                    f"iterations at load step {step}/{load_steps}: residual "
-                                   f"{rn:.3e} N; increase load_steps")
+                                   f"{rn:.3e} N (pressure {rp:.3e} m^3); increase load_steps")
         if on_step is not None:
-            w = {"u": basis.interpolate(u)}
-            on_step(step, u[basis.nodal_dofs[:, :mesh.n_nodes]].T,
-                    transfer_to_nodes(basis, W, D, (asm(internal, basis, **w) - s * f_body)[D]))
-    w = {"u": basis.interpolate(u)}
-    reaction = transfer_to_nodes(basis, W, D, (asm(internal, basis, **w) - f_body)[D])
-    F, J, FinvT = _kinematics(w)
-    cauchy = np.einsum("ij...,kj...->ik...", P(F, J, FinvT), F) / J
-    stress = np.moveaxis(cell_average(basis, cauchy), -1, 0)
+            on_step(step, x[ub.nodal_dofs[:, :mesh.n_nodes]].T,
+                    transfer_to_nodes(ub, W, D, res[D]))
+    res, _, energy = d.evaluate(x, tangent=False)
+    res -= f_body
+    reaction = transfer_to_nodes(ub, W, D, res[D])
+    stress, _ = stress_on_input(ub, W, mesh, d.cauchy(x))
     vm, tmax, p = stress_measures(stress)
-    return HyperelasticResult(u=u[basis.nodal_dofs[:, :mesh.n_nodes]].T, stress=stress,
-                              von_mises=vm, max_shear=tmax, pressure=p, reaction=reaction,
-                              iterations=iters, info={"element": element,
-                                                      "load_steps": load_steps})
+    u_all = x[:ub.N]
+    return HyperelasticResult(
+        u=check_finite("displacement", u_all[ub.nodal_dofs[:, :mesh.n_nodes]].T.copy()),
+        stress=stress, von_mises=vm, max_shear=tmax, pressure=p, reaction=reaction,
+        iterations=iters, energy=float(energy), basis=ub, dofs=u_all,
+        info={"element": element, "mixed": bool(mixed), "refine": int(refine),
+              "dofs": int(d.N), "load_steps": int(load_steps)})
+
+
+def converged(mesh, E, nu, dirichlet, levels=1, element="P2", mixed=True, **kw):
+    """Solve on ``mesh`` refined 0..levels times and estimate the error of the finest, as
+    ``reference.linear.converged`` does: the relative changes of the nodal displacement and
+    of the stored energy between levels give an observed rate and a Richardson estimate; the
+    larger of the two estimates is the reference's. ``kw`` as :func:`solve` takes them."""
+    if levels < 1:
+        raise ModelError(f"converged needs levels >= 1 to estimate its error, got {levels}")
+    sols = [solve(mesh, E, nu, dirichlet, element=element, mixed=mixed, refine=k, **kw)
+            for k in range(levels + 1)]
+    norm = max(np.linalg.norm(sols[-1].u), 1e-300)
+    inc = [float(np.linalg.norm(b.u - a.u) / norm) for a, b in zip(sols, sols[1:])]
+    scale = max(abs(sols[-1].energy), 1e-300)
+    inc_e = [abs(b.energy - a.energy) / scale for a, b in zip(sols, sols[1:])]
+    rate, est = richardson(inc)
+    rate_e, est_e = richardson(inc_e)
+    return ConvergedResult(result=sols[-1], levels=list(range(levels + 1)), increments=inc,
+                           rate=rate, error_estimate=max(est, est_e), energy_increments=inc_e,
+                           energy_rate=rate_e)
+
+
+__all__ = ["solve", "converged", "HyperelasticResult", "Discretisation"]

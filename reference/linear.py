@@ -8,9 +8,9 @@ from skfem.models.elasticity import linear_stress
 
 from model.bc import bc_arrays
 from model.errors import ModelError
-from .fem import (INTORDER, cell_average, check_finite, dirichlet_dofs, dof_hats,
-                  element_basis, lame, linear_solve, parent_of, refine_with_data, skfem_mesh,
-                  stiffness, stress_measures)
+from .fem import (INTORDER, check_finite, dirichlet_dofs, dof_hats, element_basis, lame,
+                  linear_solve, probe, refine_with_data, skfem_mesh, stiffness,
+                  stress_measures, stress_on_input)
 
 
 @dataclass
@@ -40,10 +40,7 @@ class LinearResult:
         """The displacement (k, 3) of the finite-element solution at arbitrary ``points``
         (k, 3) inside the mesh (its basis functions evaluated there, not the nodal values
         interpolated): what compares a solution with results on another mesh."""
-        pts = np.asarray(points, dtype=float)
-        values = self.basis.probes(np.ascontiguousarray(pts.T)) @ self.dofs
-        return check_finite("displacement at the probed points",
-                            values.reshape(3, len(pts)).T.copy())
+        return probe(self.basis, self.dofs, points)
 
 
 @LinearForm
@@ -129,15 +126,7 @@ def solve(mesh, E, nu, dirichlet, body_force=None, traction=None, element="P1", 
     u = u_all[basis.nodal_dofs[:, :n]].T
     # stress: volume average over each input tetrahedron of the solution's stress
     w = basis.interpolate(u_all)
-    sig = linear_stress(lam, mu)(sym_grad(w))
-    sig_fine = np.moveaxis(cell_average(basis, sig), -1, 0)         # (m_fine, 3, 3)
-    vol_fine = basis.dx.sum(axis=1)
-    parent = parent_of(m, W, mesh.tets)
-    vol = np.bincount(parent, weights=vol_fine, minlength=mesh.n_tets)
-    stress = np.stack([np.bincount(parent, weights=vol_fine * sig_fine[:, i, j],
-                                   minlength=mesh.n_tets)
-                       for i in range(3) for j in range(3)], axis=1).reshape(-1, 3, 3)
-    stress /= vol[:, None, None]
+    stress, vol = stress_on_input(basis, W, mesh, linear_stress(lam, mu)(sym_grad(w)))
     vm, tmax, p = stress_measures(stress)
     node_vol = np.zeros(n)
     np.add.at(node_vol, mesh.tets, vol[:, None])

@@ -1,0 +1,166 @@
+"""The converged neo-Hookean reference (issue 25): the homogeneous closed form, the small-load
+limit equal to linear P2, a tangent and a residual consistent with finite differences of the
+energy, convergence under refinement with an estimate, the mixed form up to nu = 0.499, and an
+independent code (FElupe) on a bonded block compressed 20 %."""
+import numpy as np
+import pytest
+from scipy.optimize import brentq
+
+from model.errors import ConvergenceError, ModelError
+from model.mesh import box, cube
+from reference import hyperelastic, linear
+from reference.fem import element_basis, lame, skfem_mesh
+from reference.hyperelastic import Discretisation
+
+E, L = 10e3, 0.01
+
+
+def sliding_cube(mesh, stretch):
+    """Symmetry planes x = 0, y = 0, z = 0 and the top face moved to ``stretch``: the
+    homogeneous uniaxial field, which P1 and P2 represent exactly."""
+    bc = {}
+
+    def put(nodes, k, value):
+        for i in nodes:
+            u = list(bc.get(int(i), (None, None, None)))
+            u[k] = value
+            bc[int(i)] = tuple(u)
+    put(mesh.nodes_on_plane("x", 0.0), 0, 0.0)
+    put(mesh.nodes_on_plane("y", 0.0), 1, 0.0)
+    put(mesh.nodes_on_plane("z", 0.0), 2, 0.0)
+    put(mesh.nodes_on_plane("z", L), 2, (stretch - 1) * L)
+    return bc
+
+
+def uniaxial(stretch, nu):
+    """The compressible neo-Hookean law by hand: the lateral stretch that frees the lateral
+    faces, mu (l - 1/l) + lam ln(J) / l = 0 with J = stretch l^2, and the axial nominal
+    stress mu (s - 1/s) + lam ln(J) / s."""
+    lam, mu = lame(E, nu)
+    lt = brentq(lambda l: mu * (l - 1 / l) + lam * np.log(stretch * l * l) / l, 0.5, 2.0)
+    J = stretch * lt * lt
+    return lt, mu * (stretch - 1 / stretch) + lam * np.log(J) / stretch
+
+
+@pytest.mark.parametrize("element, mixed, nu", [("P1", False, 0.45), ("P2", False, 0.45),
+                                                ("P2", True, 0.45), ("P2", True, 0.499)])
+def test_homogeneous_compression_is_the_law_worked_by_hand(element, mixed, nu):
+    mesh = cube(3, L, "six")
+    r = hyperelastic.solve(mesh, E, nu, sliding_cube(mesh, 0.7), element=element, mixed=mixed,
+                           load_steps=3)
+    lt, P = uniaxial(0.7, nu)
+    expect = np.column_stack([(lt - 1) * mesh.points[:, 0], (lt - 1) * mesh.points[:, 1],
+                              -0.3 * mesh.points[:, 2]])
+    assert np.abs(r.u - expect).max() < 1e-9 * L
+    top = mesh.nodes_on_plane("z", L)
+    assert r.reaction[top, 2].sum() == pytest.approx(P * L * L, rel=1e-8)
+    # the Cauchy stress is uniaxial: sigma_zz = P stretch / J, the lateral ones zero
+    assert np.allclose(r.stress[:, 2, 2], P * 0.7 / (0.7 * lt * lt), rtol=1e-7)
+    assert np.abs(r.stress[:, 0, 0]).max() < 1e-7 * abs(P)
+
+
+def test_the_worked_numbers_of_the_sliding_compression():
+    # the figures quoted for the large-compression case at stretch 0.7 and nu = 0.45: lateral
+    # stretch 1.17085 and 4.4435 N on the 32 mm cube (a check of the hand formula itself)
+    lt, P = uniaxial(0.7, 0.45)
+    assert lt == pytest.approx(1.17085, abs=1e-5)
+    assert abs(P) * 0.032 ** 2 == pytest.approx(4.4435, abs=1e-4)
+
+
+def bonded_block(mesh, strain, height):
+    """Base clamped, top bonded and moved down by ``strain`` of the height."""
+    bc = {int(i): (0.0, 0.0, 0.0) for i in mesh.nodes_on_plane("z", 0.0)}
+    bc.update({int(i): (0.0, 0.0, -strain * height) for i in mesh.nodes_on_plane("z", height)})
+    return bc
+
+
+def test_the_small_load_limit_is_linear_p2():
+    mesh = box(4, 3, 4, 0.012, 0.008, 0.012, "five")
+    bc = bonded_block(mesh, 1e-7, 0.012)
+    nh = hyperelastic.solve(mesh, E, 0.45, bc, element="P2")
+    lin = linear.solve(mesh, E, 0.45, bc, element="P2", solver="direct")
+    assert np.linalg.norm(nh.u - lin.u) < 1e-6 * np.linalg.norm(lin.u)
+    top = mesh.nodes_on_plane("z", 0.012)
+    assert nh.reaction[top, 2].sum() == pytest.approx(lin.reaction[top, 2].sum(), rel=1e-6)
+
+
+@pytest.mark.parametrize("mixed", [False, True])
+def test_residual_and_tangent_are_the_derivatives_of_the_energy(mixed):
+    m = skfem_mesh(box(3, 3, 3, 0.01, 0.01, 0.01, "six"))
+    lam, mu = lame(E, 0.45)
+    d = Discretisation(m, "P2", mixed, lam, mu)
+    rng = np.random.default_rng(1)
+    x = np.zeros(d.N)
+    x[:d.ub.N] = 1e-4 * rng.standard_normal(d.ub.N)      # strains of several per cent
+    if mixed:
+        x[d.ub.N:] = 0.1 * E * rng.standard_normal(d.N - d.ub.N)
+    res, K, energy = d.evaluate(x)
+    v = rng.standard_normal(d.N)
+    v[:d.ub.N] *= 1e-3
+    if mixed:
+        v[d.ub.N:] *= 0.1 * E
+    h = 1e-5
+    e_plus, e_minus = (d.evaluate(x + s * h * v, tangent=False)[2] for s in (1, -1))
+    assert (e_plus - e_minus) / (2 * h) == pytest.approx(res @ v, rel=1e-7)
+    r_plus, r_minus = (d.evaluate(x + s * h * v, tangent=False)[0] for s in (1, -1))
+    fd = (r_plus - r_minus) / (2 * h)
+    assert np.linalg.norm(K @ v - fd) < 1e-7 * np.linalg.norm(fd)
+    assert abs(K - K.T).max() < 1e-12 * abs(K).max()
+
+
+def test_the_mixed_form_solves_the_same_law_and_converges_with_an_estimate():
+    mesh = box(3, 3, 4, 0.01, 0.01, 0.012, "five")
+    bc = bonded_block(mesh, 0.1, 0.012)
+    conv = hyperelastic.converged(mesh, E, 0.45, bc, levels=2, mixed=True, load_steps=2)
+    assert conv.increments[1] < 0.5 * conv.increments[0]        # converging
+    assert conv.rate > 1 and conv.energy_rate > 0.5
+    assert conv.increments[-1] <= conv.error_estimate < 0.05
+    disp = hyperelastic.solve(mesh, E, 0.45, bc, element="P2", refine=2, load_steps=2)
+    # the displacement form on the same mesh agrees within the mixed form's estimate
+    diff = np.linalg.norm(disp.u - conv.result.u) / np.linalg.norm(conv.result.u)
+    assert diff < conv.error_estimate
+
+
+def test_bad_input_is_refused_before_solving():
+    mesh = cube(2, L, "six")
+    with pytest.raises(ModelError, match="Taylor-Hood"):
+        hyperelastic.solve(mesh, E, 0.45, sliding_cube(mesh, 0.9), element="P1", mixed=True)
+    with pytest.raises(ModelError, match="load_steps"):
+        hyperelastic.solve(mesh, E, 0.45, sliding_cube(mesh, 0.9), load_steps=0)
+    with pytest.raises(ModelError, match="levels"):
+        hyperelastic.converged(mesh, E, 0.45, sliding_cube(mesh, 0.9), levels=0)
+    with pytest.raises(ConvergenceError, match="inverted"):
+        hyperelastic.solve(mesh, E, 0.45, sliding_cube(mesh, -0.5), element="P1")
+
+
+def test_against_felupe_on_a_bonded_block_compressed_20_percent():
+    """FElupe (an independent code) solves the same law on the same quadratic tetrahedra."""
+    fem = pytest.importorskip("felupe")
+    H = 0.01
+    mesh = box(3, 3, 3, 0.01, 0.01, H, "five")
+    nu = 0.45
+    lam, mu = lame(E, nu)
+    ours = hyperelastic.solve(mesh, E, nu, bonded_block(mesh, 0.2, H), element="P2",
+                              load_steps=4)
+
+    m1 = fem.Mesh(np.array(mesh.points), np.array(mesh.tets), "tetra")
+    m2 = fem.mesh.add_midpoints_edges(m1.points, m1.cells, m1.cell_type)
+    m2 = fem.Mesh(*m2)
+    region = fem.RegionQuadraticTetra(m2)
+    field = fem.FieldContainer([fem.Field(region, dim=3)])
+    base = fem.Boundary(field[0], fz=lambda z: np.isclose(z, 0.0))
+    top_fixed = fem.Boundary(field[0], fz=lambda z: np.isclose(z, H), skip=(0, 0, 1))
+    top_move = fem.Boundary(field[0], fz=lambda z: np.isclose(z, H), skip=(1, 1, 0))
+    boundaries = {"base": base, "top": top_fixed, "move": top_move}
+    solid = fem.SolidBody(fem.NeoHookeCompressible(mu=mu, lmbda=lam), field)
+    step = fem.Step(items=[solid], ramp={top_move: fem.math.linsteps([0, -0.2 * H], num=4)},
+                    boundaries=boundaries)
+    fem.Job(steps=[step]).evaluate(tol=1e-12, verbose=0)
+    theirs = field[0].values[:mesh.n_nodes]
+    assert np.linalg.norm(ours.u - theirs) < 1e-3 * np.linalg.norm(theirs)
+    # the total force on the top face: FElupe's on every node of the face (vertices and
+    # midpoints), ours carried to the vertices by the P1 hats (which keeps the sum)
+    force = solid.results.force.toarray().reshape(-1, 3)
+    top = mesh.nodes_on_plane("z", H)
+    assert ours.reaction[top, 2].sum() == pytest.approx(
+        force[np.isclose(m2.points[:, 2], H), 2].sum(), rel=1e-4)
