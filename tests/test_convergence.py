@@ -173,8 +173,8 @@ def test_study_refuses_bcs_before_computing(capsys):
 
 
 def test_study_metrics_do_not_depend_on_the_workers(study, tmp_path):
-    """The (problem, bc) units on two worker processes give the same rows, bit for bit, as
-    the serial run, for the models both ran."""
+    """The units (a reference per (problem, bc), the runs per family) on two worker processes
+    give the same rows, bit for bit, as the serial run, for the models both ran."""
     out = tmp_path / "convergence"
     assert main(["run", "convergence", "--quick", "--out", str(out), "--workers", "2",
                  "--models", "pbcm-corner", "msm"]) == 0

@@ -157,10 +157,12 @@ def test_against_felupe_on_a_bonded_block_compressed_20_percent():
                     boundaries=boundaries)
     fem.Job(steps=[step]).evaluate(tol=1e-12, verbose=0)
     theirs = field[0].values[:mesh.n_nodes]
-    assert np.linalg.norm(ours.u - theirs) < 1e-3 * np.linalg.norm(theirs)
+    # the same law, element and quadrature: agreement to the Newton tolerance (measured
+    # 3e-10 and 2e-9), far inside what the issue asks (1e-3 and 1e-4)
+    assert np.linalg.norm(ours.u - theirs) < 1e-7 * np.linalg.norm(theirs)
     # the total force on the top face: FElupe's on every node of the face (vertices and
     # midpoints), ours carried to the vertices by the P1 hats (which keeps the sum)
     force = solid.results.force.toarray().reshape(-1, 3)
     top = mesh.nodes_on_plane("z", H)
     assert ours.reaction[top, 2].sum() == pytest.approx(
-        force[np.isclose(m2.points[:, 2], H), 2].sum(), rel=1e-4)
+        force[np.isclose(m2.points[:, 2], H), 2].sum(), rel=1e-7)

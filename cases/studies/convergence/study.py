@@ -254,26 +254,52 @@ def _metrics(problem, mesh, bc, ps, u, reaction, u_ref, fem):
             "reaction_rel_err": None if ratio is None else abs(ratio - 1)}
 
 
-def problem_unit(job, step=None):
-    """One (problem, bc): its reference, then every family at its levels, each piece from
-    the run store where kept. ``step(family)`` is called as each family finishes. Returns
-    (reference summary, runs)."""
+class ReferenceValues:
+    """What the runs of one (problem, bc) read of its reference, computed once and handed to
+    the (problem, bc, family) units: the values at each family mesh's nodes, the response and
+    the summary (a StoredReference's interface, without the P2 ladder)."""
+
+    def __init__(self, what, response, summary, at):
+        self.what, self.response, self._summary, self._at = what, response, summary, at
+
+    def summary(self):
+        return self._summary
+
+    def at_mesh(self, family, h, points):
+        return self._at[(family, float(h))]
+
+
+def reference_unit(job):
+    """The reference of one (problem, bc) as its runs read it (a ReferenceValues): nothing is
+    solved where the store keeps every value; the values at the nodes of a family's meshes are
+    taken only where some run of that family is not stored."""
     name, bc, s, store = job
     problem = PROBLEMS[name]
-    hs = {fam: levels(problem, fam, s) for fam in s.meshes}
     ref = StoredReference(problem, bc, s, store)
-    rows = []
+    at = {}
     for fam in s.meshes:
-        rows += family_runs(problem, bc, fam, s, ref, hs[fam], store)
-        if step:
-            step(fam)
-    return ref.summary(), rows
+        for h in levels(problem, fam, s):
+            if not _all_stored(ref, fam, h, s, store):
+                at[(fam, float(h))] = ref.at_mesh(fam, h, problem.mesh(fam, h).points)
+    return ReferenceValues(ref.what, ref.response, ref.summary(), at)
 
 
-def _unit_in_worker(item):
-    i, job = item
+def _all_stored(ref, family, h, s, store):
+    return all(store.get(key(kind="convergence-run", **ref.what, mesh=family, level_mm=float(h),
+                             model=m)) is not None for m in (FEM_P1,) + tuple(s.models))
+
+
+def family_unit(job):
+    """The runs of one (problem, bc, family) at its levels against the reference values."""
+    name, bc, family, s, store, ref = job
+    problem = PROBLEMS[name]
+    return family_runs(problem, bc, family, s, ref, levels(problem, family, s), store)
+
+
+def _in_worker(item):
+    fn, i, job = item
     with one_blas_thread():
-        return i, problem_unit(job)
+        return i, fn(job)
 
 
 def _weights(name, s):
@@ -313,37 +339,53 @@ def fits(runs):
     return out
 
 
+def _map(fn, jobs, workers, done):
+    """``fn`` over ``jobs`` in this process or on ``workers``; ``done(i)`` as each finishes;
+    the results in the jobs' order."""
+    results = [None] * len(jobs)
+    if workers is None:
+        with one_blas_thread():
+            for i, job in enumerate(jobs):
+                stop.checkpoint()
+                results[i] = fn(job)
+                done(i)
+    else:
+        for i, result in workers.unordered(_in_worker, [(fn, i, j) for i, j in enumerate(jobs)]):
+            stop.checkpoint()
+            results[i] = result
+            done(i)
+    return results
+
+
 def run(s, workers=None, log=True, bench=None, store=OFF):
     """Run the study with settings ``s``: the metrics document (runs, fits, references,
     effective elasticity, accuracy per cost from the ``bench`` document). ``workers`` (a
-    started cases.workers.Workers) runs the (problem, bc) units side by side; the results do
-    not depend on it (one BLAS thread everywhere). ``store`` gives the (problem, bc) units
-    and the elasticity table it has, and keeps those computed."""
-    jobs = [(name, bc, s, store) for name in s.problems for bc in PROBLEMS[name].bcs]
-    weights = [_weights(name, s) for name, *_ in jobs]
-    elastic_weight = 0.05 * sum(sum(w.values()) for w in weights)
-    results = [None] * len(jobs)
-    with Progress("convergence", sum(sum(w.values()) for w in weights) + elastic_weight,
-                  log=log, width=36) as track:
-        if workers is None:
-            with one_blas_thread():
-                for i, job in enumerate(jobs):
-                    stop.checkpoint()
-                    results[i] = problem_unit(job, lambda fam, i=i: track.advance(
-                        weights[i][fam], f"{jobs[i][0]} {jobs[i][1]} {fam}"))
-        else:
-            for i, result in workers.unordered(_unit_in_worker, list(enumerate(jobs))):
-                stop.checkpoint()
-                results[i] = result
-                track.advance(sum(weights[i].values()), f"{jobs[i][0]} {jobs[i][1]}")
+    started cases.workers.Workers) runs the units side by side: first the reference of each
+    (problem, bc), then the runs of each (problem, bc, family); the results do not depend on
+    it (one BLAS thread everywhere). ``store`` gives the runs, reference values and the
+    elasticity table it has, and keeps those computed."""
+    pairs = [(name, bc) for name in s.problems for bc in PROBLEMS[name].bcs]
+    weights = {name: _weights(name, s) for name in s.problems}
+    total = sum(sum(weights[name].values()) for name, _ in pairs)
+    ref_weight, elastic_weight = 0.05 * total, 0.05 * total
+    with Progress("convergence", total + ref_weight + elastic_weight, log=log,
+                  width=36) as track:
+        refs = _map(reference_unit, [(name, bc, s, store) for name, bc in pairs], workers,
+                    lambda i: track.advance(ref_weight / len(pairs),
+                                            f"{pairs[i][0]} {pairs[i][1]}: reference"))
+        jobs = [(name, bc, fam, s, store, ref) for (name, bc), ref in zip(pairs, refs)
+                for fam in s.meshes]
+        rows = _map(family_unit, jobs, workers,
+                    lambda i: track.advance(weights[jobs[i][0]][jobs[i][2]],
+                                            " ".join(jobs[i][:3])))
         with one_blas_thread():
             eff = elasticity.table(s, store)
         track.advance(elastic_weight, "effective elasticity")
-    runs = [r for _, rows in results for r in rows]
-    data = {"runs": runs, "fits": fits(runs), "references": [ref for ref, _ in results],
+    runs = [r for rs in rows for r in rs]
+    data = {"runs": runs, "fits": fits(runs), "references": [ref.summary() for ref in refs],
             "elasticity": eff, "cost": cost.accuracy_per_cost(runs, bench, EXACT)}
     return jsonable(data)
 
 
 __all__ = ["ConvergenceSettings", "run", "fits", "levels", "solve_reference", "family_runs",
-           "problem_unit", "StoredReference", "FEM_P1"]
+           "reference_unit", "family_unit", "StoredReference", "ReferenceValues", "FEM_P1"]
