@@ -19,7 +19,7 @@ from ._neohookean import neohookean
 from .assembly import scalar_gradients
 from .fem import (check_finite, dirichlet_dofs, element_basis, lame, linear_solve, probe,
                   refine_with_data, saddle_solve, skfem_mesh, stress_measures, stress_on_input)
-from .linear import ConvergedResult, body_load, dof_component, richardson, transfer_to_nodes
+from .linear import body_load, converged_from, dof_component, transfer_to_nodes
 
 
 @dataclass
@@ -200,17 +200,8 @@ def converged(mesh, E, nu, dirichlet, levels=1, element="P2", mixed=True, **kw):
     larger of the two estimates is the reference's. ``kw`` as :func:`solve` takes them."""
     if levels < 1:
         raise ModelError(f"converged needs levels >= 1 to estimate its error, got {levels}")
-    sols = [solve(mesh, E, nu, dirichlet, element=element, mixed=mixed, refine=k, **kw)
-            for k in range(levels + 1)]
-    norm = max(np.linalg.norm(sols[-1].u), 1e-300)
-    inc = [float(np.linalg.norm(b.u - a.u) / norm) for a, b in zip(sols, sols[1:])]
-    scale = max(abs(sols[-1].energy), 1e-300)
-    inc_e = [abs(b.energy - a.energy) / scale for a, b in zip(sols, sols[1:])]
-    rate, est = richardson(inc)
-    rate_e, est_e = richardson(inc_e)
-    return ConvergedResult(result=sols[-1], levels=list(range(levels + 1)), increments=inc,
-                           rate=rate, error_estimate=max(est, est_e), energy_increments=inc_e,
-                           energy_rate=rate_e)
+    return converged_from([solve(mesh, E, nu, dirichlet, element=element, mixed=mixed,
+                                 refine=k, **kw) for k in range(levels + 1)])
 
 
 __all__ = ["solve", "converged", "HyperelasticResult", "Discretisation"]

@@ -192,14 +192,20 @@ def converged(mesh, E, nu, dirichlet, levels=2, **kw):
     """Solve with P2 on ``mesh`` refined 0..levels times and estimate the error of the finest."""
     if levels < 1:
         raise ModelError(f"converged needs levels >= 1 to estimate its error, got {levels}")
-    sols = [solve(mesh, E, nu, dirichlet, element="P2", refine=k, **kw)
-            for k in range(levels + 1)]
+    return converged_from([solve(mesh, E, nu, dirichlet, element="P2", refine=k, **kw)
+                           for k in range(levels + 1)])
+
+
+def converged_from(sols):
+    """The ConvergedResult of solutions on the mesh refined 0, 1, ... times (each with ``u``
+    at the input nodes and ``energy``): the finest, with the larger of the Richardson
+    estimates from the relative changes of the displacement and of the energy."""
     norm = max(np.linalg.norm(sols[-1].u), 1e-300)
     inc = [float(np.linalg.norm(b.u - a.u) / norm) for a, b in zip(sols, sols[1:])]
     scale = max(abs(sols[-1].energy), 1e-300)
     inc_e = [abs(b.energy - a.energy) / scale for a, b in zip(sols, sols[1:])]
     rate, est = richardson(inc)
     rate_e, est_e = richardson(inc_e)
-    return ConvergedResult(result=sols[-1], levels=list(range(levels + 1)), increments=inc,
+    return ConvergedResult(result=sols[-1], levels=list(range(len(sols))), increments=inc,
                            rate=rate, error_estimate=max(est, est_e), energy_increments=inc_e,
                            energy_rate=rate_e)

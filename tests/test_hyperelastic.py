@@ -9,7 +9,7 @@ from scipy.optimize import brentq
 from model.errors import ConvergenceError, ModelError
 from model.mesh import box, cube
 from reference import hyperelastic, linear
-from reference.fem import element_basis, lame, skfem_mesh
+from reference.fem import lame, skfem_mesh
 from reference.hyperelastic import Discretisation
 
 E, L = 10e3, 0.01
