@@ -84,14 +84,19 @@ class StaticResult:
     iterations: int
 
 
-def newton_step(J, rhs):
-    """Solve J du = rhs by sparse LU ordered for a structurally symmetric matrix (minimum
+# a chord step (the last factorised Jacobian again) is kept when it divides the residual by
+# this much; otherwise the Jacobian is formed and factorised afresh (a full Newton step)
+CHORD_GAIN = 10.0
+
+
+def factorise(J):
+    """Sparse LU of the Newton matrix, ordered for a structurally symmetric matrix (minimum
     degree on J + J^T, diagonal pivots preferred, 1 % threshold so that the non-symmetric
     Jacobians of the corner and balanced readings still pivot where they must): 2 to 3 times
     faster than the default column ordering on the convergence study's meshes (bcc, 4 721
     nodes: 0.87 against 1.59 s)."""
     return splu(J.tocsc(), permc_spec="MMD_AT_PLUS_A", diag_pivot_thresh=0.01,
-                options={"SymmetricMode": True}).solve(rhs)
+                options={"SymmetricMode": True})
 
 
 def force_scale(model):
@@ -106,7 +111,10 @@ def solve(model, bc, f_ext=None, rtol=1e-9, max_iter=50, load_steps=1):
 
     Newton with a backtracking line search on the residual norm, in ``load_steps`` equal
     increments of the prescribed displacement and of ``f_ext``; converged when the largest
-    free-node residual is below ``rtol * E h^2``. Raises ConvergenceError otherwise.
+    free-node residual is below ``rtol * E h^2``. A step first tries the last factorised
+    Jacobian (a chord step) and keeps it when it divides the residual by CHORD_GAIN, which
+    saves the finite-difference Jacobian and its factorisation in the last iterations.
+    Raises ConvergenceError otherwise.
     """
     mesh = model.mesh
     mask, vals = bc_arrays(bc, mesh.n_nodes)
@@ -118,6 +126,7 @@ def solve(model, bc, f_ext=None, rtol=1e-9, max_iter=50, load_steps=1):
     tol = rtol * force_scale(model)
     x = mesh.points.copy()
     iters = 0
+    lu = None
 
     def residual(x, s):
         return (model.forces(x) + s * f_ext).ravel()
@@ -136,8 +145,19 @@ def solve(model, bc, f_ext=None, rtol=1e-9, max_iter=50, load_steps=1):
             rn = np.abs(r[free]).max(initial=0.0)
             if rn <= tol:
                 break
-            J = model.jacobian(x).tocsc()[free][:, free]
-            du = newton_step(J, -r[free])
+            if lu is not None:      # near the solution the last Jacobian still contracts
+                xt = x.copy()
+                xt.ravel()[free] += lu.solve(-r[free])
+                try:
+                    rt = residual(xt, s)
+                    if np.abs(rt[free]).max() * CHORD_GAIN < rn:
+                        x, r = xt, rt
+                        iters += 1
+                        continue
+                except DegenerateTetError:
+                    pass
+            lu = factorise(model.jacobian(x).tocsc()[free][:, free])
+            du = lu.solve(-r[free])
             alpha = 1.0
             while True:
                 xt = x.copy()
