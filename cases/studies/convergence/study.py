@@ -303,11 +303,10 @@ def _in_worker(item):
 
 
 def _weights(name, s):
-    """{family: the expected cost of its runs}, for the time left (the sparse solves grow
-    about as nodes^1.3)."""
+    """{family: the expected cost of its runs}, for the time left and the order of work."""
     p = PROBLEMS[name]
-    return {fam: sum(float(np.prod(p.nodes_per_side(h))) ** 1.3 * (2 if fam == "bcc" else 1)
-                     for h in levels(p, fam, s)) * (len(s.models) + 1) for fam in s.meshes}
+    return {fam: sum(p.cost(h) * (2 if fam == "bcc" else 1) for h in levels(p, fam, s))
+            * (len(s.models) + 1) for fam in s.meshes}
 
 
 # ---------------------------------------------------------------------- the study
@@ -339,18 +338,20 @@ def fits(runs):
     return out
 
 
-def _map(fn, jobs, workers, done):
-    """``fn`` over ``jobs`` in this process or on ``workers``; ``done(i)`` as each finishes;
-    the results in the jobs' order."""
+def _map(fn, jobs, workers, done, cost):
+    """``fn`` over ``jobs`` in this process or on ``workers``, the dearest first (``cost``
+    one expected cost per job: the longest unit then does not start last and run alone);
+    ``done(i)`` as each finishes; the results in the jobs' order."""
     results = [None] * len(jobs)
+    order = sorted(range(len(jobs)), key=lambda i: -cost[i])
     if workers is None:
         with one_blas_thread():
-            for i, job in enumerate(jobs):
+            for i in order:
                 stop.checkpoint()
-                results[i] = fn(job)
+                results[i] = fn(jobs[i])
                 done(i)
     else:
-        for i, result in workers.unordered(_in_worker, [(fn, i, j) for i, j in enumerate(jobs)]):
+        for i, result in workers.unordered(_in_worker, [(fn, i, jobs[i]) for i in order]):
             stop.checkpoint()
             results[i] = result
             done(i)
@@ -372,12 +373,14 @@ def run(s, workers=None, log=True, bench=None, store=OFF):
                   width=36) as track:
         refs = _map(reference_unit, [(name, bc, s, store) for name, bc in pairs], workers,
                     lambda i: track.advance(ref_weight / len(pairs),
-                                            f"{pairs[i][0]} {pairs[i][1]}: reference"))
+                                            f"{pairs[i][0]} {pairs[i][1]}: reference"),
+                    [PROBLEMS[name].reference_cost() for name, _ in pairs])
         jobs = [(name, bc, fam, s, store, ref) for (name, bc), ref in zip(pairs, refs)
                 for fam in s.meshes]
         rows = _map(family_unit, jobs, workers,
                     lambda i: track.advance(weights[jobs[i][0]][jobs[i][2]],
-                                            " ".join(jobs[i][:3])))
+                                            " ".join(jobs[i][:3])),
+                    [weights[name][fam] for name, _, fam, *_ in jobs])
         with one_blas_thread():
             eff = elasticity.table(s, store)
         track.advance(elastic_weight, "effective elasticity")
