@@ -454,8 +454,10 @@ def policy_text(policy):
             "#   |measured - gold| <= rtol |gold| + atol, atol = atol_of[metric] or atol.\n"
             "# atol keeps metrics near zero (momentum residuals, a zig-zag of FEM) from failing\n"
             "# on noise; static displacements are solved to a residual of 1e-9, so their\n"
-            "# differences below 1e-8 are the solver's. full: where the full-mode gold is\n"
-            "# (the committed reports/CASE/metrics.json). Rewritten by `pbcm bless --margin`.\n"
+            "# differences below 1e-8 are the solver's, and so are those of the force errors\n"
+            "# of a model exact on its problem (a homogeneous field). full: where the\n"
+            "# full-mode gold is (the committed reports/CASE/metrics.json). Rewritten by\n"
+            "# `pbcm bless --margin`.\n"
             + tomli_w.dumps(policy.__dict__))
 
 

@@ -14,10 +14,11 @@ def add(sub):
                     "files gold/CASE.quick.jsonl (6 significant digits; a value that agrees "
                     "to that precision is kept as it is), full mode by installing the case "
                     "folder as the committed reports/CASE. Without --metrics it first runs "
-                    "every case and study: in full mode (about 75 minutes on 2 cores) unless "
-                    "--quick is given. It keeps the gold rows of runs it did not see (other "
-                    "modes, meshes, models) unless --prune is given; --margin sets the "
-                    "policy's rtol. It prints every value it adds, changes or removes.")
+                    "every case and study: in full mode (about 30 minutes on 2 cores from "
+                    "an empty run store) unless --quick is given. It keeps the gold rows of "
+                    "runs it did not see (other modes, meshes, models) unless --prune is "
+                    "given; --margin sets the policy's rtol. It prints every value it adds, "
+                    "changes or removes.")
     b.add_argument("--margin", type=number("--margin", "a relative tolerance, a number > 0",
                                             low=0), default=None,
                    help="relative tolerance rtol of the policy (default: keep the policy's, "
