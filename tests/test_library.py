@@ -97,7 +97,8 @@ def test_paper_cube_on_the_framework_matches_the_landed_case(quick):
     rewrote the force kernels and compiled the RK4 step (sums in another order) and takes the
     calibration from strain measures instead of whole energies (c moves by 1e-9), so values
     now agree to 1e-7 relative with a floor of 1e-7 (an error that is a difference of two
-    numbers moves by the Newton tolerance), series to 1e-7 of their largest value, and the
+    numbers moves by the Newton tolerance), series to 1e-7 of their largest value with the
+    same floor (a profile of 0.005 mm moves by 1e-8 mm with chord Newton steps), and the
     Newton residual only has to stay converged (rounding noise, 1e-16 to 1e-9 N). The
     metrics measured against the FEM transient and FEM modes are left out since those
     references changed on purpose (mass matrices integrated exactly, the transient exact in
@@ -123,7 +124,8 @@ def _close(a, b, key):
         assert a == pytest.approx(b, rel=1e-7, abs=1e-7), key   # errors are differences
     elif isinstance(b, list) and b and all(isinstance(y, float) for y in b):
         scale = max(abs(y) for y in b)
-        assert len(a) == len(b) and np.allclose(a, b, rtol=0, atol=1e-7 * scale), key
+        floor = max(1e-7 * scale, 1e-7)
+        assert len(a) == len(b) and np.allclose(a, b, rtol=0, atol=floor), key
     elif isinstance(b, list):
         assert len(a) == len(b), key
         for x, y in zip(a, b):
