@@ -142,7 +142,7 @@ def definitions(names):
 DESCRIPTORS = frozenset({
     "case", "mesh", "bc", "model", "failed", "static_failed", "dyn_failed", "dyn_failed_dt4",
     "model_info", "nodes", "tets", "h_mm", "dyn_dt_s", "dyn_steps", "dyn_t_end_s", "label",
-    "why", "verdict", "levels", "metric", "dropped", "dyn_reaction_t_s"})
+    "why", "verdict", "levels", "metric", "dropped", "dyn_reaction_t_s", "homogeneous_failed"})
 
 # ---------------------------------------------------------------- the standard static metrics
 declare("disp_rel_l2_p1", "1", "disp L2 P1",
@@ -288,6 +288,16 @@ declare("linear_force_rel_err_max", "1", "linear FEM force err",
          "error at this strain).")
 declare("linear_lateral_rel_err_max", "1", "linear FEM lateral err",
          "the lateral err max of linear FEM P2 against neo-Hookean.")
+declare("homogeneous_force_n_steps", "N", "homogeneous force(steps)",
+         "the top force of the homogeneous (sliding) compression at each step.")
+declare("homogeneous_energy_force_n_steps", "N", "energy force(steps)",
+         "dW/d(push) of the model's stored energy along the homogeneous compression, by "
+         "central differences (conservative models).")
+declare("homogeneous_force_law_n_steps", "N", "neo-Hookean law force(steps)",
+         "the neo-Hookean law's top force in homogeneous compression, in closed form.")
+declare("homogeneous_force_dev_max", "1", "law deviation",
+         "the largest |F_model / F_law - 1| of the homogeneous compression over the steps: "
+         "how far the model's own law is from neo-Hookean (a constitutive check, not ranked).")
 
 # ---------------------------------------------------------------- convergence and extensions
 declare("response", "1", "response",

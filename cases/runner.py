@@ -7,13 +7,12 @@ import dataclasses
 
 import numpy as np
 
-from model import PbcmError
 from model.terms.shear import Shear
 from reference import linear
 from . import metrics as M
 from . import stop
 from .catalogue import STATIC, err_name, ref_name
-from .framework import Reference
+from .framework import FINDINGS, Reference
 from .progress import Progress
 from .store import OFF, key
 from .workers import one_blas_thread
@@ -22,8 +21,6 @@ from .workers import one_blas_thread
 # variation is the iterative solver's (relative residual 1e-10 gives about 1e-9 here), and a
 # correlation with it would correlate with solver noise (the sliding cube's pressure)
 UNIFORM_TOL = 1e-6
-# what a run may fail with and still be a finding: the suite's own errors and numerical ones
-FINDINGS = (PbcmError, ArithmeticError, np.linalg.LinAlgError)
 
 
 def uniform(field):

@@ -11,6 +11,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 import scipy.sparse as sp
+from scipy.optimize import brentq
 from skfem import Basis, ElementTetP1
 
 from model.bc import bc_arrays
@@ -193,6 +194,20 @@ def solve(mesh, E, nu, dirichlet, body_force=None, element="P1", refine=0, diric
               "dofs": int(d.N), "load_steps": int(load_steps)})
 
 
+def uniaxial(stretch, E, nu):
+    """The law in homogeneous uniaxial stretch with free lateral faces: (lateral stretch l,
+    nominal axial stress P [Pa]). The lateral faces are free when mu (l - 1/l) +
+    lam ln(J) / l = 0 with J = stretch l^2; then P = mu (stretch - 1/stretch) +
+    lam ln(J) / stretch (negative in compression)."""
+    if not (np.isfinite(stretch) and stretch > 0):
+        raise ModelError(f"a stretch must be a finite number > 0, got {stretch!r}")
+    lam, mu = lame(E, nu)
+    lat = brentq(lambda t: mu * (t - 1 / t) + lam * np.log(stretch * t * t) / t,
+                 stretch ** -0.5 * 1e-3, stretch ** -0.5 * 1e3)
+    return float(lat), float(mu * (stretch - 1 / stretch)
+                             + lam * np.log(stretch * lat * lat) / stretch)
+
+
 def converged(mesh, E, nu, dirichlet, levels=1, element="P2", mixed=True, **kw):
     """Solve on ``mesh`` refined 0..levels times and estimate the error of the finest, as
     ``reference.linear.converged`` does: the relative changes of the nodal displacement and
@@ -204,4 +219,4 @@ def converged(mesh, E, nu, dirichlet, levels=1, element="P2", mixed=True, **kw):
                                  refine=k, **kw) for k in range(levels + 1)])
 
 
-__all__ = ["solve", "converged", "HyperelasticResult", "Discretisation"]
+__all__ = ["solve", "converged", "uniaxial", "HyperelasticResult", "Discretisation"]

@@ -152,3 +152,21 @@ def test_paper_cube_conclusion_groups_the_artefact_by_model():
         "No model reproduces the paper's bulge/neck pattern clearly, nor does the converged FEM.")
     assert "and by the converged FEM on five/sliding." in R.conclusion(
         Config(), [dict(run, paper_pattern_fem=True)])[0]
+
+
+def test_rankings_tie_models_the_reference_cannot_order():
+    from cases.library import common
+    runs = [{"model": m, "err": e, "p2_error_estimate": 0.01}
+            for m, e in (("a", 0.10), ("b", 0.105), ("c", 0.30))]
+    lines = common.ranking(runs, "err", "error")
+    assert lines[0].startswith("a:") and "Tied" not in lines[0]
+    assert lines[1].startswith("b:") and "Tied with a" in lines[1]
+    assert "Tied" not in lines[2]
+    line = common.best_and_worst(runs, "err", "Error")
+    assert "closest a" in line and "farthest c" in line and ": b." in line
+    assert "not resolved" not in line           # 0.01 < 0.10 / 5
+    coarse = [dict(r, p2_error_estimate=0.03) for r in runs]
+    assert "not resolved" in common.best_and_worst(coarse, "err", "Error")
+    # against a closed form there is no estimate: no ties, no caveat
+    exact = common.best_and_worst(coarse, "err", "Error", exact=True)
+    assert "Tied" not in exact and "not resolved" not in exact

@@ -98,7 +98,8 @@ def test_paper_cube_on_the_framework_matches_the_landed_case(quick):
     calibration from strain measures instead of whole energies (c moves by 1e-9), so values
     now agree to 1e-7 relative with a floor of 1e-7 (an error that is a difference of two
     numbers moves by the Newton tolerance), series to 1e-7 of their largest value with the
-    same floor (a profile of 0.005 mm moves by 1e-8 mm with chord Newton steps), and the
+    same floor (a profile of 0.005 mm moves by 1e-8 mm with chord Newton steps; the zig-zag,
+    divided by that profile's largest value, to 1e-5), and the
     Newton residual only has to stay converged (rounding noise, 1e-16 to 1e-9 N). The
     metrics measured against the FEM transient and FEM modes are left out since those
     references changed on purpose (mass matrices integrated exactly, the transient exact in
@@ -115,6 +116,8 @@ def test_paper_cube_on_the_framework_matches_the_landed_case(quick):
                 continue
             if k == "static_residual_n":
                 assert (new[k] is None) == (v is None) and (v is None or new[k] < 1e-8), k
+            elif k == "zigzag":   # over the profile's largest value: 0.005 mm on msm six/sliding
+                assert new[k] == pytest.approx(v, rel=1e-5, abs=1e-7), k
             else:
                 _close(new[k], v, k)
 

@@ -53,29 +53,60 @@ def vs_closed_form(name, runs, key, closed, unit):
     return out
 
 
+def _by_model(runs, metric):
+    by = {}
+    for r in runs:
+        if r.get(metric) is not None:
+            by.setdefault(r["model"], []).append(r[metric])
+    return by
+
+
+def estimate(runs):
+    """The reference's error estimate a ranking of ``runs`` respects: the largest of their
+    references' (one per mesh and bc; None where the reference has none)."""
+    est = [r["p2_error_estimate"] for r in runs if r.get("p2_error_estimate") is not None]
+    return max(est) if est else None
+
+
 def ranking(runs, metric, label):
-    """'model: median metric (range)' sentences, best first, over the runs that gave it."""
-    by = {}
-    for r in runs:
-        if r.get(metric) is not None:
-            by.setdefault(r["model"], []).append(r[metric])
-    order = sorted(by, key=lambda m: np.median(by[m]))
-    return [f"{m}: {label} median {np.median(by[m]):.3g} (from {min(by[m]):.3g} to "
-            f"{max(by[m]):.3g} over {len(by[m])} runs)." for m in order]
+    """'model: median metric (range)' sentences, best first, over the runs that gave it; a
+    model whose median is within the reference's estimate of the one above is called tied
+    with it (the reference cannot order them)."""
+    by, est = _by_model(runs, metric), estimate(runs)
+    med = {m: float(np.median(v)) for m, v in by.items()}
+    order = sorted(by, key=med.get)
+    out = []
+    for k, m in enumerate(order):
+        tie = ""
+        if k and est is not None and med[m] - med[order[k - 1]] < est:
+            tie = f" Tied with {order[k - 1]} (within the reference's estimate {est:.2g})."
+        out.append(f"{m}: {label} median {med[m]:.3g} (from {min(by[m]):.3g} to "
+                   f"{max(by[m]):.3g} over {len(by[m])} runs).{tie}")
+    return out
 
 
-def best_and_worst(runs, metric, what):
-    """One line naming the model closest to FEM and the farthest, by median ``metric``."""
-    by = {}
-    for r in runs:
-        if r.get(metric) is not None:
-            by.setdefault(r["model"], []).append(r[metric])
+def best_and_worst(runs, metric, what, exact=False):
+    """One line naming the model closest to FEM and the farthest, by median ``metric``; the
+    models within the reference's estimate of the closest are named tied with it, and the
+    line says so where that estimate exceeds a fifth of the smallest error it ranks
+    (``exact``: the metric is against a closed form, which has no estimate)."""
+    by, est = _by_model(runs, metric), None if exact else estimate(runs)
     if not by:
         return f"No model gave {what}."
     med = {m: float(np.median(v)) for m, v in by.items()}
     best, worst = min(med, key=med.get), max(med, key=med.get)
-    return (f"{what}: closest {best} (median error {med[best]:.3g}), farthest {worst} "
+    line = (f"{what}: closest {best} (median error {med[best]:.3g}), farthest {worst} "
             f"({med[worst]:.3g}).")
+    if est is None:
+        return line
+    tied = [m for m in sorted(med, key=med.get) if m != best and med[m] - med[best] < est]
+    if tied:
+        line += f" Tied with {best} within the reference's estimate {est:.2g}: {', '.join(tied)}."
+    smallest = min(min(v) for v in by.values())
+    if est > smallest / 5:
+        line += (f" The reference's estimate ({est:.2g}) exceeds a fifth of the smallest "
+                 f"error ranked ({smallest:.2g}): differences below it are not resolved.")
+    return line
 
 
 def failures(runs):

@@ -31,6 +31,13 @@ def end_rotation(points, angle, centre):
     return np.column_stack([c * y - s * z - y, s * y + c * z - z])
 
 
+def end_rotation_linearised(points, angle, centre):
+    """The same rotation linearised, u = angle e_x x r: the small rotation of linear
+    elasticity, whose torque Saint-Venant's beta G a^4 angle / L bounds from below."""
+    y, z = points[:, 1] - centre[0], points[:, 2] - centre[1]
+    return angle * np.column_stack([-z, y])
+
+
 class Torsion(Case):
     name = "torsion"
     resolution = Knob("spacing_mm", "lattice spacing [mm]")
@@ -57,8 +64,15 @@ class Torsion(Case):
         return common.bar(family, LENGTH_MM, SIDE_MM, SIDE_MM, s.spacing_mm)
 
     def dirichlet(self, mesh, bc, s):
+        return self._turned(mesh, s, end_rotation)
+
+    def dirichlet_linear(self, mesh, bc, s):
+        return self._turned(mesh, s, end_rotation_linearised)
+
+    def _turned(self, mesh, s, rotation):
+        """x = 0 clamped, the end face moved in its plane by ``rotation``, x free."""
         end = common.face(mesh, LENGTH_MM * MM)
-        uv = end_rotation(mesh.points[end], np.radians(s.angle_deg), (SIDE_MM * MM / 2,) * 2)
+        uv = rotation(mesh.points[end], np.radians(s.angle_deg), (SIDE_MM * MM / 2,) * 2)
         out = {int(i): (0.0, 0.0, 0.0) for i in common.face(mesh, 0.0)}
         out.update({int(i): (None, float(a), float(b)) for i, (a, b) in zip(end, uv)})
         return out

@@ -64,9 +64,9 @@ class Problem:
         return sum(self.cost(h) for h in self.ref_ladder_mm)
 
     def dirichlet(self, mesh, bc, s, scale):
-        """The case's prescribed displacements times ``scale``."""
+        """The case's prescribed displacements of the linear regime times ``scale``."""
         return {k: tuple(None if v is None else v * scale for v in val)
-                for k, val in self.spec.dirichlet(mesh, bc, s).items()}
+                for k, val in self.spec.dirichlet_linear(mesh, bc, s).items()}
 
     def loads(self, mesh, bc, s, scale):
         """The case's loads times ``scale``."""

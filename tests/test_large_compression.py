@@ -1,0 +1,70 @@
+"""The large-compression case (issue 25): bonded plates make a barrel judged against the
+converged mixed neo-Hookean reference with its estimate; the homogeneous (sliding) compression
+is a constitutive check whose law is the closed form and whose energy curve is dW/d(push)."""
+import numpy as np
+import pytest
+
+from cases.library import large_compression as lc
+from cases.registry import CASES
+from model import build
+from model.terms.shear import Shear
+from reference.hyperelastic import uniaxial
+
+CASE = CASES["large-compression"]
+
+
+def test_the_law_in_closed_form_is_the_hand_formula():
+    # lateral stretch and nominal stress at stretch 0.7, E = 10 kPa, nu = 0.45, worked by hand
+    # in tests/test_hyperelastic.py: 1.17085 and 4.4435 N on the 32 mm cube
+    lt, P = uniaxial(0.7, 10e3, 0.45)
+    assert lt == pytest.approx(1.17085, abs=1e-5)
+    assert -P * 0.032 ** 2 == pytest.approx(4.4435, abs=1e-4)
+    s = CASE.settings()
+    assert lc.law_force(s)[-1] == pytest.approx(4.4435, abs=1e-4)
+    assert uniaxial(1.0, 10e3, 0.45) == (1.0, 0.0)
+    with pytest.raises(Exception, match="stretch"):
+        uniaxial(-0.5, 10e3, 0.45)
+
+
+@pytest.fixture(scope="module")
+def bonded():
+    s = CASE.settings(quick=True, steps=3)
+    mesh = CASE.mesh("five", s)
+    probe = Shear(mesh, s.material, reading="corner")
+    return s, mesh, CASE.solve_reference(mesh, "clamped", s, probe)
+
+
+def test_bonded_reference_is_a_barrel_with_an_estimate(bonded):
+    s, mesh, ref = bonded
+    assert ref.p2.info["mixed"] and ref.p2.info["refine"] == s.ref_levels >= 1
+    force, law = np.array(ref.extra["force"]), np.array(lc.law_force(s))
+    assert len(force) == s.steps and np.all(np.diff(force) > 0)
+    # bonded plates restrain the lateral expansion: stiffer than the homogeneous law
+    assert np.all(force > 1.05 * law)
+    # a barrel: the mid layer bulges out, the bonded layers do not move sideways
+    profile = lc.M.layer_profile(mesh.points, ref.p2.u, [y * lc.MM for y in lc.LAYERS_MM],
+                                 lc.SIZE_MM * lc.MM)
+    assert profile[0] == pytest.approx(0, abs=1e-12) and profile[-1] == pytest.approx(0, abs=1e-12)
+    assert profile[2] > profile[1] > 0 and profile[2] > profile[3] > 0
+    assert 0 < ref.error_estimate < 0.1
+    # the estimate brackets the change between the two refinements it came from
+    assert ref.error_estimate >= ref.conv.increments[-1] * (1 - 1e-12)
+
+
+def test_homogeneous_check_of_fem_neohookean_is_the_law():
+    """P1 neo-Hookean represents the homogeneous field exactly: its sliding curve is the law
+    to the Newton tolerance, and the force its energy implies equals it to the central
+    difference's error (ENERGY_STEP^2 of the curvature)."""
+    s = CASE.settings(steps=3)
+    mesh = CASE.mesh("six", s)
+    pm = build("fem-neohookean", mesh, s.material)
+    force, from_energy = lc.homogeneous_curve(pm, mesh, s)
+    assert np.allclose(force, lc.law_force(s), rtol=1e-8)
+    assert np.allclose(from_energy, force, rtol=1e-5)
+
+
+def test_a_non_conservative_reading_has_no_energy_curve():
+    s = CASE.settings(steps=2)
+    mesh = CASE.mesh("five", s)
+    force, from_energy = lc.homogeneous_curve(build("pbcm-corner", mesh, s.material), mesh, s)
+    assert from_energy is None and len(force) == 2 and all(f > 0 for f in force)
