@@ -12,15 +12,20 @@ from dataclasses import dataclass, field
 import numpy as np
 import scipy.sparse as sp
 from scipy.optimize import brentq
-from skfem import Basis, ElementTetP1
+from skfem import Basis, ElementTetP1, FacetBasis
 
 from model.bc import bc_arrays
 from model.errors import ConvergenceError, ModelError
 from ._neohookean import neohookean
 from .assembly import scalar_gradients
-from .fem import (check_finite, dirichlet_dofs, element_basis, lame, linear_solve, probe,
-                  refine_with_data, saddle_solve, skfem_mesh, stress_measures, stress_on_input)
-from .linear import body_load, converged_from, dof_component, transfer_to_nodes
+from .fem import (INTORDER, check_finite, dirichlet_dofs, element_basis, lame, linear_solve,
+                  probe, refine_with_data, saddle_solve, skfem_mesh, stress_measures,
+                  stress_on_input)
+from .linear import body_load, converged_from, dof_component, traction_load, transfer_to_nodes
+
+# above this Poisson ratio ``converged(mixed="auto")`` solves the mixed (u, p) form: the
+# displacement form's volumetric locking grows with lam / mu (9 at nu = 0.45, 49 at 0.49)
+MIXED_ABOVE_NU = 0.45
 
 
 @dataclass
@@ -112,10 +117,12 @@ class Discretisation:
 
 
 def solve(mesh, E, nu, dirichlet, body_force=None, element="P1", refine=0, dirichlet_fn=None,
-          load_steps=1, rtol=1e-10, max_iter=30, on_step=None, mixed=False):
+          load_steps=1, rtol=1e-10, max_iter=30, on_step=None, mixed=False, traction=None):
     """Neo-Hookean equilibrium on ``mesh`` (a model.mesh.TetMesh) refined ``refine`` times.
 
-    Newton in ``load_steps`` equal increments of the prescribed displacement and body force,
+    Newton in ``load_steps`` equal increments of the prescribed displacement, body force and
+    ``traction`` (a dead load: force per reference area, the callable
+    ``reference.linear.solve`` takes),
     each converged to max |residual| <= rtol * E h^2 (h the mean edge of the solved mesh; the
     pressure equations of the mixed form to rtol * h^3). Raises ConvergenceError otherwise.
     ``element`` "P1" or "P2"; ``mixed`` solves the Taylor-Hood P2/P1 (u, p) form (P2 only).
@@ -142,6 +149,9 @@ def solve(mesh, E, nu, dirichlet, body_force=None, element="P1", refine=0, diric
     f_body = np.zeros(d.N)
     if body_force is not None:
         f_body[:ub.N] = body_load(ub, body_force)
+    if traction is not None:
+        f_body[:ub.N] += traction_load(FacetBasis(m, ub.elem, intorder=INTORDER[element]),
+                                       traction)
     comp = dof_component(ub)
     prescribed = np.zeros(d.N, dtype=bool)
     prescribed[D] = True
@@ -212,7 +222,10 @@ def converged(mesh, E, nu, dirichlet, levels=1, element="P2", mixed=True, **kw):
     """Solve on ``mesh`` refined 0..levels times and estimate the error of the finest, as
     ``reference.linear.converged`` does: the relative changes of the nodal displacement and
     of the stored energy between levels give an observed rate and a Richardson estimate; the
-    larger of the two estimates is the reference's. ``kw`` as :func:`solve` takes them."""
+    larger of the two estimates is the reference's. ``mixed`` True, False or "auto" (mixed
+    above nu = MIXED_ABOVE_NU); ``kw`` as :func:`solve` takes them."""
+    if mixed == "auto":
+        mixed = nu > MIXED_ABOVE_NU
     if levels < 1:
         raise ModelError(f"converged needs levels >= 1 to estimate its error, got {levels}")
     return converged_from([solve(mesh, E, nu, dirichlet, element=element, mixed=mixed,

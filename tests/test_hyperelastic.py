@@ -166,3 +166,44 @@ def test_against_felupe_on_a_bonded_block_compressed_20_percent():
     top = mesh.nodes_on_plane("z", H)
     assert ours.reaction[top, 2].sum() == pytest.approx(
         force[np.isclose(m2.points[:, 2], H), 2].sum(), rel=1e-7)
+
+
+def top_traction(value):
+    """A dead load ``value`` [Pa] along z on the face z = L (per reference area)."""
+    def traction(points, normals):
+        t = np.zeros_like(points)
+        t[..., 2] = np.where(np.abs(points[..., 2] - L) < 1e-9, value, 0.0)
+        return t
+    return traction
+
+
+def test_a_dead_traction_gives_the_law_worked_by_hand():
+    # the sliding cube under a nominal stress P on its top: the stretch where the law's
+    # nominal stress is P (the inverse of the hand formula)
+    mesh = cube(3, L, "six")
+    bc = sliding_cube(mesh, 1.0)
+    for i in mesh.nodes_on_plane("z", L):       # the top is loaded, not moved
+        bc[int(i)] = bc[int(i)][:2] + (None,)
+    bc = {i: u for i, u in bc.items() if u != (None, None, None)}
+    P = -0.2 * E
+    stretch = brentq(lambda s: uniaxial(s, 0.45)[1] - P, 0.3, 1.0)
+    r = hyperelastic.solve(mesh, E, 0.45, bc, element="P2", traction=top_traction(P),
+                           load_steps=2)
+    top = mesh.nodes_on_plane("z", L)
+    assert r.u[top, 2] == pytest.approx((stretch - 1) * L, rel=1e-8)
+
+
+def test_the_small_load_limit_with_a_traction_is_linear_p2():
+    mesh = box(3, 3, 3, 0.01, 0.01, L, "five")
+    bc = {int(i): (0.0, 0.0, 0.0) for i in mesh.nodes_on_plane("z", 0.0)}
+    t = top_traction(1e-7 * E)
+    nh = hyperelastic.solve(mesh, E, 0.45, bc, element="P2", traction=t)
+    lin = linear.solve(mesh, E, 0.45, bc, element="P2", traction=t, solver="direct")
+    assert np.linalg.norm(nh.u - lin.u) < 1e-6 * np.linalg.norm(lin.u)
+
+
+@pytest.mark.parametrize("nu, mixed", [(0.45, False), (0.49, True)])
+def test_auto_takes_the_mixed_form_above_the_locking_threshold(nu, mixed):
+    mesh = cube(2, L, "six")
+    conv = hyperelastic.converged(mesh, E, nu, sliding_cube(mesh, 0.99), mixed="auto")
+    assert conv.result.info["mixed"] is mixed
