@@ -142,7 +142,8 @@ def definitions(names):
 DESCRIPTORS = frozenset({
     "case", "mesh", "bc", "model", "failed", "static_failed", "dyn_failed", "dyn_failed_dt4",
     "model_info", "nodes", "tets", "h_mm", "dyn_dt_s", "dyn_steps", "dyn_t_end_s", "label",
-    "why", "verdict", "levels", "metric", "dropped", "dyn_reaction_t_s", "homogeneous_failed"})
+    "why", "verdict", "levels", "metric", "dropped", "dyn_reaction_t_s", "homogeneous_failed",
+    "finite_failed"})
 
 # ---------------------------------------------------------------- the standard static metrics
 declare("disp_rel_l2_p1", "1", "disp L2 P1",
@@ -185,6 +186,30 @@ declare("net_torque_rel", "1", "net T",
          "|sum x x f| / sum |x||f| of those forces.", digits=2)
 declare("p2_error_estimate", "1", "P2 error estimate",
          "the P2 reference's own error estimate: its change over the last refinement.")
+
+declare("linear_scale", "1", "linear-regime scale",
+         "the factor on the case's loads at which the linear-regime metrics were solved: the "
+         "largest tetrahedron-average strain of the linear reference is then 1e-4; the "
+         "model's answer is divided by it again, so that the linear-regime metrics compare "
+         "its linearisation with linear FEM.", digits=3)
+
+# ---------------------------------------------------------------- the case's load
+declare("disp_rel_l2_nh", "1", "disp L2 NH",
+        "at the case's load: ||u_model - u_ref|| / ||u_ref|| against the converged "
+        "neo-Hookean P2 reference at the particle nodes (fem-linear's is its linearisation "
+        "error).", "max")
+declare("disp_max_rel_nh", "1", "disp max NH",
+        "at the case's load: max_i |u_model,i - u_ref,i| / max_i |u_ref,i| against the "
+        "neo-Hookean reference.", "max")
+declare("reaction_rel_err_nh", "1", "reaction err NH",
+        "at the case's load: |reaction / neo-Hookean reaction - 1| (n/a in a load-controlled "
+        "case).", "max")
+declare("reaction_fem_nh_n", "N", "NH reaction",
+        "the reaction of the converged neo-Hookean reference at the case's load.",
+        shown=("mN", 1e3), digits=4)
+declare("nh_error_estimate", "1", "NH error estimate",
+        "the neo-Hookean reference's own error estimate: its change over the last "
+        "refinement, Richardson-extrapolated where an order can be observed.")
 
 # ---------------------------------------------------------------- paper cube: the artefact
 declare("bulge_profile_mm", "mm", "layer profile",
@@ -337,6 +362,9 @@ del _n
 STATIC = ("disp_rel_l2_p1", "disp_max_rel_p1", "disp_rel_l2_p2", "disp_max_rel_p2",
           "reaction_n", "reaction_ratio", "reaction_rel_err", "stress_corr", "stress_rel_err",
           "pressure_corr", "pressure_rel_err", "static_residual_n")
-STANDARD_GATED = gated(*(n for n in STATIC + ("net_force_rel",) if CATALOGUE[n].direction))
+# the metrics at the case's load, against the neo-Hookean reference (None where it failed)
+FINITE = ("disp_rel_l2_nh", "disp_max_rel_nh", "reaction_rel_err_nh")
+STANDARD_GATED = gated(*(n for n in STATIC + FINITE + ("net_force_rel",)
+                         if CATALOGUE[n].direction))
 TABLE = ("disp_rel_l2_p1", "disp_rel_l2_p2", "disp_max_rel_p2", "reaction_ratio",
          "stress_corr", "stress_rel_err", "pressure_corr", "net_force_rel", "net_torque_rel")

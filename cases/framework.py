@@ -15,6 +15,8 @@ from typing import ClassVar
 import numpy as np
 
 from model import PRESETS, Material, PbcmError, build
+from model.errors import ModelError
+from model import static
 from model.compose import parse
 from model.mesh import SCHEMES
 from model.loads import body_forces, traction_forces
@@ -25,6 +27,14 @@ FINDINGS = (PbcmError, ArithmeticError, np.linalg.LinAlgError)
 
 MM = 1e-3
 MESH_FAMILIES = SCHEMES          # five, six, bcc, unstructured
+# the linear regime: the case's loads scaled so that the largest strain of the converged linear
+# reference (its tetrahedron averages) is this; every model then answers as its linearisation
+LINEAR_STRAIN = 1e-4
+
+
+def scaled(dirichlet, k):
+    """Prescribed displacements ``dirichlet`` ({node: (ux, uy, uz)}, None free) times ``k``."""
+    return {i: tuple(None if v is None else v * k for v in u) for i, u in dirichlet.items()}
 
 
 @dataclass
@@ -41,6 +51,7 @@ class Settings:
     bcs: tuple = ()
     models: tuple = ()
     p2_levels: int = 1          # refinements of the converged P2 reference
+    nh_levels: int = 1          # refinements of the converged neo-Hookean reference
     quick: bool = False
     shear_scale: float = 1.0    # for tests, in the API only: scales every shear term (1 = the model)
     # True: the standard static metrics and quantities only; the case's extra reference work
@@ -55,7 +66,7 @@ class Settings:
         """The parameters that define the problem the metrics answer (what a bound was
         measured at). Subclasses add their geometry and loads."""
         return {"E_Pa": self.E, "nu": self.nu, "rho_kg_m3": self.rho,
-                "p2_levels": self.p2_levels}
+                "p2_levels": self.p2_levels, **regimes(self)}
 
     @property
     def units(self):
@@ -68,6 +79,26 @@ class Settings:
         return {**self.problem(), "meshes": list(self.meshes), "bcs": list(self.bcs),
                 "models": list(self.models), "quick": self.quick,
                 "shear_scale": self.shear_scale}
+
+
+def linear_scale(p2, material):
+    """The factor that brings the loads of the linear result ``p2`` down to the linear
+    regime: its largest tetrahedron-average principal strain to LINEAR_STRAIN (1 where it is
+    already below)."""
+    E, nu = material.E, material.nu
+    sig = p2.stress
+    eps = ((1 + nu) * sig - nu * np.trace(sig, axis1=1, axis2=2)[:, None, None] * np.eye(3)) / E
+    largest = float(np.abs(np.linalg.eigvalsh(eps)).max())
+    if not np.isfinite(largest) or largest == 0:
+        raise ModelError("the linear reference has no strain: the case's loads are zero "
+                            "or not finite")
+    return min(1.0, LINEAR_STRAIN / largest)
+
+
+def regimes(s):
+    """The problem's entries that say how the two regimes are posed (what a gold file's
+    bounds were measured at)."""
+    return {"linear_strain": LINEAR_STRAIN, "nh_levels": s.nh_levels}
 
 
 @dataclass(frozen=True)
@@ -101,6 +132,13 @@ class Loads:
             f += body_forces(mesh, self.body_force)
         return f
 
+    def scaled(self, k):
+        """These loads times ``k``."""
+        return Loads(tractions=tuple(Traction(t.axis, t.at, tuple(v * k for v in t.value))
+                                     for t in self.tractions),
+                     body_force=None if self.body_force is None
+                     else tuple(v * k for v in self.body_force))
+
     def fem_traction(self, tol):
         """The tractions as the callable ``(points, normals) -> (..., 3)`` that
         ``reference.linear.solve`` takes (None without tractions)."""
@@ -128,10 +166,17 @@ class Knob:
 
 @dataclass
 class Reference:
-    """The FEM side of one (mesh, bc), as the runner computes it by default: P1 on the mesh,
-    converged P2 (``conv``, its finest solution ``p2``), the paper's max |tau| of the P2
-    displacement (``tau``), the reaction on the driven nodes, the case's quantities of
-    interest of the P2 solution, and anything the case adds in ``extra``."""
+    """The FEM side of one (mesh, bc), as the runner computes it by default.
+
+    The linear regime: linear P1 on the mesh and converged linear P2 (``conv``, its finest
+    solution ``p2``) under ``dirichlet_linear`` and the loads at the case's size (linear, so
+    any size gives the same relative errors), the paper's max |tau| of the P2 displacement
+    (``tau``), the reaction on the driven nodes, the case's quantities of interest of the P2
+    solution; ``scale`` the factor that brings the loads down to LINEAR_STRAIN, at which
+    each model is solved (None: the case has no linear regime, its metrics come from its
+    own solve). The case's load: the converged neo-Hookean reference under ``dirichlet``
+    (``nonlinear``, its reaction ``nonlinear_reaction``; None with ``nonlinear_failed`` the
+    reason when it has none). Anything the case adds is in ``extra``."""
 
     dirichlet: dict
     f_ext: np.ndarray
@@ -143,6 +188,11 @@ class Reference:
     quantities: dict
     error_estimate: float
     extra: dict = field(default_factory=dict)
+    dirichlet_linear: dict = None
+    scale: float = None
+    nonlinear: object = None
+    nonlinear_reaction: float = None
+    nonlinear_failed: str = None
 
 
 class Case(abc.ABC):
@@ -171,6 +221,7 @@ class Case(abc.ABC):
     draws_stress, magnify : whether the case draws its own stress panels; the magnification
         of the standard ones.
     static : whether the case has a static displacement problem (what ``pbcm fit`` fits).
+    finite_steps : load steps of the neo-Hookean reference at the case's load.
     resolution, load : the Settings fields a sweep's ``resolution`` and ``load`` axes turn
         (a Knob each), or None where the case has none.
     """
@@ -193,6 +244,7 @@ class Case(abc.ABC):
     draws_stress: ClassVar[bool] = False   # True: the case draws its own max |tau| panels
     magnify: ClassVar[float] = 5.0         # displacement magnification of the panels
     static: ClassVar[bool] = True          # False: no static displacement (modes)
+    finite_steps: ClassVar[int] = 1        # load steps of the neo-Hookean reference
     resolution: ClassVar[Knob] = None      # what a sweep's resolution axis turns
     load: ClassVar[Knob] = None            # what a sweep's load axis turns
 
@@ -284,9 +336,18 @@ class Case(abc.ABC):
         return {}
 
     def solve_static(self, pm, mesh, bc, s, ref):
-        """The model's static solution (default one Newton solve with the loads); None for a
-        case without a static problem."""
+        """The model's static solution at the case's load (default one Newton solve with the
+        loads); None for a case without a static problem."""
         return pm.solve_static(ref.dirichlet, f_ext=ref.f_ext)
+
+    def solve_linear(self, pm, mesh, bc, s, ref):
+        """The model's static solution in the linear regime: ``dirichlet_linear`` and the
+        loads times ``ref.scale``, the solver's force tolerance scaled alike (so that the
+        regime's relative accuracy is the case load's)."""
+        k = ref.scale
+        return pm.solve_static(scaled(ref.dirichlet_linear, k),
+                               f_ext=None if ref.f_ext is None else k * ref.f_ext,
+                               rtol=static.RTOL * k)
 
     def run_extra(self, pm, mesh, bc, s, ref, st):
         """Case-specific metrics of one run; ``st`` is None when the static solve failed."""

@@ -15,9 +15,11 @@ from model.mesh import write as write_mesh
 from . import costs, figures
 from .document import Document, fmt
 from . import catalogue
+from .library import common
 from .runner import jsonable
 
 TIMING_KEYS = ("dyn_wall_s",)   # wall times: in run.json, never in metrics.json
+REGIMES = ("linear_scale", "reaction_fem_nh_n", "nh_error_estimate")
 
 def environment():
     import numba
@@ -122,9 +124,12 @@ def build_report(case, s, runs, fields, out):
         "Quick mode." if s.quick else "Full mode."])
     doc.h(2, "Definitions")
     doc.ul(catalogue.definitions(catalogue.TABLE + case.columns + case.gated
-                                 + (case.headline,)) + list(case.notes))
+                                 + (case.headline,) + catalogue.FINITE + REGIMES)
+           + list(case.notes))
     failed = [r for r in runs if r.get("failed")]
-    groups = dict(case.findings(s, [r for r in runs if not r.get("failed")]))
+    ok = [r for r in runs if not r.get("failed")]
+    groups = dict(case.findings(s, ok))
+    groups.update(common.finite_load(ok))
     tets = [r["tets"] for r in runs if r.get("tets")]
     groups["Cost"] = groups.get("Cost", []) + costs.cost_sentences(
         costs.load(Path(out).parent), s.models,
@@ -155,12 +160,35 @@ def _tables(doc, case, s, runs):
             if rs[0].get("reaction_fem_p2_n") is not None:
                 line += f"; FEM P2 reaction {fmt(rs[0]['reaction_fem_p2_n'], 4)} N"
             doc.p(line + f"; P2 reference error estimate {fmt(rs[0]['p2_error_estimate'], 2)}.")
+            if rs[0].get("linear_scale") is not None:
+                doc.p(f"Linear regime: the loads times {fmt(rs[0]['linear_scale'], 3)} (largest "
+                      "strain of the linear reference 1e-4), each model's answer divided by "
+                      "it again, against linear FEM:")
             doc.table(["model"] + [m.header for m in shown],
                       [[r["model"]] + [case.cell(m, r) for m in shown] for r in rs])
+            _finite_table(doc, case, rs)
             bad = [r for r in rs if r["static_failed"]]
             if bad:
-                doc.p("Static solve failed (its metrics are n/a): " + "; ".join(
+                doc.p("No equilibrium in the linear regime (its metrics are n/a): " + "; ".join(
                     f"{r['model']}: {r['static_failed']}" for r in bad) + ".")
+
+
+def _finite_table(doc, case, rs):
+    """The (mesh, bc)'s runs at the case's load against the neo-Hookean reference."""
+    if rs[0].get("nh_error_estimate") is None:
+        return
+    shown = [catalogue.metric(n) for n in catalogue.FINITE]
+    line = (f"At the case's load, against the converged neo-Hookean reference (error estimate "
+            f"{fmt(rs[0]['nh_error_estimate'], 2)}")
+    if rs[0].get("reaction_fem_nh_n") is not None:
+        line += f", reaction {fmt(rs[0]['reaction_fem_nh_n'], 4)} N"
+    doc.p(line + "):")
+    doc.table(["model"] + [m.header for m in shown],
+              [[r["model"]] + [case.cell(m, r) for m in shown] for r in rs])
+    bad = [r for r in rs if r.get("finite_failed")]
+    if bad:
+        doc.p("No equilibrium at the case's load (its metrics are n/a): " + "; ".join(
+            f"{r['model']}: {r['finite_failed']}" for r in bad) + ".")
 
 
 def _standard_figures(doc, case, s, runs, fields, out):

@@ -4,15 +4,16 @@ metrics. A failure (a mesh that cannot be built, a reference that does not conve
 without equilibrium) is recorded in the runs it touches and the case goes on.
 """
 import dataclasses
+from dataclasses import dataclass
 
 import numpy as np
 
 from model.terms.shear import Shear
-from reference import linear
+from reference import hyperelastic, linear
 from . import metrics as M
 from . import stop
-from .catalogue import STATIC, err_name, ref_name
-from .framework import FINDINGS, Reference
+from .catalogue import FINITE, STATIC, err_name, ref_name
+from .framework import FINDINGS, Reference, linear_scale
 from .progress import Progress
 from .store import OFF, key
 from .workers import one_blas_thread
@@ -35,18 +36,20 @@ def reaction_along(reaction, driven):
 
 
 def reference(case, mesh, bc, s, probe, extra=True):
-    """The default references of one (mesh, bc): P1 on the mesh and converged P2, with the
-    case's loads, quantities and (``extra``) its extra reference work."""
+    """The default references of one (mesh, bc): the linear regime's (P1 on the mesh and
+    converged linear P2) and the case load's (converged neo-Hookean), with the case's loads,
+    quantities and (``extra``) its extra reference work."""
     mat = s.material
     dirichlet = case.dirichlet(mesh, bc, s)
+    dirichlet_lin = case.dirichlet_linear(mesh, bc, s)
     loads = case.loads(mesh, bc, s)
     kw = {"traction": loads.fem_traction(1e-9 * mesh.size),
           "body_force": None if loads.body_force is None else np.asarray(loads.body_force)}
     kw = {k: v for k, v in kw.items() if v is not None}
-    kw["solver"] = case.fem_solver
     kw["dirichlet_fn"] = case.dirichlet_fn(mesh, bc, s)
-    p1 = linear.solve(mesh, mat.E, mat.nu, dirichlet, element="P1", **kw)
-    conv = linear.converged(mesh, mat.E, mat.nu, dirichlet, levels=s.p2_levels, **kw)
+    lin = dict(kw, solver=case.fem_solver)
+    p1 = linear.solve(mesh, mat.E, mat.nu, dirichlet_lin, element="P1", **lin)
+    conv = linear.converged(mesh, mat.E, mat.nu, dirichlet_lin, levels=s.p2_levels, **lin)
     p2 = conv.result
     driven = case.driven(mesh, bc, s)
     ref = Reference(dirichlet=dirichlet, f_ext=loads.nodal_forces(mesh), p1=p1, conv=conv,
@@ -54,24 +57,61 @@ def reference(case, mesh, bc, s, probe, extra=True):
                     reaction=None if driven is None else float(reaction_along(p2.reaction,
                                                                               driven)),
                     quantities=case.quantities(mesh, p2.u, p2.reaction, s, bc),
-                    error_estimate=conv.error_estimate)
+                    error_estimate=conv.error_estimate, dirichlet_linear=dirichlet_lin,
+                    scale=linear_scale(p2, mat))
+    try:
+        ref.nonlinear = hyperelastic.converged(mesh, mat.E, mat.nu, dirichlet,
+                                               levels=s.nh_levels, mixed="auto",
+                                               load_steps=case.finite_steps, **kw)
+        if driven is not None:
+            ref.nonlinear_reaction = float(reaction_along(ref.nonlinear.result.reaction,
+                                                          driven))
+    except FINDINGS as exc:     # recorded: the linear regime still stands
+        ref.nonlinear_failed = str(exc)
     ref.extra = case.reference_extra(mesh, bc, s, ref) if extra else {}
     return ref
 
 
-def static_metrics(case, pm, st, mesh, bc, s, ref):
-    """The standard metrics of a static solution against the references (docs/model.md "What is
+@dataclass
+class LinearRegime:
+    """A model's solution in the linear regime, brought back to the case's load (divided by
+    the scale): what the linear references' answers at the case's load are compared with."""
+
+    u: np.ndarray
+    reaction: np.ndarray
+    residual: float
+    stress: dict
+
+    @classmethod
+    def of(cls, st, pm, scale):
+        stress = pm.tet_stress(st.x)
+        return cls(u=st.u / scale, reaction=st.reaction / scale, residual=st.residual / scale,
+                   stress={k: v / scale for k, v in stress.items()})
+
+
+def linear_regime(case, pm, mesh, bc, s, ref):
+    """The model's answer in the linear regime brought back to the case's load (the case's
+    own solve where the reference has no linear regime; None without a static problem)."""
+    if ref.scale is None:
+        st = case.solve_static(pm, mesh, bc, s, ref)
+        return None if st is None else LinearRegime.of(st, pm, 1.0)
+    return LinearRegime.of(case.solve_linear(pm, mesh, bc, s, ref), pm, ref.scale)
+
+
+def static_metrics(case, lr, mesh, bc, s, ref):
+    """The standard metrics of a static solution ``lr`` (its u, reaction, residual and
+    per-tetrahedron stress) against the linear references (docs/model.md "What is
     compared"), then the case's quantities of interest and their errors."""
-    stress = pm.tet_stress(st.x)
-    out = {"disp_rel_l2_p1": M.rel_l2(st.u, ref.p1.u),
-           "disp_max_rel_p1": M.max_rel(st.u, ref.p1.u),
-           "disp_rel_l2_p2": M.rel_l2(st.u, ref.p2.u),
-           "disp_max_rel_p2": M.max_rel(st.u, ref.p2.u)}
+    stress = lr.stress
+    out = {"disp_rel_l2_p1": M.rel_l2(lr.u, ref.p1.u),
+           "disp_max_rel_p1": M.max_rel(lr.u, ref.p1.u),
+           "disp_rel_l2_p2": M.rel_l2(lr.u, ref.p2.u),
+           "disp_max_rel_p2": M.max_rel(lr.u, ref.p2.u)}
     driven = case.driven(mesh, bc, s)
     if driven is None:
         out.update(reaction_n=None, reaction_ratio=None, reaction_rel_err=None)
     else:
-        reaction = M.finite("reaction", reaction_along(st.reaction, driven))
+        reaction = M.finite("reaction", reaction_along(lr.reaction, driven))
         out.update(reaction_n=reaction,
                    reaction_ratio=M.finite("reaction_ratio", reaction / ref.reaction),
                    reaction_rel_err=M.finite("reaction_rel_err",
@@ -82,13 +122,27 @@ def static_metrics(case, pm, st, mesh, bc, s, ref):
         "pressure_corr": (None if uniform(ref.p2.pressure)
                           else M.correlation(stress["pressure"], ref.p2.pressure)),
         "pressure_rel_err": M.rel_l2(stress["pressure"], ref.p2.pressure)})
-    q = case.quantities(mesh, st.u, st.reaction, s, bc)
+    q = case.quantities(mesh, lr.u, lr.reaction, s, bc)
     out.update(q)
     for name in case.qoi_errors:
         out[err_name(name)] = M.finite(err_name(name),
                                        abs(q[name] / _nonzero(name, ref.quantities[name]) - 1))
-    out["static_residual_n"] = st.residual
-    return out, stress
+    out["static_residual_n"] = lr.residual
+    return out
+
+
+def finite_metrics(case, st, mesh, bc, s, ref):
+    """The metrics of the model at the case's load against the neo-Hookean reference."""
+    nh = ref.nonlinear.result
+    out = {"disp_rel_l2_nh": M.rel_l2(st.u, nh.u), "disp_max_rel_nh": M.max_rel(st.u, nh.u),
+           "reaction_rel_err_nh": None}
+    driven = case.driven(mesh, bc, s)
+    if driven is not None:
+        reaction = reaction_along(st.reaction, driven)
+        out["reaction_rel_err_nh"] = M.finite(
+            "reaction_rel_err_nh", abs(reaction / _nonzero("reaction", ref.nonlinear_reaction)
+                                       - 1))
+    return out
 
 
 def _nonzero(name, value):
@@ -99,33 +153,53 @@ def _nonzero(name, value):
 
 
 def model_run(case, mesh_name, mesh, bc, model_name, s, ref):
-    """One (mesh, bc, model): its metrics, and its fields for figures (None when the static
-    solve failed). A failure of a phase is recorded in that phase's ``*_failed`` entry, its
-    metrics are None, and the other phases still run."""
+    """One (mesh, bc, model): its metrics in the linear regime and at the case's load, and
+    its fields for figures (the linear regime's; None when that solve failed). A failure of a
+    phase is recorded in that phase's ``*_failed`` entry, its metrics are None, and the other
+    phases still run."""
     r = {"mesh": mesh_name, "bc": bc, "model": model_name, "nodes": mesh.n_nodes,
          "tets": mesh.n_tets, "failed": None}
     if ref.reaction is not None:
         r["reaction_fem_p2_n"] = ref.reaction
     r.update({ref_name(k): v for k, v in ref.quantities.items()})
     r["p2_error_estimate"] = ref.error_estimate
+    r["linear_scale"] = ref.scale
+    if ref.nonlinear is not None:
+        r["nh_error_estimate"] = ref.nonlinear.error_estimate
+        if ref.nonlinear_reaction is not None:
+            r["reaction_fem_nh_n"] = ref.nonlinear_reaction
     if not s.static_only:
         r.update(case.reference_entries(ref))
     pm = case.build_model(model_name, mesh, s)
-    st, fields = None, None
+    fields = None
+    try:                     # the case's load
+        st, finite_failed = case.solve_static(pm, mesh, bc, s, ref), None
+    except FINDINGS as exc:  # no equilibrium found: a finding
+        st, finite_failed = None, str(exc)
     blank = {k: None for k in STATIC + tuple(ref.quantities)
              + tuple(err_name(q) for q in case.qoi_errors)}
-    try:
-        st = case.solve_static(pm, mesh, bc, s, ref)
-        if st is None:       # a case without a static problem (modes)
+    try:                     # the linear regime (the case's own solve where it has none)
+        if ref.scale is None:    # the case's own solve, done above
+            if finite_failed:
+                raise M.MetricError(finite_failed)
+            lr = None if st is None else LinearRegime.of(st, pm, 1.0)
+        else:
+            lr = linear_regime(case, pm, mesh, bc, s, ref)
+        if lr is None:       # a case without a static problem (modes)
             r.update(blank, static_failed=None)
         else:
-            values, stress = static_metrics(case, pm, st, mesh, bc, s, ref)
-            r.update(values, static_failed=None)
-            fields = {"mesh": mesh, "u": st.u, "max_tau": stress["max_tau"],
-                      "pressure": stress["pressure"]}
+            r.update(static_metrics(case, lr, mesh, bc, s, ref), static_failed=None)
+            fields = {"mesh": mesh, "u": lr.u, "max_tau": lr.stress["max_tau"],
+                      "pressure": lr.stress["pressure"]}
     except FINDINGS as exc:   # no equilibrium found, or a metric undefined: a finding
         r.update(blank, static_failed=str(exc))
-        st = None
+    if ref.nonlinear is not None or ref.nonlinear_failed:
+        r.update(dict.fromkeys(FINITE), finite_failed=finite_failed or ref.nonlinear_failed)
+        if st is not None and ref.nonlinear is not None:
+            try:
+                r.update(finite_metrics(case, st, mesh, bc, s, ref))
+            except FINDINGS as exc:
+                r["finite_failed"] = str(exc)
     if ref.p2 is not None:
         nft = pm.net_force_torque(mesh.points + ref.p2.u)
         r.update(net_force_rel=M.finite("net_force", nft["force_rel"]),

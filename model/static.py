@@ -10,6 +10,10 @@ from .bc import bc_arrays
 from .errors import ConvergenceError, DegenerateTetError, ModelError
 
 
+# the default force tolerance: max free-node residual <= RTOL * E h^2
+RTOL = 1e-9
+
+
 def node_adjacency(mesh):
     """Sparse boolean node-node adjacency through shared tetrahedra (self included)."""
     rows = np.repeat(mesh.tets, 4, axis=1).ravel()
@@ -106,7 +110,7 @@ def force_scale(model):
     return model.material.E * h * h
 
 
-def solve(model, bc, f_ext=None, rtol=1e-9, max_iter=50, load_steps=1):
+def solve(model, bc, f_ext=None, rtol=RTOL, max_iter=50, load_steps=1):
     """Solve f_int(x) + f_ext = 0 on the free components, prescribed ones set from ``bc``.
 
     Newton with a backtracking line search on the residual norm, in ``load_steps`` equal

@@ -99,7 +99,7 @@ class ParticleModel:
             self._jacobian_pattern = static.JacobianPattern(self.mesh)
         return static.jacobian(self.forces, self.mesh, x, self._jacobian_pattern)
 
-    def solve_static(self, bc, f_ext=None, rtol=1e-9, max_iter=50, load_steps=1):
+    def solve_static(self, bc, f_ext=None, rtol=static.RTOL, max_iter=50, load_steps=1):
         """Equilibrium f_int(x) + f_ext = 0 on the free components (see model.static.solve)."""
         return static.solve(self, bc, f_ext=f_ext, rtol=rtol, max_iter=max_iter,
                             load_steps=load_steps)

@@ -36,19 +36,24 @@ def bonded():
 
 def test_bonded_reference_is_a_barrel_with_an_estimate(bonded):
     s, mesh, ref = bonded
-    assert ref.p2.info["mixed"] and ref.p2.info["refine"] == s.ref_levels >= 1
+    nh = ref.nonlinear
+    assert nh.result.info["mixed"] and nh.result.info["refine"] == s.nh_levels >= 1
     force, law = np.array(ref.extra["force"]), np.array(lc.law_force(s))
     assert len(force) == s.steps and np.all(np.diff(force) > 0)
     # bonded plates restrain the lateral expansion: stiffer than the homogeneous law
     assert np.all(force > 1.05 * law)
     # a barrel: the mid layer bulges out, the bonded layers do not move sideways
-    profile = lc.M.layer_profile(mesh.points, ref.p2.u, [y * lc.MM for y in lc.LAYERS_MM],
+    profile = lc.M.layer_profile(mesh.points, nh.result.u, [y * lc.MM for y in lc.LAYERS_MM],
                                  lc.SIZE_MM * lc.MM)
     assert profile[0] == pytest.approx(0, abs=1e-12) and profile[-1] == pytest.approx(0, abs=1e-12)
     assert profile[2] > profile[1] > 0 and profile[2] > profile[3] > 0
-    assert 0 < ref.error_estimate < 0.1
+    assert 0 < nh.error_estimate < 0.1
     # the estimate brackets the change between the two refinements it came from
-    assert ref.error_estimate >= ref.conv.increments[-1] * (1 - 1e-12)
+    assert nh.error_estimate >= nh.increments[-1] * (1 - 1e-12)
+    assert ref.nonlinear_reaction == force[-1]
+    # the linear regime: the largest strain of the linear reference scaled to 1e-4
+    eps = 9.6 / 32 * ref.scale      # about the nominal strain, scaled
+    assert 0.3 * 1e-4 < eps < 1e-4
 
 
 def test_homogeneous_check_of_fem_neohookean_is_the_law():

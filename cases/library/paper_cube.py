@@ -13,7 +13,7 @@ from model.bc import Ramp, bc_arrays
 from model.mesh import cube
 from .. import metrics as M
 from . import transient
-from ..framework import Case, Knob, MESH_FAMILIES, Settings
+from ..framework import Case, Knob, MESH_FAMILIES, Settings, regimes
 from . import common
 from . import paper_cube_report as report
 
@@ -50,7 +50,8 @@ class Config(Settings):
                 "speed_mm_s": SPEED_MM_S, "layers_mm": layers_mm(self.nodes_per_side),
                 "p2_levels": self.p2_levels, "transient_element": self.transient_element,
                 "damping_1_s": self.damping, "rk4_safety": self.safety,
-                "hold_max_s": self.hold_max, "rest_speed_fraction": self.rest_speed}
+                "hold_max_s": self.hold_max, "rest_speed_fraction": self.rest_speed,
+                **regimes(self)}
 
 def make_mesh(name, nodes_per_side=NODES_PER_SIDE):
     return cube(nodes_per_side, SIZE_MM * MM, name)

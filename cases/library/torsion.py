@@ -56,9 +56,11 @@ class Torsion(Case):
     notes = (
         "The torque's arms are rest positions: the frame of linear FEM's equilibrium. "
         "Saint-Venant's free warping of a square is not zero; the clamped root restrains it.",
-        "The end face is turned by the exact rotation (not linearised); linear FEM reads that "
-        "displacement as a small strain, which adds a radial contraction of 1 - cos 10 deg = "
-        "1.5 % of the radius at the face.")
+        "In the linear regime the end face gets the linearised rotation u = theta e_x x r, "
+        "against linear FEM and Saint-Venant; at the case's angle it gets the exact rotation, "
+        "against the neo-Hookean reference (linear FEM would read an exact rotation as a "
+        "small strain: a radial contraction of 1 - cos(angle) of the radius at the face, "
+        "which is what fem-linear's error there measures).")
 
     def mesh(self, family, s):
         return common.bar(family, LENGTH_MM, SIDE_MM, SIDE_MM, s.spacing_mm)

@@ -2,7 +2,8 @@
 
 Each term that declares a ``fit_constant`` (shear c, normal c_n, spring stiffness scale) gets
 a factor ``scale_j = exp(theta_j)`` on its calibrated (or given) constant; the residual is the
-displacement of every (mesh, bc) of the training cases against its FEM reference at the
+displacement of every (mesh, bc) of the training cases in the linear regime (the case's loads
+scaled to strains of 1e-4, the answer scaled back) against its linear FEM reference at the
 nodes, divided by the reference's norm, so that the cost is the sum of the squared
 ``disp_rel_l2_p2`` of the runs. scipy's ``least_squares`` (trust region reflective) minimises
 it from theta = 0 (the model as built); the Jacobian at the optimum gives the conditioning
@@ -26,7 +27,7 @@ from model.terms import registered
 from model.terms.shear import Shear
 from .. import metrics as M
 from .. import stop
-from ..runner import FINDINGS, reaction_along, reference
+from ..runner import FINDINGS, linear_regime, reaction_along, reference
 from ..workers import one_blas_thread
 
 
@@ -105,7 +106,7 @@ def errors(spec, scales, probs):
         stop.checkpoint()
         pm = build(spec, p.mesh, p.settings.material, **{t: {"scale": float(k)}
                                                          for t, k in scales.items()})
-        st = p.case.solve_static(pm, p.mesh, p.bc, p.settings, p.ref)
+        st = linear_regime(p.case, pm, p.mesh, p.bc, p.settings, p.ref)
         r = [(st.u - p.ref.p2.u).ravel() / np.linalg.norm(p.ref.p2.u)]
         driven = p.case.driven(p.mesh, p.bc, p.settings)
         if driven is not None and p.ref.reaction:

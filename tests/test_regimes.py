@@ -1,0 +1,80 @@
+"""Two regimes kept apart (issue 25): every case with a load is answered in the linear regime
+(loads scaled to strains of 1e-4, against linear FEM) and at its own load (against the
+converged neo-Hookean reference). The sliding paper cube is homogeneous, so both references
+are closed forms there: the tests work them out by hand."""
+from types import SimpleNamespace
+
+import numpy as np
+import pytest
+
+from cases.framework import LINEAR_STRAIN, linear_scale
+from cases.library.paper_cube import CASE, PUSH_MM, SIZE_MM
+from cases.runner import model_run, reference
+from model import Material
+from model.errors import ModelError
+from model.terms.shear import Shear
+from reference.hyperelastic import uniaxial
+
+E, NU = 10e3, 0.45
+
+
+def test_the_scale_brings_the_largest_principal_strain_to_the_regime():
+    # a uniaxial stress sigma: strains sigma / E axially and -nu sigma / E laterally
+    sigma = np.zeros((2, 3, 3))
+    sigma[0, 1, 1] = 1e-3 * E           # strain 1e-3: the largest
+    sigma[1, 0, 0] = -5e-4 * E
+    k = linear_scale(SimpleNamespace(stress=sigma), Material(E=E, nu=NU))
+    assert k == pytest.approx(LINEAR_STRAIN / 1e-3, rel=1e-12)
+    # already small: left alone
+    assert linear_scale(SimpleNamespace(stress=sigma * 1e-3), Material(E=E, nu=NU)) == 1.0
+    with pytest.raises(ModelError, match="no strain"):
+        linear_scale(SimpleNamespace(stress=0 * sigma), Material(E=E, nu=NU))
+
+
+@pytest.fixture(scope="module")
+def sliding():
+    s = CASE.settings(quick=True, meshes=("five",), bcs=("sliding",), static_only=True)
+    mesh = CASE.mesh("five", s)
+    ref = reference(CASE, mesh, "sliding", s, Shear(mesh, s.material, reading="corner"),
+                    extra=False)
+    return s, mesh, ref
+
+
+def test_the_sliding_cube_references_are_the_closed_forms(sliding):
+    s, mesh, ref = sliding
+    strain = PUSH_MM / SIZE_MM
+    # homogeneous: the largest strain is the axial one
+    assert ref.scale == pytest.approx(LINEAR_STRAIN / strain, rel=1e-9)
+    lt, _ = uniaxial(1 - strain, E, NU)
+    x = mesh.points
+    expect = np.column_stack([(lt - 1) * x[:, 0], -strain * x[:, 1], (lt - 1) * x[:, 2]])
+    assert np.abs(ref.nonlinear.result.u - expect).max() < 1e-9 * PUSH_MM * 1e-3
+
+
+def runs(sliding, model):
+    s, mesh, ref = sliding
+    return model_run(CASE, "five", mesh, "sliding", model, s, ref)[0]
+
+
+def test_fem_neohookean_is_exact_at_the_load_and_linear_in_the_regime(sliding):
+    r = runs(sliding, "fem-neohookean")
+    # the same law on a field P1 represents exactly
+    assert r["disp_rel_l2_nh"] < 1e-7
+    # its linearisation is linear elasticity: the patch test passes to the strain left
+    # (1e-4), where at the case's load (5.3 %) it was 0.0202 off linear P2
+    assert r["disp_rel_l2_p2"] < 3 * LINEAR_STRAIN
+
+
+def test_fem_linear_at_the_load_is_off_by_its_linearisation_error(sliding):
+    s, mesh, _ = sliding
+    r = runs(sliding, "fem-linear")
+    assert r["disp_rel_l2_p2"] < 1e-8              # the patch test, exact
+    # by hand: u_lin = (nu e x, -e y, nu e z) against the neo-Hookean field
+    e = PUSH_MM / SIZE_MM
+    lt, _ = uniaxial(1 - e, E, NU)
+    x = mesh.points
+    lin = np.column_stack([NU * e * x[:, 0], -e * x[:, 1], NU * e * x[:, 2]])
+    nh = np.column_stack([(lt - 1) * x[:, 0], -e * x[:, 1], (lt - 1) * x[:, 2]])
+    expect = np.linalg.norm(lin - nh) / np.linalg.norm(nh)
+    assert 0.005 < expect
+    assert r["disp_rel_l2_nh"] == pytest.approx(expect, rel=1e-6)
