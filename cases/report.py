@@ -15,7 +15,7 @@ from model.mesh import write as write_mesh
 from . import costs, figures
 from .document import Document, fmt
 from . import catalogue
-from .library import common
+from . import rankings
 from .runner import jsonable
 
 TIMING_KEYS = ("dyn_wall_s",)   # wall times: in run.json, never in metrics.json
@@ -129,7 +129,7 @@ def build_report(case, s, runs, fields, out):
     failed = [r for r in runs if r.get("failed")]
     ok = [r for r in runs if not r.get("failed")]
     groups = dict(case.findings(s, ok))
-    groups.update(common.finite_load(ok))
+    groups.update(rankings.finite_load(ok))
     tets = [r["tets"] for r in runs if r.get("tets")]
     groups["Cost"] = groups.get("Cost", []) + costs.cost_sentences(
         costs.load(Path(out).parent), s.models,
