@@ -256,8 +256,9 @@ declare("frequencies_hz", "Hz", "frequencies",
          "the first 10 non-rigid frequencies of the model linearised at rest (coloured "
          "finite-difference Jacobian, lumped mass; |Re sqrt(lambda)| / 2 pi).")
 declare("modal_rel_err", "1", "modal err",
-         "the largest relative error of the first 10 non-rigid frequencies (sorted) against "
-         "FEM P2 (consistent mass), with the case's constraints.", "max")
+         "the largest relative frequency error of the first 10 non-rigid FEM P2 modes "
+         "(consistent mass), with the case's constraints, each against the model mode paired "
+         "with it by shape (unpaired ones left out).", "max")
 declare("modal_rel_err_median", "1", "median err",
          "the median of those relative errors.", "max")
 declare("modal_rel_err_free", "1", "modal err free",
@@ -265,6 +266,10 @@ declare("modal_rel_err_free", "1", "modal err free",
 declare("rigid_modes", "count", "rigid modes",
          "zero eigenvalues (below 1e-8 of the largest): 6 free-free, 0 clamped expected.",
          "max")
+declare("modes_unpaired", "count", "unpaired",
+        "FEM modes among the first 10 (of each set compared) that no model mode matches in "
+        "shape (MAC >= 0.8 with the mode, or with the space of a cluster of equal "
+        "frequencies): left out of the frequency errors.", "max")
 declare("rigid_modes_free", "count", "rigid modes free",
          "zero eigenvalues free-free (6 expected).", "max")
 declare("rest_time_fem_s", "s", "FEM rest",

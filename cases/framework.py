@@ -54,8 +54,9 @@ class Settings:
     nh_levels: int = 1          # refinements of the converged neo-Hookean reference
     quick: bool = False
     shear_scale: float = 1.0    # for tests, in the API only: scales every shear term (1 = the model)
-    # True: the standard static metrics and quantities only; the case's extra reference work
-    # and metrics (reference_extra, reference_entries, run_extra: dynamics, modes) are skipped
+    # True: the linear regime's static metrics and quantities only; the case load's
+    # neo-Hookean reference and the case's extra reference work and metrics (reference_extra,
+    # reference_entries, run_extra: dynamics, modes) are skipped
     static_only: bool = False
     material: Material = field(init=False, repr=False, compare=False)
 
@@ -221,7 +222,6 @@ class Case(abc.ABC):
     draws_stress, magnify : whether the case draws its own stress panels; the magnification
         of the standard ones.
     static : whether the case has a static displacement problem (what ``pbcm fit`` fits).
-    finite_steps : load steps of the neo-Hookean reference at the case's load.
     resolution, load : the Settings fields a sweep's ``resolution`` and ``load`` axes turn
         (a Knob each), or None where the case has none.
     """
@@ -244,7 +244,6 @@ class Case(abc.ABC):
     draws_stress: ClassVar[bool] = False   # True: the case draws its own max |tau| panels
     magnify: ClassVar[float] = 5.0         # displacement magnification of the panels
     static: ClassVar[bool] = True          # False: no static displacement (modes)
-    finite_steps: ClassVar[int] = 1        # load steps of the neo-Hookean reference
     resolution: ClassVar[Knob] = None      # what a sweep's resolution axis turns
     load: ClassVar[Knob] = None            # what a sweep's load axis turns
 
@@ -294,6 +293,10 @@ class Case(abc.ABC):
     def loads(self, mesh, bc, s):
         """The case's loads (default none)."""
         return Loads()
+
+    def finite_steps(self, s):
+        """Load steps of the neo-Hookean reference at the case's load (default 1)."""
+        return 1
 
     def driven(self, mesh, bc, s):
         """(nodes, axis) whose summed reaction along ``axis`` is the case's force (the

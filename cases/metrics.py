@@ -92,3 +92,43 @@ def paper_pattern(profile):
     d2 = b[:-2] - 2 * b[1:-1] + b[2:]
     tol = PATTERN_TOL * np.abs(b).max()  # rounding noise on a uniform profile is no pattern
     return bool(d2[0] > tol and d2[1] < -tol and d2[2] > tol)
+
+
+MAC_MIN = 0.8          # a model mode pairs with a reference mode whose shape it matches this well
+CLUSTER_TOL = 0.01     # reference frequencies this close (relative) span one degenerate space
+
+
+def mac(a, B):
+    """The subspace modal assurance criterion of the mode shape ``a`` (3n,) against the span of
+    the columns of ``B`` (3n, k): ||P a||^2 / ||a||^2 with P the orthogonal projector onto
+    it; for one column the classic |a . b|^2 / (|a|^2 |b|^2). Complex shapes (a
+    non-conservative model's) are compared by their modulus."""
+    Q, _ = np.linalg.qr(np.asarray(B, dtype=complex).reshape(len(a), -1))
+    a = np.asarray(a, dtype=complex)
+    return float(np.linalg.norm(Q.conj().T @ a) ** 2 / np.vdot(a, a).real)
+
+
+def pair_modes(f_model, v_model, f_ref, v_ref, mac_min=MAC_MIN, cluster_tol=CLUSTER_TOL):
+    """Pair reference modes with model modes by shape: [(i_ref, j_model)] and the unpaired
+    reference indices. ``f_*`` ascending frequencies, ``v_*`` (k, 3n) shapes. The reference
+    modes are grouped into clusters of (near-)equal frequency, whose shapes are only defined
+    as a space (the cube's symmetry makes pairs and triples); each cluster takes the unused
+    model modes whose subspace MAC with it is at least ``mac_min``, the best matching first,
+    paired in frequency order. A spurious model mode thus stays unpaired instead of shifting
+    every later frequency."""
+    f_ref = np.asarray(f_ref, float)
+    clusters, start = [], 0
+    for i in range(1, len(f_ref) + 1):
+        if i == len(f_ref) or f_ref[i] > f_ref[start] * (1 + cluster_tol):
+            clusters.append(list(range(start, i)))
+            start = i
+    used, pairs, unpaired = set(), [], []
+    for c in clusters:
+        B = np.asarray(v_ref)[c].T
+        score = {j: mac(v_model[j], B) for j in range(len(f_model)) if j not in used}
+        fit = sorted((j for j, s in score.items() if s >= mac_min), key=lambda j: -score[j])
+        chosen = sorted(fit[:len(c)], key=lambda j: f_model[j])
+        used.update(chosen)
+        pairs += list(zip(c, chosen))
+        unpaired += c[len(chosen):]
+    return pairs, unpaired

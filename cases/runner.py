@@ -35,10 +35,11 @@ def reaction_along(reaction, driven):
     return -reaction[nodes, axis].sum()
 
 
-def reference(case, mesh, bc, s, probe, extra=True):
+def reference(case, mesh, bc, s, probe, extra=True, nonlinear=None):
     """The default references of one (mesh, bc): the linear regime's (P1 on the mesh and
-    converged linear P2) and the case load's (converged neo-Hookean), with the case's loads,
-    quantities and (``extra``) its extra reference work."""
+    converged linear P2) with the case's loads and quantities, the case load's (converged
+    neo-Hookean; ``nonlinear``, default ``extra``: not for a static-only run) and
+    (``extra``) the case's extra reference work."""
     mat = s.material
     dirichlet = case.dirichlet(mesh, bc, s)
     dirichlet_lin = case.dirichlet_linear(mesh, bc, s)
@@ -59,15 +60,16 @@ def reference(case, mesh, bc, s, probe, extra=True):
                     quantities=case.quantities(mesh, p2.u, p2.reaction, s, bc),
                     error_estimate=conv.error_estimate, dirichlet_linear=dirichlet_lin,
                     scale=linear_scale(p2, mat))
-    try:
-        ref.nonlinear = hyperelastic.converged(mesh, mat.E, mat.nu, dirichlet,
-                                               levels=s.nh_levels, mixed="auto",
-                                               load_steps=case.finite_steps, **kw)
-        if driven is not None:
-            ref.nonlinear_reaction = float(reaction_along(ref.nonlinear.result.reaction,
-                                                          driven))
-    except FINDINGS as exc:     # recorded: the linear regime still stands
-        ref.nonlinear_failed = str(exc)
+    if extra if nonlinear is None else nonlinear:     # not for the linear regime alone
+        try:
+            ref.nonlinear = hyperelastic.converged(mesh, mat.E, mat.nu, dirichlet,
+                                                   levels=s.nh_levels, mixed="auto",
+                                                   load_steps=case.finite_steps(s), **kw)
+            if driven is not None:
+                ref.nonlinear_reaction = float(reaction_along(
+                    ref.nonlinear.result.reaction, driven))
+        except FINDINGS as exc:     # recorded: the linear regime still stands
+            ref.nonlinear_failed = str(exc)
     ref.extra = case.reference_extra(mesh, bc, s, ref) if extra else {}
     return ref
 
@@ -193,8 +195,9 @@ def model_run(case, mesh_name, mesh, bc, model_name, s, ref):
                       "pressure": lr.stress["pressure"]}
     except FINDINGS as exc:   # no equilibrium found, or a metric undefined: a finding
         r.update(blank, static_failed=str(exc))
+    r.update(dict.fromkeys(FINITE))
     if ref.nonlinear is not None or ref.nonlinear_failed:
-        r.update(dict.fromkeys(FINITE), finite_failed=finite_failed or ref.nonlinear_failed)
+        r["finite_failed"] = finite_failed or ref.nonlinear_failed
         if st is not None and ref.nonlinear is not None:
             try:
                 r.update(finite_metrics(case, st, mesh, bc, s, ref))

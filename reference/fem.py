@@ -84,6 +84,21 @@ def skfem_mesh(mesh):
     return MeshTet(np.ascontiguousarray(mesh.points.T), np.ascontiguousarray(mesh.tets.T))
 
 
+class Region:
+    """A prescribed displacement declared by geometry: ``fn(points (k, 3)) -> (k, 3)``, NaN
+    where a component is free. Given as ``dirichlet_fn``, it decides every new boundary point
+    of a refinement or a P2 midpoint by where it lies, whatever its facet's vertices: a
+    punch declared this way is the same patch on every mesh, resolved ever finer as the
+    reference refines (a plain ``dirichlet_fn`` only fills in facets whose vertices are all
+    prescribed, so a patch would be the mesh's polygon of prescribed nodes)."""
+
+    def __init__(self, fn):
+        self.fn = fn
+
+    def __call__(self, points):
+        return self.fn(points)
+
+
 def prescribed_edges(m, mask, vals, dirichlet_fn):
     """Which edges' new points (refined vertices, P2 midpoints) are prescribed, and to what.
 
@@ -91,26 +106,38 @@ def prescribed_edges(m, mask, vals, dirichlet_fn):
     are all prescribed in k: a free face stays free even where two of its vertices are held.
     The value is ``dirichlet_fn(midpoint)`` when given (NaN there leaves the component free:
     how a caller keeps free a face that lies between two prescribed surfaces, e.g. the sides
-    of a body one element thick), else the mean of the edge's two ends.
+    of a body one element thick), else the mean of the edge's two ends. A :class:`Region`
+    decides every boundary edge by its midpoint alone.
     Returns (n_edges, 3) mask and values.
     """
     bf = m.boundary_facets()
-    full = mask[m.facets[:, bf]].all(axis=0)                 # (n boundary facets, 3)
+    e = m.edges
     edge_mask = np.zeros((m.edges.shape[1], 3), dtype=bool)
+    if isinstance(dirichlet_fn, Region):
+        on = np.unique(m.f2e[:, bf].ravel())                  # every boundary edge
+        given = _given(dirichlet_fn, 0.5 * (m.p[:, e[0, on]] + m.p[:, e[1, on]]).T)
+        edge_mask[on] = ~np.isnan(given)
+        edge_vals = np.zeros((m.edges.shape[1], 3))
+        edge_vals[on] = np.where(edge_mask[on], given, 0.0)
+        return edge_mask, edge_vals
+    full = mask[m.facets[:, bf]].all(axis=0)                 # (n boundary facets, 3)
     for k in range(3):
         edge_mask[m.f2e[:, bf[full[:, k]]].ravel(), k] = True
-    e = m.edges
     edge_vals = np.where(edge_mask, 0.5 * (vals[e[0]] + vals[e[1]]), 0.0)
     cand = np.flatnonzero(edge_mask.any(axis=1))
     if dirichlet_fn is not None and cand.size:
-        mid = 0.5 * (m.p[:, e[0, cand]] + m.p[:, e[1, cand]]).T
-        given = np.asarray(dirichlet_fn(mid), dtype=float)
-        if given.shape != (cand.size, 3):
-            raise ModelError(f"dirichlet_fn must return a ({cand.size}, 3) array for "
-                             f"({cand.size}, 3) points, got shape {given.shape}")
+        given = _given(dirichlet_fn, 0.5 * (m.p[:, e[0, cand]] + m.p[:, e[1, cand]]).T)
         edge_mask[cand] &= ~np.isnan(given)
         edge_vals[cand] = np.where(edge_mask[cand], given, 0.0)
     return edge_mask, edge_vals
+
+
+def _given(dirichlet_fn, points):
+    given = np.asarray(dirichlet_fn(points), dtype=float)
+    if given.shape != points.shape:
+        raise ModelError(f"dirichlet_fn must return a {points.shape} array for "
+                         f"{points.shape} points, got shape {given.shape}")
+    return given
 
 
 def refine_with_data(m, mask, vals, dirichlet_fn, levels):

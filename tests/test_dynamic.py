@@ -223,3 +223,30 @@ def test_modal_method_names_what_it_needs():
         kw = {"method": "modal", **kw}
         with pytest.raises(ModelError, match=word):
             dynamic.solve(mesh, E, 0.3, RHO, *args, 0.02, **kw)
+
+
+def test_mac_of_shapes_and_spaces_worked_by_hand():
+    from cases.metrics import mac
+    e = np.eye(5)
+    assert mac(e[0], e[:1].T) == pytest.approx(1.0)
+    assert mac(e[0], e[1:2].T) == pytest.approx(0.0)
+    a = np.array([1.0, 1.0, 0, 0, 0])
+    assert mac(a, e[:1].T) == pytest.approx(0.5)          # |a.b|^2 / (|a|^2 |b|^2)
+    assert mac(a, e[:2].T) == pytest.approx(1.0)          # in the span of the pair
+    assert mac(1j * a, e[:2].T) == pytest.approx(1.0)     # a complex shape by its modulus
+
+
+def test_pairing_by_shape_skips_a_spurious_mode_and_spans_degenerate_pairs():
+    from cases.metrics import pair_modes
+    e = np.eye(6)
+    f_ref, v_ref = [1.0, 1.0, 2.0, 3.0], e[[0, 1, 2, 3]]
+    rot = np.array([e[0] + e[1], e[0] - e[1]]) / np.sqrt(2)   # the pair's space, rotated
+    f_model = [1.05, 1.06, 1.5, 2.2, 3.3]
+    v_model = np.vstack([rot, e[4], e[2], e[3]])              # 1.5 Hz: a spurious shape
+    pairs, unpaired = pair_modes(f_model, v_model, f_ref, v_ref)
+    assert pairs == [(0, 0), (1, 1), (2, 3), (3, 4)] and unpaired == []
+    errors = [abs(f_model[j] / f_ref[i] - 1) for i, j in pairs]
+    assert max(errors) == pytest.approx(0.1)   # by rank it would be |1.5 / 2 - 1| = 0.25
+    # a reference shape no model mode has stays unpaired
+    pairs, unpaired = pair_modes(f_model[:3], v_model[:3], f_ref, v_ref)
+    assert pairs == [(0, 0), (1, 1)] and unpaired == [2, 3]

@@ -89,6 +89,12 @@ def test_quick_library_passes_the_committed_bounds(library, capsys):
 # baseline was stored (consistent mass integrated exactly, transient exact in time)
 FEM_DYNAMICS_CHANGED = {"reaction_time_rel_l2", "disp_end_push_rel_l2", "modal_rel_err",
                         "modal_rel_err_free", "rest_time_fem_s"}
+# issue 25 moved the standard static metrics and the model's quantities to the linear regime
+# (loads scaled to strains of 1e-4, the answer scaled back) and dropped the sliding base's
+# modes and rest time (ill-posed): changed on purpose, gated by the gold values
+REGIMES_CHANGED = set(catalogue.STATIC) | {"bulge_profile_mm", "zigzag", "paper_pattern",
+                                           "apparent_poisson"}
+SLIDING_DROPPED = {"frequencies_hz", "rest_time_s"}
 
 
 def test_paper_cube_on_the_framework_matches_the_landed_case(quick):
@@ -112,7 +118,10 @@ def test_paper_cube_on_the_framework_matches_the_landed_case(quick):
         new = now[(old["mesh"], old["bc"], old["model"])]
         for k, v in old.items():
             assert k not in TIMING_KEYS
-            if k == "step_time_state" or k in FEM_DYNAMICS_CHANGED:
+            if k == "step_time_state" or k in FEM_DYNAMICS_CHANGED | REGIMES_CHANGED:
+                continue
+            if old["bc"] == "sliding" and k in SLIDING_DROPPED:
+                assert new[k] is None, k
                 continue
             if k == "static_residual_n":
                 assert (new[k] is None) == (v is None) and (v is None or new[k] < 1e-8), k

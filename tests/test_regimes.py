@@ -36,7 +36,7 @@ def sliding():
     s = CASE.settings(quick=True, meshes=("five",), bcs=("sliding",), static_only=True)
     mesh = CASE.mesh("five", s)
     ref = reference(CASE, mesh, "sliding", s, Shear(mesh, s.material, reading="corner"),
-                    extra=False)
+                    extra=False, nonlinear=True)
     return s, mesh, ref
 
 

@@ -1,7 +1,11 @@
 """Indentation: a 32 mm cube on a clamped base, a centred 8 x 8 mm patch of the top face pushed
-down 2 mm by a rigid flat punch (the patch nodes fully prescribed: the punch holds them, no
-friction model beyond that): punch force, the surface profile along the centre line, and the
-peak shear stress under the punch edge."""
+down 2 mm by a rigid flat punch (the patch fully prescribed: the punch holds it, no friction
+model beyond that), in load steps: punch force, the surface profile along the centre line,
+and the peak shear stress under the punch edge.
+
+The patch is declared by geometry (a ``reference.fem.Region``): each model holds its top nodes
+inside the square, and the references every boundary point inside it at every refinement, so
+that every mesh poses the same continuum problem."""
 from dataclasses import dataclass
 
 import numpy as np
@@ -9,19 +13,40 @@ import numpy as np
 from model.mesh import cube
 from model.terms.shear import Shear
 from .. import metrics as M
+from reference.fem import Region
 from ..framework import Case, Knob, MM, Settings
 from . import common
 
 SIZE_MM, PATCH_MM, DEPTH_MM = 32.0, 8.0, 2.0
+STEPS = 4     # load steps of every model and of the neo-Hookean reference
 
 
 @dataclass
 class IndentationSettings(Settings):
     spacing_mm: float = 4.0
+    steps: int = STEPS
 
     def problem(self):
         return {**super().problem(), "size_mm": SIZE_MM, "patch_mm": PATCH_MM,
-                "depth_mm": DEPTH_MM, "spacing_mm": self.spacing_mm}
+                "depth_mm": DEPTH_MM, "spacing_mm": self.spacing_mm, "steps": self.steps,
+                "punch": "square declared by geometry"}
+
+
+def in_patch(points, grow=0.0):
+    """Whether points (k, 3) [m] lie on the top face inside the centred square patch (grown
+    by ``grow`` m on each side)."""
+    half, c = PATCH_MM * MM / 2 + grow + 1e-9, SIZE_MM * MM / 2
+    return ((np.abs(points[:, 1] - SIZE_MM * MM) <= 1e-9)
+            & (np.abs(points[:, 0] - c) <= half) & (np.abs(points[:, 2] - c) <= half))
+
+
+def punch(points):
+    """The prescribed displacement by where a boundary point lies: held on the base, pushed
+    down under the punch, free elsewhere (NaN)."""
+    out = np.full(points.shape, np.nan)
+    out[np.abs(points[:, 1]) <= 1e-9] = 0.0
+    out[in_patch(points)] = (0.0, -DEPTH_MM * MM, 0.0)
+    return out
 
 
 def _top(mesh):
@@ -31,10 +56,7 @@ def _top(mesh):
 def _patch(mesh, grow=0.0):
     """Top nodes inside the centred patch (grown by ``grow`` m on each side)."""
     top = _top(mesh)
-    half = PATCH_MM * MM / 2 + grow + 1e-9
-    c = SIZE_MM * MM / 2
-    p = mesh.points[top]
-    return top[(np.abs(p[:, 0] - c) <= half) & (np.abs(p[:, 2] - c) <= half)]
+    return top[in_patch(mesh.points[top], grow)]
 
 
 def centre_line(mesh, spacing):
@@ -70,7 +92,8 @@ class Indentation(Case):
                "edge_shear_fem_pa", "edge_shear_rel_err")
     magnify = 2.0
     notes = (
-        "The punch force is the reaction on the patch nodes along y.",
+        "The punch force is the reaction on the top face along y (the punch's: the rest of "
+        "the top is free).",
         "The corner of a rigid punch is singular in the continuum: FEM's edge shear grows "
         "under refinement, so its error is a mesh-level comparison.")
 
@@ -83,8 +106,20 @@ class Indentation(Case):
         out.update({int(i): (0.0, -DEPTH_MM * MM, 0.0) for i in _patch(mesh)})
         return out
 
+    def dirichlet_fn(self, mesh, bc, s):
+        return Region(punch)
+
     def driven(self, mesh, bc, s):
-        return _patch(mesh), 1
+        # the whole top: the punch force on the models (their free top nodes carry none) and
+        # on the references, whose refined punch points beside the patch nodes hand their
+        # force to top nodes outside it (the P1 hats of the top face)
+        return _top(mesh), 1
+
+    def finite_steps(self, s):
+        return s.steps
+
+    def solve_static(self, pm, mesh, bc, s, ref):
+        return pm.solve_static(ref.dirichlet, load_steps=s.steps)
 
     def quantities(self, mesh, u, reaction, s, bc):
         line = centre_line(mesh, s.spacing_mm * MM)
@@ -103,8 +138,10 @@ class Indentation(Case):
 
     def what_was_run(self, s, runs):
         return [f"Cube of side {SIZE_MM:g} mm, nodes every {s.spacing_mm:g} mm, base clamped; "
-                f"the top nodes within the centred {PATCH_MM:g} x {PATCH_MM:g} mm patch moved "
-                f"(0, -{DEPTH_MM:g}, 0) mm (a rigid punch that holds them)."]
+                f"the centred {PATCH_MM:g} x {PATCH_MM:g} mm patch of the top moved "
+                f"(0, -{DEPTH_MM:g}, 0) mm in {s.steps} load steps (a rigid punch that holds "
+                "it): the models' top nodes inside the square, the references' every "
+                "boundary point inside it at every refinement."]
 
     def conclusion(self, s, runs):
         return [common.best_and_worst(runs, "reaction_rel_err", "Punch force"),

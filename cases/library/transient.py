@@ -44,41 +44,80 @@ def compare_transient(dyn, fem, mesh):
             "rest_time_s": dyn["t_end"] if dyn["at_rest"] else None}
 
 
-def model_frequencies(pm, free):
+def model_frequencies(pm, free, shapes=False):
     """Frequencies [Hz] of the model linearised at rest on the ``free`` components (a (3n,)
-    mask), ascending, and the number of rigid (zero) modes. For a non-conservative reading
-    the eigenvalues lambda of -M^-1 df/dx are complex: the frequency is |Re sqrt(lambda)| / 2 pi
+    mask), ascending, and the number of rigid (zero) modes; with ``shapes`` also the mode
+    shapes (k, 3n), zero on the held components. For a non-conservative reading the
+    eigenvalues lambda of -M^-1 df/dx are complex: the frequency is |Re sqrt(lambda)| / 2 pi
     (its growth rate, Im, is the case's growth_rate)."""
     J = pm.jacobian(pm.mesh.points).toarray()[free][:, free]
     A = -J / np.repeat(pm.mass, 3)[free][:, None]
-    lam = np.linalg.eigvals(A).astype(complex)
+    if shapes:
+        lam, vecs = np.linalg.eig(A)
+    else:
+        lam, vecs = np.linalg.eigvals(A), None
+    lam = lam.astype(complex)
     scale = np.abs(lam).max()
     rigid = int((np.abs(lam) < RIGID_TOL * scale).sum())
-    freq = np.sort(np.abs(np.sqrt(lam).real)) / (2 * np.pi)
-    return freq, rigid
+    freq = np.abs(np.sqrt(lam).real) / (2 * np.pi)
+    order = np.argsort(freq, kind="stable")
+    if not shapes:
+        return freq[order], rigid
+    full = np.zeros((len(lam), free.size), dtype=complex)
+    full[:, free] = vecs[:, order].T
+    return freq[order], full, rigid
+
+
+def paired_errors(freq, shapes, fem_freq, fem_shapes, name):
+    """The relative frequency errors of the model modes paired by shape with the FEM modes
+    (``metrics.pair_modes``) and how many FEM modes found no partner; a MetricError naming
+    ``name`` when none did."""
+    pairs, unpaired = M.pair_modes(freq, shapes, fem_freq, fem_shapes)
+    if not pairs:
+        raise M.MetricError(f"{name}: no model mode matches the shape of any FEM mode "
+                            f"(MAC >= {M.MAC_MIN})")
+    return np.array([abs(freq[j] / fem_freq[i] - 1) for i, j in pairs]), len(unpaired)
+
+
+def first_modes(pm, free, rigid_expected=None):
+    """The model's first 3 N_MODES non-rigid (frequencies, shapes) and its rigid count: the
+    candidates the first N_MODES FEM modes are paired with."""
+    freq, shapes, rigid = model_frequencies(pm, free, shapes=True)
+    skip = rigid if rigid_expected is None else rigid_expected
+    return freq[skip:skip + 3 * N_MODES], shapes[skip:skip + 3 * N_MODES], rigid
 
 
 def modal_comparison(pm, mesh, static_bc, fem_free, fem_held):
-    """``modal_rel_err`` (the first N_MODES frequencies with the case's constraints, largest
-    relative error against FEM P2), ``modal_rel_err_free`` (free-free, after the rigid
-    modes) and ``rigid_modes_free`` (6 for a model that resists every deformation)."""
-    mask, _ = bc_arrays(static_bc, mesh.n_nodes)
-    held, _ = model_frequencies(pm, ~mask.ravel())
-    free, rigid = model_frequencies(pm, np.ones(3 * mesh.n_nodes, dtype=bool))
-    free = free[rigid:rigid + N_MODES]
-    return {"modal_rel_err": M.finite("modal_rel_err",
-                                      np.abs(held[:N_MODES] / fem_held - 1).max()),
-            "modal_rel_err_free": M.finite("modal_rel_err_free",
-                                           np.abs(free / fem_free - 1).max()),
-            "rigid_modes_free": rigid,
-            "frequencies_hz": held[:N_MODES].tolist()}
+    """``modal_rel_err`` (the first N_MODES FEM modes with the case's constraints, each paired
+    with the model mode of the same shape: the largest relative frequency error),
+    ``modal_rel_err_free`` (free-free, after the rigid modes), ``modes_unpaired`` (FEM modes of
+    either set without a partner) and ``rigid_modes_free`` (6 for a model that resists every
+    deformation). ``fem_*`` are (frequencies, shapes (k, 3n)); ``fem_held`` None: the case's
+    constraints pose no modal problem (their metrics None)."""
+    free, free_v, rigid = first_modes(pm, np.ones(3 * mesh.n_nodes, dtype=bool))
+    err_free, lost = paired_errors(free, free_v, *fem_free, "modal_rel_err_free")
+    out = {"modal_rel_err": None, "modal_rel_err_free": M.finite("modal_rel_err_free",
+                                                                 err_free.max()),
+           "rigid_modes_free": rigid, "frequencies_hz": None}
+    if fem_held is not None:
+        mask, _ = bc_arrays(static_bc, mesh.n_nodes)
+        held, held_v, _ = first_modes(pm, ~mask.ravel(), rigid_expected=0)
+        err_held, lost_held = paired_errors(held, held_v, *fem_held, "modal_rel_err")
+        lost += lost_held
+        out.update(modal_rel_err=M.finite("modal_rel_err", err_held.max()),
+                   frequencies_hz=held[:N_MODES].tolist())
+    return {**out, "modes_unpaired": lost}
 
 
-def fem_modes(mesh, static_bc, cfg):
-    """FEM P2 frequencies: the first N_MODES with the case's constraints (held at zero) and
-    the first N_MODES non-rigid ones free-free."""
+def fem_modes(mesh, static_bc, cfg, held=True):
+    """FEM P2 modes (frequencies, shapes (k, 3n) at the mesh nodes): the first N_MODES
+    non-rigid ones free-free and (``held``; else None) the first N_MODES with the case's
+    constraints (held at zero)."""
     mat = cfg.material
+    free = modal.frequencies(mesh, mat.E, mat.nu, mat.rho, {}, k=N_MODES + 6)
+    free = (free.frequencies[6:], free.modes[6:].reshape(N_MODES, -1))
+    if not held:
+        return free, None
     zero = {i: tuple(None if c is None else 0.0 for c in comp) for i, comp in static_bc.items()}
-    held = modal.frequencies(mesh, mat.E, mat.nu, mat.rho, zero, k=N_MODES).frequencies
-    free = modal.frequencies(mesh, mat.E, mat.nu, mat.rho, {}, k=N_MODES + 6).frequencies[6:]
-    return free, held
+    r = modal.frequencies(mesh, mat.E, mat.nu, mat.rho, zero, k=N_MODES)
+    return free, (r.frequencies, r.modes.reshape(N_MODES, -1))
