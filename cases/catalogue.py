@@ -266,6 +266,9 @@ declare("modal_rel_err_free", "1", "modal err free",
 declare("rigid_modes", "count", "rigid modes",
          "zero eigenvalues (below 1e-8 of the largest): 6 free-free, 0 clamped expected.",
          "max")
+declare("frequencies_fem_estimate", "1", "FEM frequency estimates",
+        "each FEM P2 frequency's relative change over the reference's last refinement (n/a "
+        "without one, in quick mode).")
 declare("modes_unpaired", "count", "unpaired",
         "FEM modes among the first 10 (of each set compared) that no model mode matches in "
         "shape (MAC >= 0.8 with the mode, or with the space of a cluster of equal "

@@ -2,6 +2,7 @@
 from dataclasses import dataclass, field
 
 import numpy as np
+from scipy.optimize import brentq
 from skfem import FacetBasis, LinearForm, asm, condense
 from skfem.helpers import dot, sym_grad
 from skfem.models.elasticity import linear_stress
@@ -177,15 +178,44 @@ class ConvergedResult:
     energy_rate: float = float("nan")
 
 
-def richardson(increments):
+def richardson(increments, h=None):
     """(observed order, estimated error of the finest level) from the relative changes
-    between successive levels of a sequence halving h."""
+    between successive levels at spacings ``h`` (descending; default: each level halves h).
+    The order p solves (h1^p - h2^p) / (h2^p - h3^p) = inc[-2] / inc[-1] over the last three
+    levels (log2 of the ratio when h halves); the estimate is inc[-1] h3^p / (h2^p - h3^p),
+    or the last change itself where no order above 0.5 is observed."""
     inc = increments
     # no rate from a change that is exactly zero (an exact solution: the uniform sliding cube)
-    rate = float(np.log2(inc[-2] / inc[-1])) if len(inc) > 1 and inc[-1] > 0 and inc[-2] > 0 \
-        else float("nan")
-    est = inc[-1] / (2**rate - 1) if np.isfinite(rate) and rate > 0.5 else inc[-1]
-    return rate, float(est)
+    rate = float("nan")
+    h1, h2, h3 = (4.0, 2.0, 1.0) if h is None else (float(x) for x in h[-3:])
+    if len(inc) > 1 and inc[-1] > 0 and inc[-2] > 0:
+        ratio = inc[-2] / inc[-1]
+        if np.isclose(h1 / h2, h2 / h3, rtol=1e-12):
+            rate = float(np.log(ratio) / np.log(h2 / h3))
+        else:
+            def gap(p):
+                return (h1**p - h2**p) / (h2**p - h3**p) - ratio
+            if gap(0.05) * gap(20.0) < 0:
+                rate = float(brentq(gap, 0.05, 20.0, xtol=1e-12))
+    if np.isfinite(rate) and rate > 0.5:
+        return rate, float(inc[-1] * h3**rate / (h2**rate - h3**rate))
+    return rate, float(inc[-1])
+
+
+def estimate(sols, h=None):
+    """The one error estimate of every converged FEM reference: of the finest of solutions
+    ``sols`` (each with ``u`` at common points and ``energy``) at spacings ``h`` (default:
+    halving), the larger of the Richardson estimates from the relative changes of the
+    displacement and of the energy, with those changes and orders:
+    (estimate, increments, rate, energy increments, energy rate). The energy keeps the
+    estimate honest where the compared points are all prescribed and cannot move."""
+    norm = max(np.linalg.norm(sols[-1].u), 1e-300)
+    inc = [float(np.linalg.norm(b.u - a.u) / norm) for a, b in zip(sols, sols[1:])]
+    scale = max(abs(sols[-1].energy), 1e-300)
+    inc_e = [abs(b.energy - a.energy) / scale for a, b in zip(sols, sols[1:])]
+    rate, est = richardson(inc, h)
+    rate_e, est_e = richardson(inc_e, h)
+    return max(est, est_e), inc, rate, inc_e, rate_e
 
 
 def converged(mesh, E, nu, dirichlet, levels=2, **kw):
@@ -198,14 +228,8 @@ def converged(mesh, E, nu, dirichlet, levels=2, **kw):
 
 def converged_from(sols):
     """The ConvergedResult of solutions on the mesh refined 0, 1, ... times (each with ``u``
-    at the input nodes and ``energy``): the finest, with the larger of the Richardson
-    estimates from the relative changes of the displacement and of the energy."""
-    norm = max(np.linalg.norm(sols[-1].u), 1e-300)
-    inc = [float(np.linalg.norm(b.u - a.u) / norm) for a, b in zip(sols, sols[1:])]
-    scale = max(abs(sols[-1].energy), 1e-300)
-    inc_e = [abs(b.energy - a.energy) / scale for a, b in zip(sols, sols[1:])]
-    rate, est = richardson(inc)
-    rate_e, est_e = richardson(inc_e)
+    at the input nodes and ``energy``): the finest, with :func:`estimate`."""
+    est, inc, rate, inc_e, rate_e = estimate(sols)
     return ConvergedResult(result=sols[-1], levels=list(range(len(sols))), increments=inc,
-                           rate=rate, error_estimate=max(est, est_e), energy_increments=inc_e,
+                           rate=rate, error_estimate=est, energy_increments=inc_e,
                            energy_rate=rate_e)

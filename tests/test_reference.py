@@ -222,6 +222,18 @@ def test_richardson_of_an_exact_solution_has_no_rate():
     assert rate == pytest.approx(2.0) and est == pytest.approx(1e-3 / 3)
 
 
+def test_richardson_on_a_ladder_that_does_not_halve():
+    # e(h) = C h^2 on the torsion bar's ladder 8, 4, 2, 4/3 mm: the changes between levels
+    # give back the order 2 and the finest level's error C (4/3)^2
+    h = [8.0, 4.0, 2.0, 4.0 / 3.0]
+    e = [1e-4 * x**2 for x in h]
+    inc = [a - b for a, b in zip(e, e[1:])]
+    rate, est = linear.richardson(inc, h)
+    assert rate == pytest.approx(2.0, rel=1e-9) and est == pytest.approx(e[-1], rel=1e-9)
+    # read as halving, the same changes would give another order
+    assert linear.richardson(inc)[0] != pytest.approx(2.0, rel=1e-3)
+
+
 def test_amg_and_direct_agree():
     mesh = cube(6, L, "six")
     bc = sliding_bc(mesh, -1e-3)

@@ -62,17 +62,20 @@ class Modes(Case):
             return r.frequencies[skip:], r.modes[skip:].reshape(N_MODES, -1)
         freq, shapes = modes(s.fem_refine)
         # the refinement estimate: each frequency's change over the last refinement
-        est = (float(np.abs(modes(s.fem_refine - 1)[0] / freq - 1).max())
-               if s.fem_refine >= 1 else None)
+        each = (np.abs(modes(s.fem_refine - 1)[0] / freq - 1) if s.fem_refine >= 1
+                else None)
         return Reference(dirichlet=dirichlet, f_ext=None, p1=None, conv=None, p2=None,
-                         tau=None, reaction=None, quantities={}, error_estimate=est,
-                         extra={"frequencies_hz": freq, "shapes": shapes})
+                         tau=None, reaction=None, quantities={},
+                         error_estimate=None if each is None else float(each.max()),
+                         extra={"frequencies_hz": freq, "shapes": shapes,
+                                "estimates": None if each is None else each.tolist()})
 
     def solve_static(self, pm, mesh, bc, s, ref):
         return None
 
     def reference_entries(self, ref):
-        return {"frequencies_fem_hz": ref.extra["frequencies_hz"].tolist()}
+        return {"frequencies_fem_hz": ref.extra["frequencies_hz"].tolist(),
+                "frequencies_fem_estimate": ref.extra["estimates"]}
 
     def run_extra(self, pm, mesh, bc, s, ref, st):
         mask = np.zeros((mesh.n_nodes, 3), dtype=bool)

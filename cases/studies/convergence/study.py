@@ -4,6 +4,7 @@ reference per problem; then the fits, the effective elasticity of every model on
 and the accuracy per cost.
 """
 from dataclasses import dataclass, field
+from types import SimpleNamespace
 
 import numpy as np
 
@@ -117,8 +118,10 @@ def solve_reference(problem, bc, s):
     levels, u_f + (u_f - u_c) h_f^p / (h_c^p - h_f^p), has as error estimate its distance to
     the same extrapolation one level coarser (an upper estimate: what is left when the error
     is not yet a pure C h^p); the reference is whichever of the two has the smaller estimate.
+    The finest level's own estimate is ``reference.linear.estimate``'s, as every case's
+    reference's (the larger of the displacement's and the energy's Richardson estimates).
     Without an order (a problem P2 solves exactly: the sliding cube) it is the finest level
-    with its last change as estimate."""
+    with that estimate."""
     hs = problem.ref_ladder_mm
     probe = problem.mesh("five", hs[0]).points
     ps = problem.settings(s.E, s.nu)
@@ -133,8 +136,9 @@ def solve_reference(problem, bc, s):
                                    **_fem_loads(loads, mesh)))
         meshes.append(mesh)
     u = [r.at(probe) for r in levels]
-    norm = max(float(np.linalg.norm(u[-1])), 1e-300)
-    inc = [float(np.linalg.norm(b - a)) / norm for a, b in zip(u, u[1:])]
+    # the finest level's estimate: the one estimator every reference uses
+    plain, inc, _, _, _ = linear.estimate([SimpleNamespace(u=x, energy=r.energy)
+                                           for x, r in zip(u, levels)], hs)
     responses = [problem.response_value(m, r.u, r.reaction, bc, ps)
                  for m, r in zip(meshes, levels)]
     order = observed_order(hs[-3:], [inc[-2] + inc[-1], inc[-1], 0.0])
@@ -142,10 +146,9 @@ def solve_reference(problem, bc, s):
     def factor(hc, hf):
         return hf**order / (hc**order - hf**order)
     if order is None or order <= 0.5:
-        return ProblemReference(problem.case, bc, hs, levels, 0.0, responses[-1], inc[-1],
-                                inc[-1], inc, order)
+        return ProblemReference(problem.case, bc, hs, levels, 0.0, responses[-1], plain,
+                                plain, inc, order)
     k, k1 = factor(hs[-2], hs[-1]), factor(hs[-3], hs[-2])
-    plain = inc[-1] * k
     fine, coarse = u[-1] + k * (u[-1] - u[-2]), u[-2] + k1 * (u[-2] - u[-3])
     est = float(np.linalg.norm(fine - coarse) / max(np.linalg.norm(fine), 1e-300))
     if est >= plain:
