@@ -269,6 +269,11 @@ declare("rigid_modes", "count", "rigid modes",
 declare("frequencies_fem_estimate", "1", "FEM frequency estimates",
         "each FEM P2 frequency's relative change over the reference's last refinement (n/a "
         "without one, in quick mode).")
+declare("modal_fem_estimate", "1", "FEM modal estimate",
+        "the largest relative change of the first 10 FEM P2 frequencies with the case's "
+        "constraints over the reference's last refinement (n/a without one).")
+declare("modal_free_fem_estimate", "1", "FEM free modal estimate",
+        "the same, free-free.")
 declare("modes_unpaired", "count", "unpaired",
         "FEM modes among the first 10 (of each set compared) that no model mode matches in "
         "shape (MAC >= 0.8 with the mode, or with the space of a cluster of equal "

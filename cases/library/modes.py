@@ -5,7 +5,6 @@ from dataclasses import dataclass
 import numpy as np
 
 from model.mesh import cube
-from reference import modal
 from . import transient
 from ..document import fmt
 from ..framework import MM, Case, Reference, Settings
@@ -54,15 +53,8 @@ class Modes(Case):
     def solve_reference(self, mesh, bc, s, probe):
         dirichlet = self.dirichlet(mesh, bc, s)
         skip = 6 if bc == "free" else 0
-
-        def modes(refine):
-            r = modal.frequencies(mesh, s.E, s.nu, s.rho, dirichlet, k=N_MODES + skip,
-                                  refine=refine)
-            return r.frequencies[skip:], r.modes[skip:].reshape(N_MODES, -1)
-        freq, shapes = modes(s.fem_refine)
-        # the refinement estimate: each frequency's change over the last refinement
-        each = (np.abs(modes(s.fem_refine - 1)[0] / freq - 1) if s.fem_refine >= 1
-                else None)
+        (freq, shapes), each = transient.fem_frequencies(mesh, s.material, dirichlet,
+                                                         s.fem_refine, skip)
         return Reference(dirichlet=dirichlet, f_ext=None, p1=None, conv=None, p2=None,
                          tau=None, reaction=None, quantities={},
                          error_estimate=None if each is None else float(each.max()),

@@ -3,7 +3,7 @@ Figure 1 analogue, the layer profiles, the step-time chart and the reaction hist
 sentence is computed from the runs."""
 import numpy as np
 
-from .. import figures
+from .. import figures, rankings
 from ..document import fmt
 
 SIZE_MM = 32.0
@@ -61,7 +61,23 @@ def what_was_run(cfg, runs):
         "prescribed at top and bottom, rigid motions pinned). The paper does not say which.",
         f"Static equilibrium at {cfg.push_mm:g} mm and the paper's dynamic run: classical RK4, "
         f"{SPEED_MM_S:g} mm/s for {cfg.push_mm / SPEED_MM_S:g} s, then held until at rest (mass damping {cfg.damping:g} 1/s, at most "
-        f"{cfg.hold_max:g} s), against the FEM {cfg.transient_element} transient."]
+        f"{cfg.hold_max:g} s), against the FEM {cfg.transient_element} transient.",
+        _modal_reference(cfg, runs)]
+
+
+def _modal_reference(cfg, runs):
+    """The modal reference and the range of its refinement estimates over the runs."""
+    line = (f"Modes against FEM P2 (consistent mass) on {cfg.modal_refine} refinement(s) of "
+            "the mesh")
+    ranges = []
+    for key, label in (("modal_fem_estimate", "clamped base"),
+                       ("modal_free_fem_estimate", "free-free")):
+        est = [r[key] for r in runs if r.get(key) is not None]
+        if est:
+            ranges.append(f"{fmt(min(est), 2)} to {fmt(max(est), 2)} {label}")
+    return line + ("; its estimate (the largest change of the first 10 frequencies over the "
+                   "last refinement) " + ", ".join(ranges) + "." if ranges
+                   else ", without a refinement estimate.")
 
 
 def _runs(runs, **kw):
@@ -99,15 +115,13 @@ def conclusion(cfg, runs):
         out.append(f"Closest to FEM P2 in displacement: {best} (median error {med[best]:.3g} "
                    f"over {len(by_model[best])} runs); farthest: {worst} ({med[worst]:.3g}).")
     blown = sorted({r["model"] for r in runs if r.get("dyn_failed")})
-    modal = {m: max(r["modal_rel_err"] for r in _runs(runs, model=m)
-                    if r.get("modal_rel_err") is not None)
-             for m in cfg.models if any(r.get("modal_rel_err") is not None
-                                        for r in _runs(runs, model=m))}
-    best_modal = min(modal, key=modal.get) if modal else None
-    out.append(("Dynamic runs blow up for " + ", ".join(blown) if blown
-                else "Every dynamic run comes to rest")
-               + (f"; the first 10 frequencies are closest for {best_modal} (off by up to "
-                  f"{modal[best_modal]:.3g})." if best_modal else "."))
+    out.append("Dynamic runs blow up for " + ", ".join(blown) + "." if blown
+               else "Every dynamic run comes to rest.")
+    held = [r for r in runs if r.get("modal_rel_err") is not None]
+    if held:
+        out.append(rankings.best_and_worst(held, "modal_rel_err",
+                                           "First 10 frequencies, clamped base",
+                                           estimate_key="modal_fem_estimate"))
     return out
 
 

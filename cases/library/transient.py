@@ -107,15 +107,26 @@ def modal_comparison(pm, mesh, static_bc, fem_free, fem_held):
     return {**out, "modes_unpaired": lost}
 
 
-def fem_modes(mesh, static_bc, cfg, held=True):
-    """FEM P2 modes (frequencies, shapes (k, 3n) at the mesh nodes): the first N_MODES
-    non-rigid ones free-free and (``held``; else None) the first N_MODES with the case's
-    constraints (held at zero)."""
-    mat = cfg.material
-    free = modal.frequencies(mesh, mat.E, mat.nu, mat.rho, {}, k=N_MODES + 6)
-    free = (free.frequencies[6:], free.modes[6:].reshape(N_MODES, -1))
+def fem_frequencies(mesh, material, dirichlet, refine=0, skip=0):
+    """FEM P2 modes (consistent mass) on ``refine`` refinements of the mesh: the N_MODES
+    after the first ``skip`` (the rigid ones free-free) as (frequencies, shapes (k, 3n) at the
+    mesh nodes), and each frequency's refinement estimate, its relative change over the last
+    refinement (None without one: ``refine`` 0)."""
+    def solve(level):
+        r = modal.frequencies(mesh, material.E, material.nu, material.rho, dirichlet,
+                              k=N_MODES + skip, refine=level)
+        return r.frequencies[skip:], r.modes[skip:].reshape(N_MODES, -1)
+    freq, shapes = solve(refine)
+    each = np.abs(solve(refine - 1)[0] / freq - 1) if refine >= 1 else None
+    return (freq, shapes), each
+
+
+def fem_modes(mesh, static_bc, cfg, held=True, refine=0):
+    """FEM P2 modes on ``refine`` refinements, each set ((frequencies, shapes), estimates) as
+    ``fem_frequencies`` gives it: the first N_MODES non-rigid ones free-free and (``held``;
+    else None) the first N_MODES with the case's constraints (held at zero)."""
+    free = fem_frequencies(mesh, cfg.material, {}, refine, skip=6)
     if not held:
         return free, None
     zero = {i: tuple(None if c is None else 0.0 for c in comp) for i, comp in static_bc.items()}
-    r = modal.frequencies(mesh, mat.E, mat.nu, mat.rho, zero, k=N_MODES)
-    return free, (r.frequencies, r.modes.reshape(N_MODES, -1))
+    return free, fem_frequencies(mesh, cfg.material, zero, refine)
