@@ -28,7 +28,8 @@ UNIT_SUFFIXES = ("_mm", "_n", "_nm", "_hz", "_s", "_pa")
 class Metric:
     """One metric: ``name`` (its run key), ``unit`` ("1" for a ratio; SI but for names
     ending in _mm), ``label`` (table header), ``definition`` (one line), ``direction``
-    ("max", "min" or None), and how a table shows it: ``shown`` = (unit text, factor) when
+    ("max": an error, "min": a correlation, "signed": gated but neither side better, or None:
+    not gated), and how a table shows it: ``shown`` = (unit text, factor) when
     shown in another unit than stored (e.g. ("mN", 1e3)), ``digits`` significant."""
 
     name: str
@@ -40,9 +41,9 @@ class Metric:
     digits: int = 3
 
     def __post_init__(self):
-        if self.direction not in (None, "max", "min"):
+        if self.direction not in (None, "max", "min", "signed"):
             raise ValueError(f"metric {self.name}: direction {self.direction!r} is not "
-                             "'max', 'min' or None")
+                             "'max', 'min', 'signed' or None")
 
     @property
     def header(self):
@@ -77,7 +78,7 @@ def declare(name, unit, label, definition, direction=None, shown=None, digits=3)
 
 def ref_name(name):
     """The run key of the FEM value of quantity ``name``: '_fem' before a unit suffix
-    (bulge_profile_mm -> bulge_profile_fem_mm, zigzag -> zigzag_fem)."""
+    (bulge_profile_mm -> bulge_profile_fem_mm, paper_pattern -> paper_pattern_fem)."""
     for unit in UNIT_SUFFIXES:
         if name.endswith(unit):
             return name[:-len(unit)] + "_fem" + unit
@@ -215,10 +216,18 @@ declare("nh_error_estimate", "1", "NH error estimate",
 declare("bulge_profile_mm", "mm", "layer profile",
          "for each y-layer (0, 8, 16, 24, 32 mm) the mean outward lateral displacement of the "
          "side-face nodes.")
-declare("zigzag", "1", "zig-zag",
-         "RMS residual of a least-squares quadratic fit to the five-layer profile over its "
-         "largest |value|: 0 for a barrel or uniform expansion, about 0.86 for pure "
-         "alternation.", "max")
+declare("alternation_mm", "mm", "alternation",
+         "the alternating-layer (Nyquist) component of the layer profile beyond the "
+         "reference's: beta of the least-squares fit profile_k = alpha profile_FEM,k + beta "
+         "(-1)^k. Zero for any profile of the reference's shape at any scale (the continuum "
+         "against itself, a smooth barrel stiffer or softer); positive puts the ends and the "
+         "middle layer out, the paper's sign.", digits=2)
+declare("alternation_rel", "1", "alternation rel",
+         "the alternation over the reference profile's mean |lateral displacement|; the "
+         "pattern is called clear from 0.01.", "signed")
+declare("alternation_max_rel", "1", "largest |alternation|",
+         "a model's largest |alternation rel| over its paper-cube runs (extensions study).",
+         "max")
 declare("paper_pattern", "1", "paper pattern",
          "1 when the middle and end layers bulge relative to their neighbours while the 8 and "
          "24 mm layers neck (second differences +, -, +), as the paper reports, else 0.")

@@ -216,6 +216,8 @@ class Case(abc.ABC):
     columns : case metrics shown in the per-(mesh, bc) table after the standard ones
         (catalogue names: the catalogue gives header, unit and digits; ``cell`` the text).
     qoi_errors : scalar quantities of interest that get ``<name>_rel_err`` = |model / FEM - 1|.
+    quantity_compared : the metrics ``quantity_metrics`` computes from the model's and the
+        reference's quantities (None where the linear regime failed).
     notes : report lines on how the case is set up; the metrics' definitions come from the
         catalogue.
     fem_solver : the linear FEM solver ("auto", "direct", "amg").
@@ -239,6 +241,7 @@ class Case(abc.ABC):
     gated: ClassVar[tuple] = ()
     columns: ClassVar[tuple] = ()
     qoi_errors: ClassVar[tuple] = ()
+    quantity_compared: ClassVar[tuple] = ()   # the names quantity_metrics returns
     notes: ClassVar[tuple] = ()
     fem_solver: ClassVar[str] = "auto"    # the linear FEM solver (reference.fem.linear_solve)
     draws_stress: ClassVar[bool] = False   # True: the case draws its own max |tau| panels
@@ -250,11 +253,11 @@ class Case(abc.ABC):
     def __init_subclass__(cls, **kw):
         """A declaration error shows when the case is imported, not in its report."""
         super().__init_subclass__(**kw)
-        for attr in ("gated", "columns", "qoi_errors", "notes"):
+        for attr in ("gated", "columns", "qoi_errors", "quantity_compared", "notes"):
             if not isinstance(getattr(cls, attr), tuple):
                 raise TypeError(f"{cls.__name__}.{attr} must be a tuple (a one-element tuple "
                                 "needs its trailing comma)")
-        for name in (cls.headline, *cls.gated, *cls.columns):
+        for name in (cls.headline, *cls.gated, *cls.columns, *cls.quantity_compared):
             catalogue.metric(name)      # a KeyError naming where to declare it
 
     # ------------------------------------------------------------------ settings
@@ -306,6 +309,12 @@ class Case(abc.ABC):
     def quantities(self, mesh, u, reaction, s, bc):
         """Quantities of interest of a displacement ``u`` (n, 3) and reaction (n, 3), computed
         alike for the model and the FEM reference; names ending in _mm are in millimetres."""
+        return {}
+
+    def quantity_metrics(self, q, ref_q):
+        """The metrics ``quantity_compared`` of the model's quantities ``q`` against the
+        reference's ``ref_q``, beyond the relative errors of ``qoi_errors`` (a profile's
+        shape, say)."""
         return {}
 
     def closed_form(self, s, bc):

@@ -92,10 +92,12 @@ class Bound:
 
     def verdict(self, measured):
         """'' inside the band; else whether the metric got worse or better (``direction``
-        says which way is worse: 'max' an error, 'min' a correlation)."""
+        says which way is worse: 'max' an error, 'min' a correlation, 'signed' neither)."""
         if self.passes(measured):
             return ""
         higher = measured > self.value
+        if self.direction == "signed":      # an alternation: neither side is better
+            return f"changed ({'higher' if higher else 'lower'}): bless it only if meant"
         worse = higher if self.direction == "max" else not higher
         return ("worse: a regression" if worse else
                 "better: bless it on purpose if the change is meant")
@@ -452,7 +454,7 @@ def policy_text(policy):
     import tomli_w
     return ("# The gate's tolerance policy, for every gold value (`pbcm check`):\n"
             "#   |measured - gold| <= rtol |gold| + atol, atol = atol_of[metric] or atol.\n"
-            "# atol keeps metrics near zero (momentum residuals, a zig-zag of FEM) from failing\n"
+            "# atol keeps metrics near zero (momentum residuals, an alternation of FEM) from failing\n"
             "# on noise; static displacements are solved to a residual of 1e-9, so their\n"
             "# differences below 1e-8 are the solver's, and so are those of the force errors\n"
             "# of a model exact on its problem (a homogeneous field). full: where the\n"

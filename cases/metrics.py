@@ -8,6 +8,7 @@ from model.errors import PbcmError
 
 
 PATTERN_TOL = 1e-6  # second differences below this fraction of the profile count as zero
+ALTERNATION_CLEAR = 0.01   # an alternation below 1 % of the mean lateral displacement is not clear
 
 
 class MetricError(PbcmError, ArithmeticError):
@@ -67,19 +68,24 @@ def layer_profile(points, u, layers, size, tol=None):
     return finite("layer_profile", np.array(out))
 
 
-def zigzag(profile):
-    """Zig-zag amplitude of a layer profile: the RMS residual of a least-squares quadratic in
-    the layer index, over the largest |profile|. Zero for any profile a quadratic fits (a
-    barrel, a uniform expansion), about 0.86 for pure alternation +a, -a, +a, -a, +a."""
-    b = np.asarray(profile, float)
-    if b.size < 4:
-        raise MetricError("zig-zag needs at least four layers")
-    scale = np.abs(b).max()
+def alternation(profile, reference):
+    """The alternating-layer (Nyquist) amplitude of a layer profile beyond the reference's:
+    ``beta`` [same unit as the profiles] of the least-squares fit
+    profile_k ~ alpha reference_k + beta (-1)^k, and ``beta`` over the reference's mean
+    |profile| (``relative``). Zero whenever the profile is the reference's shape at any scale
+    (the continuum against itself, a stiffer or softer smooth barrel); +beta puts the ends and
+    the middle layer of five outwards (the paper's sign)."""
+    b, r = np.asarray(profile, float), np.asarray(reference, float)
+    if b.shape != r.shape or b.ndim != 1 or b.size < 3:
+        raise MetricError(f"alternation needs two profiles of the same three or more layers, "
+                          f"got shapes {b.shape} and {r.shape}")
+    s = (-1.0) ** np.arange(b.size)
+    (_, beta), *_ = np.linalg.lstsq(np.stack([r, s], axis=1), b, rcond=None)
+    scale = np.abs(r).mean()
     if scale == 0:
-        return 0.0
-    k = np.arange(b.size)
-    residual = b - np.polyval(np.polyfit(k, b, 2), k)
-    return finite("zigzag", np.sqrt((residual**2).mean()) / scale)
+        raise MetricError("alternation: the reference's layer profile is zero, so no relative "
+                          "amplitude exists; compare a loaded case")
+    return finite("alternation_mm", beta), finite("alternation_rel", beta / scale)
 
 
 def paper_pattern(profile):

@@ -126,6 +126,7 @@ def static_metrics(case, lr, mesh, bc, s, ref):
         "pressure_rel_err": M.rel_l2(stress["pressure"], ref.p2.pressure)})
     q = case.quantities(mesh, lr.u, lr.reaction, s, bc)
     out.update(q)
+    out.update(case.quantity_metrics(q, ref.quantities))
     for name in case.qoi_errors:
         out[err_name(name)] = M.finite(err_name(name),
                                        abs(q[name] / _nonzero(name, ref.quantities[name]) - 1))
@@ -181,7 +182,7 @@ def model_run(case, mesh_name, mesh, bc, model_name, s, ref):
     except FINDINGS as exc:  # no equilibrium found: a finding
         finite_failed = str(exc)
     blank = {k: None for k in STATIC + tuple(ref.quantities)
-             + tuple(err_name(q) for q in case.qoi_errors)}
+             + tuple(err_name(q) for q in case.qoi_errors) + case.quantity_compared}
     try:                     # the linear regime (the case's own solve where it has none)
         if ref.scale is None:    # the case's own solve, done above
             if finite_failed:

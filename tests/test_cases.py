@@ -18,7 +18,7 @@ FILES = ["metrics.json", "report.md", "report.html", "errors.png",
          "reaction_time.png", "run.json"] + [f"{kind}_{mesh}_{bc}.png" for kind in ("fig1", "profile")
                                  for mesh in ("five", "six") for bc in ("clamped", "sliding")]
 KEYS = ["mesh", "bc", "model", "disp_rel_l2_p1", "disp_rel_l2_p2", "disp_max_rel_p2",
-        "reaction_ratio", "stress_corr", "bulge_profile_mm", "bulge_profile_fem_mm", "zigzag",
+        "reaction_ratio", "stress_corr", "bulge_profile_mm", "bulge_profile_fem_mm", "alternation_rel",
         "reaction_time_rel_l2", "disp_end_push_rel_l2", "rest_time_s",
         "modal_rel_err", "modal_rel_err_free", "rigid_modes_free", "dyn_failed_dt4",
         "verdict_changes_dt4"]
@@ -89,7 +89,7 @@ def test_same_command_gives_the_same_metrics(quick, tmp_path):
                 assert r[k] == ref[k], k
 
 
-def test_fem_against_itself_has_zero_error_and_zigzag():
+def test_fem_against_itself_has_zero_error_and_alternation():
     mesh = make_mesh("five")
     L = SIZE_MM * 1e-3
     layers = [y * 1e-3 for y in LAYERS_MM]
@@ -97,17 +97,41 @@ def test_fem_against_itself_has_zero_error_and_zigzag():
         u = linear.solve(mesh, 10e3, 0.45, static_bc(mesh, bc), element="P2").u
         assert M.rel_l2(u, u) == 0 and M.max_rel(u, u) == 0
         profile = M.layer_profile(mesh.points, u, layers, L)
+        amplitude, relative = M.alternation(profile, profile)
+        assert abs(amplitude) < 1e-12 * np.abs(profile).max() and abs(relative) < 1e-12
         if bc == "sliding":  # homogeneous: uniform lateral expansion nu * 1.7 / 32 * 16 mm
             assert np.allclose(profile, 0.45 * 1.7e-3 / 2, rtol=1e-9)
-            assert M.zigzag(profile) < 1e-9
 
 
-def test_zigzag_separates_alternation_from_smooth_profiles():
+def test_alternation_is_zero_for_smooth_profiles_of_the_reference_shape():
+    """The alternation measures the (-1)^k layer component beyond the reference's shape: zero
+    (1e-12 relative) for a barrel or a half-sine against itself or scaled (a stiffer smooth
+    model), and exactly the amplitude added to them, with the paper's sign positive."""
+    k = np.arange(5)
+    barrel = 1.0 - ((k - 2) / 2.0) ** 2 + 0.1          # a clamped barrel: quadratic
+    half_sine = np.sin(np.pi * (k + 0.5) / 5)
+    alt = (-1.0) ** k                                   # ends and middle out: the paper's sign
+    for ref in (barrel, half_sine):
+        for model in (ref, 0.7 * ref, 1.3 * ref):
+            a, rel = M.alternation(model, ref)
+            assert abs(a) < 1e-12 and abs(rel) < 1e-12
+        a, rel = M.alternation(0.9 * ref + 0.02 * alt, ref)
+        assert a == pytest.approx(0.02, rel=1e-12)
+        assert rel == pytest.approx(0.02 / np.abs(ref).mean(), rel=1e-12)
+        assert M.alternation(ref - 0.03 * alt, ref)[0] == pytest.approx(-0.03, rel=1e-12)
+    # a near-zero model profile does not inflate it: the scale is the reference's
+    assert M.alternation(1e-6 * barrel, barrel)[1] == pytest.approx(0.0, abs=1e-12)
+    with pytest.raises(M.MetricError, match="zero"):
+        M.alternation(barrel, np.zeros(5))
+    with pytest.raises(M.MetricError, match="same"):
+        M.alternation(barrel, barrel[:4])
+
+
+def test_paper_pattern_is_the_sign_pattern_of_the_second_differences():
     alternating = np.array([1.0, 0.4, 1.0, 0.4, 1.0])
     barrel = np.sin(np.pi * np.linspace(0, 1, 5)) + 0.2
-    assert M.zigzag(alternating) > 0.2 and M.paper_pattern(alternating)
-    assert M.zigzag(barrel) < 0.03 and not M.paper_pattern(barrel)
-    assert M.zigzag(np.full(5, 0.38)) < 1e-12
+    assert M.paper_pattern(alternating) and not M.paper_pattern(barrel)
+    assert not M.paper_pattern(np.full(5, 0.38))
     noisy = 0.3825 + 1e-14 * np.array([1, -1, 1, -1, 1])  # a uniform FEM profile's rounding
     assert not M.paper_pattern(noisy)
 
@@ -143,13 +167,13 @@ def test_paper_cube_conclusion_groups_the_artefact_by_model():
     from cases.library import paper_cube_report as R
     from cases.library.paper_cube import Config
     run = dict(model="msm", mesh="five", bc="sliding", disp_rel_l2_p2=0.1, paper_pattern=True,
-               zigzag=0.07)
-    runs = [run, dict(run, model="pbcm-balanced", zigzag=0.03), dict(run, mesh="six")]
+               alternation_rel=0.07)
+    runs = [run, dict(run, model="pbcm-balanced", alternation_rel=0.03), dict(run, mesh="six")]
     assert R.conclusion(Config(), runs)[0] == (
         "The paper's bulge/neck pattern is reproduced clearly by msm (on five/sliding, "
         "six/sliding) and pbcm-balanced (on five/sliding), never by the converged FEM: it is an "
         "artefact of those models.")
-    faint = [dict(run, zigzag=0.001)]
+    faint = [dict(run, alternation_rel=0.001)]
     assert R.conclusion(Config(), faint)[0] == (
         "No model reproduces the paper's bulge/neck pattern clearly, nor does the converged FEM.")
     assert "and by the converged FEM on five/sliding." in R.conclusion(

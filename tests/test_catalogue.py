@@ -48,7 +48,7 @@ def test_an_undeclared_key_is_caught():
 
 def test_twins_and_errors_are_derived_from_a_quantity():
     assert ref_name("bulge_profile_mm") == "bulge_profile_fem_mm"
-    assert ref_name("zigzag") == "zigzag_fem"
+    assert ref_name("paper_pattern") == "paper_pattern_fem"
     assert err_name("tip_deflection_mm") == "tip_deflection_rel_err"
     assert err_name("torque_nm") == "torque_rel_err"
     twin = metric("tip_deflection_fem_mm")
@@ -60,12 +60,12 @@ def test_twins_and_errors_are_derived_from_a_quantity():
 def test_every_declaration_is_complete():
     for name, m in CATALOGUE.items():
         assert m.name == name and m.unit and m.label and m.definition.endswith("."), name
-        assert m.direction in (None, "max", "min")
+        assert m.direction in (None, "max", "min", "signed")
         assert name not in DESCRIPTORS
     with pytest.raises(ValueError, match="direction"):
         catalogue.Metric("x", "1", "x", "x.", direction="up")
     with pytest.raises(ValueError, match="declared twice, differently"):
-        catalogue.declare("zigzag", "1", "zig-zag", "another meaning.")
+        catalogue.declare("alternation_rel", "1", "alternation", "another meaning.")
     with pytest.raises(ValueError, match="no gate direction"):
         catalogue.gated("disp_max_rel_p1")
 
@@ -81,7 +81,7 @@ def test_headers_show_units_where_they_are_not_ratios():
     assert metric("reaction_n").cell(0.0123) == "12.3"
     assert metric("disp_rel_l2_p2").header == "disp L2 P2"
     assert metric("rigid_modes").cell(6) == "6"
-    assert metric("zigzag").cell(None) == "n/a"
+    assert metric("alternation_rel").cell(None) == "n/a"
 
 
 def test_cases_and_studies_gate_declared_metrics():

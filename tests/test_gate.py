@@ -159,11 +159,11 @@ def test_nan_metric_exits_2(blessed, tmp_path, capsys):
     shutil.copytree(blessed / "good", tmp_path / "nan")
     f = tmp_path / "nan" / "paper-cube" / "metrics.json"
     data = json.loads(f.read_text())
-    data["runs"][0]["zigzag"] = float("nan")
+    data["runs"][0]["alternation_rel"] = float("nan")
     f.write_text(json.dumps(data))
     assert check(tmp_path / "nan", blessed / "g") == 2
     err = capsys.readouterr().err
-    assert "zigzag" in err and "not a finite number" in err
+    assert "alternation_rel" in err and "not a finite number" in err
 
 
 @pytest.mark.parametrize("name,text,word", [
@@ -188,15 +188,18 @@ def test_the_band_is_two_sided_for_either_sign():
     from cases.gate import Bound
     for value in (-0.6, 0.6):
         for direction in ("min", "max"):
-            b = Bound("c", "quick", "m", "b", "x", "zigzag", value, 0.1, 0.0, direction)
+            b = Bound("c", "quick", "m", "b", "x", "alternation_rel", value, 0.1, 0.0, direction)
             low, high = b.band
             assert low == pytest.approx(value - 0.06) and high == pytest.approx(value + 0.06)
             assert b.passes(value) and b.margin(value) == 1.0
             assert not b.passes(value - 0.07) and not b.passes(value + 0.07)
-    error = Bound("c", "quick", "m", "b", "x", "zigzag", 0.5, 0.1, 0.0, "max")
+    error = Bound("c", "quick", "m", "b", "x", "disp_rel_l2_p2", 0.5, 0.1, 0.0, "max")
     assert "worse" in error.verdict(0.6) and "better" in error.verdict(0.4)
     corr = Bound("c", "quick", "m", "b", "x", "stress_corr", 0.5, 0.1, 0.0, "min")
     assert "better" in corr.verdict(0.6) and "worse" in corr.verdict(0.4)
+    signed = Bound("c", "quick", "m", "b", "x", "alternation_rel", 0.5, 0.1, 0.0, "signed")
+    for moved in (0.6, 0.4):    # a signed measure has no better side: either change is news
+        assert "changed" in signed.verdict(moved) and "better" not in signed.verdict(moved)
 
 
 def test_a_better_result_fails_until_blessed(blessed, tmp_path, capsys):

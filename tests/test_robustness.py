@@ -57,7 +57,7 @@ def test_a_failed_static_solve_is_recorded_and_the_case_goes_on(tmp_path, monkey
                  "--models", "msm", "pbcm-variational", "--out", str(out)]) == 0
     runs = {r["model"]: r for r in json.loads((out / "metrics.json").read_text())["runs"]}
     assert "planted" in runs["msm"]["static_failed"]
-    assert runs["msm"]["disp_rel_l2_p2"] is None and runs["msm"]["zigzag"] is None
+    assert runs["msm"]["disp_rel_l2_p2"] is None and runs["msm"]["alternation_rel"] is None
     assert runs["msm"]["growth_rate_1_s"] is not None     # the other phases still ran
     assert runs["pbcm-variational"]["static_failed"] is None
     md = (out / "report.md").read_text()

@@ -75,7 +75,7 @@ def case_row(case, r):
     return {"case": case.name, "mesh": r["mesh"], "bc": r["bc"], "model": r["model"],
             "metric": case.headline, "error": None if failed else r.get(case.headline),
             "failed": failed,
-            "zigzag": r.get("zigzag"), "zigzag_fem": r.get("zigzag_fem"),
+            "alternation_rel": r.get("alternation_rel"),
             "dropped": info.get("calibration_dropped", [])}
 
 
