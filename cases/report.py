@@ -107,6 +107,20 @@ def _runs(runs, **kw):
     return [r for r in runs if all(r.get(k) == v for k, v in kw.items())]
 
 
+def _constants(runs):
+    """One line per model with calibrated constants: its c on each mesh (``c = "auto"`` is
+    fitted per lattice, every reading alike: model.calibrate)."""
+    by = {}
+    for r in runs:
+        info = r.get("model_info") or {}
+        cs = {k: v for k, v in info.items() if k.endswith("_c") and isinstance(v, float)}
+        if cs:
+            by.setdefault(r["model"], {})[r["mesh"]] = cs
+    return [f"Constants of {m}: " + "; ".join(
+        f"{mesh} " + ", ".join(f"{k} = {fmt(v, 4)}" for k, v in cs.items())
+        for mesh, cs in meshes.items()) + "." for m, meshes in by.items()]
+
+
 def build_report(case, s, runs, fields, out):
     doc = Document(f"pbcm report: {case.name}")
     for line in case.conclusion(s, runs):
@@ -121,7 +135,7 @@ def build_report(case, s, runs, fields, out):
         f"Material E = {s.E:g} Pa, nu = {s.nu:g}, rho = {s.rho:g} kg/m^3 (override with --E, "
         "--nu, --rho).",
         case.references_line(s),
-        "Quick mode." if s.quick else "Full mode."])
+        "Quick mode." if s.quick else "Full mode."] + _constants(runs))
     doc.h(2, "Definitions")
     doc.ul(catalogue.definitions(catalogue.TABLE + case.columns + case.gated
                                  + (case.headline,) + catalogue.FINITE + REGIMES)

@@ -20,8 +20,8 @@ _NUMBER = re.compile(r"[+-]?(\d+\.?\d*|\.\d+)([eE][+-]?\d+)?$")
 
 
 def _presets():
-    from .presets import PRESETS
-    return PRESETS
+    from .presets import NAMED
+    return NAMED
 
 
 def _value(text, where):

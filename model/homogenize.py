@@ -49,14 +49,21 @@ def effective_stiffness(model, boundary=None):
     symmetric C_eff (its Jacobian is), a non-conservative one need not, and the symmetric part
     is not taken here: ``asymmetry`` reports it.
     """
-    mesh = model.mesh
+    K = -model.jacobian(model.mesh.points).tocsc()
+    return condensed_stiffness(K, model.mesh, boundary, model.name)
+
+
+def condensed_stiffness(K, mesh, boundary=None, name="the model"):
+    """C_eff (6, 6) [Pa] of the stiffness ``K`` = -df/dx (3n x 3n, sparse) on ``mesh``, a
+    box-shaped patch: the ``boundary`` nodes (default its surface) moved by each unit
+    homogeneous strain, the interior condensed out (see :func:`effective_stiffness`)."""
     b = boundary_nodes(mesh) if boundary is None else np.asarray(boundary)
     n = mesh.n_nodes
     on_b = np.zeros(n, bool)
     on_b[b] = True
     dof_b = np.flatnonzero(np.repeat(on_b, 3))
     dof_i = np.flatnonzero(~np.repeat(on_b, 3))
-    K = -model.jacobian(mesh.points).tocsc()
+    K = sp.csc_matrix(K)
     x = mesh.points - mesh.points.mean(axis=0)
     U = np.stack([(x @ strain_tensor(k).T).ravel() for k in range(6)], axis=1)   # (3n, 6)
     if dof_i.size:
@@ -65,7 +72,7 @@ def effective_stiffness(model, boundary=None):
         try:
             U[dof_i] = splu(sp.csc_matrix(Kii)).solve(np.ascontiguousarray(rhs))
         except RuntimeError as exc:      # SuperLU: "Factor is exactly singular"
-            raise ModelError(f"the effective stiffness of {model.name} is undefined: the patch "
+            raise ModelError(f"the effective stiffness of {name} is undefined: the patch "
                              f"interior is not held by the model ({exc})") from None
     F = (K @ U).reshape(n, 3, 6)          # force the supports exert (zero inside)
     F[~on_b] = 0.0
@@ -75,9 +82,47 @@ def effective_stiffness(model, boundary=None):
         sigma = np.einsum("bi,bj->ij", F[:, :, k], x) / V
         C[:, k] = voigt_stress(0.5 * (sigma + sigma.T))
     if not np.isfinite(C).all():
-        raise ModelError(f"the effective stiffness of {model.name} is not finite: the patch "
+        raise ModelError(f"the effective stiffness of {name} is not finite: the patch "
                          "interior is not held by the model (a singular stiffness)")
     return C
+
+
+# Mandel weights: a Voigt C with engineering shear becomes W C W, whose eigenvalues are the
+# Kelvin moduli (3K once and 2G five times for an isotropic material)
+_MANDEL = np.array([1.0, 1.0, 1.0, np.sqrt(2.0), np.sqrt(2.0), np.sqrt(2.0)])
+
+
+def _deviatoric_mandel():
+    """Five orthonormal traceless directions (6, 5) in Mandel form."""
+    s2, s6 = np.sqrt(2.0), np.sqrt(6.0)
+    B = np.zeros((6, 5))
+    B[:3, 0] = np.array([1.0, -1.0, 0.0]) / s2
+    B[:3, 1] = np.array([1.0, 1.0, -2.0]) / s6
+    B[3, 2] = B[4, 3] = B[5, 4] = 1.0
+    return B
+
+
+def kelvin_moduli(C):
+    """(K, mu): the bulk modulus [Pa] of a Voigt stiffness C (engineering shear), v.M v / 3
+    with M = W C W its Mandel form and v the unit volumetric direction, and its five
+    deviatoric Kelvin moduli, ascending: the eigenvalues of the symmetric part of M on the
+    deviatoric subspace (each 2G for an isotropic C). Of a non-conservative model's C the
+    symmetric part is what stores energy."""
+    M = _MANDEL[:, None] * np.asarray(C, float) * _MANDEL[None, :]
+    M = 0.5 * (M + M.T)
+    v = np.array([1.0, 1.0, 1.0, 0.0, 0.0, 0.0]) / np.sqrt(3.0)
+    B = _deviatoric_mandel()
+    return float(v @ M @ v / 3.0), np.linalg.eigvalsh(B.T @ M @ B)
+
+
+def moduli_errors(C, E, nu):
+    """Isotropy judged by moduli: {"bulk": K / K_target - 1, "deviatoric": (5,) mu / 2G - 1}
+    and "largest", the largest |relative error| of the six, against the isotropic E, nu."""
+    K, mu = kelvin_moduli(C)
+    K_t, G_t = E / (3 * (1 - 2 * nu)), E / (2 * (1 + nu))
+    bulk, dev = K / K_t - 1, mu / (2 * G_t) - 1
+    return {"bulk": float(bulk), "deviatoric": dev.tolist(),
+            "largest": float(max(abs(bulk), np.abs(dev).max()))}
 
 
 def isotropic_stiffness(E, nu):
@@ -145,6 +190,7 @@ def asymmetry(C):
     return float(np.linalg.norm(C - C.T) / np.linalg.norm(C))
 
 
-__all__ = ["effective_stiffness", "isotropic_stiffness", "engineering_constants",
+__all__ = ["effective_stiffness", "condensed_stiffness", "kelvin_moduli", "moduli_errors",
+           "isotropic_stiffness", "engineering_constants",
            "voigt_reuss", "anisotropy_index", "directional_young", "distance", "asymmetry",
            "boundary_nodes", "strain_tensor", "VOIGT", "VOIGT_NAMES"]

@@ -31,10 +31,13 @@ class TetMesh:
     points : (n, 3) float64 array of node coordinates [m].
     tets : (m, 4) int array of node indices. Negatively oriented tetrahedra are re-oriented
         (v1 and v2 swapped); the count is kept in ``reoriented``.
+    lattice : for a generated box, ``(scheme, seed, (hx, hy, hz))``: the lattice it repeats
+        (what a calibration patch of the same lattice is built from); None otherwise.
     """
 
     points: np.ndarray
     tets: np.ndarray
+    lattice: tuple = field(default=None, compare=False)
     reoriented: int = field(default=0, init=False)
     _edges: tuple = field(default=None, init=False, repr=False, compare=False)
 
@@ -202,7 +205,8 @@ def box(nx, ny, nz, lx, ly, lz, scheme="five", seed=0):
         raise MeshError(f"unknown mesh scheme {scheme!r}; choose one of {', '.join(SCHEMES)}")
     neg = geometry.signed_volumes(pts, tets) < 0  # generate right-handed tetrahedra directly
     tets[neg] = tets[neg][:, [0, 2, 1, 3]]
-    return TetMesh(pts, tets)
+    h = tuple(float(v) for v in np.array([lx, ly, lz]) / (np.array([nx, ny, nz]) - 1))
+    return TetMesh(pts, tets, lattice=(scheme, int(seed), h))
 
 
 SCHEMES = ("five", "six", "bcc", "unstructured")

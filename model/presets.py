@@ -1,10 +1,14 @@
 """The named models: each a list of (term, parameters) of the term registry
-(``model.terms``); ``model.compose`` reads a preset name, ``model.build`` builds one."""
+(``model.terms``); ``model.compose`` reads a preset name, ``model.build`` builds one.
+
+``PRESETS`` are what the cases and studies run by default: every shear reading calibrated alike
+(``c = "auto"``, :mod:`model.calibrate`). ``LITERAL`` are the same readings at the paper's
+literal constant c = 1, by name, run where asked for (``--models pbcm-corner-literal``)."""
 
 # name -> list of (term, parameters); docs/model.md "Shear force" and "Mass-spring baseline"
 PRESETS = {
-    "pbcm-corner": [("shear", {"reading": "corner"}), ("volume", {})],
-    "pbcm-balanced": [("shear", {"reading": "balanced"}), ("volume", {})],
+    "pbcm-corner": [("shear", {"reading": "corner", "c": "auto"}), ("volume", {})],
+    "pbcm-balanced": [("shear", {"reading": "balanced", "c": "auto"}), ("volume", {})],
     "pbcm-variational": [("shear", {"reading": "variational", "c": "auto"}), ("volume", {})],
     "pbcm-variational+normal": [("shear", {"reading": "variational", "c": "auto"}),
                                 ("normal", {"c": "auto"}), ("volume", {})],
@@ -16,4 +20,10 @@ PRESETS = {
     "fem-neohookean": [("fem_neohookean", {})],
 }
 
-__all__ = ["PRESETS"]
+LITERAL = {f"pbcm-{reading}-literal": [("shear", {"reading": reading, "c": 1.0}), ("volume", {})]
+           for reading in ("corner", "balanced", "variational")}
+
+# every name a model spec may use
+NAMED = {**PRESETS, **LITERAL}
+
+__all__ = ["PRESETS", "LITERAL", "NAMED"]

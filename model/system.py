@@ -27,7 +27,7 @@ class ParticleModel:
         self.terms = [make_term(t, mesh, material, **p) for t, p in terms]
         if not self.terms:
             raise ModelError("a model needs at least one force term")
-        fit = calibrate(self.terms, mesh, material.G)
+        fit = calibrate(self.terms, mesh, material)
         self.mass = np.zeros(mesh.n_nodes)
         np.add.at(self.mass, mesh.tets, np.repeat(material.rho * mesh.volumes[:, None] / 4, 4, 1))
         self._strain_probe = None   # built on the first tet_stress: 24 strains per tet

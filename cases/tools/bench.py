@@ -57,7 +57,7 @@ class _Timed:
         self.memory = tracemalloc.get_traced_memory()[1]
         tracemalloc.stop()
         t0 = time.perf_counter()
-        calibrate(self.pm.terms, mesh, mat.G)
+        calibrate(self.pm.terms, mesh, mat, cache=False)
         self.calibration = time.perf_counter() - t0 if any(
             getattr(t, "calibrate", False) for t in self.pm.terms) else 0.0
         self.kernels = self.pm.kernels()

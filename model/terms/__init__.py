@@ -156,6 +156,8 @@ class Term:
     params = {}
     # what `pbcm fit` calls the constant it fits (None: nothing to fit)
     fit_constant = None
+    # true while the constant ``c = "auto"`` awaits model.calibrate (which sets ``coef``)
+    calibrate = False
 
     def __init__(self, mesh, material, scale=1.0, **params):
         unknown = set(params) - set(self.params)

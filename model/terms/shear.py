@@ -10,6 +10,9 @@ gamma = (d . e) |c| / (6 V) - gamma_0: 24 strains per tetrahedron, tau = G gamma
 
 Readings of the force (``reading``):
 
+Every reading takes tau = c G gamma, c the factor ``c`` (1: the paper's literal constant;
+"auto": calibrated alike for all three, :mod:`model.calibrate`).
+
 * ``corner``   f_a += (1/4) tau S_F e, on corner a alone (literal eq. 5). The sign is the one
   that restores: gamma grows when the tip moves along +e relative to a, and moving a along +e
   undoes that (checked in tests/test_terms.py). Momentum is not conserved.
@@ -63,14 +66,15 @@ class Shear(Term):
     Parameters
     ----------
     reading : ``corner`` | ``balanced`` | ``variational`` (see the module docstring).
-    c : calibration of ``variational``: ``"auto"`` (fitted by :func:`model.build` so that a
-        homogeneous deviatoric strain gives G |dev eps|^2 per unit volume) or a number.
+    c : the factor on G, for every reading: ``"auto"`` (fitted by :func:`model.build` so that
+        the deviatoric moduli of the model's effective tensor are closest to 2G, see
+        :mod:`model.calibrate`) or a number (1: the paper's literal constant).
     """
 
     name = "shear"
     checks_inversion = True
     params = {"reading": "variational", "c": "auto"}
-    fit_constant = "c"      # for corner and balanced: the factor on G (they have no c)
+    fit_constant = "c"
 
     def __init__(self, mesh, material, scale=1.0, **params):
         super().__init__(mesh, material, scale, **params)
@@ -83,7 +87,7 @@ class Shear(Term):
         if c != "auto" and not (isinstance(c, (int, float)) and np.isfinite(c) and c > 0):
             raise ModelError(f"shear c must be 'auto' or a positive number, got {c!r}")
         self.coef = None if c == "auto" else float(c)
-        self.calibrate = self.conservative and c == "auto"
+        self.calibrate = c == "auto"
         self.G = material.G  # scale multiplies forces and energy after calibration
         self.vol0 = mesh.volumes
         self.gamma0 = np.zeros((mesh.n_tets, 24))
@@ -94,10 +98,7 @@ class Shear(Term):
         return f"shear/{self.p['reading']}"
 
     def info(self):
-        out = super().info()
-        if self.conservative:
-            out["c"] = self.coef
-        return out
+        return {**super().info(), "c": self.coef}
 
     def strains(self, x):
         """The 24 shear strains (m, 24) at positions x."""
@@ -113,10 +114,10 @@ class Shear(Term):
         return self.material.G * np.abs(self.strains(x)).max(axis=1)
 
     def kernel(self):
-        if self.reading == 2 and self.coef is None:
-            raise ModelError("variational shear with c='auto' is not calibrated yet: "
+        if self.coef is None:
+            raise ModelError(f"{self.p['reading']} shear with c='auto' is not calibrated yet: "
                              "build the model with model.build, or pass a number for c")
-        k = self.scale * self.G * (self.coef if self.reading == 2 else 1.0)
+        k = self.scale * self.G * self.coef
         return KERNELS[self.reading], (self.mesh.tets, self.vol0, self.gamma0, k)
 
     def threaded_kernel(self):
@@ -127,7 +128,7 @@ class Shear(Term):
     def forces_numpy(self, x):
         tets = self.mesh.tets
         gam, area, e, V = strains_numpy(x, tets, self.gamma0)
-        tau_area = (self.scale * self.G * gam * area)[..., None] * e  # (m, 24, 3)
+        tau_area = (self.scale * self.coef * self.G * gam * area)[..., None] * e  # (m, 24, 3)
         out = np.zeros_like(x)
         a, j, m, l = COMBOS.T
         if self.reading == 0:
