@@ -367,9 +367,11 @@ for _n in ("G_xy", "G_xz", "G_yz"):
     declare(_n, "Pa", _n, f"the effective shear modulus {_n[2:]} of C_eff.")
 for _n in ("nu_xy", "nu_xz", "nu_yx", "nu_yz", "nu_zx", "nu_zy"):
     declare(_n, "1", _n, f"the effective Poisson ratio {_n[3:]} of C_eff.")
-declare("distance", "1", "distance",
-         "||C_eff - C|| / ||C||: how far the lattice answers from the isotropic target.",
-         "max")
+declare("moduli_rel_err", "1", "moduli err",
+         "the largest relative error of C_eff's bulk modulus and five deviatoric Kelvin moduli "
+         "(eigenvalues of its Mandel form on the deviatoric subspace, symmetric part) against "
+         "the isotropic target's K and 2G: isotropy judged modulus by modulus, so that a "
+         "stiff bulk block cannot hide a soft shear modulus.", "max")
 declare("anisotropy_AU", "1", "A^U",
          "the universal anisotropy index of C_eff (0 for an isotropic material).", "max")
 declare("asymmetry", "1", "asymmetry",

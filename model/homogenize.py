@@ -180,11 +180,6 @@ def directional_young(C, directions):
     return 1.0 / np.einsum("ka,ab,kb->k", m, S, m)
 
 
-def distance(C, target):
-    """||C - target|| / ||target|| (Frobenius, Voigt matrices)."""
-    return float(np.linalg.norm(C - target) / np.linalg.norm(target))
-
-
 def asymmetry(C):
     """||C - C^T|| / ||C||: zero for a model with an energy."""
     return float(np.linalg.norm(C - C.T) / np.linalg.norm(C))
@@ -192,5 +187,5 @@ def asymmetry(C):
 
 __all__ = ["effective_stiffness", "condensed_stiffness", "kelvin_moduli", "moduli_errors",
            "isotropic_stiffness", "engineering_constants",
-           "voigt_reuss", "anisotropy_index", "directional_young", "distance", "asymmetry",
+           "voigt_reuss", "anisotropy_index", "directional_young", "asymmetry",
            "boundary_nodes", "strain_tensor", "VOIGT", "VOIGT_NAMES"]

@@ -31,7 +31,7 @@ def _doc(case_errors, alternation, tensors):
              "alternation_rel": alternation.get(m) if c == "paper-cube" else None}
             for c, es in case_errors.items() for m, e in es.items()]
     data = {"case_runs": runs, "fits": [], "cost_vs_fem_linear": dict.fromkeys(models, 1.0),
-            "elasticity": [{"model": m, "mesh": lat, "distance": d}
+            "elasticity": [{"model": m, "mesh": lat, "moduli_rel_err": d}
                            for m, ds in tensors.items() for lat, d in ds.items()]}
     return models, data
 
@@ -101,7 +101,7 @@ def small_study(tmp_path_factory):
 
 def test_small_study_writes_rankings_and_gate_rows(small_study):
     doc = json.loads((small_study / "metrics.json").read_text())
-    for f in ("report.md", "report.html", "case_errors.png", "ceff_distance.png"):
+    for f in ("report.md", "report.html", "case_errors.png", "ceff_moduli.png"):
         assert (small_study / f).is_file()
     rank = doc["rankings"]
     assert set(rank["case_errors"]) == {"cantilever"}
@@ -122,7 +122,7 @@ def test_rewrite_draws_the_same_report_from_the_recorded_runs(small_study, tmp_p
     shutil.copytree(small_study, copy)
     (copy / "report.md").unlink()
     assert main(["run", "extensions", "--rewrite", "--out", str(copy)]) == 0
-    for f in ("report.md", "metrics.json", "case_errors.png", "ceff_distance.png"):
+    for f in ("report.md", "metrics.json", "case_errors.png", "ceff_moduli.png"):
         assert (copy / f).read_bytes() == (small_study / f).read_bytes(), f
     doc = json.loads((copy / "metrics.json").read_text())
     doc["problem"]["nu"] = 0.3        # recorded at other parameters than the code's

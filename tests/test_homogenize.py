@@ -5,7 +5,7 @@ import numpy as np
 import pytest
 
 from model import Material, ModelError, build
-from model.homogenize import (anisotropy_index, asymmetry, directional_young, distance,
+from model.homogenize import (anisotropy_index, asymmetry, directional_young, moduli_errors,
                               effective_stiffness, engineering_constants, isotropic_stiffness,
                               voigt_reuss)
 from model.mesh import cube
@@ -60,7 +60,7 @@ def test_cubic_crystal_against_the_closed_forms():
 def test_constant_strain_fem_patch_answers_with_the_target(family):
     mat = Material(E=10e3, nu=0.45)
     C = effective_stiffness(build("fem-linear", cube(4, 0.032, family), mat))
-    assert distance(C, isotropic_stiffness(mat.E, mat.nu)) < 1e-8
+    assert moduli_errors(C, mat.E, mat.nu)["largest"] < 1e-8
     assert asymmetry(C) < 1e-8
 
 
@@ -88,3 +88,19 @@ def test_a_patch_is_refused_when_its_interior_is_not_held():
             return sp.csr_matrix((3 * len(x), 3 * len(x)))
     with pytest.raises(ModelError, match="effective stiffness of nothing is undefined"):
         effective_stiffness(Free())
+
+
+def test_isotropy_judged_by_moduli_sees_a_soft_shear_modulus_the_frobenius_norm_hides():
+    """At nu = 0.45 the bulk block dominates ||C||: one shear modulus 12 % low moves the
+    Frobenius distance by under 1 % (the old criterion passed it), while the largest relative
+    modulus error is the 12 % (the deviatoric modulus 2 C44 over 2G)."""
+    E, nu = 10e3, 0.45
+    C = isotropic_stiffness(E, nu)
+    soft = C.copy()
+    soft[5, 5] *= 0.878
+    frobenius = np.linalg.norm(soft - C) / np.linalg.norm(C)
+    assert frobenius < 0.01
+    err = moduli_errors(soft, E, nu)
+    assert err["largest"] == pytest.approx(0.122, rel=1e-12)
+    assert err["bulk"] == pytest.approx(0.0, abs=1e-14)
+    assert sorted(err["deviatoric"])[0] == pytest.approx(-0.122, rel=1e-12)

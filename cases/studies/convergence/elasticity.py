@@ -4,8 +4,9 @@ patch of the lattice, its surface moved by each unit homogeneous strain, its int
 import numpy as np
 
 from model import build
-from model.homogenize import (anisotropy_index, asymmetry, directional_young, distance,
-                              effective_stiffness, engineering_constants, isotropic_stiffness)
+from model.homogenize import (anisotropy_index, asymmetry, directional_young,
+                              effective_stiffness, engineering_constants, kelvin_moduli,
+                              moduli_errors)
 from model.mesh import cube
 from ... import stop
 from ...runner import FINDINGS
@@ -23,19 +24,23 @@ def patch(family, n):
 
 def entry(model_name, family, s):
     """C_eff of one model on one lattice and what it says, relative to the isotropic target
-    (E, nu of the settings)."""
+    (E, nu of the settings): its bulk modulus and five deviatoric Kelvin moduli, each against
+    the target's (the criterion is the largest relative error of the six)."""
     mesh = patch(family, s.patch_n)
     pm = build(model_name, mesh, s.material)
     C = effective_stiffness(pm)
-    target = isotropic_stiffness(s.E, s.nu)
     const = engineering_constants(C)
+    K, mu = kelvin_moduli(C)
+    err = moduli_errors(C, s.E, s.nu)
     diag = np.array([[1, 1, 0], [1, -1, 0], [1, 1, 1]], float)
     E_dir = directional_young(C, diag)
     theta = np.radians(ANGLES_DEG)
     return {"model": model_name, "mesh": family, "C_eff_Pa": C.tolist(),
             **{k: v for k, v in const.items()},
             "E_110": float(E_dir[0]), "E_111": float(E_dir[2]),
-            "anisotropy_AU": anisotropy_index(C), "distance": distance(C, target),
+            "anisotropy_AU": anisotropy_index(C), "K_eff_Pa": K,
+            "deviatoric_moduli_Pa": mu.tolist(), "bulk_rel_err": err["bulk"],
+            "deviatoric_rel_err": err["deviatoric"], "moduli_rel_err": err["largest"],
             "asymmetry": asymmetry(C),
             "E_xy_plane": directional_young(
                 C, np.column_stack([np.cos(theta), np.sin(theta), 0 * theta])).tolist()}

@@ -1,8 +1,8 @@
 """Which normal-stress extension, if any, fixes which failure of the paper's model? Every
 candidate (the paper's variational reading plus one deviatoric normal term each) on every case
 of the library and in the convergence study, ranked by error per case and overall, by cost
-(from `pbcm bench`), by the bulge/neck artefact, by convergence floor and by the distance of
-its effective elasticity from the isotropic target.
+(from `pbcm bench`), by the bulge/neck artefact, by convergence floor and by how far the moduli
+of its effective elasticity are from the isotropic target's.
 """
 from dataclasses import fields
 

@@ -108,7 +108,7 @@ def run(s, workers=None, log=True, bench=None, store=OFF):
     conv = studies()["convergence"].run(s.convergence_settings(), workers=workers, log=log,
                                         bench=None, store=store)
     return jsonable({"case_runs": rows, "fits": conv["fits"], "elasticity": [
-        {k: e.get(k) for k in ("model", "mesh", "distance", "anisotropy_AU", "E_x", "nu_xy",
+        {k: e.get(k) for k in ("model", "mesh", "moduli_rel_err", "anisotropy_AU", "E_x", "nu_xy",
                                "G_xy", "failed")} for e in conv["elasticity"]],
         "cost_vs_fem_linear": costs(bench, s.models),
         # the preset with the same terms as +normal_edge, timed by another bench run
