@@ -211,6 +211,13 @@ class Case(abc.ABC):
     quick : settings that ``--quick`` changes (e.g. ``{"p2_levels": 1}``).
     headline : the metric (a catalogue name) that sums the case up in the scorecard: an
         error, smaller is better, per run.
+    headline_pair : the metric shown beside it, so that a scalar cannot hide a wrong field
+        nor a field a wrong stiffness: the reaction error of a displacement-driven case, the
+        displacement error of a force-driven one (None: nothing to pair).
+    headline_estimate : the run key of the error estimate of the headline's reference (the
+        floor of its entries in the index's geometric mean).
+    patch_tests : the boundary conditions whose problem is a patch test (a field every
+        consistent discretisation reproduces exactly): reported pass or fail, never pooled.
     gated : case metrics the CI gate bounds beside the standard ones (catalogue names; the
         catalogue gives their direction).
     columns : case metrics shown in the per-(mesh, bc) table after the standard ones
@@ -238,6 +245,9 @@ class Case(abc.ABC):
     models: ClassVar[tuple] = tuple(PRESETS)
     quick: ClassVar[dict] = {}
     headline: ClassVar[str] = "disp_rel_l2_p2"
+    headline_pair: ClassVar[str] = None
+    headline_estimate: ClassVar[str] = "p2_error_estimate"
+    patch_tests: ClassVar[tuple] = ()
     gated: ClassVar[tuple] = ()
     columns: ClassVar[tuple] = ()
     qoi_errors: ClassVar[tuple] = ()
@@ -253,11 +263,13 @@ class Case(abc.ABC):
     def __init_subclass__(cls, **kw):
         """A declaration error shows when the case is imported, not in its report."""
         super().__init_subclass__(**kw)
-        for attr in ("gated", "columns", "qoi_errors", "quantity_compared", "notes"):
+        for attr in ("gated", "columns", "qoi_errors", "quantity_compared", "notes",
+                     "patch_tests"):
             if not isinstance(getattr(cls, attr), tuple):
                 raise TypeError(f"{cls.__name__}.{attr} must be a tuple (a one-element tuple "
                                 "needs its trailing comma)")
-        for name in (cls.headline, *cls.gated, *cls.columns, *cls.quantity_compared):
+        for name in (cls.headline, *cls.gated, *cls.columns, *cls.quantity_compared,
+                     *([cls.headline_pair] if cls.headline_pair else [])):
             catalogue.metric(name)      # a KeyError naming where to declare it
 
     # ------------------------------------------------------------------ settings

@@ -1,6 +1,8 @@
-"""reports/index: the scorecard (case x model headline errors, coloured by band in HTML) and
-a five-line conclusion written from the numbers."""
+"""reports/index: the scorecard (one population per row: a case's runs under one boundary
+condition, its headline error and the metric paired with it, per model, coloured by band in
+HTML) and a five-line conclusion written from the numbers."""
 import json
+from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
@@ -13,62 +15,141 @@ BANDS = ((0.05, "#c8e6c9", "within 5 %"), (0.20, "#fff59d", "within 20 %"),
          (float("inf"), "#ffcdd2", "beyond 20 %"))
 
 
-def headline_table(root, cases):
-    """{case: {model: median headline error over the case's runs or None}}, the metric's name
-    per case and the loaded metrics."""
-    table, metric, data = {}, {}, {}
+PATCH_TOL = 1e-6    # a patch test passes when the headline error is below this (solver level)
+
+
+@dataclass
+class Population:
+    """One aggregate of the scorecard: a case's runs under one boundary condition, for one
+    metric (its headline or the one paired with it). ``values`` {model: values over the runs
+    that gave one}, ``runs`` {model: runs it had}, ``floor`` the reference's estimate."""
+
+    case: str
+    bc: str
+    metric: str
+    primary: bool
+    patch_test: bool
+    values: dict
+    runs: dict
+    floor: float
+
+    @property
+    def label(self):
+        return f"{self.case}/{self.bc}"
+
+    def complete(self, model):
+        full = max(self.runs.values(), default=0)
+        return len(self.values.get(model, [])) == self.runs.get(model, -1) == full
+
+    def median(self, model):
+        v = self.values.get(model)
+        return float(np.median(v)) if v else None
+
+
+def _declared(case):
+    from .registry import CASES
+    return CASES[case]
+
+
+def populations(root, cases):
+    """Every scorecard population of the cases' metrics under ``root``, and the loaded
+    metrics: per case and boundary condition, its headline and the metric paired with it."""
+    out, data = [], {}
     for case in cases:
         d = json.loads((Path(root) / case / "metrics.json").read_text())
-        # metrics written before the case framework lack "headline": the case declares it
-        data[case], metric[case] = d, d.get("headline") or _declared_headline(case)
-        table[case] = {}
-        for model in d["parameters"]["models"]:
-            vals = [r[metric[case]] for r in d["runs"] if r["model"] == model
-                    and r.get(metric[case]) is not None]
-            table[case][model] = float(np.median(vals)) if vals else None
-    return table, metric, data
-
-
-def _declared_headline(case):
-    from .registry import CASES
-    return CASES[case].headline.metric
+        data[case] = d
+        declared = _declared(case)
+        metrics = [(d.get("headline") or declared.headline, True)]
+        pair = d.get("headline_pair", declared.headline_pair)
+        if pair:
+            metrics.append((pair, False))
+        est_key = d.get("headline_estimate", declared.headline_estimate)
+        patch = set(d.get("patch_tests", declared.patch_tests))
+        bcs = list(dict.fromkeys(r["bc"] for r in d["runs"]))
+        for bc in bcs:
+            rs = [r for r in d["runs"] if r["bc"] == bc]
+            est = [r[est_key] for r in rs if r.get(est_key) is not None]
+            for metric, primary in metrics:
+                values, had = {}, {}
+                for model in d["parameters"]["models"]:
+                    mine = [r for r in rs if r["model"] == model]
+                    had[model] = len(mine)
+                    values[model] = [r[metric] for r in mine if r.get(metric) is not None]
+                out.append(Population(case, bc, metric, primary, bc in patch, values, had,
+                                      max(est) if est else 0.0))
+    return out, data
 
 
 def _band(v):
     return next(b for b in BANDS if v < b[0])
 
 
-def conclusion(table, metric):
-    """Five sentences from the scorecard."""
-    models = sorted({m for row in table.values() for m in row})
-    scores = {}
+def geometric_means(pops, models):
+    """{model: (geometric mean, (low, high) leaving one population out)} over the primary,
+    non-patch-test populations where every model has a value in every run (the others are
+    not comparable), each entry floored at its reference's estimate (an error below what the
+    reference resolves counts as that estimate); and the populations used."""
+    used = [p for p in pops if p.primary and not p.patch_test
+            and all(p.complete(m) for m in models)]
+
+    def gmean(model, ps):
+        vals = [max(p.median(model), p.floor, 1e-300) for p in ps]
+        return float(np.exp(np.mean(np.log(vals)))) if vals else None
+
+    out = {}
     for m in models:
-        vals = [row[m] for row in table.values() if row.get(m) is not None and row[m] > 0]
-        if vals:
-            scores[m] = (float(np.exp(np.mean(np.log(vals)))), len(vals))
+        g = gmean(m, used)
+        if g is None:
+            continue
+        loo = [gmean(m, used[:k] + used[k + 1:]) for k in range(len(used))] if len(used) > 1 \
+            else [g]
+        out[m] = (g, (min(loo), max(loo)))
+    return out, used
+
+
+def conclusion(pops, models):
+    """Five sentences from the scorecard's populations."""
+    means, used = geometric_means(pops, models)
     out = []
-    if scores:
-        best = min(scores, key=lambda m: scores[m][0])
-        worst = max(scores, key=lambda m: scores[m][0])
-        out.append(f"Closest to the continuum overall: {best} (geometric mean of its headline "
-                   f"errors {scores[best][0]:.3g} over {scores[best][1]} cases).")
-        out.append(f"Farthest: {worst} ({scores[worst][0]:.3g}); the ranking of every model "
-                   "is " + ", ".join(f"{m} {scores[m][0]:.3g}" for m in
-                                     sorted(scores, key=lambda m: scores[m][0])) + ".")
-    worst_case = {m: max(((row[m], c) for c, row in table.items() if row.get(m) is not None),
-                         default=None) for m in models}
-    out.append("Where each model fails worst: " + "; ".join(
-        f"{m} in {wc[1]} ({metric[wc[1]]} {wc[0]:.3g})" for m, wc in worst_case.items()
-        if wc) + ".")
-    within = {c: [m for m, v in row.items() if v is not None and v < BANDS[0][0]]
-              for c, row in table.items()}
-    out.append("Cases where some model is within 5 % of FEM: " + (", ".join(
-        f"{c} ({', '.join(ms)})" for c, ms in within.items() if ms) or "none") + "; where none "
-        "is: " + (", ".join(c for c, ms in within.items() if not ms) or "none") + ".")
-    missing = [(c, m) for c, row in table.items() for m, v in row.items() if v is None]
-    out.append("Every model gave a headline number in every case." if not missing else
-               "No headline number (every run failed): " + ", ".join(f"{m} in {c}"
-                                                                     for c, m in missing) + ".")
+    primaries = [p for p in pops if p.primary and not p.patch_test]
+    if means:
+        best = min(means, key=lambda m: means[m][0])
+        g, (lo, hi) = means[best]
+        out.append(f"Closest to the continuum overall: {best}, geometric mean of its headline "
+                   f"errors {g:.3g} (from {lo:.3g} to {hi:.3g} leaving one population out) over "
+                   f"the {len(used)} of {len(primaries)} case/boundary-condition populations "
+                   "where every model has a result in every run (entries floored at their "
+                   "reference's estimate).")
+        out.append("Every model so: " + ", ".join(
+            f"{m} {means[m][0]:.3g} [{means[m][1][0]:.3g}-{means[m][1][1]:.3g}]"
+            for m in sorted(means, key=lambda m: means[m][0])) + "; not comparable (a run "
+            "without a result): " + (", ".join(p.label for p in primaries if p not in used)
+                                     or "none") + ".")
+    else:
+        out.append("No population has a result from every model in every run: no overall "
+                   "ranking.")
+        out.append("Every population lacks some model's run.")
+    worst = {}
+    for p in primaries:
+        for m in models:
+            v = p.median(m)
+            if v is not None and (m not in worst or v > worst[m][0]):
+                worst[m] = (v, p)
+    out.append("Where each model is farthest (median headline): " + "; ".join(
+        f"{m} in {p.label} ({p.metric} {v:.3g})" for m, (v, p) in worst.items()) + ".")
+    within = {p.label: [m for m in models if p.complete(m) and max(p.values[m]) < BANDS[0][0]]
+              for p in primaries}
+    patch = [p for p in pops if p.primary and p.patch_test]
+    out.append("Within 5 % of FEM in every run: " + ("; ".join(
+        f"{c}: {', '.join(ms)}" for c, ms in within.items() if ms) or "none") + ". "
+        + " ".join(f"Patch test {p.label}: passed (error below {PATCH_TOL:g}) by "
+                   + (", ".join(m for m in models if p.complete(m)
+                                and max(p.values[m]) < PATCH_TOL) or "none") + "."
+                   for p in patch))
+    missing = [f"{m} in {p.label} ({len(p.values.get(m, []))} of {p.runs.get(m, 0)} runs)"
+               for p in pops if p.primary for m in models if not p.complete(m)]
+    out.append("Every model gave a headline number in every run." if not missing else
+               "Runs without a headline number: " + ", ".join(missing) + ".")
     return out
 
 
@@ -88,10 +169,10 @@ def index_documents(root, cases, studies=()):
     study says whether the models converge at all), then the cases' conclusion and
     scorecard."""
     root = Path(root)
-    table, metric, data = headline_table(root, cases)
+    pops, data = populations(root, cases)
     models = []
-    for row in table.values():
-        models += [m for m in row if m not in models]
+    for case in cases:
+        models += [m for m in data[case]["parameters"]["models"] if m not in models]
     doc = Document("pbcm reports")
     for name, lines in study_headlines(root, studies).items():
         mode = " (quick mode)" if json.loads((root / name / "metrics.json").read_text())[
@@ -99,21 +180,38 @@ def index_documents(root, cases, studies=()):
         doc.p(f"**{name}{mode}** ([report]({name}/report.md)): " + (lines[0] if lines else ""))
         for line in lines[1:]:
             doc.p(line)
-    for line in conclusion(table, metric):
+    for line in conclusion(pops, models):
         doc.p(line)
     doc.h(2, "Scorecard")
-    doc.p("Each cell is the median over the case's meshes and boundary conditions of its "
-          "headline error against FEM (named under the case); colours in the HTML: "
+    doc.p("One row per case, boundary condition and metric: the case's headline error against "
+          "its reference, then the metric paired with it (a displacement-driven case's "
+          "stiffness error, a force-driven one's displacement error). Each cell is the median "
+          "over the meshes [smallest-largest], n of N runs; a patch test reads pass or fail at "
+          f"{PATCH_TOL:g}. Colours in the HTML: "
           + ", ".join(f"{label}" for _, _, label in BANDS) + ". Quick-mode cases are marked.")
     rows = []
-    for case in cases:
-        mode = " (quick)" if data[case]["parameters"]["quick"] else ""
-        row = [Link(case + mode, f"{case}/report.md", f"{case}/report.html"), metric[case]]
+    for p in pops:
+        mode = " (quick)" if data[p.case]["parameters"]["quick"] else ""
+        label = p.label + mode + (" (patch test)" if p.patch_test else "")
+        row = [Link(label, f"{p.case}/report.md", f"{p.case}/report.html")
+               if p.primary else "", p.metric]
         for m in models:
-            v = table[case].get(m)
-            row.append("n/a" if v is None else Cell(f"{v:.3g}", _band(v)[1]))
+            vals, total = p.values.get(m, []), p.runs.get(m, 0)
+            if not total:
+                row.append("")
+            elif not vals:
+                row.append(f"n/a, 0 of {total}")
+            elif p.patch_test and p.primary:
+                worst = max(vals)
+                row.append(Cell(("pass" if worst < PATCH_TOL else f"fail {worst:.2g}")
+                                + f", {len(vals)} of {total}",
+                                BANDS[0][1] if worst < PATCH_TOL else BANDS[-1][1]))
+            else:
+                med = float(np.median(vals))
+                row.append(Cell(f"{med:.3g} [{min(vals):.3g}-{max(vals):.3g}] {len(vals)}/"
+                                f"{total}", _band(med)[1]))
         rows.append(row)
-    doc.table(["case", "headline"] + models, rows)
+    doc.table(["case/bc", "metric"] + models, rows)
     doc.p("Each case folder holds metrics.json, report.md, report.html and the figures; "
           "regenerate with `pbcm report`.")
     sweeps = sorted((root / "sweeps").glob(f"*/{SWEEP_MARK}"))

@@ -30,15 +30,39 @@ def _nonzero(name, ref):
     return ref
 
 
-def rel_l2(u, ref):
-    """||u - ref|| / ||ref|| over all nodal components."""
-    return finite("rel_l2", np.linalg.norm(u - ref) / _nonzero("rel_l2", np.linalg.norm(ref)))
+def rel_l2(u, ref, free=None):
+    """||u - ref|| / ||ref|| over the nodal components ``free`` ((n, 3) bool; all when None):
+    the prescribed ones, equal in model and reference, would only dilute the error."""
+    d, r = _masked(u, ref, free)
+    return finite("rel_l2", np.linalg.norm(d) / _nonzero("rel_l2", np.linalg.norm(r)))
 
 
-def max_rel(u, ref):
-    """max_i |u_i - ref_i| / max_i |ref_i| (nodal vector norms)."""
-    num = np.linalg.norm(u - ref, axis=1).max()
-    return finite("max_rel", num / _nonzero("max_rel", np.linalg.norm(ref, axis=1).max()))
+def max_rel(u, ref, free=None):
+    """max_i |u_i - ref_i| / max_i |ref_i| (nodal vector norms of the ``free`` components)."""
+    d, r = _masked(u, ref, free)
+    num = np.linalg.norm(d, axis=1).max()
+    return finite("max_rel", num / _nonzero("max_rel", np.linalg.norm(r, axis=1).max()))
+
+
+def _masked(u, ref, free):
+    """(u - ref, ref), zero on the components outside ``free``."""
+    d, r = np.asarray(u, float) - ref, np.asarray(ref, float)
+    if free is None:
+        return d, r
+    free = np.asarray(free, bool)
+    if free.shape != r.shape:
+        raise MetricError(f"free-component mask of shape {free.shape} for a field of shape "
+                          f"{r.shape}")
+    return np.where(free, d, 0.0), np.where(free, r, 0.0)
+
+
+def energy_rel(u, ref, K):
+    """||u - ref||_K / ||ref||_K: the error in the energy norm of the stiffness K (3n x 3n,
+    node-major components: u.ravel()), the continuum's measure of a displacement error."""
+    d = (np.asarray(u, float) - ref).ravel()
+    r = np.asarray(ref, float).ravel()
+    ref_energy = _nonzero("energy_rel", float(r @ (K @ r)))
+    return finite("energy_rel", np.sqrt(max(float(d @ (K @ d)), 0.0) / ref_energy))
 
 
 def correlation(a, b):

@@ -1,15 +1,36 @@
-"""Sentences that rank the models of a case's runs, computed from the runs: medians per model,
-ties within the reference's error estimate, the closest and farthest model, failures, and the
-case's load against the neo-Hookean reference."""
+"""Sentences that rank the models of a case's runs, computed from the runs: one population per
+aggregate (each boundary condition apart), each cell 'median [min-max], n of N runs', only
+models with a value in every run ranked, ties within the reference's error estimate, the
+closest and farthest model, failures, and the case's load against the neo-Hookean
+reference."""
 import numpy as np
 
 
-def _by_model(runs, metric):
-    by = {}
+def populations(runs):
+    """The runs split by boundary condition: each (case, bc) is one population (a patch test
+    and a clamped cube are never pooled); {bc: runs}, in the runs' order."""
+    out = {}
     for r in runs:
+        out.setdefault(r["bc"], []).append(r)
+    return out
+
+
+def _by_model(runs, metric):
+    """{model: values} over the runs that gave ``metric``, and {model: runs it had}."""
+    by, had = {}, {}
+    for r in runs:
+        had[r["model"]] = had.get(r["model"], 0) + 1
         if r.get(metric) is not None:
             by.setdefault(r["model"], []).append(r[metric])
-    return by
+    return by, had
+
+
+def cell(values, total):
+    """'median [min-max], n of N runs' of one aggregate."""
+    if not values:
+        return f"no result, 0 of {total} runs"
+    return (f"median {np.median(values):.3g} [{min(values):.3g}-{max(values):.3g}], "
+            f"{len(values)} of {total} runs")
 
 
 def estimate(runs, key="p2_error_estimate"):
@@ -20,45 +41,77 @@ def estimate(runs, key="p2_error_estimate"):
     return max(est) if est else None
 
 
+def _complete(by, had):
+    """The models with a value in every run they had (the others are not ranked)."""
+    full = max(had.values(), default=0)
+    return [m for m in by if len(by[m]) == had[m] == full]
+
+
+def _labelled(runs, line_of):
+    """``line_of(population runs)`` per boundary condition, prefixed by the bc when there are
+    several populations."""
+    pops = populations(runs)
+    if len(pops) == 1:
+        return [line_of(next(iter(pops.values())))]
+    return [f"[{bc}] {line_of(rs)}" for bc, rs in pops.items()]
+
+
 def ranking(runs, metric, label, estimate_key="p2_error_estimate"):
-    """'model: median metric (range)' sentences, best first, over the runs that gave it; a
-    model whose median is within the reference's estimate (``estimate_key``) of the one
+    """Per population (boundary condition): 'model: median metric [range], n of N runs'
+    sentences, best first, the models with a value in every run ranked, the others listed
+    after, unranked; a model within the reference's estimate (``estimate_key``) of the one
     above is called tied with it (the reference cannot order them)."""
-    by, est = _by_model(runs, metric), estimate(runs, estimate_key)
-    med = {m: float(np.median(v)) for m, v in by.items()}
-    order = sorted(by, key=med.get)
     out = []
-    for k, m in enumerate(order):
-        tie = ""
-        if k and est is not None and med[m] - med[order[k - 1]] < est:
-            tie = f" Tied with {order[k - 1]} (within the reference's estimate {est:.2g})."
-        out.append(f"{m}: {label} median {med[m]:.3g} (from {min(by[m]):.3g} to "
-                   f"{max(by[m]):.3g} over {len(by[m])} runs).{tie}")
+    for bc, rs in populations(runs).items():
+        by, had = _by_model(rs, metric)
+        est = estimate(rs, estimate_key)
+        med = {m: float(np.median(v)) for m, v in by.items()}
+        ranked = sorted(_complete(by, had), key=med.get)
+        prefix = f"[{bc}] " if len(populations(runs)) > 1 else ""
+        for k, m in enumerate(ranked):
+            tie = ""
+            if k and est is not None and med[m] - med[ranked[k - 1]] < est:
+                tie = f" Tied with {ranked[k - 1]} (within the reference's estimate {est:.2g})."
+            out.append(f"{prefix}{m}: {label} {cell(by[m], had[m])}.{tie}")
+        for m in sorted(set(had) - set(ranked)):
+            out.append(f"{prefix}{m}: {label} {cell(by.get(m, []), had[m])}: incomplete, "
+                       "not ranked.")
     return out
 
 
 def best_and_worst(runs, metric, what, exact=False, estimate_key="p2_error_estimate"):
-    """One line naming the model closest to FEM and the farthest, by median ``metric``; the
-    models within the reference's estimate (``estimate_key``) of the closest are named tied
-    with it, and the line says so where that estimate exceeds a fifth of the smallest error
-    it ranks (``exact``: the metric is against a closed form, which has no estimate)."""
-    by, est = _by_model(runs, metric), None if exact else estimate(runs, estimate_key)
-    if not by:
-        return f"No model gave {what}."
-    med = {m: float(np.median(v)) for m, v in by.items()}
-    best, worst = min(med, key=med.get), max(med, key=med.get)
-    line = (f"{what}: closest {best} (median error {med[best]:.3g}), farthest {worst} "
-            f"({med[worst]:.3g}).")
-    if est is None:
+    """Per population (boundary condition), one line naming the model closest to FEM and the
+    farthest by median ``metric`` among the models with a value in every run; the models
+    within the reference's estimate (``estimate_key``) of the closest are named tied with it,
+    the line says so where that estimate exceeds a fifth of the smallest error it ranks
+    (``exact``: the metric is against a closed form, which has no estimate), and it names
+    the models left out for a missing run."""
+    def line_of(rs):
+        by, had = _by_model(rs, metric)
+        est = None if exact else estimate(rs, estimate_key)
+        ranked = _complete(by, had)
+        if not ranked:
+            return f"No model gave {what} in every run."
+        med = {m: float(np.median(by[m])) for m in ranked}
+        best, worst = min(med, key=med.get), max(med, key=med.get)
+        line = (f"{what}: closest {best} ({cell(by[best], had[best])}), farthest {worst} "
+                f"({cell(by[worst], had[worst])}).")
+        left = sorted(set(had) - set(ranked))
+        if left:
+            line += (" Not ranked, a run without a value: " + ", ".join(
+                f"{m} ({len(by.get(m, []))} of {had[m]})" for m in left) + ".")
+        if est is None:
+            return line
+        tied = [m for m in sorted(med, key=med.get) if m != best and med[m] - med[best] < est]
+        if tied:
+            line += (f" Tied with {best} within the reference's estimate {est:.2g}: "
+                     f"{', '.join(tied)}.")
+        smallest = min(min(by[m]) for m in ranked)
+        if est > smallest / 5:
+            line += (f" The reference's estimate ({est:.2g}) exceeds a fifth of the smallest "
+                     f"error ranked ({smallest:.2g}): differences below it are not resolved.")
         return line
-    tied = [m for m in sorted(med, key=med.get) if m != best and med[m] - med[best] < est]
-    if tied:
-        line += f" Tied with {best} within the reference's estimate {est:.2g}: {', '.join(tied)}."
-    smallest = min(min(v) for v in by.values())
-    if est > smallest / 5:
-        line += (f" The reference's estimate ({est:.2g}) exceeds a fifth of the smallest "
-                 f"error ranked ({smallest:.2g}): differences below it are not resolved.")
-    return line
+    return " ".join(_labelled(runs, line_of))
 
 
 def failures(runs, key="static_failed", where="in the linear regime"):
@@ -84,8 +137,8 @@ def finite_load(runs):
     lin = [r["disp_rel_l2_nh"] for r in runs
            if r["model"] == "fem-linear" and r.get("disp_rel_l2_nh") is not None]
     if lin:
-        out.append(f"fem-linear's error at the case's load is its linearisation error: "
-                   f"median {np.median(lin):.3g} (from {min(lin):.3g} to {max(lin):.3g}).")
+        out.append("fem-linear's error at the case's load is its linearisation error: "
+                   f"{cell(lin, len(lin))}.")
     refs = sorted({f"{r['mesh']}/{r['bc']}" for r in runs if r.get(nh) is None
                    and r.get("finite_failed")})
     if refs:

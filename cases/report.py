@@ -64,7 +64,9 @@ def metrics_document(case, s, runs, extra=None):
     return jsonable({"case": case.name, "parameters": s.describe(), "problem": s.problem(),
                      "params": case.params(s), "gated": {**catalogue.STANDARD_GATED,
                                                           **catalogue.gated(*case.gated)},
-                     "headline": case.headline, **(extra or {}),
+                     "headline": case.headline, "headline_pair": case.headline_pair,
+                     "headline_estimate": case.headline_estimate,
+                     "patch_tests": list(case.patch_tests), **(extra or {}),
                      "environment": environment(),
                      "runs": [{k: v for k, v in r.items() if k not in TIMING_KEYS} for r in runs]})
 

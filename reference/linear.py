@@ -141,6 +141,16 @@ def solve(mesh, E, nu, dirichlet, body_force=None, traction=None, element="P1", 
                               **sinfo}, basis=basis, dofs=u_all)
 
 
+def p1_stiffness(mesh, E, nu):
+    """The linear elastic P1 stiffness (3n x 3n, CSR) on ``mesh``'s own tetrahedra, its rows
+    and columns node-major (u.ravel() of an (n, 3) field): the energy norm ||v||_K of the
+    continuum's energy of a nodal field's P1 interpolant, v.K v = 2 x that energy."""
+    lam, mu = lame(E, nu)
+    basis = element_basis(skfem_mesh(mesh), "P1")
+    order = basis.nodal_dofs.T.ravel()
+    return stiffness(basis, lam, mu)[order][:, order].tocsr()
+
+
 def transfer_to_nodes(basis, W, dofs, values):
     """Carry forces on ``dofs`` to the input mesh's nodes with its P1 hat functions
     (preserves their sum and first moments; the identity for P1 without refinement)."""

@@ -182,7 +182,7 @@ def test_paper_cube_conclusion_groups_the_artefact_by_model():
 
 def test_rankings_tie_models_the_reference_cannot_order():
     from cases.library import common
-    runs = [{"model": m, "err": e, "p2_error_estimate": 0.01}
+    runs = [{"model": m, "bc": "clamped", "err": e, "p2_error_estimate": 0.01}
             for m, e in (("a", 0.10), ("b", 0.105), ("c", 0.30))]
     lines = common.ranking(runs, "err", "error")
     assert lines[0].startswith("a:") and "Tied" not in lines[0]
@@ -196,3 +196,104 @@ def test_rankings_tie_models_the_reference_cannot_order():
     # against a closed form there is no estimate: no ties, no caveat
     exact = common.best_and_worst(coarse, "err", "Error", exact=True)
     assert "Tied" not in exact and "not resolved" not in exact
+
+
+def test_rankings_keep_populations_apart_and_rank_only_complete_models():
+    """A patch test (sliding, exact for some) and a clamped cube are never pooled: each bc is
+    ranked on its own, each cell 'median [min-max], n of N runs'; a model with a run that gave
+    no value is listed as incomplete and never named closest, however small its median."""
+    from cases import rankings
+    runs = []
+    for mesh, (a, b, c) in (("five", (1e-10, 0.02, 0.05)), ("six", (1e-10, 0.04, None))):
+        runs += [{"model": "a", "mesh": mesh, "bc": "sliding", "err": a},
+                 {"model": "b", "mesh": mesh, "bc": "clamped", "err": b},
+                 {"model": "c", "mesh": mesh, "bc": "clamped", "err": c},
+                 {"model": "a", "mesh": mesh, "bc": "clamped", "err": 0.06}]
+    lines = rankings.ranking(runs, "err", "error")
+    assert lines[0] == "[sliding] a: error median 1e-10 [1e-10-1e-10], 2 of 2 runs."
+    clamped = [line for line in lines if line.startswith("[clamped]")]
+    assert clamped[0] == "[clamped] b: error median 0.03 [0.02-0.04], 2 of 2 runs."
+    assert clamped[1].startswith("[clamped] a: error median 0.06")
+    assert clamped[2] == ("[clamped] c: error median 0.05 [0.05-0.05], 1 of 2 runs: "
+                          "incomplete, not ranked.")
+    line = rankings.best_and_worst(runs, "err", "Error")
+    assert "[clamped] Error: closest b" in line and "farthest a" in line
+    assert "Not ranked, a run without a value: c (1 of 2)" in line
+    assert "[sliding] Error: closest a" in line
+
+
+def test_errors_over_free_components_leave_out_what_is_prescribed():
+    """Two nodes, node 0 prescribed (equal in model and reference): the relative error is the
+    free node's alone, worked by hand; without the mask the prescribed value dilutes it."""
+    ref = np.array([[3.0, 0.0, 4.0], [0.0, 1.0, 0.0]])
+    u = ref + np.array([[0.0, 0.0, 0.0], [0.0, 0.5, 0.0]])
+    free = np.array([[False] * 3, [True] * 3])
+    assert M.rel_l2(u, ref, free) == pytest.approx(0.5)
+    assert M.rel_l2(u, ref) == pytest.approx(0.5 / np.sqrt(26.0))
+    assert M.max_rel(u, ref, free) == pytest.approx(0.5)
+    assert M.max_rel(u, ref) == pytest.approx(0.1)
+    with pytest.raises(M.MetricError, match="mask"):
+        M.rel_l2(u, ref, free[:1])
+
+
+def test_energy_norm_of_a_homogeneous_strain_and_of_rigid_motions():
+    """u = eps x on a cube: u.K u = V (lambda tr(eps)^2 + 2 mu eps:eps) (twice the energy,
+    closed form); an infinitesimal rotation has zero energy, which holds only with the
+    node-major ordering the metric assumes."""
+    from model.mesh import cube
+    E, nu = 10e3, 0.3
+    lam, mu = E * nu / ((1 + nu) * (1 - 2 * nu)), E / (2 * (1 + nu))
+    mesh = cube(3, 0.02, "six")
+    K = linear.p1_stiffness(mesh, E, nu)
+    eps = np.array([[1.0, 0.3, 0.0], [0.3, -0.5, 0.2], [0.0, 0.2, 0.4]]) * 1e-3
+    u = mesh.points @ eps.T
+    V = 0.02 ** 3
+    assert u.ravel() @ (K @ u.ravel()) == pytest.approx(
+        V * (lam * np.trace(eps) ** 2 + 2 * mu * np.sum(eps * eps)), rel=1e-12)
+    w = np.array([0.2, -0.1, 0.3]) * 1e-3
+    rot = np.cross(w, mesh.points)
+    assert M.energy_rel(u + rot, u, K) == pytest.approx(0.0, abs=1e-7)
+    assert M.energy_rel(1.1 * u, u, K) == pytest.approx(0.1, rel=1e-12)
+
+
+def test_index_keeps_populations_apart_ranks_complete_ones_and_floors_at_the_estimate(tmp_path):
+    """The sliding paper cube is a patch test (pass/fail, never pooled with the clamped cube);
+    a population where some model lacks a run is not comparable and leaves the geometric mean;
+    an entry below its reference's estimate counts as that estimate."""
+    from cases.index import conclusion, index_documents, populations
+
+    def write(case, runs, pair, patch=()):
+        (tmp_path / case).mkdir()
+        (tmp_path / case / "metrics.json").write_text(json.dumps({
+            "headline": "err", "headline_pair": pair, "headline_estimate": "est",
+            "patch_tests": list(patch), "parameters": {"models": ["a", "b"], "quick": True},
+            "runs": runs}))
+    run = dict(mesh="five", err=None, stiff=None, est=0.0)
+    write("paper-cube", [
+        dict(run, model="a", bc="sliding", err=1e-10), dict(run, model="b", bc="sliding", err=0.02),
+        dict(run, model="a", bc="clamped", err=0.05, stiff=0.2),
+        dict(run, model="b", bc="clamped", err=0.03, stiff=0.1),
+        dict(run, mesh="six", model="a", bc="sliding", err=1e-10),
+        dict(run, mesh="six", model="b", bc="sliding", err=0.04),
+        dict(run, mesh="six", model="a", bc="clamped", err=0.07, stiff=0.3),
+        dict(run, mesh="six", model="b", bc="clamped", stiff=0.1)], "stiff", ("sliding",))
+    write("torsion", [dict(run, model="a", bc="clamped", err=0.1, est=0.15),
+                      dict(run, mesh="six", model="a", bc="clamped", err=0.2, est=0.15),
+                      dict(run, model="b", bc="clamped", err=0.3, est=0.15),
+                      dict(run, mesh="six", model="b", bc="clamped", err=0.3, est=0.15)], None)
+    pops, _ = populations(tmp_path, ["paper-cube", "torsion"])
+    assert [(p.label, p.metric) for p in pops] == [
+        ("paper-cube/sliding", "err"), ("paper-cube/sliding", "stiff"),
+        ("paper-cube/clamped", "err"), ("paper-cube/clamped", "stiff"), ("torsion/clamped", "err")]
+    lines = conclusion(pops, ["a", "b"])
+    # only torsion/clamped is complete; a's median 0.15 is at the estimate 0.15; b's 0.3
+    assert lines[0].startswith("Closest to the continuum overall: a, geometric mean of its "
+                               "headline errors 0.15 (from 0.15 to 0.15")
+    assert "the 1 of 2 case/boundary-condition populations" in lines[0]
+    assert "b 0.3" in lines[1] and "not comparable (a run without a result): paper-cube/clamped" \
+        in lines[1]
+    assert "Patch test paper-cube/sliding: passed (error below 1e-06) by a." in lines[3]
+    assert "b in paper-cube/clamped (1 of 2 runs)" in lines[4]
+    md, _ = index_documents(tmp_path, ["paper-cube", "torsion"])
+    assert "pass, 2 of 2" in md and "fail 0.04, 2 of 2" in md
+    assert "0.06 [0.05-0.07] 2/2" in md and "0.03 [0.03-0.03] 1/2" in md

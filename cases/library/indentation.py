@@ -86,6 +86,7 @@ class Indentation(Case):
     settings_class = IndentationSettings
     bcs = ("clamped",)
     headline = "reaction_rel_err"
+    headline_pair = "disp_rel_l2_p2"
     qoi_errors = ("edge_shear_pa",)
     gated = ("edge_shear_rel_err", "profile_rel_err")
     columns = ("reaction_n", "reaction_fem_p2_n", "profile_rel_err", "edge_shear_pa",

@@ -103,6 +103,8 @@ class LargeCompression(Case):
     meshes = ("five", "six", "bcc", "unstructured")
     bcs = ("clamped",)
     headline = "force_rel_err_max"
+    headline_pair = "disp_rel_l2_nh"
+    headline_estimate = "nh_error_estimate"
     gated = ("force_rel_err_max", "lateral_rel_err_max")
     columns = ("reaction_fem_nh_n", "force_rel_err_max", "lateral_rel_err_max",
                "linear_force_rel_err_max", "homogeneous_force_dev_max")

@@ -171,6 +171,8 @@ class PaperCube(Case):
     bcs = BCS
     quick = {"p2_levels": 1, "transient_element": "P1", "hold_max": 1.0, "modal_refine": 0}
     headline = "disp_rel_l2_p2"
+    headline_pair = "reaction_rel_err"
+    patch_tests = ("sliding",)   # homogeneous: FEM exact, a consistent model too
     gated = ("alternation_rel", "reaction_time_rel_l2", "disp_end_push_rel_l2", "rest_time_s",
              "modal_rel_err", "modal_rel_err_free", "rigid_modes_free", "modes_unpaired")
     columns = report.COLUMNS

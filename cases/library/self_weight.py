@@ -38,6 +38,7 @@ class SelfWeight(Case):
     settings_class = SelfWeightSettings
     bcs = ("sliding", "clamped")
     headline = "top_settlement_rel_err"
+    headline_pair = "disp_rel_l2_p2"
     qoi_errors = ("top_settlement_mm",)
     gated = ("top_settlement_rel_err", "top_settlement_cf_rel_err")
     columns = ("top_settlement_mm", "top_settlement_fem_mm", "top_settlement_cf_mm",

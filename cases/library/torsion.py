@@ -48,6 +48,7 @@ class Torsion(Case):
     bcs = ("clamped",)
     fem_solver = "direct"   # a slender bar, as the cantilever: AMG-CG stagnates
     headline = "torque_rel_err"
+    headline_pair = "disp_rel_l2_p2"
     qoi_errors = ("torque_nm", "warping_mm")
     gated = ("torque_rel_err", "warping_rel_err")
     columns = ("torque_nm", "torque_fem_nm", "torque_rel_err", "warping_mm", "warping_fem_mm",
