@@ -114,6 +114,23 @@ def best_and_worst(runs, metric, what, exact=False, estimate_key="p2_error_estim
     return " ".join(_labelled(runs, line_of))
 
 
+def per_run(runs, holds, what):
+    """'what' said run by run, never of a median: the models for which ``holds(run)`` is true
+    in every run that gave an answer, those for which it is true in some (with where), and
+    those for which it never is."""
+    by = {}
+    for r in runs:
+        v = holds(r)
+        if v is not None:
+            by.setdefault(r["model"], []).append((f"{r['mesh']}/{r['bc']}", bool(v)))
+    every = [m for m, vs in by.items() if all(v for _, v in vs)]
+    some = [f"{m} (on {', '.join(w for w, v in vs if v)}, {sum(v for _, v in vs)} of {len(vs)})"
+            for m, vs in by.items() if any(v for _, v in vs) and not all(v for _, v in vs)]
+    never = [m for m, vs in by.items() if not any(v for _, v in vs)]
+    return (f"{what} in every run: {', '.join(every) or 'none'}; in some runs: "
+            f"{'; '.join(some) or 'none'}; in none: {', '.join(never) or 'none'}.")
+
+
 def failures(runs, key="static_failed", where="in the linear regime"):
     """One line on the runs whose static solve (``key``) failed, or that none did."""
     bad = [f"{r['model']} on {r['mesh']}/{r['bc']}" for r in runs if r.get(key)]

@@ -7,7 +7,8 @@ from model import ModelError
 from model.bc import merge
 from model.mesh import box
 from ..framework import MM
-from ..rankings import best_and_worst, estimate, failures, finite_load, ranking  # noqa: F401
+from ..rankings import (best_and_worst, estimate, failures, finite_load, per_run,  # noqa: F401
+                        ranking)
 
 CUBE_BCS = ("clamped", "sliding")    # the compressed cube's bases
 

@@ -151,10 +151,10 @@ class Indentation(Case):
                 + " " + common.failures(runs)]
 
     def findings(self, s, runs):
-        stiff = sorted({r["model"] for r in runs if r.get("reaction_ratio") is not None
-                        and r["reaction_ratio"] > 1})
+        stiff = common.per_run(runs, lambda r: None if r.get("reaction_ratio") is None
+                               else r["reaction_ratio"] > 1, "Stiffer than FEM under the punch")
         return {"Punch force": common.ranking(runs, "reaction_rel_err", "force error")
-                + [f"Stiffer than FEM under the punch: {', '.join(stiff) or 'none'}."],
+                + [stiff],
                 "Surface profile": common.ranking(runs, "profile_rel_err", "profile error"),
                 "Shear under the punch edge": common.ranking(runs, "edge_shear_rel_err",
                                                              "edge shear error"),

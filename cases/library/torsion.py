@@ -116,10 +116,11 @@ class Torsion(Case):
 
     def findings(self, s, runs):
         cf = self.closed_form(s, "clamped")["torque_nm"]
-        stiff = sorted({r["model"] for r in runs if r.get("torque_nm") is not None
-                        and r["torque_nm"] > r["torque_fem_nm"]})
+        stiff = common.per_run(runs, lambda r: None if r.get("torque_nm") is None
+                               else r["torque_nm"] > r["torque_fem_nm"],
+                               "Stiffer than FEM in torsion")
         return {"Torsional stiffness": common.ranking(runs, "torque_rel_err", "torque error")
-                + [f"Stiffer than FEM in torsion: {', '.join(stiff) or 'none'}."],
+                + [stiff],
                 "Warping": common.ranking(runs, "warping_rel_err", "warping error"),
                 "Reference against Saint-Venant": common.vs_closed_form(
                     "torque", runs, "torque_fem_nm", cf, "N m"),
