@@ -214,3 +214,45 @@ def test_study_bad_arguments_fail_before_computing(tmp_path, capsys, monkeypatch
         assert main(["run", "convergence", "--quick", *argv]) == 2
         err = capsys.readouterr().err.strip()
         assert err.startswith("pbcm: error: ") and len(err.splitlines()) == 1, err
+
+
+def test_fits_that_cannot_lie():
+    """The limit of an error is never below zero (a series whose extrapolation is negative
+    beyond its uncertainty is 'not asymptotic'), a family that is not self-similar is never
+    extrapolated, a stiffness ratio's limit is never at or below zero, and a series whose
+    error is not monotone or whose ratio crosses 1 is flagged 'cancellation'."""
+    from cases.studies.convergence.fit import cancellation, fit, ratio_limit
+    # order 0.74 from 1, 0.5, 0.2: Richardson's correction 0.45 overshoots to -0.25 +- 0.56
+    f = fit([8.0, 4.0, 2.0], [1.0, 0.5, 0.2])
+    assert f.e_inf == 0.0 and f.e_inf_err == pytest.approx(1.25 * 0.45, rel=1e-2)
+    assert f.verdict == "converges"
+    assert fit([8.0, 4.0, 2.0], [0.1, 0.05, 0.025], nested=False).verdict == "not asymptotic"
+    assert fit([8.0, 4.0, 2.0], [0.1, 0.05, 0.025], nested=False).e_inf is None
+    # a ratio 2.46, 1.24, 0.835, 0.747 (pbcm-variational's cantilever on six) crosses 1
+    assert cancellation([0.3, 0.2, 0.1, 0.15]) == "the error is not monotone in h"
+    assert cancellation([1.46, 0.24, 0.165, 0.253], [2.46, 1.24, 0.835, 0.747]) \
+        == "the error is not monotone in h"
+    assert cancellation([1.46, 0.24, 0.165, 0.1], [2.46, 1.24, 0.835, 0.9]) \
+        == "the stiffness ratio crosses 1"
+    assert cancellation([0.3, 0.2, 0.1], [1.3, 1.2, 1.1]) is None
+    limit, why = ratio_limit([8.0, 4.0, 2.0], [0.9, 0.6, 0.35])
+    assert limit is None and "not asymptotic" in why
+    assert ratio_limit([8.0, 4.0, 2.0], [1.2, 1.1, 1.05])[0] > 0
+    assert ratio_limit([8.0, 4.0, 2.0], [1.2, 1.1, 1.05], nested=False)[0] is None
+
+
+def test_a_cancelling_series_is_never_on_the_cost_front():
+    from cases.studies.convergence.cost import accuracy_per_cost
+    bench = None
+    runs = [{"case": "c", "bc": "b", "mesh": "six", "model": m, "h_mm": 4.0, "tets": 100,
+             "disp_rel_l2": e} for m, e in (("lucky", 0.001), ("honest", 0.01))]
+    import cases.studies.convergence.cost as C
+    original = C.step_cost_us
+    try:
+        C.step_cost_us = lambda bench, model, tets: 1.0
+        out = accuracy_per_cost(runs, {"any": 1}, 0.0, {("c", "six", "b", "lucky")})
+    finally:
+        C.step_cost_us = original
+    g = out["groups"][0]
+    assert [g["points"][i]["model"] for i in g["front"]] == ["honest"]
+    assert g["points"][0]["cancellation"] is True

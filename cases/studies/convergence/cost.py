@@ -19,11 +19,13 @@ def pareto(points):
     return front
 
 
-def accuracy_per_cost(runs, bench, exact=0.0):
+def accuracy_per_cost(runs, bench, exact=0.0, cancelling=()):
     """{"source", "groups": [{case, bc, points: [...], front: [...]}], "front_counts"}: every
     model run with its step cost, grouped by (case, bc), and how often each model is on the
     front; errors below ``exact`` count as equal (the reference's own level), so that no
-    rounding puts a point on the front. None without a bench."""
+    rounding puts a point on the front. The runs of a series that may cancel (``cancelling``:
+    (case, mesh, bc, model) whose error is not monotone or whose stiffness ratio crosses 1)
+    are drawn, marked ``cancellation``, and never put on the front. None without a bench."""
     if not bench:
         return None
     groups, counts = [], {}
@@ -35,8 +37,12 @@ def accuracy_per_cost(runs, bench, exact=0.0):
             c = step_cost_us(bench, r["model"], r["tets"])
             if c is not None:
                 pts.append({"model": r["model"], "mesh": r["mesh"], "h_mm": r["h_mm"],
-                            "tets": r["tets"], "cost_us": c, "disp_rel_l2": r["disp_rel_l2"]})
-        front = pareto([(p["cost_us"], max(p["disp_rel_l2"], exact)) for p in pts])
+                            "tets": r["tets"], "cost_us": c, "disp_rel_l2": r["disp_rel_l2"],
+                            "cancellation": (case, r["mesh"], bc, r["model"]) in cancelling})
+        eligible = [i for i, p in enumerate(pts) if not p["cancellation"]]
+        front = [eligible[i] for i in pareto([(pts[i]["cost_us"],
+                                               max(pts[i]["disp_rel_l2"], exact))
+                                              for i in eligible])]
         for i in front:
             counts[pts[i]["model"]] = counts.get(pts[i]["model"], 0) + 1
         groups.append({"case": case, "bc": bc, "points": pts, "front": front})

@@ -27,8 +27,10 @@ ORDER_RANGE = (0.05, 8.0)      # orders the three-level equation is solved over
 @dataclass(frozen=True)
 class Fit:
     """``order`` observed (None when the errors do not fall monotonically), ``e_inf`` the
-    extrapolated limit, ``e_inf_err`` its uncertainty, ``verdict`` 'exact', 'converges',
-    'floor' or 'diverges', ``why`` one sentence, ``levels`` the number of mesh sizes used."""
+    extrapolated limit (never below 0; None where no extrapolation is made), ``e_inf_err``
+    its uncertainty, ``verdict`` 'exact', 'converges', 'floor', 'diverges' or 'not
+    asymptotic' (a family that is not self-similar, or a limit the levels put below zero),
+    ``why`` one sentence, ``levels`` the number of mesh sizes used."""
 
     order: float
     e_inf: float
@@ -45,7 +47,7 @@ class Fit:
             return "exact"
         if self.verdict == "floor":
             return f"floor {self.e_inf:.2g} +- {self.e_inf_err:.1g}"
-        return "diverges"
+        return self.verdict
 
 
 def observed_order(h, e):
@@ -108,8 +110,10 @@ def extrapolate(h, v):
     return v[-1] - corr, FS_TWO * abs(corr), None
 
 
-def fit(h, e):
-    """The Fit of errors ``e`` at mesh sizes ``h`` (any order; NaN-free, at least two)."""
+def fit(h, e, nested=True):
+    """The Fit of errors ``e`` at mesh sizes ``h`` (any order; NaN-free, at least two);
+    ``nested`` False for a family whose meshes are not self-similar (unstructured), which is
+    never extrapolated."""
     order = np.argsort(h)[::-1]
     h = [float(h[i]) for i in order]
     e = [float(e[i]) for i in order]
@@ -125,11 +129,20 @@ def fit(h, e):
     if e[-1] > GROWTH * e[0]:
         return Fit(None, e[-1], abs(e[-1] - e[-2]), "diverges",
                    f"the error grows from {e[0]:.3g} to {e[-1]:.3g} as h falls", n)
+    if not nested:
+        return Fit(None, None, None, "not asymptotic",
+                   "the meshes are not self-similar (no asymptotic expansion in h holds), so "
+                   f"no limit is extrapolated; the finest error is {e[-1]:.3g}", n)
     e_inf, err, p = extrapolate(h, e)
     r = h[-2] / h[-1]
     p_obs = p if p is not None else (
         math.log(e[-2] / e[-1]) / math.log(r) if n == 2 and e[-1] > 0 and e[-2] > e[-1]
         else None)
+    if e_inf + err < 0:     # an error cannot tend below zero: the levels are not asymptotic
+        return Fit(p_obs, 0.0, err, "not asymptotic",
+                   f"the extrapolated limit {e_inf:.3g} +- {err:.2g} is below zero: the levels "
+                   "are not in the asymptotic range", n)
+    e_inf = max(e_inf, 0.0)
     if e_inf - err > 0 and e_inf > 0.2 * e[-1]:
         return Fit(p_obs, e_inf, err, "floor",
                    f"the error tends to {e_inf:.3g} +- {err:.2g}, which no refinement removes",
@@ -139,4 +152,31 @@ def fit(h, e):
     return Fit(p_obs, e_inf, err, "converges", why + f"; limit {e_inf:.2g} +- {err:.2g}", n)
 
 
-__all__ = ["Fit", "fit", "extrapolate", "observed_order", "EXACT"]
+def ratio_limit(h, ratios, nested=True):
+    """(limit, uncertainty) of a stiffness ratio (model over FEM, > 0) over the levels, or
+    (None, why) where none is credible: a family that is not self-similar, or a limit at or
+    below zero."""
+    if not nested:
+        return None, "not self-similar: no extrapolation"
+    limit, err, _ = extrapolate(h, ratios)
+    if not limit > 0:
+        return None, f"extrapolated to {limit:.3g}: not asymptotic"
+    return limit, err
+
+
+def cancellation(e, ratios=None):
+    """Why the errors over the levels (h descending) may cancel rather than converge, or None:
+    an error sequence that is not monotone, or a stiffness ratio that crosses 1 (an error that
+    falls through zero looks small at one level by accident)."""
+    d = np.diff(np.asarray(e, float))
+    if len(d) and np.any(d > 0) and np.any(d < 0):
+        return "the error is not monotone in h"
+    if ratios is not None and len(ratios) > 1:
+        side = np.sign(np.asarray(ratios, float) - 1.0)
+        if np.any(side > 0) and np.any(side < 0):
+            return "the stiffness ratio crosses 1"
+    return None
+
+
+__all__ = ["Fit", "fit", "extrapolate", "observed_order", "ratio_limit", "cancellation",
+           "EXACT"]

@@ -69,6 +69,11 @@ def conclusion(s, data):
             f"{np.median([f['e_inf'] for f in floors[m]]):.2g})" for m in floored) or "none")
         + f" (loads scaled by {s.load_scale:g}: the linear regime, so that a floor is the "
         "model's consistency error, not geometric nonlinearity).")
+    odd = [f for f in data["fits"] if f.get("verdict") == "not asymptotic"]
+    if odd:
+        out.append(f"Not asymptotic ({len(odd)} fits, not extrapolated or with a limit below "
+                   "zero): " + ", ".join(sorted({f"{f['model']} on {f['mesh']}" for f in odd}))
+                   + ".")
     div = sorted({f["model"] for f in data["fits"] if f.get("verdict") == "diverges"})
     if div:
         out.append("Diverging somewhere (error growing as h falls): " + ", ".join(div) + ".")
@@ -214,7 +219,13 @@ def build(out, study, s, data):
         f"verdict: 'exact' when every error is below {EXACT:g} (the reference's own level: "
         "the static solver's tolerance and the nonlinearity left at the scaled load); 'floor' when e_inf - err > 0 and e_inf > 0.2 x the finest error (a "
         "consistency error no refinement removes); 'diverges' when the finest error exceeds "
-        "the coarsest by 10 %; otherwise 'converges' (with the order when one is observed).",
+        "the coarsest by 10 %; 'not asymptotic' on a family whose meshes are not "
+        "self-similar (unstructured: never extrapolated) or where the extrapolated limit lies "
+        "below zero beyond its uncertainty (a limit is never below 0; a stiffness ratio's "
+        "limit never at or below 0); otherwise 'converges' (with the order when one is "
+        "observed). 'cancellation' marks a series whose error is not monotone in h or whose "
+        "stiffness ratio crosses 1: an error falling through zero is small at one level by "
+        "accident, so such a run is never on a cost front.",
         "C_eff: 6 x 6 in Voigt order (xx, yy, zz, yz, xz, xy), engineering shear; E_i = "
         "1 / S_ii, nu_ij = -S_ij / S_ii, G = 1 / S_44.. with S = C_eff^-1 (symmetric part); "
         "A_U = 5 G_V / G_R + K_V / K_R - 6 (0 for isotropy); K/K and mu_k/2G: the bulk "
@@ -276,8 +287,11 @@ def _problem_section(doc, out, s, data, name, bc):
                         + [fmt(f.get("order"), 2),
                            "n/a" if f.get("e_inf") is None
                            else f"{f['e_inf']:.2g} +- {f['e_inf_err']:.1g}",
-                           f.get("verdict", "n/a"), fmt(finest.get("reaction_ratio")),
-                           fmt(f.get("ratio_inf"))])
+                           f.get("verdict", "n/a")
+                           + (", cancellation" if f.get("cancellation") else ""),
+                           fmt(finest.get("reaction_ratio")),
+                           fmt(f.get("ratio_inf")) if f.get("ratio_inf") is not None
+                           else f"n/a ({f.get('ratio_why') or 'no ratio'})"])
     doc.table(header, rows)
     png = f"convergence_{name}_{bc}.png"
     plots.error_vs_h(out / png, f"{name}, {bc}: displacement error against h",
@@ -323,8 +337,9 @@ def _cost_section(doc, out, s, data):
         return (f"{p['model']} ({p['mesh']}, h {p['h_mm']:.3g}: {p['cost_us']:.3g} us, "
                 f"e {p['disp_rel_l2']:.2g})")
 
-    def cheapest(g, target):
-        ok = [p for p in g["points"] if p["disp_rel_l2"] <= target]
+    def cheapest(g, target):      # never a run whose series may cancel
+        ok = [p for p in g["points"] if p["disp_rel_l2"] <= target
+              and not p.get("cancellation")]
         return point(min(ok, key=lambda p: p["cost_us"])) if ok else "none"
     for g in c["groups"]:
         rows.append([f"{g['case']} {g['bc']}", len(g["points"]),
@@ -332,7 +347,8 @@ def _cost_section(doc, out, s, data):
                      cheapest(g, BUDGETS[0]), cheapest(g, BUDGETS[1])])
     doc.p("The Pareto front of each problem: the runs no other run beats in both step cost "
           "and displacement error, cheapest first; and the cheapest run that reaches an error "
-          "target.")
+          "target. A run whose series may cancel rather than converge (its error not monotone "
+          "in h, or its stiffness ratio crossing 1) is never on the front nor the cheapest.")
     doc.table(["problem", "runs", "front", f"cheapest with e <= {BUDGETS[0]:g}",
                f"cheapest with e <= {BUDGETS[1]:g}"], rows)
     plots.pareto(out / "pareto.png", c["groups"], list(s.models), EXACT)
