@@ -165,3 +165,16 @@ def test_fit_refuses_before_computing(args, said, tmp_path, capsys):
     assert main(["fit", *args, "--quick", "--out", str(tmp_path / "f")]) == 2
     assert said in capsys.readouterr().err
     assert not (tmp_path / "f").exists()
+
+
+def test_fit_reports_the_worst_change_on_the_cases_left_out():
+    """An rms of 0.0325 -> 0.05 can hide one left-out problem going from 0.0325 to 0.186:
+    the worst factor is named beside it; a problem that fails after the fit is the worst."""
+    from cases.studies.fit import worst_change
+    rows = [{"problem": "a", "before": 0.0325, "after": 0.186},
+            {"problem": "b", "before": 0.2, "after": 0.01}]
+    w = worst_change(rows)
+    assert w["problem"] == "a" and w["factor"] == pytest.approx(0.186 / 0.0325)
+    assert worst_change(rows + [{"problem": "c", "before": 0.1, "after": "failed: x"}])[
+        "problem"] == "c"
+    assert worst_change([]) is None

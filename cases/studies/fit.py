@@ -206,6 +206,19 @@ def fit(spec, train, validate, quick=True, overrides=None, progress=print):
     }
 
 
+def worst_change(rows):
+    """The left-out problem whose error the fit multiplied most (after / before), with that
+    factor; a problem that failed after the fit is the worst; None without any."""
+    scored = []
+    for r in rows:
+        b, a = r["before"], r["after"]
+        if isinstance(a, str):
+            return {**r, "factor": float("inf")}
+        if isinstance(b, (int, float)) and b > 0:
+            scored.append({**r, "factor": a / b})
+    return max(scored, key=lambda r: r["factor"]) if scored else None
+
+
 def report(doc):
     """A report (cases.document.Document) of a fit document: the constants, their
     conditioning, and the errors before and after on the training and left-out cases."""
@@ -218,6 +231,12 @@ def report(doc):
         f"{fmt(rms['before'])} to {fmt(rms['after'])}"
         + (f"; on the cases left out ({', '.join(doc['validate'])}) from "
            f"{fmt(vrms['before'])} to {fmt(vrms['after'])}." if doc["validate_rows"] else "."))
+    worst = worst_change(doc["validate_rows"])
+    if worst:
+        d.p(f"Worst change on a case left out: {worst['problem']}, from {fmt(worst['before'])} "
+            f"to {fmt(worst['after'])} ({fmt(worst['factor'])} times): an rms can hide one "
+            "problem the fit made worse. Fit where the reference problem is converged: a fit "
+            "trained where the reference itself is far off learns the reference's error.")
     d.p("Error of a problem: sqrt(disp_rel_l2^2 + reaction_rel_err^2 + the squared relative "
         "errors of the case's quantities of interest) against its FEM reference (the reaction "
         "where the problem is driven by a displacement); the fit minimises the sum of their "
