@@ -323,7 +323,7 @@ class Case(abc.ABC):
         alike for the model and the FEM reference; names ending in _mm are in millimetres."""
         return {}
 
-    def quantity_metrics(self, q, ref_q):
+    def quantity_metrics(self, q, ref_q, bc):
         """The metrics ``quantity_compared`` of the model's quantities ``q`` against the
         reference's ``ref_q``, beyond the relative errors of ``qoi_errors`` (a profile's
         shape, say)."""

@@ -9,6 +9,7 @@ from model.errors import PbcmError
 
 PATTERN_TOL = 1e-6  # second differences below this fraction of the profile count as zero
 ALTERNATION_CLEAR = 0.01   # an alternation below 1 % of the mean lateral displacement is not clear
+RANK_TOL = 1e-8     # singular values below this (unit columns) count as zero: rounding, not shape
 
 
 class MetricError(PbcmError, ArithmeticError):
@@ -65,6 +66,34 @@ def energy_rel(u, ref, K):
     return finite("energy_rel", np.sqrt(max(float(d @ (K @ d)), 0.0) / ref_energy))
 
 
+def node_patch_average(mesh, per_tet):
+    """The volume-weighted average over each node's tetrahedra of a per-tetrahedron field
+    (m, ...) -> (n, ...), as FEM's nodal stress is averaged."""
+    per_tet = np.asarray(per_tet, float)
+    V = mesh.volumes
+    tail = per_tet.shape[1:]
+    acc = np.zeros((mesh.n_nodes,) + tail)
+    w = np.zeros(mesh.n_nodes)
+    for k in range(4):
+        np.add.at(acc, mesh.tets[:, k], V.reshape((-1,) + (1,) * len(tail)) * per_tet)
+        np.add.at(w, mesh.tets[:, k], V)
+    return acc / w.reshape((-1,) + (1,) * len(tail))
+
+
+def tensor_rel_l2(a, ref):
+    """sqrt(sum_i |a_i - ref_i|_F^2) / sqrt(sum_i |ref_i|_F^2) over a field of tensors."""
+    a, ref = np.asarray(a, float), np.asarray(ref, float)
+    return finite("tensor_rel_l2", np.linalg.norm(a - ref)
+                  / _nonzero("tensor_rel_l2", np.linalg.norm(ref)))
+
+
+def von_mises(sigma):
+    """The von Mises stress of each tensor of (k, 3, 3)."""
+    s = np.asarray(sigma, float)
+    dev = s - np.trace(s, axis1=1, axis2=2)[:, None, None] * np.eye(3) / 3
+    return np.sqrt(1.5 * np.einsum("kij,kij->k", dev, dev))
+
+
 def correlation(a, b):
     """Pearson correlation of two per-tetrahedron fields."""
     a, b = np.asarray(a, float), np.asarray(b, float)
@@ -92,23 +121,37 @@ def layer_profile(points, u, layers, size, tol=None):
     return finite("layer_profile", np.array(out))
 
 
-def alternation(profile, reference):
+def alternation(profile, reference, free=None):
     """The alternating-layer (Nyquist) amplitude of a layer profile beyond the reference's:
-    ``beta`` [same unit as the profiles] of the least-squares fit
-    profile_k ~ alpha reference_k + beta (-1)^k, and ``beta`` over the reference's mean
-    |profile| (``relative``). Zero whenever the profile is the reference's shape at any scale
-    (the continuum against itself, a stiffer or softer smooth barrel); +beta puts the ends and
-    the middle layer of five outwards (the paper's sign)."""
+    ``beta`` [the profiles' unit] of the least-squares fit, over the ``free`` layers (those
+    whose lateral motion nothing prescribes; all when None),
+
+        profile_k ~ alpha reference_k + q(k) + beta (-1)^k,   q a quadratic in k,
+
+    and ``beta`` over the reference's mean |profile| (``relative``). The reference's shape at
+    any scale and any smooth (quadratic) difference from it are absorbed, so the measure is
+    zero for the continuum against itself and for a stiffer, softer, flatter or peakier smooth
+    barrel; +beta puts the ends and the middle layer of five outwards (the paper's sign).
+    (None, None) where the free layers cannot tell an alternation from those (no residual
+    degree of freedom: three free layers of a clamped five-layer cube)."""
     b, r = np.asarray(profile, float), np.asarray(reference, float)
     if b.shape != r.shape or b.ndim != 1 or b.size < 3:
         raise MetricError(f"alternation needs two profiles of the same three or more layers, "
                           f"got shapes {b.shape} and {r.shape}")
-    s = (-1.0) ** np.arange(b.size)
-    (_, beta), *_ = np.linalg.lstsq(np.stack([r, s], axis=1), b, rcond=None)
     scale = np.abs(r).mean()
     if scale == 0:
         raise MetricError("alternation: the reference's layer profile is zero, so no relative "
                           "amplitude exists; compare a loaded case")
+    k = np.arange(b.size, dtype=float)
+    keep = np.ones(b.size, bool) if free is None else np.asarray(free, bool)
+    A = np.stack([r, np.ones_like(k), k, k * k, (-1.0) ** k], axis=1)[keep]
+    A = A / np.linalg.norm(A, axis=0)       # unit columns: ranks judged at RANK_TOL
+    smooth, full = (np.linalg.matrix_rank(A[:, :-1], tol=RANK_TOL),
+                    np.linalg.matrix_rank(A, tol=RANK_TOL))
+    if full == smooth or full >= keep.sum():
+        return None, None       # (-1)^k is in the smooth span here, or nothing is left over
+    coef, *_ = np.linalg.lstsq(A, b[keep], rcond=RANK_TOL)
+    beta = coef[-1] / np.linalg.norm(((-1.0) ** k)[keep])
     return finite("alternation_mm", beta), finite("alternation_rel", beta / scale)
 
 

@@ -87,7 +87,7 @@ class LinearRegime:
 
     @classmethod
     def of(cls, st, pm, scale):
-        stress = pm.tet_stress(st.x)
+        stress = {**pm.tet_stress(st.x), "virial": pm.tet_virial(st.x)}
         return cls(u=st.u / scale, reaction=st.reaction / scale, residual=st.residual / scale,
                    stress={k: v / scale for k, v in stress.items()})
 
@@ -128,9 +128,14 @@ def static_metrics(case, lr, mesh, bc, s, ref):
         "pressure_corr": (None if uniform(ref.p2.pressure)
                           else M.correlation(stress["pressure"], ref.p2.pressure)),
         "pressure_rel_err": M.rel_l2(stress["pressure"], ref.p2.pressure)})
+    nodal = M.node_patch_average(mesh, stress["virial"])
+    out.update({"stress_force_rel_err": M.tensor_rel_l2(nodal, ref.p2.stress_nodes),
+                "stress_force_corr": (None if uniform(M.von_mises(ref.p2.stress_nodes))
+                                      else M.correlation(M.von_mises(nodal),
+                                                         M.von_mises(ref.p2.stress_nodes)))})
     q = case.quantities(mesh, lr.u, lr.reaction, s, bc)
     out.update(q)
-    out.update(case.quantity_metrics(q, ref.quantities))
+    out.update(case.quantity_metrics(q, ref.quantities, bc))
     for name in case.qoi_errors:
         out[err_name(name)] = M.finite(err_name(name),
                                        abs(q[name] / _nonzero(name, ref.quantities[name]) - 1))

@@ -97,34 +97,53 @@ def test_fem_against_itself_has_zero_error_and_alternation():
         u = linear.solve(mesh, 10e3, 0.45, static_bc(mesh, bc), element="P2").u
         assert M.rel_l2(u, u) == 0 and M.max_rel(u, u) == 0
         profile = M.layer_profile(mesh.points, u, layers, L)
-        amplitude, relative = M.alternation(profile, profile)
-        assert abs(amplitude) < 1e-12 * np.abs(profile).max() and abs(relative) < 1e-12
+        free = np.ones(len(profile), bool)
+        if bc == "clamped":
+            free[[0, -1]] = False
+        amplitude, relative = M.alternation(profile, profile, free)
+        if bc == "clamped":     # three free layers: no alternation can be told apart
+            assert amplitude is None
+        else:
+            assert abs(amplitude) < 1e-12 * np.abs(profile).max() and abs(relative) < 1e-12
         if bc == "sliding":  # homogeneous: uniform lateral expansion nu * 1.7 / 32 * 16 mm
             assert np.allclose(profile, 0.45 * 1.7e-3 / 2, rtol=1e-9)
 
 
 def test_alternation_is_zero_for_smooth_profiles_of_the_reference_shape():
-    """The alternation measures the (-1)^k layer component beyond the reference's shape: zero
-    (1e-12 relative) for a barrel or a half-sine against itself or scaled (a stiffer smooth
-    model), and exactly the amplitude added to them, with the paper's sign positive."""
-    k = np.arange(5)
-    barrel = 1.0 - ((k - 2) / 2.0) ** 2 + 0.1          # a clamped barrel: quadratic
-    half_sine = np.sin(np.pi * (k + 0.5) / 5)
-    alt = (-1.0) ** k                                   # ends and middle out: the paper's sign
-    for ref in (barrel, half_sine):
-        for model in (ref, 0.7 * ref, 1.3 * ref):
-            a, rel = M.alternation(model, ref)
-            assert abs(a) < 1e-12 and abs(rel) < 1e-12
-        a, rel = M.alternation(0.9 * ref + 0.02 * alt, ref)
-        assert a == pytest.approx(0.02, rel=1e-12)
-        assert rel == pytest.approx(0.02 / np.abs(ref).mean(), rel=1e-12)
-        assert M.alternation(ref - 0.03 * alt, ref)[0] == pytest.approx(-0.03, rel=1e-12)
+    """The alternation measures the (-1)^k layer component beyond the reference's shape and
+    any smooth (quadratic) difference from it: zero (1e-12 relative) for a barrel or a
+    half-sine against itself, scaled (a stiffer smooth model) or made flatter, and exactly
+    the amplitude added to them, with the paper's sign positive; undefined (None) where the
+    free layers leave nothing over (the clamped five-layer cube's three)."""
+    for n in (5, 7):
+        k = np.arange(n)
+        mid = (n - 1) / 2
+        barrel = 1.0 - ((k - mid) / mid) ** 2 + 0.1           # a clamped barrel: quadratic
+        half_sine = np.sin(np.pi * (k + 0.5) / n)
+        alt = (-1.0) ** k                                       # ends out: the paper's sign
+        refs = (barrel, half_sine) if n == 7 else (barrel,)     # five layers: too few for both
+        for ref in refs:
+            flatter = ref + 0.05 * (k - mid) ** 2 / mid ** 2
+            for model in (ref, 0.7 * ref, 1.3 * ref, flatter):
+                a, rel = M.alternation(model, ref)
+                assert abs(a) < 1e-12 and abs(rel) < 1e-12
+            a, rel = M.alternation(0.9 * ref + 0.02 * alt, ref)
+            assert a == pytest.approx(0.02, rel=1e-10)
+            assert rel == pytest.approx(0.02 / np.abs(ref).mean(), rel=1e-10)
+            assert M.alternation(ref - 0.03 * alt, ref)[0] == pytest.approx(-0.03, rel=1e-10)
+    uniform = np.full(5, 0.3825)        # the sliding cube's continuum profile
+    msm = np.array([0.1452, 0.1233, 0.1452, 0.1233, 0.1452])
+    a, rel = M.alternation(msm, uniform)
+    assert a == pytest.approx((0.1452 - 0.1233) / 2, rel=1e-10)
     # a near-zero model profile does not inflate it: the scale is the reference's
-    assert M.alternation(1e-6 * barrel, barrel)[1] == pytest.approx(0.0, abs=1e-12)
+    assert M.alternation(1e-6 * msm, uniform)[1] == pytest.approx(1e-6 * rel, rel=1e-8)
+    clamped = np.array([0.0, 0.399, 0.4488, 0.399, 0.0])
+    assert M.alternation(clamped * 1.1, clamped, [False, True, True, True, False]) \
+        == (None, None)
     with pytest.raises(M.MetricError, match="zero"):
-        M.alternation(barrel, np.zeros(5))
+        M.alternation(msm, np.zeros(5))
     with pytest.raises(M.MetricError, match="same"):
-        M.alternation(barrel, barrel[:4])
+        M.alternation(msm, msm[:4])
 
 
 def test_paper_pattern_is_the_sign_pattern_of_the_second_differences():

@@ -197,8 +197,12 @@ class PaperCube(Case):
                 "paper_pattern": M.paper_pattern(profile) if len(profile) == 5 else None,
                 "apparent_poisson": apparent_poisson(profile, s.push_mm)}
 
-    def quantity_metrics(self, q, ref_q):
-        amplitude, relative = M.alternation(q["bulge_profile_mm"], ref_q["bulge_profile_mm"])
+    def quantity_metrics(self, q, ref_q, bc):
+        free = np.ones(len(q["bulge_profile_mm"]), bool)
+        if bc == "clamped":     # the base and the top layer are held laterally
+            free[[0, -1]] = False
+        amplitude, relative = M.alternation(q["bulge_profile_mm"], ref_q["bulge_profile_mm"],
+                                            free)
         return {"alternation_mm": amplitude, "alternation_rel": relative}
 
     def reference_extra(self, mesh, bc, s, ref):
