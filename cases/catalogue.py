@@ -142,6 +142,7 @@ def definitions(names):
 # what it was run with
 DESCRIPTORS = frozenset({
     "case", "mesh", "bc", "model", "failed", "static_failed", "dyn_failed", "dyn_failed_dt4",
+    "dyn_verdict", "cancellation", "ratio_why", "calibration_patch",
     "model_info", "nodes", "tets", "h_mm", "dyn_dt_s", "dyn_steps", "dyn_t_end_s", "label",
     "why", "verdict", "levels", "metric", "dropped", "dyn_reaction_t_s", "homogeneous_failed",
     "finite_failed"})

@@ -118,3 +118,21 @@ def test_warp_engine_computes_our_neohookean_forces():
     ours = pm.forces(x)
     assert np.abs(WarpNeoHookean(pm.terms[0], x)().numpy() - ours).max() < 1e-12 * np.abs(
         ours).max()
+
+
+def test_own_stable_step_is_rk4s_limit_of_the_highest_frequency():
+    """fem-linear's own step is 2 sqrt 2 / omega_max with omega_max^2 the largest eigenvalue
+    of M^-1 K, K the P1 stiffness assembled by the reference (an independent route to the
+    model's finite-difference Jacobian) and M the lumped mass."""
+    import numpy as np
+    from cases.tools.bench import own_stable_step
+    from model import Material, build
+    from model.mesh import cube
+    from reference.linear import p1_stiffness
+    mat = Material(10e3, 0.45, 1000.0)
+    mesh = cube(3, 0.032, "five")
+    pm = build("fem-linear", mesh, mat)
+    K = p1_stiffness(mesh, mat.E, mat.nu).toarray()
+    m = np.repeat(pm.mass, 3)
+    w2 = np.linalg.eigvals(K / m[:, None]).real.max()
+    assert own_stable_step(pm) == pytest.approx(2 * np.sqrt(2) / np.sqrt(w2), rel=1e-6)

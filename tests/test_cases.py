@@ -332,3 +332,13 @@ def test_stiffer_than_fem_is_said_run_by_run():
                             "Stiffer than FEM")
     assert line == ("Stiffer than FEM in every run: fem; in some runs: msm (on five/clamped, "
                     "1 of 2); in none: soft.")
+
+
+def test_a_fluttering_run_is_unstable_whatever_step_it_ran_at():
+    """Growth above half the damping is flutter even when the run came to rest at its step
+    (pbcm-balanced on four mesh/bc pairs rested at dt and blew up at dt/4)."""
+    from cases.library.paper_cube import FLUTTER, dynamic_verdict
+    rested = {"growth_rate_1_s": 30.0, "dyn_failed": None, "dyn_at_rest": True}
+    assert dynamic_verdict(rested, damping=50.0) == FLUTTER
+    assert dynamic_verdict(dict(rested, growth_rate_1_s=24.9), 50.0) == "at rest"
+    assert dynamic_verdict(dict(rested, growth_rate_1_s=0.0, dyn_failed="x"), 50.0) == "blew up"

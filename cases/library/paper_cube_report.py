@@ -233,6 +233,14 @@ def _accuracy(runs, cfg):
 
 def _dynamics(runs, cfg):
     out = []
+    flutter = [r for r in runs if r.get("dyn_verdict") == "unstable (flutter)"]
+    if flutter:
+        out.append(f"Unstable (flutter: linearised growth above half the damping, "
+                   f"{cfg.damping / 2:g} 1/s), so their dynamic metrics are not scored "
+                   "whatever step they ran at: " + "; ".join(
+                       f"{r['model']} on {r['mesh']}/{r['bc']} ({r['growth_rate_1_s']:.3g} 1/s"
+                       + (", came to rest at its step" if r.get("dyn_at_rest") else "") + ")"
+                       for r in flutter) + ".")
     for r in [r for r in runs if r["dyn_failed"]]:
         out.append(f"Dynamic run of {r['model']} on {r['mesh']}/{r['bc']} blew up: "
                    f"{r['dyn_failed']}. " + _stability(r, cfg))

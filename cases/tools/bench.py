@@ -29,6 +29,8 @@ from ..costs import FILE
 from ..document import Document, fmt
 
 SIZES = (1e2, 1e3, 1e4, 1e5, 1e6)
+STABLE_STEP_TETS = 2e4      # the own stable step is measured up to this size (an eigenvalue)
+RK4_LIMIT = 2 * np.sqrt(2)  # RK4 is stable for |omega dt| up to 2 sqrt 2 on the imaginary axis
 QUICK_SIZES = (1e2, 1e3)
 BASELINES = ("msm", "fem-linear")
 SAMPLE_S = 0.02          # each timing sample runs at least this long (many calls if need be)
@@ -39,6 +41,19 @@ ENGINE_REFERENCE = "fem-neohookean"   # what the optional engines' forces are co
 def _force_loop(kernels, x, out, reps):
     for _ in range(reps):
         total_forces(kernels, x, out)
+
+
+def own_stable_step(pm):
+    """The model's own largest stable RK4 step [s] on its mesh, undamped: 2 sqrt 2 / omega_max
+    with omega_max^2 the largest |eigenvalue| of M^-1 df/dx at rest (lumped mass), so that a
+    stiffer model pays for its stiffness in steps per simulated second."""
+    from scipy.sparse import diags
+    from scipy.sparse.linalg import eigs
+    J = pm.jacobian(pm.mesh.points)
+    A = diags(1.0 / np.repeat(pm.mass, 3)) @ J
+    start = np.random.default_rng(0).standard_normal(A.shape[0])   # the same bits every run
+    lam = eigs(A, k=1, which="LM", v0=start, tol=1e-6, return_eigenvectors=False)
+    return float(RK4_LIMIT / np.sqrt(np.abs(lam[0])))
 
 
 def bench_mesh(target):
@@ -205,6 +220,10 @@ def run(sizes=SIZES, models=None, rounds=7, progress=print, with_engines=True):
                    "two_thread_speedup": (float(np.median(own[:, 2]))
                                           if timed[name].kernels_2 is not None else None),
                    "memory_mb": timed[name].memory / 1e6, "rounds": rounds}
+            if mesh.n_tets <= STABLE_STEP_TETS:
+                dt = own_stable_step(timed[name].pm)
+                row.update(stable_dt_us=dt * 1e6,
+                           cpu_s_per_simulated_s=row["us_per_step"] * 1e-6 / dt)
             for base in BASELINES:
                 ref = np.array(samples[base])
                 row[f"force_vs_{base}"] = float(np.median(own[:, 0] / ref[:, 0]))
