@@ -45,7 +45,7 @@ def test_a_strain_of_the_simple_shear_by_hand():
     assert strains[(0, 2, 1)] == pytest.approx(S, rel=1e-12)
     assert strains[(0, 2, 3)] == pytest.approx(0.0, abs=1e-15)
     G = MAT.G
-    pm = build([("shear", {"reading": "corner"})], TetMesh(X, np.array([[0, 1, 2, 3]])), MAT)
+    pm = build([("shear", {"reading": "corner", "c": 1.0})], TetMesh(X, np.array([[0, 1, 2, 3]])), MAT)
     worst = max(abs(g) for *_, g, _, _ in hand_strains(sheared(), X))
     assert pm.tet_stress(sheared())["max_tau"][0] == pytest.approx(G * worst, rel=1e-12)
 
@@ -64,7 +64,8 @@ def test_corner_and_balanced_forces_on_one_tetrahedron_by_hand(reading):
             f[j] -= push
             for i in (a, m, l):
                 f[i] += push / 3
-    pm = build([("shear", {"reading": reading})], TetMesh(X, np.array([[0, 1, 2, 3]])), MAT)
+    pm = build([("shear", {"reading": reading, "c": 1.0})], TetMesh(X, np.array([[0, 1, 2, 3]])),
+               MAT)
     assert np.abs(f).max() > 0
     assert np.allclose(pm.forces(sheared()), f, rtol=1e-12, atol=1e-12 * np.abs(f).max())
 
