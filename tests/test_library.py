@@ -94,8 +94,10 @@ FEM_DYNAMICS_CHANGED = {"reaction_time_rel_l2", "disp_end_push_rel_l2", "modal_r
 # modes and rest time (ill-posed): changed on purpose, gated by the gold values
 REGIMES_CHANGED = set(catalogue.STATIC) | {"bulge_profile_mm", "paper_pattern",
                                            "apparent_poisson"}
-# issue 26 replaced the zig-zag (not zero for a smooth profile) by the alternation
+# issue 26 replaced the zig-zag (not zero for a smooth profile) by the alternation, and
+# calibrates every reading alike: corner and balanced are other models now (c fitted, not 1)
 ZIGZAG_RETIRED = {"zigzag", "zigzag_fem"}
+RECALIBRATED = {"pbcm-corner", "pbcm-balanced"}
 SLIDING_DROPPED = {"frequencies_hz", "rest_time_s"}
 
 
@@ -116,6 +118,8 @@ def test_paper_cube_on_the_framework_matches_the_landed_case(quick):
     now = {(r["mesh"], r["bc"], r["model"]): r
            for r in json.loads((quick / "metrics.json").read_text())["runs"]}
     for old in before["runs"]:
+        if old["model"] in RECALIBRATED:
+            continue
         new = now[(old["mesh"], old["bc"], old["model"])]
         for k, v in old.items():
             assert k not in TIMING_KEYS
