@@ -454,7 +454,7 @@ def policy_text(policy):
     import tomli_w
     return ("# The gate's tolerance policy, for every gold value (`pbcm check`):\n"
             "#   |measured - gold| <= rtol |gold| + atol, atol = atol_of[metric] or atol.\n"
-            "# atol keeps metrics near zero (momentum residuals, an alternation of FEM) from failing\n"
+            "# atol keeps metrics near zero (momentum residuals, FEM's alternation) from failing\n"
             "# on noise; static displacements are solved to a residual of 1e-9, so their\n"
             "# differences below 1e-8 are the solver's, and so are those of the force errors\n"
             "# of a model exact on its problem (a homogeneous field). full: where the\n"

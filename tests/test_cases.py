@@ -18,7 +18,8 @@ FILES = ["metrics.json", "report.md", "report.html", "errors.png",
          "reaction_time.png", "run.json"] + [f"{kind}_{mesh}_{bc}.png" for kind in ("fig1", "profile")
                                  for mesh in ("five", "six") for bc in ("clamped", "sliding")]
 KEYS = ["mesh", "bc", "model", "disp_rel_l2_p1", "disp_rel_l2_p2", "disp_max_rel_p2",
-        "reaction_ratio", "stress_corr", "bulge_profile_mm", "bulge_profile_fem_mm", "alternation_rel",
+        "reaction_ratio", "stress_corr", "bulge_profile_mm", "bulge_profile_fem_mm",
+        "alternation_rel",
         "reaction_time_rel_l2", "disp_end_push_rel_l2", "rest_time_s",
         "modal_rel_err", "modal_rel_err_free", "rigid_modes_free", "dyn_failed_dt4",
         "verdict_changes_dt4"]
@@ -289,7 +290,8 @@ def test_index_keeps_populations_apart_ranks_complete_ones_and_floors_at_the_est
             "runs": runs}))
     run = dict(mesh="five", err=None, stiff=None, est=0.0)
     write("paper-cube", [
-        dict(run, model="a", bc="sliding", err=1e-10), dict(run, model="b", bc="sliding", err=0.02),
+        dict(run, model="a", bc="sliding", err=1e-10),
+        dict(run, model="b", bc="sliding", err=0.02),
         dict(run, model="a", bc="clamped", err=0.05, stiff=0.2),
         dict(run, model="b", bc="clamped", err=0.03, stiff=0.1),
         dict(run, mesh="six", model="a", bc="sliding", err=1e-10),

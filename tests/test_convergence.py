@@ -243,7 +243,6 @@ def test_fits_that_cannot_lie():
 
 def test_a_cancelling_series_is_never_on_the_cost_front():
     from cases.studies.convergence.cost import accuracy_per_cost
-    bench = None
     runs = [{"case": "c", "bc": "b", "mesh": "six", "model": m, "h_mm": 4.0, "tets": 100,
              "disp_rel_l2": e} for m, e in (("lucky", 0.001), ("honest", 0.01))]
     import cases.studies.convergence.cost as C

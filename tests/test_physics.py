@@ -45,7 +45,8 @@ def test_a_strain_of_the_simple_shear_by_hand():
     assert strains[(0, 2, 1)] == pytest.approx(S, rel=1e-12)
     assert strains[(0, 2, 3)] == pytest.approx(0.0, abs=1e-15)
     G = MAT.G
-    pm = build([("shear", {"reading": "corner", "c": 1.0})], TetMesh(X, np.array([[0, 1, 2, 3]])), MAT)
+    pm = build([("shear", {"reading": "corner", "c": 1.0})], TetMesh(X, np.array([[0, 1, 2, 3]])),
+               MAT)
     worst = max(abs(g) for *_, g, _, _ in hand_strains(sheared(), X))
     assert pm.tet_stress(sheared())["max_tau"][0] == pytest.approx(G * worst, rel=1e-12)
 

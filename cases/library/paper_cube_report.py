@@ -13,7 +13,8 @@ PAPER_TETS = 374     # the paper's mesh (section 4), unpublished
 CAUCHY_TOL = 0.02    # an apparent Poisson ratio this close to 1/4 does not show anisotropy
 
 # the paper cube's own columns (catalogue names) and the notes beside the catalogue's definitions
-COLUMNS = ("alternation_mm", "alternation_rel", "paper_pattern", "growth_rate_1_s", "dyn_vs_static_rel_l2",
+COLUMNS = ("alternation_mm", "alternation_rel", "paper_pattern", "growth_rate_1_s",
+           "dyn_vs_static_rel_l2",
            "verdict_changes_dt4", "reaction_time_rel_l2", "disp_end_push_rel_l2", "rest_time_s",
            "modal_rel_err", "modal_rel_err_free", "rigid_modes_free")
 NOTES = ("The dynamic run is repeated at a quarter of the step (dt/4) to see whether its "
@@ -159,7 +160,7 @@ def _artefact(runs, cfg):
     def listing(rs):
         return "; ".join(f"{r['model']} on {r['mesh']}/{r['bc']} (profile "
                          + ", ".join(f"{v:.4f}" for v in r["bulge_profile_mm"])
-                         + f" mm against FEM's "
+                         + " mm against FEM's "
                          + ", ".join(f"{v:.4f}" for v in r["bulge_profile_fem_mm"])
                          + f"; alternation {r['alternation_mm']:.2g} mm, "
                          f"{100 * r['alternation_rel']:.2g} %)" for r in rs)

@@ -257,7 +257,8 @@ def conclusion(data):
         lead = (f"Over the {len(rank['case_errors'])} case populations of the library the best "
                 f"normal-stress extension is {short(best[0])}"
                 if rank["overall"][best[0]] < 1 else
-                f"Over the {len(rank['case_errors'])} case populations of the library no normal-stress "
+                f"Over the {len(rank['case_errors'])} case populations of the library no "
+                "normal-stress "
                 f"extension beats the paper model; the closest is {short(best[0])}")
         rng = rank.get("overall_range", {})
 
