@@ -8,6 +8,7 @@ from pathlib import Path
 import numpy as np
 
 from .document import Cell, Document, Link
+from .metrics import PATCH_TOL
 from .output import SWEEP_MARK
 
 # headline error bands of the scorecard: within 5 %, within 20 %, beyond
@@ -15,7 +16,6 @@ BANDS = ((0.05, "#c8e6c9", "within 5 %"), (0.20, "#fff59d", "within 20 %"),
          (float("inf"), "#ffcdd2", "beyond 20 %"))
 
 
-PATCH_TOL = 1e-6    # a patch test passes when the headline error is below this (solver level)
 
 
 @dataclass

@@ -9,6 +9,7 @@ from model.errors import PbcmError
 
 PATTERN_TOL = 1e-6  # second differences below this fraction of the profile count as zero
 ALTERNATION_CLEAR = 0.01   # an alternation below 1 % of the mean lateral displacement is not clear
+PATCH_TOL = 1e-6    # a patch test passes when the displacement error is below this (solver level)
 RANK_TOL = 1e-8     # singular values below this (unit columns) count as zero: rounding, not shape
 
 

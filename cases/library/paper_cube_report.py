@@ -4,7 +4,7 @@ sentence is computed from the runs."""
 import numpy as np
 
 from .. import figures, rankings
-from ..metrics import ALTERNATION_CLEAR
+from ..metrics import ALTERNATION_CLEAR, PATCH_TOL
 from ..document import fmt
 
 SIZE_MM = 32.0
@@ -107,14 +107,19 @@ def conclusion(cfg, runs):
     else:
         first += ", nor does the converged FEM."
     out = [first]
-    if solved:
-        by_model = {}
-        for r in solved:
-            by_model.setdefault(r["model"], []).append(r["disp_rel_l2_p2"])
-        med = {m: float(np.median(v)) for m, v in by_model.items()}
-        best, worst = min(med, key=med.get), max(med, key=med.get)
-        out.append(f"Closest to FEM P2 in displacement: {best} (median error {med[best]:.3g} "
-                   f"over {len(by_model[best])} runs); farthest: {worst} ({med[worst]:.3g}).")
+    patch = [r for r in runs if r["bc"] == "sliding"]
+    if patch:       # homogeneous: every consistent discretisation is exact (a patch test)
+        passed = sorted({r["model"] for r in patch} - {
+            r["model"] for r in patch if r.get("disp_rel_l2_p2") is None
+            or r["disp_rel_l2_p2"] >= PATCH_TOL})
+        out.append(f"Sliding base, a patch test (error below {PATCH_TOL:g} on every mesh): "
+                   f"passed by {', '.join(passed) or 'none'}; failed by "
+                   + (", ".join(sorted({r["model"] for r in patch} - set(passed))) or "none")
+                   + ".")
+    clamped = [r for r in runs if r["bc"] == "clamped"]
+    if clamped:
+        out.append(rankings.best_and_worst(clamped, "disp_rel_l2_p2",
+                                           "Clamped base, displacement against FEM P2"))
     blown = sorted({r["model"] for r in runs if r.get("dyn_failed")})
     out.append("Dynamic runs blow up for " + ", ".join(blown) + "." if blown
                else "Every dynamic run comes to rest.")
