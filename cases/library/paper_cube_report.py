@@ -1,7 +1,6 @@
 """The paper cube's own report pieces: its definitions, columns, findings (grouped), the
 Figure 1 analogue, the layer profiles, the step-time chart and the reaction history. Every
 sentence is computed from the runs."""
-import numpy as np
 
 from .. import figures, rankings
 from ..metrics import ALTERNATION_CLEAR, PATCH_TOL
