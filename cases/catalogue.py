@@ -385,6 +385,15 @@ for _n in ("G_xy", "G_xz", "G_yz"):
     declare(_n, "Pa", _n, f"the effective shear modulus {_n[2:]} of C_eff.")
 for _n in ("nu_xy", "nu_xz", "nu_yx", "nu_yz", "nu_zx", "nu_zy"):
     declare(_n, "1", _n, f"the effective Poisson ratio {_n[3:]} of C_eff.")
+declare("K_eff_Pa", "Pa", "K_eff",
+         "C_eff's bulk modulus: v.M v / 3 of its Mandel form M, v the unit volumetric "
+         "direction.")
+declare("deviatoric_moduli_Pa", "Pa", "deviatoric moduli",
+         "C_eff's five deviatoric Kelvin moduli, ascending (each 2G when isotropic).")
+declare("bulk_rel_err", "1", "bulk err",
+         "K_eff over the target's K, minus 1.")
+declare("deviatoric_rel_err", "1", "deviatoric errs",
+         "each deviatoric Kelvin modulus over the target's 2G, minus 1.")
 declare("moduli_rel_err", "1", "moduli err",
          "the largest relative error of C_eff's bulk modulus and five deviatoric Kelvin moduli "
          "(eigenvalues of its Mandel form on the deviatoric subspace, symmetric part) against "

@@ -22,9 +22,11 @@ under finite rotations (tests/test_user_terms.py shows it): what ``normal_corota
 What a term provides (``model.terms.Term``): ``name``, ``params`` and ``kernel()``, a numba
 function ``fn(x, *args, out)`` that adds the forces into ``out`` and returns -1 (or the index of
 a degenerate element); ``forces_numpy`` for the tests; ``energy`` when ``conservative``. With
-``c="auto"`` the calibration hooks (``CalibratedTerm``): ``calibration_residuals(x, rows)``
--> (r, w) with the energy at c = 1 equal to sum_t w_t sum_k r_tk^2; the model then fits c with
-the other auto terms against the isotropic deviatoric energy. ``fit_constant`` names what
+``c="auto"`` the calibration hooks (``CalibratedTerm``): forces linear in ``coef``; the model
+then fits c with the other auto terms so that the deviatoric Kelvin moduli of its relaxed
+lattice patch are closest to 2G (``model.calibrate``); ``calibration_residuals(x, rows)`` ->
+(r, w), with the energy at c = 1 equal to sum_t w_t sum_k r_tk^2, lets the tests check the
+term's closed form. ``fit_constant`` names what
 ``pbcm fit`` reports.
 """
 import numpy as np

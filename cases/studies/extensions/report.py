@@ -336,7 +336,8 @@ def build(out, study, s, doc):
     d.ul([study.title + ".",
           f"The paper's model: {BASE} (the variational reading of docs/model.md, c fitted). Each "
           "candidate adds one deviatoric normal-stress term with c_n = auto (fitted with the "
-          "shear c against the isotropic deviatoric energy): "
+          "shear c so that the deviatoric moduli of the relaxed lattice patch are closest to "
+          "2G): "
           + "; ".join(f"{short(m)} = `{m}`" for m in models if short(m) != m) + ". "
           f"{YARDSTICK} (constant-strain FEM on the same tetrahedra) is the yardstick.",
           f"Cases: {', '.join(cases)}, each with its own {'quick' if s.quick else 'full'} "
