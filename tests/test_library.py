@@ -207,7 +207,9 @@ def test_scorecard_index(library):
     md, html = index_documents(library, list(CASES))
     lines = md.split("## Scorecard")[0].strip().splitlines()
     assert len([line for line in lines[1:] if line.strip()]) == 5
-    assert all(f"[{name} (quick)]" in md for name in CASES)
+    # one row per population: each case's first boundary condition links its report
+    assert all(f"[{name}/" in md and f"({name}/report.md)" in md for name in CASES)
+    assert "(quick)" in md
     assert "background:" in html
 
 
