@@ -313,7 +313,7 @@ def test_index_keeps_populations_apart_ranks_complete_ones_and_floors_at_the_est
     assert "the 1 of 2 case/boundary-condition populations" in lines[0]
     assert "b 0.3" in lines[1] and "not comparable (a run without a result): paper-cube/clamped" \
         in lines[1]
-    assert "Patch test paper-cube/sliding: passed (error below 1e-06) by a." in lines[3]
+    assert "Patch test paper-cube/sliding: passed (error below 0.001) by a." in lines[3]
     assert "b in paper-cube/clamped (1 of 2 runs)" in lines[4]
     md, _ = index_documents(tmp_path, ["paper-cube", "torsion"])
     assert "pass, 2 of 2" in md and "fail 0.04, 2 of 2" in md

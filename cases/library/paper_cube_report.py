@@ -166,8 +166,10 @@ def _artefact(runs, cfg):
                          + ", ".join(f"{v:.4f}" for v in r["bulge_profile_mm"])
                          + " mm against FEM's "
                          + ", ".join(f"{v:.4f}" for v in r["bulge_profile_fem_mm"])
-                         + f"; alternation {r['alternation_mm']:.2g} mm, "
-                         f"{100 * r['alternation_rel']:.2g} %)" for r in rs)
+                         + ("; alternation n/a: too few free layers)"
+                            if r.get("alternation_mm") is None else
+                            f"; alternation {r['alternation_mm']:.2g} mm, "
+                            f"{100 * r['alternation_rel']:.2g} %)") for r in rs)
 
     clear = [r for r in pattern if _clear(r)]
     faint = [r for r in pattern if not _clear(r)]
