@@ -24,7 +24,8 @@ def stress_panels(path, panels, title, magnify):
     deformed (displacement x ``magnify``), boundary faces coloured by max |tau| on one shared
     scale: blue at or below 0.01 of it, red at or above 0.9."""
     scale = max(float(np.max(p[3])) for p in panels)
-    norm = matplotlib.colors.Normalize(vmin=0.01 * scale, vmax=0.9 * scale, clip=True)
+    # the paper's normalisation: max |tau| / scale, blue at or below 0.01, red from 0.9
+    norm = matplotlib.colors.Normalize(vmin=0.01, vmax=0.9, clip=True)
     cmap = plt.get_cmap("jet")
     cols = min(4, len(panels))
     rows = int(np.ceil(len(panels) / cols))
@@ -33,7 +34,7 @@ def stress_panels(path, panels, title, magnify):
         ax = fig.add_subplot(rows, cols, k + 1, projection="3d")
         tri, owner = boundary_faces(mesh.tets)
         x = (mesh.points + magnify * u) / MM
-        ax.add_collection3d(Poly3DCollection(x[tri], facecolors=cmap(norm(tau[owner])),
+        ax.add_collection3d(Poly3DCollection(x[tri], facecolors=cmap(norm(tau[owner] / scale)),
                                              edgecolors="k", linewidths=0.2))
         lo, hi = mesh.points.min(axis=0) / MM, mesh.points.max(axis=0) / MM
         pad = 0.06 * (hi - lo).max()
@@ -44,7 +45,8 @@ def stress_panels(path, panels, title, magnify):
         ax.set_title(label, fontsize=9)
         ax.set_axis_off()
     sm = matplotlib.cm.ScalarMappable(norm=norm, cmap=cmap)
-    fig.colorbar(sm, ax=fig.axes, shrink=0.6, label=f"max |tau| [Pa] (scale {scale:.4g} Pa)")
+    fig.colorbar(sm, ax=fig.axes, shrink=0.6, extend="both", ticks=[0.01, 0.25, 0.5, 0.75, 0.9],
+                 label=f"max |tau| / {scale:.4g} Pa (blue <= 0.01, red >= 0.9)")
     fig.suptitle(f"{title} (displacement x{magnify:g})", fontsize=10)
     fig.savefig(path, dpi=90)
     plt.close(fig)
@@ -57,19 +59,49 @@ def _finish(fig, ax, path, xlabel, ylabel, title, grid_axis="both"):
     ax.set_ylabel(ylabel)
     ax.set_title(title, fontsize=10)
     ax.grid(alpha=0.3, axis=grid_axis)
-    ax.legend(fontsize=7)
+    if ax.get_legend_handles_labels()[1]:   # beside the axes: a legend never covers data
+        ax.legend(fontsize=7, loc="upper left", bbox_to_anchor=(1.01, 1.0), borderaxespad=0)
     fig.tight_layout()
     fig.savefig(path, dpi=90)
     plt.close(fig)
 
 
-def profiles(path, layers_mm, series, fem, title):
-    """Layer profiles: mean outward lateral displacement per y-layer, models against FEM."""
-    fig, ax = plt.subplots(figsize=(6, 4))
-    ax.plot(fem, layers_mm, "k-o", lw=2.5, label="FEM P2 (converged)")
+def profiles(path, layers_mm, series, fem, title, highlight=None, fem_label="FEM P2 (converged)"):
+    """Layer profiles: mean outward lateral displacement per y-layer, models against FEM.
+    Models in ``highlight`` (default: all) are drawn in colour, the rest in grey, unlabelled
+    but for one legend entry."""
+    fig, ax = plt.subplots(figsize=(7.5, 4))
+    ax.plot(fem, layers_mm, "k-o", lw=2.5, label=fem_label, zorder=3)
+    grey = False
     for label, prof in series:
-        ax.plot(prof, layers_mm, "-s", ms=4, label=label)
+        if highlight is None or label in highlight:
+            ax.plot(prof, layers_mm, "-s", ms=4, label=label, zorder=2)
+        else:
+            ax.plot(prof, layers_mm, "-", color="0.75", lw=1, zorder=1,
+                    label=None if grey else "the others (close to a smooth profile)")
+            grey = True
     _finish(fig, ax, path, "mean outward lateral displacement [mm]", "layer y [mm]", title)
+
+
+def heatmap(path, rows, cols, values, title, label, limit):
+    """A table of numbers as colours: ``values[i][j]`` (None: hatched grey) for row ``rows[i]``
+    and column ``cols[j]``, on a diverging scale from -limit to +limit, the value written in
+    each cell."""
+    v = np.array([[np.nan if x is None else x for x in r] for r in values], float)
+    fig, ax = plt.subplots(figsize=(1.0 + 0.62 * len(cols), 1.2 + 0.24 * len(rows)))
+    ax.set_facecolor("0.85")
+    im = ax.imshow(v, cmap="coolwarm", vmin=-limit, vmax=limit, aspect="auto")
+    for i in range(len(rows)):
+        for j in range(len(cols)):
+            if np.isfinite(v[i, j]):
+                ax.text(j, i, f"{v[i, j]:.3f}", ha="center", va="center", fontsize=5.5)
+    ax.set_xticks(range(len(cols)), cols, rotation=45, ha="right", fontsize=7)
+    ax.set_yticks(range(len(rows)), rows, fontsize=6.5)
+    ax.set_title(title, fontsize=9)
+    fig.colorbar(im, ax=ax, label=label, shrink=0.8)
+    fig.tight_layout()
+    fig.savefig(path, dpi=90)
+    plt.close(fig)
 
 
 def grouped_bars(path, groups, labels, values, ylabel, title, log=False):

@@ -80,6 +80,25 @@ def populations(root, cases):
     return out, data
 
 
+GLOSSARY = "glossary.md"
+
+
+def _score_cell(p, m):
+    vals, total = p.values.get(m, []), p.runs.get(m, 0)
+    if not total:
+        return ""
+    if not vals:
+        return f"n/a, 0 of {total}"
+    if p.patch_test and p.primary:
+        worst = max(vals)
+        return Cell(("pass" if worst < PATCH_TOL else f"fail {worst:.2g}")
+                    + f", {len(vals)} of {total}",
+                    BANDS[0][1] if worst < PATCH_TOL else BANDS[-1][1])
+    med = float(np.median(vals))
+    return Cell(f"{med:.3g} [{min(vals):.3g}-{max(vals):.3g}] {len(vals)}/{total}",
+                _band(med)[1])
+
+
 def _band(v):
     return next(b for b in BANDS if v < b[0])
 
@@ -153,35 +172,32 @@ def conclusion(pops, models):
     return out
 
 
-def study_headlines(root, studies):
-    """{study: its headline sentences} for the studies whose metrics.json is under ``root``."""
-    from .registry import studies as declared
-    out = {}
-    for name in studies:
-        path = Path(root) / name / "metrics.json"
-        if path.is_file():
-            out[name] = declared()[name].headline(json.loads(path.read_text()))
-    return out
+MAX_COLUMNS = 10      # a table wider than this is split into several
 
 
 def index_documents(root, cases, studies=()):
-    """The Markdown and HTML of reports/index: the studies' headlines first (the convergence
-    study says whether the models converge at all), then the cases' conclusion and
-    scorecard."""
+    """The Markdown and HTML of reports/index: the answers (``cases.answers``) and their
+    table first, then the studies, the scorecard and its conclusion."""
+    from . import answers
+    from .registry import studies as declared
     root = Path(root)
     pops, data = populations(root, cases)
     models = []
     for case in cases:
         models += [m for m in data[case]["parameters"]["models"] if m not in models]
     doc = Document("pbcm reports")
-    for name, lines in study_headlines(root, studies).items():
-        mode = " (quick mode)" if json.loads((root / name / "metrics.json").read_text())[
-            "parameters"]["quick"] else ""
-        doc.p(f"**{name}{mode}** ([report]({name}/report.md)): " + (lines[0] if lines else ""))
-        for line in lines[1:]:
-            doc.p(line)
-    for line in conclusion(pops, models):
+    for line in answers.lines(root, models):
         doc.p(line)
+    header, rows = answers.table(root, models)
+    doc.table(header, rows)
+    doc.p(f"Definitions of every column and metric: [glossary]({GLOSSARY}).")
+    shown = [n for n in studies if (root / n / "metrics.json").is_file()]
+    if shown:
+        doc.h(2, "Studies")
+        doc.table(["study", "what it measures", "mode"], [
+            [Link(n, f"{n}/report.md", f"{n}/report.html"), declared()[n].title,
+             "quick" if json.loads((root / n / "metrics.json").read_text())["parameters"][
+                 "quick"] else "full"] for n in shown])
     doc.h(2, "Scorecard")
     doc.p("One row per case, boundary condition and metric: the case's headline error against "
           "its reference, then the metric paired with it (a displacement-driven case's "
@@ -189,29 +205,20 @@ def index_documents(root, cases, studies=()):
           "over the meshes [smallest-largest], n of N runs; a patch test reads pass or fail at "
           f"{PATCH_TOL:g}. Colours in the HTML: "
           + ", ".join(f"{label}" for _, _, label in BANDS) + ". Quick-mode cases are marked.")
-    rows = []
-    for p in pops:
-        mode = " (quick)" if data[p.case]["parameters"]["quick"] else ""
-        label = p.label + mode + (" (patch test)" if p.patch_test else "")
-        row = [Link(label, f"{p.case}/report.md", f"{p.case}/report.html")
-               if p.primary else "", p.metric]
-        for m in models:
-            vals, total = p.values.get(m, []), p.runs.get(m, 0)
-            if not total:
-                row.append("")
-            elif not vals:
-                row.append(f"n/a, 0 of {total}")
-            elif p.patch_test and p.primary:
-                worst = max(vals)
-                row.append(Cell(("pass" if worst < PATCH_TOL else f"fail {worst:.2g}")
-                                + f", {len(vals)} of {total}",
-                                BANDS[0][1] if worst < PATCH_TOL else BANDS[-1][1]))
-            else:
-                med = float(np.median(vals))
-                row.append(Cell(f"{med:.3g} [{min(vals):.3g}-{max(vals):.3g}] {len(vals)}/"
-                                f"{total}", _band(med)[1]))
-        rows.append(row)
-    doc.table(["case/bc", "metric"] + models, rows)
+    width = MAX_COLUMNS - 2
+    for start in range(0, len(models), width):
+        group = models[start:start + width]
+        rows = []
+        for p in pops:
+            mode = " (quick)" if data[p.case]["parameters"]["quick"] else ""
+            label = p.label + mode + (" (patch test)" if p.patch_test else "")
+            row = [Link(label, f"{p.case}/report.md", f"{p.case}/report.html")
+                   if p.primary else "", p.metric]
+            row += [_score_cell(p, m) for m in group]
+            rows.append(row)
+        doc.table(["case/bc", "metric"] + group, rows)
+    for line in conclusion(pops, models):
+        doc.p(line)
     doc.p("Each case folder holds metrics.json, report.md, report.html and the figures; "
           "regenerate with `pbcm report`.")
     sweeps = sorted((root / "sweeps").glob(f"*/{SWEEP_MARK}"))
@@ -222,3 +229,55 @@ def index_documents(root, cases, studies=()):
              json.loads(m.read_text())["spec"]] for m in sweeps])
         doc.p("Each is written by `pbcm sweep SPEC` (not by `pbcm report`).")
     return doc.markdown() + "\n", doc.html(root) + "\n"
+
+
+# what the index's answer table and the studies call things, beside the catalogue's metrics
+TERMS = {
+    "consistency error": "the error a model keeps under mesh refinement on a problem whose "
+    "answer every consistent discretisation reproduces exactly: the converged limit e_inf of "
+    "the sliding cube (a homogeneous compression, a patch test) in the linear regime, per "
+    "lattice; FEM's is zero to rounding.",
+    "finite-load error": "the headline error of the large-compression case (30 % "
+    "compression), against the converged neo-Hookean reference.",
+    "worst isotropy error": "the largest relative error of the six Kelvin moduli of the "
+    "model's effective elasticity tensor (a relaxed lattice patch) against the isotropic "
+    "target's, over the lattices.",
+    "largest |alternation|": "the largest |alternation rel| of the paper cube's runs.",
+    "RK4 run": "flutters when the linearised growth rate of the clamped paper cube exceeds "
+    "half the mass damping (so that the damped RK4 run grows), else stable.",
+    "s per simulated s": "CPU seconds one simulated second costs at the model's own stable "
+    "RK4 step (undamped), from `pbcm bench` at about 1e4 tetrahedra.",
+    "calibrated / literal": "a shear reading with c fitted so that its deviatoric moduli are "
+    "closest to 2G (calibrated), or with the paper's c = 1 (literal).",
+    "patch test": "a problem with a homogeneous exact answer (the sliding cube): a consistent "
+    "discretisation reproduces it on any mesh; a model that does not has a consistency error.",
+    "population": "the runs of one case under one boundary condition: what a median, a range "
+    "or a criterion is taken over (never pooled across populations).",
+}
+
+
+def glossary_documents():
+    """The Markdown and HTML of reports/glossary: the index's terms, then every metric of the
+    catalogue (label, name, unit, definition), written once for every report to link to."""
+    from . import catalogue
+    doc = Document("pbcm glossary")
+    doc.h(2, "Terms")
+    doc.ul(f"{k}: {v}" for k, v in TERMS.items())
+    doc.h(2, "Metrics")
+    doc.table(["label", "name", "unit", "definition"],
+              [[m.label, m.name, m.shown[0] if m.shown else m.unit, m.definition]
+               for m in sorted(catalogue.CATALOGUE.values(), key=lambda m: m.name)])
+    return doc.markdown() + "\n", doc.html(".") + "\n"
+
+
+def write_index(root, cases, studies):
+    """index.md/.html and glossary.md/.html under ``root``, each written atomically."""
+    from .output import write_atomic
+    root = Path(root)
+    md, html = index_documents(root, cases, studies)
+    write_atomic(root / "index.md", md)
+    write_atomic(root / "index.html", html)
+    md, html = glossary_documents()
+    write_atomic(root / "glossary.md", md)
+    write_atomic(root / "glossary.html", html)
+    return root / "index.md"

@@ -15,6 +15,7 @@ MODULES = {
 STUDY_MODULES = {
     "convergence": "cases.studies.convergence",
     "extensions": "cases.studies.extensions",
+    "artefact": "cases.studies.artefact",
 }
 
 CASES = {name: importlib.import_module(module).CASE for name, module in MODULES.items()}

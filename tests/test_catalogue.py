@@ -12,7 +12,7 @@ from cases.registry import CASES, studies
 
 ROOT = Path(__file__).resolve().parents[1]
 # the sections of a metrics.json whose rows carry metrics
-ROW_SECTIONS = ("runs", "gate_runs", "case_runs", "fits", "elasticity")
+ROW_SECTIONS = ("runs", "gate_runs", "case_runs", "fits", "elasticity", "cells")
 
 
 def _rows(data):
@@ -91,7 +91,8 @@ def test_cases_and_studies_gate_declared_metrics():
             metric(name)
     from cases.studies.convergence.report import GATED as CONVERGENCE
     from cases.studies.extensions.report import GATED as EXTENSIONS
-    assert set(studies()) == {"convergence", "extensions"}
-    for gated in (CONVERGENCE, EXTENSIONS):
+    from cases.studies.artefact.report import GATED as ARTEFACT
+    assert set(studies()) == {"convergence", "extensions", "artefact"}
+    for gated in (CONVERGENCE, EXTENSIONS, ARTEFACT):
         for name, direction in gated.items():
             assert metric(name).direction == direction

@@ -115,3 +115,46 @@ def test_write_roundtrip_with_data(tmp_path):
     back = meshio.read(path)
     assert np.allclose(back.point_data["u"], m.points * 0.1)
     assert np.allclose(back.cell_data["p"][0], m.volumes)
+
+
+# ---------------------------------------------------------------- the paper's 374-tetrahedron mesh
+def test_a_cube_has_74_triangulations_two_of_five_tetrahedra_each_filling_it():
+    """De Loera, Rambau and Santos (Triangulations, 2010): the 3-cube has 74 triangulations
+    without new vertices, 2 of 5 tetrahedra and 72 of 6."""
+    from model.paper_mesh import cube_triangulations, face_diagonals, _CORNERS
+    tris = cube_triangulations()
+    assert len(tris) == 74 and sum(len(t) == 5 for t in tris) == 2
+    for t in tris:
+        vol = sum(abs(np.linalg.det(_CORNERS[list(s[1:])] - _CORNERS[s[0]])) / 6 for s in t)
+        assert vol == pytest.approx(1.0, abs=1e-12)
+    # a five split cuts all six faces along diagonals of one parity (its central tetrahedron)
+    assert sorted(face_diagonals(t) for t in tris if len(t) == 5) == [(0,) * 6, (1,) * 6]
+
+
+def test_the_delaunay_reconstruction_gives_374_tetrahedra_for_seeds_7_15_25_and_is_non_conforming():
+    from model.paper_mesh import delaunay_lattice, unmatched_faces
+    size = 0.032
+    counts = {s: delaunay_lattice(5, size, s).n_tets for s in range(26)}
+    assert [s for s, n in counts.items() if n == 374] == [7, 15, 25]
+    m = delaunay_lattice(5, size, 7)
+    assert m.n_nodes == 125 and m.volumes.sum() == pytest.approx(size**3, rel=1e-12)
+    assert unmatched_faces(m, size) > 0          # cells cut a shared square differently
+    assert unmatched_faces(cube(5, size, "five"), size) == 0
+    assert unmatched_faces(cube(5, size, "six"), size) == 0
+
+
+def test_the_mixed_split_is_conforming_with_ten_cells_in_five():
+    from model.paper_mesh import mixed_split, paper_size_meshes, unmatched_faces
+    size = 0.032
+    m = mixed_split(5, size, 10, seed=0)
+    assert (m.n_nodes, m.n_tets) == (125, 374)
+    assert unmatched_faces(m, size) == 0
+    assert m.volumes.sum() == pytest.approx(size**3, rel=1e-12)
+    cell = np.floor(m.points[m.tets].mean(axis=1) / (size / 4)).astype(int)
+    per_cell = np.unique(cell[:, 0] + 4 * cell[:, 1] + 16 * cell[:, 2], return_counts=True)[1]
+    assert sorted(per_cell.tolist()) == [5] * 10 + [6] * 54
+    assert not np.array_equal(m.tets, mixed_split(5, size, 10, seed=1).tets)
+    with pytest.raises(MeshError, match="not the paper's 374"):
+        paper_size_meshes(size, seeds=(0,), mixed_seeds=())
+    with pytest.raises(MeshError, match="n_five must be between 0 and the 64 cells"):
+        mixed_split(5, size, 65, seed=0)

@@ -1,7 +1,6 @@
 """`pbcm index`: reports/index.md and index.html from the folders already written."""
 from pathlib import Path
 
-from ..output import write_atomic
 from .common import UsageError
 
 def add(sub):
@@ -17,15 +16,13 @@ def run(args):
     """reports/index.md and index.html from the case and study folders already written (after
     a `pbcm run` of one case or study, without running the others again)."""
     from ..registry import CASES, STUDY_MODULES
-    from ..index import index_documents
+    from ..index import write_index
     root = Path(args.out)
     missing = [name for name in CASES if not (root / name / "metrics.json").is_file()]
     if missing:
         raise UsageError(f"{root} lacks the metrics.json of {', '.join(missing)}: run "
                          "`pbcm report` (or `pbcm run CASE` for each) first")
-    md, html = index_documents(root, list(CASES), list(STUDY_MODULES))
-    write_atomic(root / "index.md", md)
-    write_atomic(root / "index.html", html)
-    print(f"index written to {root / 'index.md'} and {root / 'index.html'}")
+    path = write_index(root, list(CASES), list(STUDY_MODULES))
+    print(f"index written to {path}, with index.html and the glossary")
     return 0
 

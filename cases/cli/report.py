@@ -1,7 +1,7 @@
 """`pbcm report`: every case and study, written with the index."""
 from contextlib import ExitStack
 
-from ..output import StagedFolder, writable_folder, write_atomic
+from ..output import StagedFolder, writable_folder
 from .common import add_selection
 from .pipeline import configs, run_everything
 
@@ -14,7 +14,7 @@ def add(sub):
 
 
 def run(args):
-    from ..index import index_documents
+    from ..index import write_index
     from ..registry import CASES
     cfgs = configs(args)
     root = writable_folder(args.out or "reports")
@@ -25,8 +25,6 @@ def run(args):
             what = "" if runs is None else f"{len(runs)} runs "
             print(f"{name}: {what}written to {staged[name].commit()}")
         run_everything(args, cfgs, lambda name: staged[name].path, done)
-    md, html = index_documents(root, list(CASES), [n for n in cfgs if n not in CASES])
-    write_atomic(root / "index.md", md)
-    write_atomic(root / "index.html", html)
-    print(f"index written to {root / 'index.md'} and {root / 'index.html'}")
+    path = write_index(root, list(CASES), [n for n in cfgs if n not in CASES])
+    print(f"index written to {path}, with index.html and the glossary")
     return 0

@@ -1,0 +1,171 @@
+"""The artefact study's files: metrics.json (the cells, the contrasts, the answers and the rows
+the gate reads), report.md/.html (the answers, the factor tables, the reading table, figures)
+and cells.md/.html (every cell's alternation beside the reference's). Every sentence is
+computed from the cells it is written with."""
+from pathlib import Path
+
+from ... import catalogue, figures
+from ...document import Document, fmt
+from ...metrics import ALTERNATION_CLEAR
+from ...report import environment, write_study
+from ...runner import jsonable
+from . import analysis
+from .study import LINEAR_SCALE, READINGS, YARDSTICK
+
+GATED = catalogue.gated("alternation_rel", "disp_rel_l2")
+GLOSSARY = "../glossary.md"
+
+
+def readings(models):
+    """The shear readings, calibrated and literal, without extra terms, in the study's order."""
+    return [m for m in models if m in {f"pbcm-{r}{x}" for r in READINGS
+                                       for x in ("", "-literal")}]
+
+
+def gate_rows(cells):
+    return [{"mesh": c["mesh"], "bc": f"{c['bc']}/{c['load']}", "model": c["model"],
+             "alternation_rel": c.get("alternation_rel"), "disp_rel_l2": c.get("disp_rel_l2")}
+            for c in cells]
+
+
+def analyse(data, models):
+    table = analysis.reading_table(data["cells"], data["step_vs_msm"], readings(models))
+    return {"contrasts": analysis.contrasts(data["cells"]), "answer": analysis.answer(
+        data["cells"]), "readings": table, "verdict": analysis.reading_verdict(table)}
+
+
+def write(out, study, s, data):
+    found = analyse(data, list(s.models))
+    doc = jsonable({"case": study.name, "study": True, "parameters": s.describe(),
+                    "problem": s.problem(), "gated": GATED, "environment": environment(),
+                    **data, **found, "gate_runs": gate_rows(data["cells"])})
+    return write_study(out, doc, lambda folder: build(folder, study, s, doc))
+
+
+def conclusion(doc):
+    """The study's three lines: the cause, the reading, and what the study could not see."""
+    return [f"**What causes the bulge/neck pattern.** {doc['answer']['text']}",
+            f"**Which reading.** {doc['verdict']['text']}"]
+
+
+def build(out, study, s, doc):
+    out = Path(out)
+    d = Document(f"pbcm report: {study.name}")
+    for line in conclusion(doc):
+        d.p(line)
+    d.p(f"Definitions: [glossary]({GLOSSARY}). Every cell's numbers: [cells.md](cells.md). "
+        "Regenerate with `pbcm run artefact`.")
+    d.h(2, "What was run")
+    d.ul([study.title + ".",
+          f"Meshes: {', '.join(s.meshes)} (Delaunay-374: the lattice's Delaunay tetrahedra, "
+          "joggled by seed, flat ones dropped, non-conforming; five/six mix: conforming, 10 "
+          "cells in five and 54 in six).",
+          f"Models: {len(s.models)}, each shear reading calibrated and literal (c = 1), each "
+          "with and without each normal-stress term, msm, msm with a shear term and "
+          f"{YARDSTICK} (the control: constant-strain FEM on the same tetrahedra).",
+          f"Bases: {', '.join(s.bcs)}; loads: the paper's push and {LINEAR_SCALE:g} of it (the "
+          "linear regime). The reference: " + "; ".join(
+              f"{r['bc']}/{r['load']} error estimate {fmt(r['error_estimate'])}"
+              for r in doc["references"]) + ".",
+          f"The pattern: an alternation of at least {ALTERNATION_CLEAR:g} of the reference's "
+          "mean lateral displacement with the paper's sign (ends and middle out); the reversed "
+          "sign is counted apart."])
+    d.h(2, "Which factor switches the pattern on or off")
+    d.p("Pairs of cells that differ in one factor only (the rest held equal); a pair switches "
+        "the pattern off when the first cell has it and the second does not.")
+    d.table(["factor", "from", "to", "pairs", "with the pattern before", "switched off",
+             "switched on"],
+            [[c["factor"], c["from"], c["to"], c["pairs"], c["with_pattern_before"],
+              c["switched_off"], c["switched_on"]] for c in doc["contrasts"]])
+    for key, title in (("split", "mesh split (5 nodes per side)"), ("normal", "normal stress"),
+                       ("constant", "shear constant"), ("family", "model family"),
+                       ("load", "load"), ("bc", "base")):
+        cells = [c for c in doc["cells"] if key != "split" or c["nodes_per_side"] == 5]
+        levels = analysis.by_level(cells, key)
+        d.h(3, f"By {title}")
+        d.table([key, "paper's pattern", "reversed", "median |alternation rel|"],
+                [[k, f"{p} of {n}", f"{r} of {n}", fmt(m)] for k, (p, r, n, m) in
+                 levels.items()])
+    d.h(2, "Which reading the paper used")
+    d.p(doc["verdict"]["text"])
+    d.table(["model", "pattern on paper-size meshes", "median alternation", "step / msm",
+             "flutter (clamped)", "largest growth [1/s]", "consistency error",
+             "finite-load error", "observables matched"],
+            [[r["model"], f"{r['pattern'][0]} of {r['pattern'][1]}",
+              fmt(r["pattern_median_rel"]), fmt(r["step_vs_msm"]),
+              f"{r['flutter'][0]} of {r['flutter'][1]}", fmt(r["growth_max_1_s"]),
+              fmt(r["consistency_median"]), fmt(r["finite_load_median"]),
+              f"{r['score']} of {len(r['matches'])}"] for r in doc["readings"]])
+    d.p(f"Paper-size meshes: 125 nodes, 374 tetrahedra. Step / msm: the bench's RK4 step on "
+        f"the 125-node five cube (a literal reading costs what its calibrated one does). "
+        f"Flutter: the linearised growth rate of the clamped cube above half the mass damping "
+        f"({s.damping:g} 1/s). Consistency error: displacement L2 error on the sliding cube "
+        f"(a patch test) at {LINEAR_SCALE:g} of the push; finite-load error: on the clamped "
+        "cube at the push, against the neo-Hookean reference.")
+    _figures(d, out, s, doc)
+    d.p(f"Environment: {doc['environment']}.")
+    cells_document(doc, s).write(out, stem="cells")
+    return d
+
+
+def _figures(d, out, s, doc):
+    meshes, models = list(s.meshes), list(s.models)
+    for bc in s.bcs:
+        for load in ("paper",):
+            grid = {(c["model"], c["mesh"]): c.get("alternation_rel") for c in doc["cells"]
+                    if c["bc"] == bc and c["load"] == load}
+            if all(v is None for v in grid.values()):
+                continue
+            name = f"alternation_{bc}.png"
+            figures.heatmap(out / name, models, meshes,
+                            [[grid.get((m, x)) for x in meshes] for m in models],
+                            f"alternation rel, {bc} base, the paper's push (grey: n/a)",
+                            "alternation rel (+: the paper's sign)", 5 * ALTERNATION_CLEAR)
+            d.img(name, f"Alternation of every model on every mesh, {bc} base")
+    for mesh in ("five", "mixed374-0", "delaunay374-7"):
+        rows = [c for c in doc["cells"] if c["mesh"] == mesh and c["bc"] == "sliding"
+                and c["load"] == "paper" and c.get("bulge_profile_mm")]
+        if not rows:
+            continue
+        deviating = {c["model"] for c in rows
+                     if analysis.pattern(c) in ("paper", "reversed")}
+        name = f"profiles_{mesh}.png"
+        layers = list(range(0, 33, 32 // (len(rows[0]["bulge_profile_mm"]) - 1)))
+        figures.profiles(out / name, layers, [(c["model"], c["bulge_profile_mm"]) for c in rows],
+                         rows[0]["bulge_profile_fem_mm"], f"Layer profiles on {mesh}, sliding "
+                         "base, the paper's push (colour: an alternation of 0.01 or more)",
+                         highlight=deviating, fem_label="reference (neo-Hookean P2)")
+        d.img(name, f"Layer profiles on {mesh}")
+
+
+def cells_document(doc, s):
+    """Every cell: per mesh, one row per model, the alternation [mm] and relative per base and
+    load beside the reference's own alternating component."""
+    c = Document("pbcm artefact study: every cell")
+    c.p(f"Alternation in mm (relative in brackets) per base and load; the reference's own "
+        f"(-1)^k component in mm beside it. Definitions: [glossary]({GLOSSARY}).")
+    combos = [(bc, load) for bc in s.bcs for load in s.loads]
+    for mesh in s.meshes:
+        rows = {}
+        for x in doc["cells"]:
+            if x["mesh"] == mesh:
+                rows.setdefault(x["model"], {})[(x["bc"], x["load"])] = x
+        if not rows:
+            continue
+        first = next(iter(rows.values()))
+        c.h(2, f"{mesh} ({next(iter(first.values()))['tets']} tetrahedra)")
+        c.table(["model"] + [f"{bc}/{load}" for bc, load in combos],
+                [["reference's own"] + [fmt(first.get(k, {}).get("alternation_fem_mm"))
+                                        for k in combos]]
+                + [[m] + [_cell(r.get(k)) for k in combos] for m, r in rows.items()])
+    return c
+
+
+def _cell(x):
+    if x is None:
+        return "n/a"
+    if x.get("failed"):
+        return "failed"
+    if x.get("alternation_mm") is None:
+        return "n/a"
+    return f"{fmt(x['alternation_mm'])} ({fmt(x['alternation_rel'])})"

@@ -1,0 +1,255 @@
+"""The artefact study's runs: every (mesh, model, base, load) cell of the paper's cube, its layer
+profile and alternation against the continuum's, and per (mesh, model) the linearised growth
+rate of the paper's clamped RK4 run."""
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from model import Material, build
+from model.candidates import NORMAL_FORMS
+from model.compose import label
+from model.mesh import cube
+from model.paper_mesh import paper_size_meshes, unmatched_faces
+from reference import hyperelastic, linear
+from ... import metrics as M
+from ... import stop
+from ...framework import FINDINGS
+from ...library import paper_cube as P
+from ...progress import Progress
+from ...runner import free_components, jsonable
+from ...store import OFF, key
+
+READINGS = ("corner", "balanced", "variational")
+YARDSTICK = "fem-linear"      # constant-strain FEM on the same tetrahedra: the control
+LINEAR_SCALE = 1e-3           # the linear regime: the paper's push times this
+STATIC_RTOL = 1e-10
+REF_MESH = ("six", 5)         # the reference's own mesh (refined REF_LEVELS times, P2)
+REF_LEVELS = 1
+# the five family refined: nodes per side (the paper's 5, then the lattice halved twice)
+REFINED = (9, 17)
+MSM_SHEAR = label("msm + shear(reading=variational, c=auto)")
+
+
+def model_specs(quick=False):
+    """{model: its factors}: each reading calibrated and literal, each reading calibrated with
+    each normal-stress term, msm, msm with a shear term, and the FEM control."""
+    out = {}
+    for r in READINGS:
+        out[f"pbcm-{r}"] = {"family": "particle", "reading": r, "constant": "calibrated",
+                            "normal": "none"}
+        out[f"pbcm-{r}-literal"] = {"family": "particle", "reading": r, "constant": "literal",
+                                    "normal": "none"}
+        # the normal terms on the calibrated readings only: beside a literal shear (c = 1,
+        # stiffer than 2G in every deviatoric mode) the fit sets every c_n to 0
+        for form in NORMAL_FORMS:
+            out[label(f"pbcm-{r} + {form}(c=auto)")] = {
+                "family": "particle", "reading": r, "constant": "calibrated", "normal": form}
+    out["msm"] = {"family": "msm", "reading": "none", "constant": "springs", "normal": "edges"}
+    out[MSM_SHEAR] = {"family": "msm", "reading": "variational", "constant": "calibrated",
+                      "normal": "edges"}
+    out[YARDSTICK] = {"family": "fem", "reading": "none", "constant": "none", "normal": "fem"}
+    if quick:
+        keep = ("pbcm-balanced", "pbcm-variational", "pbcm-balanced-literal",
+                label("pbcm-balanced + normal_edge(c=auto)"), "msm", YARDSTICK)
+        out = {m: out[m] for m in keep}
+    return out
+
+
+def mesh_specs(quick=False):
+    """{mesh name: (builder kind, nodes per side, seed)}: the paper-size meshes (the lattice's
+    three splits, the Delaunay-374 reconstructions and the conforming five/six mixes) and the
+    mirrored five split refined."""
+    out = {"five": ("five", 5, 0), "six": ("six", 5, 0), "bcc": ("bcc", 5, 0)}
+    out.update({f"delaunay374-{s}": ("delaunay374", 5, s) for s in (7, 15, 25)})
+    out.update({f"mixed374-{s}": ("mixed374", 5, s) for s in (0, 1, 2)})
+    out.update({f"five-{n}": ("five", n, 0) for n in REFINED})
+    if quick:
+        out = {k: out[k] for k in ("five", "six", "delaunay374-7", "mixed374-0", "five-9")}
+    return out
+
+
+def make_mesh(name, spec):
+    kind, n, seed = spec
+    size = P.SIZE_MM * P.MM
+    if kind in ("five", "six", "bcc"):
+        return cube(n, size, kind)
+    found = paper_size_meshes(size, seeds=(seed,) if kind == "delaunay374" else (),
+                              mixed_seeds=(seed,) if kind == "mixed374" else ())
+    return found[name]
+
+
+def mesh_factors(name, spec, mesh):
+    kind, n, seed = spec
+    split = {"five": "mirrored five", "six": "six (Kuhn)", "bcc": "bcc",
+             "delaunay374": "Delaunay-374", "mixed374": "five/six mix"}[kind]
+    return {"split": split, "nodes_per_side": n, "tets": mesh.n_tets,
+            "unmatched_faces": unmatched_faces(mesh, P.SIZE_MM * P.MM),
+            "paper_size": mesh.n_nodes == 125 and mesh.n_tets == 374}
+
+
+@dataclass
+class ArtefactSettings:
+    """Material (the paper cube's), the factors and the mode."""
+
+    E: float = 10e3
+    nu: float = 0.45
+    rho: float = 1000.0
+    quick: bool = False
+    bcs: tuple = P.BCS
+    loads: tuple = ("paper", "linear")
+    damping: float = 50.0     # the paper cube's mass damping [1/s]: what flutter must beat
+    material: Material = field(init=False, repr=False, compare=False)
+
+    def __post_init__(self):
+        self.material = Material(E=self.E, nu=self.nu, rho=self.rho)
+
+    @property
+    def models(self):
+        return model_specs(self.quick)
+
+    @property
+    def meshes(self):
+        return mesh_specs(self.quick)
+
+    def problem(self):
+        return {"E_Pa": self.E, "nu": self.nu, "rho_kg_m3": self.rho, "size_mm": P.SIZE_MM,
+                "push_mm": P.PUSH_MM, "linear_scale": LINEAR_SCALE, "damping_1_s": self.damping,
+                "reference": {"element": "P2", "mesh": f"{REF_MESH[0]} {REF_MESH[1]}^3",
+                              "refinements": REF_LEVELS}}
+
+    @property
+    def units(self):
+        return 1
+
+    def describe(self):
+        return {**self.problem(), "quick": self.quick, "bcs": list(self.bcs),
+                "loads": list(self.loads), "meshes": list(self.meshes),
+                "models": list(self.models)}
+
+
+def push_mm(load):
+    return P.PUSH_MM * (LINEAR_SCALE if load == "linear" else 1.0)
+
+
+def reference(bc, load, s):
+    """The continuum on the reference mesh: linear P2 in the linear regime, neo-Hookean P2
+    at the paper's push (each refined REF_LEVELS times, with its error estimate)."""
+    mesh = cube(REF_MESH[1], P.SIZE_MM * P.MM, REF_MESH[0])
+    dirichlet = P.static_bc(mesh, bc, push_mm(load))
+    if load == "linear":
+        return linear.converged(mesh, s.E, s.nu, dirichlet, levels=REF_LEVELS)
+    return hyperelastic.converged(mesh, s.E, s.nu, dirichlet, levels=REF_LEVELS, mixed="auto")
+
+
+def _free_layers(bc, n_layers):
+    free = np.ones(n_layers, bool)
+    if bc == "clamped":           # base and top held laterally
+        free[[0, -1]] = False
+    return free
+
+
+def cell(pm, mesh, n, bc, load, ref):
+    """One cell: the model's static layer profile (``n`` node planes), the reference's on the
+    same nodes, the alternation and the displacement error over the free components."""
+    layers = [y * P.MM for y in P.layers_mm(n)]
+    dirichlet = P.static_bc(mesh, bc, push_mm(load))
+    u_ref = ref.result.at(mesh.points)
+    ref_profile = M.layer_profile(mesh.points, u_ref, layers, P.SIZE_MM * P.MM) / P.MM
+    free_layers = _free_layers(bc, len(layers))
+    # the reference's own alternating component: (-1)^k beyond a quadratic in k [mm]
+    own, _ = M.alternation(ref_profile, np.ones_like(ref_profile), free_layers)
+    out = {"bulge_profile_fem_mm": ref_profile.tolist(), "alternation_fem_mm": own,
+           "failed": None}
+    try:
+        st = pm.solve_static(dirichlet, rtol=STATIC_RTOL)
+    except FINDINGS as exc:
+        return {**out, "failed": str(exc), "bulge_profile_mm": None, "alternation_mm": None,
+                "alternation_rel": None, "disp_rel_l2": None}
+    profile = M.layer_profile(mesh.points, st.u, layers, P.SIZE_MM * P.MM) / P.MM
+    amplitude, relative = M.alternation(profile, ref_profile, free_layers)
+    free = free_components(dirichlet, mesh.n_nodes)
+    return {**out, "bulge_profile_mm": profile.tolist(), "alternation_mm": amplitude,
+            "alternation_rel": relative, "disp_rel_l2": M.rel_l2(st.u, u_ref, free)}
+
+
+def mesh_rows(name, spec, s, refs, store=OFF, progress=None):
+    """Every model's cells on one mesh (the model built, and calibrated, once), and its
+    growth rate on the clamped paper cube; rows taken from ``store`` where kept."""
+    what = {"kind": "artefact-cells", **s.problem(), "mesh": name,
+            "bcs": list(s.bcs), "loads": list(s.loads)}
+    mesh = None
+    rows = []
+    for model, factors in s.models.items():
+        stop.checkpoint()
+        k = key(**what, model=model)
+        found = store.get(k)
+        if found is None:
+            mesh = mesh or make_mesh(name, spec)
+            found = store.put(k, _model_rows(model, factors, name, spec, mesh, s, refs))
+        rows += found
+        if progress:
+            progress.advance(1)
+    return rows
+
+
+def _model_rows(model, factors, name, spec, mesh, s, refs):
+    base = {"mesh": name, **mesh_factors(name, spec, mesh), "model": model, **factors}
+    try:
+        pm = build(model, mesh, s.material)
+    except FINDINGS as exc:
+        return [{**base, "bc": bc, "load": load, "failed": f"build: {exc}",
+                 "bulge_profile_mm": None, "alternation_mm": None, "alternation_rel": None,
+                 "disp_rel_l2": None, "growth_rate_1_s": None, "flutter": None}
+                for bc in s.bcs for load in s.loads]
+    # the paper's RK4 run on its own lattice (a dense eigenproblem: 5 nodes per side only)
+    rate = P.growth_rate(pm, mesh, "clamped") if spec[1] == P.NODES_PER_SIDE else None
+    return [{**base, "bc": bc, "load": load, "growth_rate_1_s": rate,
+             "flutter": None if rate is None else rate > s.damping / 2,
+             **cell(pm, mesh, spec[1], bc, load, refs[(bc, load)])}
+            for bc in s.bcs for load in s.loads]
+
+
+class References(dict):
+    """{(bc, load): the reference}, each solved when first asked for (a run whose cells are
+    all stored solves none)."""
+
+    def __init__(self, s):
+        super().__init__()
+        self.s = s
+
+    def __missing__(self, k):
+        stop.checkpoint()
+        self[k] = reference(*k, self.s)
+        return self[k]
+
+
+def run(s, workers=None, log=True, bench=None, store=OFF):
+    """Every mesh's cells, and the references' error estimates (stored apart)."""
+    refs = References(s)
+    rows = []
+    with Progress("artefact", len(s.meshes) * len(s.models), log=log) as progress:
+        for name, spec in s.meshes.items():
+            rows += mesh_rows(name, spec, s, refs, store=store, progress=progress)
+    ref_info = []
+    for bc in s.bcs:
+        for load in s.loads:
+            k = key(kind="artefact-reference", **s.problem(), bc=bc, load=load)
+            ref_info.append(store.get(k) or store.put(k, {
+                "bc": bc, "load": load, "error_estimate": refs[(bc, load)].error_estimate}))
+    return jsonable({"cells": rows, "references": ref_info,
+                     "step_vs_msm": step_costs(bench, list(s.models))})
+
+
+def step_costs(bench, models):
+    """Each model's RK4 step over msm's on the paper's 125-node five cube (320 tetrahedra),
+    from the bench's in-process ratios; a literal reading costs what its calibrated one does
+    (the constant only scales the same kernel)."""
+    from ...costs import step_cost_us
+    tets = 5 * (P.NODES_PER_SIDE - 1) ** 3
+    msm = step_cost_us(bench, "msm", tets)
+    out = {}
+    for m in models:
+        timed = m.replace("-literal", "")
+        c = step_cost_us(bench, timed, tets)
+        out[m] = None if c is None or not msm else c / msm
+    return out

@@ -1,0 +1,126 @@
+"""The artefact study: the pattern classifier, the factor contrasts and the two answers
+(computed on cells written here, whose answer is known), and the quick study against its
+gold with the controls that must hold whatever the models do."""
+import json
+from pathlib import Path
+
+import pytest
+
+from cases.studies.artefact import analysis
+
+ROOT = Path(__file__).resolve().parents[1]
+
+
+def cell(mesh, split, model, alt, bc="sliding", load="paper", n=5, family="particle",
+         reading="balanced", constant="calibrated", normal="none", **kw):
+    return {"mesh": mesh, "split": split, "nodes_per_side": n, "model": model, "bc": bc,
+            "load": load, "family": family, "reading": reading, "constant": constant,
+            "normal": normal, "alternation_rel": alt, "failed": None, "paper_size": False, **kw}
+
+
+def test_the_pattern_has_the_papers_sign_and_a_clear_level():
+    assert analysis.pattern(cell("five", "mirrored five", "m", 0.02)) == "paper"
+    assert analysis.pattern(cell("five", "mirrored five", "m", -0.02)) == "reversed"
+    assert analysis.pattern(cell("five", "mirrored five", "m", 0.009)) == "none"
+    assert analysis.pattern(cell("five", "mirrored five", "m", None)) is None
+    assert analysis.pattern(cell("five", "mirrored five", "m", 0.5, failed="no")) is None
+
+
+def _mirror_world():
+    """Every model alternates on the five split and on no other; a normal term changes
+    nothing; msm (normal forces only) alternates too."""
+    out = []
+    for mesh, split in (("five", "mirrored five"), ("six", "six (Kuhn)")):
+        on = split == "mirrored five"
+        out += [cell(mesh, split, "b", 0.03 if on else 0.001),
+                cell(mesh, split, "b+n", 0.028 if on else 0.0, normal="normal_edge"),
+                cell(mesh, split, "msm", 0.04 if on else -0.002, family="msm",
+                     reading="none", constant="springs", normal="edges")]
+    return out
+
+
+def test_contrasts_count_pairs_that_differ_in_one_factor_only():
+    rows = {(c["factor"], c["to"]): c for c in analysis.contrasts(_mirror_world())}
+    split = rows[("split", "six (Kuhn)")]
+    # three models, each a pair five -> six: all three had it, all three lose it
+    assert (split["pairs"], split["with_pattern_before"], split["switched_off"],
+            split["switched_on"]) == (3, 3, 3, 0)
+    normal = rows[("normal", "normal_edge")]
+    assert (normal["pairs"], normal["with_pattern_before"], normal["switched_off"]) == (2, 1, 0)
+
+
+def test_the_answer_names_the_mirror_when_only_the_mesh_switches_the_pattern():
+    a = analysis.answer(_mirror_world())
+    assert a["cause"].startswith("the mirror symmetry of the five split")
+    assert a["mesh_off_rate"] == 1.0 and a["normal_off_rate"] == 0.0
+    assert a["msm_five"] == [1, 1]
+
+
+def test_the_answer_names_normal_stress_when_a_normal_term_removes_it_everywhere():
+    world = []
+    for mesh, split in (("five", "mirrored five"), ("six", "six (Kuhn)")):
+        world += [cell(mesh, split, "b", 0.03), cell(mesh, split, "b+n", 0.0,
+                                                     normal="normal_edge"),
+                  cell(mesh, split, "msm", 0.0, family="msm", reading="none",
+                       constant="springs", normal="edges")]
+    a = analysis.answer(world)
+    assert a["cause"].startswith("the missing normal stress")
+    assert a["normal_off_rate"] == 1.0 and a["mesh_off_rate"] == 0.0
+
+
+def test_the_reading_verdict_counts_the_papers_observables_and_its_margin():
+    def rows(model, alt, rate):
+        return [cell("d", "Delaunay-374", model, alt, paper_size=True, disp_rel_l2=0.1),
+                cell("d", "Delaunay-374", model, None, bc="clamped", paper_size=True,
+                     growth_rate_1_s=rate, flutter=rate > 25, disp_rel_l2=0.2),
+                cell("d", "Delaunay-374", model, alt, load="linear", paper_size=True,
+                     disp_rel_l2=0.05)]
+    cells = rows("a", 0.02, 0.0) + rows("b", 0.0, 90.0)
+    table = analysis.reading_table(cells, {"a": 12.0, "b": 8.0}, ["a", "b"])
+    assert [r["score"] for r in table] == [3, 0]
+    v = analysis.reading_verdict(table)
+    assert (v["model"], v["sure"], v["margin"]) == ("a", "clear", 3)
+    assert table[0]["consistency_median"] == 0.05 and table[1]["flutter"] == [1, 1]
+    tie = analysis.reading_verdict(analysis.reading_table(cells, {"a": 8.0, "b": 12.0},
+                                                          ["a", "b"]))
+    assert tie["sure"] == "weak" and tie["model"] == "a"     # pattern and stability: 2 to 1
+
+
+@pytest.fixture(scope="module")
+def quick_artefact(tmp_path_factory):
+    from cases.cli import main
+    out = tmp_path_factory.mktemp("artefact") / "artefact"
+    assert main(["run", "artefact", "--quick", "--out", str(out)]) == 0
+    return out
+
+
+def test_the_quick_study_holds_its_gold_and_its_controls(quick_artefact, capsys):
+    from cases.cli import main
+    status = main(["check", "--metrics", str(quick_artefact.parent), "--gold",
+                   str(ROOT / "gold"), "--allow-new"])
+    assert status == 0, capsys.readouterr().out
+    doc = json.loads((quick_artefact / "metrics.json").read_text())
+    cells = doc["cells"]
+    # the control: constant-strain FEM on a conforming mesh has no alternation at all
+    fem = [c for c in cells if c["model"] == "fem-linear" and c["mesh"] != "delaunay374-7"
+           and c["alternation_rel"] is not None]
+    assert fem and max(abs(c["alternation_rel"]) for c in fem) < 1e-6
+    # ... and passes the sliding patch test in the linear regime
+    assert max(c["disp_rel_l2"] for c in cells if c["model"] == "fem-linear"
+               and c["bc"] == "sliding" and c["load"] == "linear"
+               and c["mesh"] != "delaunay374-7") < 1e-8
+    # the non-conforming reconstruction fails it even for FEM (its cells do not match)
+    dl = next(c for c in cells if c["model"] == "fem-linear" and c["mesh"] == "delaunay374-7"
+              and c["bc"] == "sliding" and c["load"] == "linear")
+    assert dl["disp_rel_l2"] > 1e-3 and dl["unmatched_faces"] > 0
+    # msm on the mirrored five split: the paper's pattern, ends and middle out
+    msm = next(c for c in cells if c["model"] == "msm" and c["mesh"] == "five"
+               and c["bc"] == "sliding" and c["load"] == "paper")
+    p = msm["bulge_profile_mm"]
+    assert p[0] > p[1] < p[2] > p[3] < p[4] and msm["alternation_rel"] > 0.01
+    # the reference's own alternating component is nothing
+    assert max(abs(c["alternation_fem_mm"]) for c in cells
+               if c.get("alternation_fem_mm") is not None) < 1e-9
+    md = (quick_artefact / "report.md").read_text()
+    assert doc["answer"]["text"] in md and doc["verdict"]["text"] in md
+    assert (quick_artefact / "cells.md").is_file()
