@@ -151,11 +151,10 @@ def _decisive(art):
 
 def _cause_numbers(art):
     a = art["answer"]
-    rate = a.get("mesh_off_rate")
-    return (("leaving the mirrored five split removes the pattern in "
-             f"{100 * rate:.0f} % of the cells that had it; " if rate is not None else "")
-            + f"msm (normal forces only) shows it on five in {a['msm_five'][0]} of "
-            f"{a['msm_five'][1]} cells.")
+    five, other, msm = a["five"], a["other_splits"], a["msm"]
+    return (f"the layers alternate in {five[0]} of {five[1]} cells on the mirrored five split "
+            f"and in {other[0]} of {other[1]} on the others; in {msm[0]} of {msm[1]} of msm's, "
+            "whose forces are all normal.")
 
 
 __all__ = ["lines", "table"]

@@ -245,10 +245,6 @@ declare("alternation_mm", "mm", "alternation",
 declare("alternation_rel", "1", "alternation rel",
          "the alternation over the reference profile's mean |lateral displacement|; the "
          "pattern is called clear from 0.01.", "signed")
-declare("alternation_fem_mm", "mm", "FEM's own alternation",
-         "the reference profile's own (-1)^k component beyond a quadratic in k, over the free "
-         "layers (the alternation of the continuum with nothing subtracted): near zero.",
-         digits=2)
 declare("alternation_max_rel", "1", "largest |alternation|",
          "a model's largest |alternation rel| over its paper-cube runs (extensions study).",
          "max")

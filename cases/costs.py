@@ -12,7 +12,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .document import fmt
+from .document import Table, fmt
 
 FILE = "bench.json"
 FOLDER = "bench"                 # beside the case folders: reports/bench/bench.json
@@ -54,9 +54,10 @@ def step_cost_us(bench, model, tets):
     return float(t_base * ratio)
 
 
-def cost_sentences(data, models, tets):
-    """The cost of each model's RK4 step against msm and fem-linear, from the bench size
-    closest to ``tets``: the sentences a case report states about cost."""
+def cost_items(data, models, tets):
+    """What a case report states about cost: a table of each model's RK4 step against msm's
+    and fem-linear's, and at its own stable step the cost of one simulated second, from the
+    bench size closest to ``tets``; a sentence naming the command where there is no bench."""
     if not data:
         return [f"No benchmark found beside this report ({SOURCE}): run `pbcm bench` for "
                 "the cost of each model."]
@@ -64,23 +65,21 @@ def cost_sentences(data, models, tets):
     near = [r for r in data["rows"] if r["tets"] == sizes[0] and r["model"] in models]
     if not near:
         return []
-    out = [f"Cost, from `pbcm bench` at {sizes[0]} tetrahedra (median of "
-           f"{near[0]['rounds']} interleaved rounds): one RK4 step of " + "; ".join(
-               f"{r['model']} takes {fmt(r['step_vs_msm'])}x the msm step and "
-               f"{fmt(r['step_vs_fem-linear'])}x the fem-linear step" for r in near)
-           + ". The paper reports more than 10x msm (per step, at one common step)."]
-    own = [r for r in near if r.get("cpu_s_per_simulated_s") is not None]
-    if own:
-        msm = next((r for r in data["rows"] if r["model"] == "msm" and r["tets"] == sizes[0]
-                    and r.get("cpu_s_per_simulated_s")), None)
-        out.append("At each model's own stable RK4 step (2 sqrt 2 / omega_max, undamped), one "
-                   "simulated second costs: " + "; ".join(
-                       f"{r['model']} {fmt(r['cpu_s_per_simulated_s'])} s (step "
-                       f"{fmt(r['stable_dt_us'])} us"
-                       + (f", {fmt(r['cpu_s_per_simulated_s'] / msm['cpu_s_per_simulated_s'])}"
-                          "x msm" if msm else "") + ")" for r in own)
-                   + ": a stiffer model needs smaller steps, which the cost per step hides.")
-    return out
+    msm = next((r for r in data["rows"] if r["model"] == "msm" and r["tets"] == sizes[0]
+                and r.get("cpu_s_per_simulated_s")), None)
+
+    def per_second(r):
+        own = r.get("cpu_s_per_simulated_s")
+        return (fmt(own), fmt(own / msm["cpu_s_per_simulated_s"]) if own and msm else "n/a")
+    return [Table(
+        f"From `pbcm bench` at {sizes[0]} tetrahedra (median of {near[0]['rounds']} "
+        "interleaved rounds; the paper reports a step over 10x msm's). The own stable step "
+        "is 2 sqrt 2 / omega_max, undamped: a stiffer model needs smaller steps, which the "
+        "cost per step hides.",
+        ["model", "step / msm", "step / fem-linear", "own stable step [us]",
+         "CPU s per simulated s", "per simulated s / msm"],
+        [[r["model"], fmt(r["step_vs_msm"]), fmt(r["step_vs_fem-linear"]),
+          fmt(r.get("stable_dt_us")), *per_second(r)] for r in near])]
 
 
-__all__ = ["FILE", "FOLDER", "SOURCE", "read", "load", "step_cost_us", "cost_sentences"]
+__all__ = ["FILE", "FOLDER", "SOURCE", "read", "load", "step_cost_us", "cost_items"]

@@ -4,6 +4,10 @@ import html
 from pathlib import Path
 
 
+MAX_COLUMNS = 10            # a table wider than this is split (a report reads in a minute)
+GLOSSARY = "glossary.md"    # the one list of definitions, at the top of the reports folder
+
+
 def fmt(v, digits=3):
     """A number for a report cell: 'n/a' for None, yes/no for a bool, ``digits`` significant
     figures for a float."""
@@ -42,6 +46,14 @@ class Link:
         return f"<a href='{html.escape(self.html_href)}'>{html.escape(self.text)}</a>"
 
 
+class Table:
+    """A table among a report's findings: sentences that would repeat with other numbers
+    (one per model, per run) are its rows instead. ``title`` introduces it."""
+
+    def __init__(self, title, header, rows):
+        self.title, self.header, self.rows = title, list(header), [list(r) for r in rows]
+
+
 def _md(c):
     return c.markdown() if isinstance(c, (Link, Cell)) else str(c)
 
@@ -62,6 +74,21 @@ class Document:
 
     def ul(self, items):
         self.blocks.append(("ul", list(items)))
+
+    def items(self, items):
+        """Findings: runs of sentences as lists, each Table as its title and a table."""
+        run = []
+        for item in items:
+            if isinstance(item, Table):
+                if run:
+                    self.ul(run)
+                    run = []
+                self.p(item.title)
+                self.table(item.header, item.rows)
+            else:
+                run.append(item)
+        if run:
+            self.ul(run)
 
     def table(self, header, rows):
         self.blocks.append(("table", list(header), [list(r) for r in rows]))

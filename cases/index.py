@@ -7,7 +7,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .document import Cell, Document, Link
+from .document import GLOSSARY, MAX_COLUMNS, Cell, Document, Link
 from .metrics import PATCH_TOL
 from .output import SWEEP_MARK
 
@@ -78,9 +78,6 @@ def populations(root, cases):
                 out.append(Population(case, bc, metric, primary, bc in patch, values, had,
                                       max(est) if est else 0.0))
     return out, data
-
-
-GLOSSARY = "glossary.md"
 
 
 def _score_cell(p, m):
@@ -170,9 +167,6 @@ def conclusion(pops, models):
     out.append("Every model gave a headline number in every run." if not missing else
                "Runs without a headline number: " + ", ".join(missing) + ".")
     return out
-
-
-MAX_COLUMNS = 10      # a table wider than this is split into several
 
 
 def index_documents(root, cases, studies=()):

@@ -5,6 +5,8 @@ closest and farthest model, failures, and the case's load against the neo-Hookea
 reference."""
 import numpy as np
 
+from .document import Table
+
 
 def populations(runs):
     """The runs split by boundary condition: each (case, bc) is one population (a patch test
@@ -57,26 +59,33 @@ def _labelled(runs, line_of):
 
 
 def ranking(runs, metric, label, estimate_key="p2_error_estimate"):
-    """Per population (boundary condition): 'model: median metric [range], n of N runs'
-    sentences, best first, the models with a value in every run ranked, the others listed
-    after, unranked; a model within the reference's estimate (``estimate_key``) of the one
-    above is called tied with it (the reference cannot order them)."""
-    out = []
+    """A table (one item of a report's findings): per population (boundary condition) the
+    models by median ``metric``, best first, with the range and 'n of N runs'; only the models
+    with a value in every run are ranked, the others listed after, unranked; a model within
+    the reference's estimate (``estimate_key``) of the one above is tied with it (the
+    reference cannot order them)."""
+    rows = []
     for bc, rs in populations(runs).items():
         by, had = _by_model(rs, metric)
         est = estimate(rs, estimate_key)
         med = {m: float(np.median(v)) for m, v in by.items()}
         ranked = sorted(_complete(by, had), key=med.get)
-        prefix = f"[{bc}] " if len(populations(runs)) > 1 else ""
         for k, m in enumerate(ranked):
             tie = ""
             if k and est is not None and med[m] - med[ranked[k - 1]] < est:
-                tie = f" Tied with {ranked[k - 1]} (within the reference's estimate {est:.2g})."
-            out.append(f"{prefix}{m}: {label} {cell(by[m], had[m])}.{tie}")
+                tie = f"tied with {ranked[k - 1]} (estimate {est:.2g})"
+            rows.append([bc, k + 1, m, *_stats(by[m], had[m]), tie])
         for m in sorted(set(had) - set(ranked)):
-            out.append(f"{prefix}{m}: {label} {cell(by.get(m, []), had[m])}: incomplete, "
-                       "not ranked.")
-    return out
+            rows.append([bc, "-", m, *_stats(by.get(m, []), had[m]), "incomplete, not ranked"])
+    return [Table(f"{label[0].upper()}{label[1:]} ({metric}) per model, median over the meshes:",
+                  ["bc", "rank", "model", "median", "range", "runs", "note"], rows)]
+
+
+def _stats(values, total):
+    if not values:
+        return "n/a", "", f"0 of {total}"
+    return (f"{np.median(values):.3g}", f"{min(values):.3g}-{max(values):.3g}",
+            f"{len(values)} of {total}")
 
 
 def best_and_worst(runs, metric, what, exact=False, estimate_key="p2_error_estimate"):

@@ -26,23 +26,26 @@ def test_the_pattern_has_the_papers_sign_and_a_clear_level():
     assert analysis.pattern(cell("five", "mirrored five", "m", 0.5, failed="no")) is None
 
 
-def _mirror_world():
-    """Every model alternates on the five split and on no other; a normal term changes
-    nothing; msm (normal forces only) alternates too."""
+def _world(alternates):
+    """Cells on the five and six splits of a model without and with a normal term and msm,
+    alternating where ``alternates(split, normal, family)`` says so."""
     out = []
     for mesh, split in (("five", "mirrored five"), ("six", "six (Kuhn)")):
-        on = split == "mirrored five"
-        out += [cell(mesh, split, "b", 0.03 if on else 0.001),
-                cell(mesh, split, "b+n", 0.028 if on else 0.0, normal="normal_edge"),
-                cell(mesh, split, "msm", 0.04 if on else -0.002, family="msm",
-                     reading="none", constant="springs", normal="edges")]
+        for model, normal, family in (("b", "none", "particle"),
+                                      ("b+n", "normal_edge", "particle"),
+                                      ("msm", "edges", "msm")):
+            alt = 0.03 if alternates(split, normal, family) else 0.001
+            out.append(cell(mesh, split, model, alt, normal=normal, family=family,
+                            reading="none" if family == "msm" else "balanced",
+                            constant="springs" if family == "msm" else "calibrated"))
     return out
 
 
 def test_contrasts_count_pairs_that_differ_in_one_factor_only():
-    rows = {(c["factor"], c["to"]): c for c in analysis.contrasts(_mirror_world())}
+    world = _world(lambda split, normal, family: split == "mirrored five")
+    rows = {(c["factor"], c["to"]): c for c in analysis.contrasts(world)}
     split = rows[("split", "six (Kuhn)")]
-    # three models, each a pair five -> six: all three had it, all three lose it
+    # three models, each a pair five -> six: all three alternate on five, none on six
     assert (split["pairs"], split["with_pattern_before"], split["switched_off"],
             split["switched_on"]) == (3, 3, 3, 0)
     normal = rows[("normal", "normal_edge")]
@@ -50,22 +53,25 @@ def test_contrasts_count_pairs_that_differ_in_one_factor_only():
 
 
 def test_the_answer_names_the_mirror_when_only_the_mesh_switches_the_pattern():
-    a = analysis.answer(_mirror_world())
+    a = analysis.answer(_world(lambda split, normal, family: split == "mirrored five"))
     assert a["cause"].startswith("the mirror symmetry of the five split")
     assert a["mesh_off_rate"] == 1.0 and a["normal_off_rate"] == 0.0
-    assert a["msm_five"] == [1, 1]
+    assert a["five"] == [3, 3] and a["other_splits"] == [0, 3]
 
 
 def test_the_answer_names_normal_stress_when_a_normal_term_removes_it_everywhere():
-    world = []
-    for mesh, split in (("five", "mirrored five"), ("six", "six (Kuhn)")):
-        world += [cell(mesh, split, "b", 0.03), cell(mesh, split, "b+n", 0.0,
-                                                     normal="normal_edge"),
-                  cell(mesh, split, "msm", 0.0, family="msm", reading="none",
-                       constant="springs", normal="edges")]
-    a = analysis.answer(world)
+    a = analysis.answer(_world(lambda split, normal, family: normal == "none"))
     assert a["cause"].startswith("the missing normal stress")
     assert a["normal_off_rate"] == 1.0 and a["mesh_off_rate"] == 0.0
+
+
+def test_the_answer_names_neither_when_the_pattern_is_everywhere_and_refinement_removes_it():
+    world = _world(lambda split, normal, family: True)
+    world += [cell("five-9", "mirrored five", "b", 0.001, n=9)]
+    a = analysis.answer(world)
+    assert a["cause"] == ("neither the mirror symmetry nor the missing normal stress: a "
+                          "mesh-scale discretisation error that refinement removes")
+    assert a["refined"] == {"5": [3, 3], "9": [0, 1]}
 
 
 def test_the_reading_verdict_counts_the_papers_observables_and_its_margin():
@@ -101,10 +107,12 @@ def test_the_quick_study_holds_its_gold_and_its_controls(quick_artefact, capsys)
     assert status == 0, capsys.readouterr().out
     doc = json.loads((quick_artefact / "metrics.json").read_text())
     cells = doc["cells"]
-    # the control: constant-strain FEM on a conforming mesh has no alternation at all
+    # the control: constant-strain FEM on a conforming mesh never alternates, and on the
+    # sliding base (a homogeneous answer it reproduces) has no alternation at all
     fem = [c for c in cells if c["model"] == "fem-linear" and c["mesh"] != "delaunay374-7"
            and c["alternation_rel"] is not None]
-    assert fem and max(abs(c["alternation_rel"]) for c in fem) < 1e-6
+    assert fem and not any(analysis.alternating(c) for c in fem)
+    assert max(abs(c["alternation_rel"]) for c in fem if c["bc"] == "sliding") < 1e-6
     # ... and passes the sliding patch test in the linear regime
     assert max(c["disp_rel_l2"] for c in cells if c["model"] == "fem-linear"
                and c["bc"] == "sliding" and c["load"] == "linear"
@@ -118,9 +126,9 @@ def test_the_quick_study_holds_its_gold_and_its_controls(quick_artefact, capsys)
                and c["bc"] == "sliding" and c["load"] == "paper")
     p = msm["bulge_profile_mm"]
     assert p[0] > p[1] < p[2] > p[3] < p[4] and msm["alternation_rel"] > 0.01
-    # the reference's own alternating component is nothing
-    assert max(abs(c["alternation_fem_mm"]) for c in cells
-               if c.get("alternation_fem_mm") is not None) < 1e-9
+    # the sliding reference is a homogeneous compression: every layer expands alike
+    ref = msm["bulge_profile_fem_mm"]
+    assert max(ref) - min(ref) < 1e-9 * max(ref)
     md = (quick_artefact / "report.md").read_text()
     assert doc["answer"]["text"] in md and doc["verdict"]["text"] in md
     assert (quick_artefact / "cells.md").is_file()

@@ -75,13 +75,16 @@ def test_merge_adds_a_composed_model_and_keeps_every_other_row(tmp_path):
     assert main(["bench", "--merge", "--models", "msm", "--out", str(tmp_path / "none")]) == 2
 
 
-def test_cost_sentences_come_from_the_nearest_bench_size():
+def test_cost_rows_come_from_the_nearest_bench_size():
     data = {"rows": [{"model": m, "tets": t, "rounds": 5, "step_vs_msm": r,
-                      "step_vs_fem-linear": r / 2}
+                      "step_vs_fem-linear": r / 2, "cpu_s_per_simulated_s": 2 * r,
+                      "stable_dt_us": 100.0}
                      for t, r in ((135, 3.0), (1080, 7.0), (10985, 9.0)) for m in ("a", "msm")]}
-    line = costs.cost_sentences(data, ["a"], 500)[0]
-    assert "1080 tetrahedra" in line and "a takes 7x the msm step and 3.5x the fem-linear" in line
-    assert "run `pbcm bench`" in costs.cost_sentences(None, ["a"], 500)[0]
+    (table,) = costs.cost_items(data, ["a"], 500)
+    assert "1080 tetrahedra" in table.title
+    # step ratios as the bench took them; per simulated second: a's 14 s over msm's 14 s
+    assert table.rows == [["a", "7", "3.5", "100", "14", "1"]]
+    assert "run `pbcm bench`" in costs.cost_items(None, ["a"], 500)[0]
 
 
 def test_bench_mesh_is_the_closest_five_cube():

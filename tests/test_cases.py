@@ -204,10 +204,9 @@ def test_rankings_tie_models_the_reference_cannot_order():
     from cases.library import common
     runs = [{"model": m, "bc": "clamped", "err": e, "p2_error_estimate": 0.01}
             for m, e in (("a", 0.10), ("b", 0.105), ("c", 0.30))]
-    lines = common.ranking(runs, "err", "error")
-    assert lines[0].startswith("a:") and "Tied" not in lines[0]
-    assert lines[1].startswith("b:") and "Tied with a" in lines[1]
-    assert "Tied" not in lines[2]
+    (table,) = common.ranking(runs, "err", "error")
+    assert [r[2] for r in table.rows] == ["a", "b", "c"]
+    assert [r[-1] for r in table.rows] == ["", "tied with a (estimate 0.01)", ""]
     line = common.best_and_worst(runs, "err", "Error")
     assert "closest a" in line and "farthest c" in line and ": b." in line
     assert "not resolved" not in line           # 0.01 < 0.10 / 5
@@ -229,13 +228,13 @@ def test_rankings_keep_populations_apart_and_rank_only_complete_models():
                  {"model": "b", "mesh": mesh, "bc": "clamped", "err": b},
                  {"model": "c", "mesh": mesh, "bc": "clamped", "err": c},
                  {"model": "a", "mesh": mesh, "bc": "clamped", "err": 0.06}]
-    lines = rankings.ranking(runs, "err", "error")
-    assert lines[0] == "[sliding] a: error median 1e-10 [1e-10-1e-10], 2 of 2 runs."
-    clamped = [line for line in lines if line.startswith("[clamped]")]
-    assert clamped[0] == "[clamped] b: error median 0.03 [0.02-0.04], 2 of 2 runs."
-    assert clamped[1].startswith("[clamped] a: error median 0.06")
-    assert clamped[2] == ("[clamped] c: error median 0.05 [0.05-0.05], 1 of 2 runs: "
-                          "incomplete, not ranked.")
+    (table,) = rankings.ranking(runs, "err", "error")
+    assert table.rows[0] == ["sliding", 1, "a", "1e-10", "1e-10-1e-10", "2 of 2", ""]
+    clamped = [r for r in table.rows if r[0] == "clamped"]
+    assert clamped[0] == ["clamped", 1, "b", "0.03", "0.02-0.04", "2 of 2", ""]
+    assert clamped[1][1:4] == [2, "a", "0.06"]
+    assert clamped[2] == ["clamped", "-", "c", "0.05", "0.05-0.05", "1 of 2",
+                          "incomplete, not ranked"]
     line = rankings.best_and_worst(runs, "err", "Error")
     assert "[clamped] Error: closest b" in line and "farthest a" in line
     assert "Not ranked, a run without a value: c (1 of 2)" in line

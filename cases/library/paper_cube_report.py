@@ -2,9 +2,13 @@
 Figure 1 analogue, the layer profiles, the step-time chart and the reaction history. Every
 sentence is computed from the runs."""
 
+import re
+
+import numpy as np
+
 from .. import figures, rankings
 from ..metrics import ALTERNATION_CLEAR, PATCH_TOL
-from ..document import fmt
+from ..document import Table, fmt
 
 SIZE_MM = 32.0
 SPEED_MM_S = 1.7
@@ -40,14 +44,6 @@ def _bracket(counts, paper):
     lo, hi = min(counts), max(counts)
     return (f"{'bracket' if lo <= paper <= hi else 'do not bracket'} it ({lo} to {hi} "
             "tetrahedra)")
-
-
-def _modal_clause(runs, model):
-    """'first 10 frequencies ... off by up to e.' over the runs with a modal problem."""
-    errs = [r["modal_rel_err"] for r in runs
-            if r["model"] == model and r.get("modal_rel_err") is not None]
-    return (f"first 10 frequencies with the clamped base off by up to {max(errs):.3g}."
-            if errs else "no modal comparison.")
 
 
 def what_was_run(cfg, runs):
@@ -133,13 +129,12 @@ def conclusion(cfg, runs):
 def _stability(r, cfg):
     """What the run at dt/4 and the linearised growth rate say of a blow-up: computed, never
     assumed."""
-    at4 = "blows up at dt/4 too" if r["dyn_failed_dt4"] else "comes to rest at dt/4"
     g, damp = r["growth_rate_1_s"], cfg.damping / 2
-    return (f"Repeated at dt/4 it {at4}. Linearised at rest it grows at {g:.3g} 1/s, "
-            + ("above" if g > damp else "below") + f" the {damp:g} 1/s mass damping removes"
-            + (": flutter that a smaller step does not cure." if g > damp and r["dyn_failed_dt4"]
-               else ": the step, not the model, was unstable." if not r["dyn_failed_dt4"]
-               else "."))
+    if not r["dyn_failed_dt4"]:
+        return "the step: it comes to rest at dt/4"
+    return (f"flutter: growth above the {damp:g} 1/s the damping removes, dt/4 does not cure it"
+            if g > damp else f"growth below the {damp:g} 1/s the damping removes, yet dt/4 "
+            "blows up too")
 
 
 def findings(runs, cfg):
@@ -218,23 +213,29 @@ def _accuracy(runs, cfg):
             out.append(f"{bc}: smallest displacement error against P2 {best['disp_rel_l2_p2']:.3g}"
                        f" ({best['model']}, {best['mesh']}), largest {worst['disp_rel_l2_p2']:.3g}"
                        f" ({worst['model']}, {worst['mesh']}).")
+    rows = []
     for model in cfg.models:
         rs = [r for r in solved if r["model"] == model]
         if rs:
             rr = [r["reaction_ratio"] for r in rs]
-            out.append(f"{model}: stiffness (reaction ratio to FEM P2) {min(rr):.3g} to "
-                       f"{max(rr):.3g}; net force up to {max(r['net_force_rel'] for r in rs):.2g}"
-                       f", net torque up to {max(r['net_torque_rel'] for r in rs):.2g} of the "
-                       "force scale.")
-    for r in [r for r in solved if r["model"] == "msm" and r["bc"] == "sliding"]:
-        nu_eff = r["apparent_poisson"]
+            rows.append([model, f"{min(rr):.3g} to {max(rr):.3g}",
+                         f"{max(r['net_force_rel'] for r in rs):.2g}",
+                         f"{max(r['net_torque_rel'] for r in rs):.2g}"])
+    if rows:
+        out.append(Table("Stiffness (reaction ratio to FEM P2) over the runs, and the largest "
+                         "net force and torque of the internal forces (of the force scale):",
+                         ["model", "reaction ratio", "net force", "net torque"], rows))
+    msm = [r for r in solved if r["model"] == "msm" and r["bc"] == "sliding"]
+    if msm:
         # the Cauchy relations bind an isotropic central-force network to nu = 1/4: a measured
         # ratio away from it shows the lattice's springs are not isotropic, one near it does not
-        why = ("these lattices are not isotropic" if abs(nu_eff - 0.25) > CAUCHY_TOL else
-               f"this one is within {CAUCHY_TOL:g} of it")
-        out.append(f"msm on {r['mesh']}/sliding: apparent Poisson ratio {nu_eff:.3f} from the "
-                   f"lateral expansion, for nu = {cfg.nu:g} asked (an isotropic spring network "
-                   f"is bound to 1/4 by the Cauchy relations; {why}).")
+        out.append(Table(
+            f"msm's apparent Poisson ratio from the lateral expansion (sliding), for nu = "
+            f"{cfg.nu:g} asked; an isotropic spring network is bound to 1/4 by the Cauchy "
+            "relations:", ["mesh", "apparent nu", "lattice"],
+            [[r["mesh"], f"{r['apparent_poisson']:.3f}",
+              "not isotropic" if abs(r["apparent_poisson"] - 0.25) > CAUCHY_TOL
+              else f"within {CAUCHY_TOL:g} of 1/4"] for r in msm]))
     return out
 
 
@@ -248,14 +249,13 @@ def _dynamics(runs, cfg):
                        f"{r['model']} on {r['mesh']}/{r['bc']} ({r['growth_rate_1_s']:.3g} 1/s"
                        + (", came to rest at its step" if r.get("dyn_at_rest") else "") + ")"
                        for r in flutter) + ".")
-    for r in [r for r in runs if r["dyn_failed"]]:
-        out.append(f"Dynamic run of {r['model']} on {r['mesh']}/{r['bc']} blew up: "
-                   f"{r['dyn_failed']}. " + _stability(r, cfg))
-    for r in runs:
-        if not r["dyn_failed"] and r["dyn_failed_dt4"]:
-            out.append(f"Verdict changes with the step: {r['model']} on {r['mesh']}/{r['bc']} "
-                       f"comes to rest at dt but blows up at dt/4 ({r['dyn_failed_dt4']}). "
-                       + _stability(r, cfg))
+    bad = [r for r in runs if r["dyn_failed"] or r["dyn_failed_dt4"]]
+    if bad:
+        out.append(Table("Dynamic runs that blew up (at the case's step dt or at dt/4):",
+                         ["model", "mesh/bc", "at dt", "at dt/4", "growth [1/s]", "why"],
+                         [[r["model"], f"{r['mesh']}/{r['bc']}",
+                           _blowup(r["dyn_failed"]), _blowup(r["dyn_failed_dt4"]),
+                           f"{r['growth_rate_1_s']:.3g}", _stability(r, cfg)] for r in bad]))
     odd = [r for r in runs if r["rigid_modes_free"] != 6]
     if odd:
         out.append("Rigid modes free-free other than 6 (zero-energy deformation modes, or "
@@ -263,22 +263,48 @@ def _dynamics(runs, cfg):
                        f"{r['model']} on {r['mesh']}: {r['rigid_modes_free']}" for r in odd) + ".")
     elif runs:
         out.append("Every model has exactly 6 rigid modes free-free on every mesh run.")
+    rows = []
     for model in cfg.models:
         rs = [r for r in runs if r["model"] == model and r["reaction_time_rel_l2"] is not None]
+        errs = [r["modal_rel_err"] for r in runs
+                if r["model"] == model and r.get("modal_rel_err") is not None]
         if rs:
-            out.append(f"{model} against the FEM {cfg.transient_element} transient: top reaction "
-                       f"over push and hold off by {min(r['reaction_time_rel_l2'] for r in rs):.3g}"
-                       f" to {max(r['reaction_time_rel_l2'] for r in rs):.3g} (relative L2); "
-                       + _modal_clause(runs, model))
+            rows.append([model, f"{min(r['reaction_time_rel_l2'] for r in rs):.3g} to "
+                                f"{max(r['reaction_time_rel_l2'] for r in rs):.3g}",
+                         f"{max(errs):.3g}" if errs else "n/a"])
+    if rows:
+        out.append(Table(f"Against the FEM {cfg.transient_element} transient: the top reaction "
+                         "over push and hold (relative L2, over the scored runs) and the "
+                         "largest error of the first 10 frequencies, clamped base:",
+                         ["model", "reaction(t) error", "modal error"], rows))
     unstable = sorted({(r["model"], r["mesh"], r["bc"], r["growth_rate_1_s"]) for r in runs
                        if r["growth_rate_1_s"] > 0})
     if unstable:
         steady = sorted({r["model"] for r in runs} - {u[0] for u in unstable})
-        out.append("Flutter (positive growth rate of the undamped linearised model): "
-                   + "; ".join(f"{m} on {me}/{b}: {g:.3g} 1/s" for m, me, b, g in unstable)
-                   + (f". No flutter on any mesh and condition run: {', '.join(steady)}."
-                      if steady else "."))
+        out.append(Table("Flutter: positive growth rate of the undamped linearised model"
+                         + (f" (none on any mesh and condition run: {', '.join(steady)})"
+                            if steady else "") + ":",
+                         ["model", "mesh/bc", "growth [1/s]"],
+                         [[m, f"{me}/{b}", f"{g:.3g}"] for m, me, b, g in unstable]))
     return out
+
+
+DEVIATES = 0.05    # a profile this far from FEM's (largest over layers, of its mean): in colour
+
+
+def _deviates(r, fem):
+    """A model drawn in colour in a profile plot: an alternation from the clear level, or a
+    profile off FEM's by DEVIATES of its mean magnitude somewhere."""
+    off = np.abs(np.asarray(r["bulge_profile_mm"]) - fem).max() / max(np.abs(fem).mean(), 1e-300)
+    return off > DEVIATES or abs(r.get("alternation_rel") or 0.0) >= ALTERNATION_CLEAR
+
+
+def _blowup(message):
+    """Where a run blew up, from its message: the step and the time, or 'no'."""
+    if not message:
+        return "no"
+    m = re.search(r"step (\d+) \(t = ([0-9.e+-]+) s", message)
+    return f"step {m.group(1)}, t = {float(m.group(2)):.3g} s" if m else message
 
 
 def _field(fields, mesh, bc, model):
@@ -308,9 +334,11 @@ def sections(doc, cfg, runs, fields, out):
             figures.stress_panels(out / name, panels, f"max |tau|, mesh {mesh}, {bc}", 5.0)
             doc.img(name, f"Figure 1 analogue: mesh {mesh}, {bc}")
             name = f"profile_{mesh}_{bc}.png"
+            fem = np.asarray(rs[0]["bulge_profile_fem_mm"])
             figures.profiles(out / name, cfg.problem()["layers_mm"],
                              [(r["model"], r["bulge_profile_mm"]) for r in solved],
-                             rs[0]["bulge_profile_fem_mm"], f"layer profile, mesh {mesh}, {bc}")
+                             fem, f"layer profile, mesh {mesh}, {bc}",
+                             highlight={r["model"] for r in solved if _deviates(r, fem)})
             doc.img(name, f"Layer profiles: mesh {mesh}, {bc}")
     keys = [(r["mesh"], r["bc"]) for r in runs if r["model"] == cfg.models[0]
             and not r.get("failed")]

@@ -4,8 +4,10 @@ and cells.md/.html (every cell's alternation beside the reference's). Every sent
 computed from the cells it is written with."""
 from pathlib import Path
 
+import numpy as np
+
 from ... import catalogue, figures
-from ...document import Document, fmt
+from ...document import GLOSSARY, Document, fmt
 from ...metrics import ALTERNATION_CLEAR
 from ...report import environment, write_study
 from ...runner import jsonable
@@ -13,7 +15,6 @@ from . import analysis
 from .study import LINEAR_SCALE, READINGS, YARDSTICK
 
 GATED = catalogue.gated("alternation_rel", "disp_rel_l2")
-GLOSSARY = "../glossary.md"
 
 
 def readings(models):
@@ -53,7 +54,7 @@ def build(out, study, s, doc):
     d = Document(f"pbcm report: {study.name}")
     for line in conclusion(doc):
         d.p(line)
-    d.p(f"Definitions: [glossary]({GLOSSARY}). Every cell's numbers: [cells.md](cells.md). "
+    d.p(f"Definitions: [glossary](../{GLOSSARY}). Every cell's numbers: [cells.md](cells.md). "
         "Regenerate with `pbcm run artefact`.")
     d.h(2, "What was run")
     d.ul([study.title + ".",
@@ -72,8 +73,9 @@ def build(out, study, s, doc):
           "sign is counted apart."])
     d.h(2, "Which factor switches the pattern on or off")
     d.p("Pairs of cells that differ in one factor only (the rest held equal); a pair switches "
-        "the pattern off when the first cell has it and the second does not.")
-    d.table(["factor", "from", "to", "pairs", "with the pattern before", "switched off",
+        "the alternation (either sign) off when the first cell alternates and the second does "
+        "not.")
+    d.table(["factor", "from", "to", "pairs", "alternating before", "switched off",
              "switched on"],
             [[c["factor"], c["from"], c["to"], c["pairs"], c["with_pattern_before"],
               c["switched_off"], c["switched_on"]] for c in doc["contrasts"]])
@@ -142,8 +144,10 @@ def cells_document(doc, s):
     """Every cell: per mesh, one row per model, the alternation [mm] and relative per base and
     load beside the reference's own alternating component."""
     c = Document("pbcm artefact study: every cell")
-    c.p(f"Alternation in mm (relative in brackets) per base and load; the reference's own "
-        f"(-1)^k component in mm beside it. Definitions: [glossary]({GLOSSARY}).")
+    c.p("Alternation in mm (relative in brackets) per base and load, beside the reference's "
+        "mean lateral displacement in mm (the scale of the relative one; the reference's own "
+        "alternation is zero by the metric's definition, and the FEM control's is its row). "
+        f"Definitions: [glossary](../{GLOSSARY}).")
     combos = [(bc, load) for bc in s.bcs for load in s.loads]
     for mesh in s.meshes:
         rows = {}
@@ -155,10 +159,15 @@ def cells_document(doc, s):
         first = next(iter(rows.values()))
         c.h(2, f"{mesh} ({next(iter(first.values()))['tets']} tetrahedra)")
         c.table(["model"] + [f"{bc}/{load}" for bc, load in combos],
-                [["reference's own"] + [fmt(first.get(k, {}).get("alternation_fem_mm"))
-                                        for k in combos]]
+                [["reference, mean lateral [mm]"] + [_scale(first.get(k)) for k in combos]]
                 + [[m] + [_cell(r.get(k)) for k in combos] for m, r in rows.items()])
     return c
+
+
+def _scale(x):
+    if not x or not x.get("bulge_profile_fem_mm"):
+        return "n/a"
+    return fmt(float(np.mean(np.abs(x["bulge_profile_fem_mm"]))))
 
 
 def _cell(x):

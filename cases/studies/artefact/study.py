@@ -27,7 +27,9 @@ REF_MESH = ("six", 5)         # the reference's own mesh (refined REF_LEVELS tim
 REF_LEVELS = 1
 # the five family refined: nodes per side (the paper's 5, then the lattice halved twice)
 REFINED = (9, 17)
-MSM_SHEAR = label("msm + shear(reading=variational, c=auto)")
+# msm with the paper's shear force at the paper's constant: with c = auto the fit sets c = 0
+# on every mesh (the springs alone are stiffer than 2G in the modes the shear adds to)
+MSM_SHEAR = label("msm + shear(reading=variational, c=1)")
 
 
 def model_specs(quick=False):
@@ -45,7 +47,7 @@ def model_specs(quick=False):
             out[label(f"pbcm-{r} + {form}(c=auto)")] = {
                 "family": "particle", "reading": r, "constant": "calibrated", "normal": form}
     out["msm"] = {"family": "msm", "reading": "none", "constant": "springs", "normal": "edges"}
-    out[MSM_SHEAR] = {"family": "msm", "reading": "variational", "constant": "calibrated",
+    out[MSM_SHEAR] = {"family": "msm", "reading": "variational", "constant": "literal",
                       "normal": "edges"}
     out[YARDSTICK] = {"family": "fem", "reading": "none", "constant": "none", "normal": "fem"}
     if quick:
@@ -156,10 +158,7 @@ def cell(pm, mesh, n, bc, load, ref):
     u_ref = ref.result.at(mesh.points)
     ref_profile = M.layer_profile(mesh.points, u_ref, layers, P.SIZE_MM * P.MM) / P.MM
     free_layers = _free_layers(bc, len(layers))
-    # the reference's own alternating component: (-1)^k beyond a quadratic in k [mm]
-    own, _ = M.alternation(ref_profile, np.ones_like(ref_profile), free_layers)
-    out = {"bulge_profile_fem_mm": ref_profile.tolist(), "alternation_fem_mm": own,
-           "failed": None}
+    out = {"bulge_profile_fem_mm": ref_profile.tolist(), "failed": None}
     try:
         st = pm.solve_static(dirichlet, rtol=STATIC_RTOL)
     except FINDINGS as exc:
