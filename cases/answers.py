@@ -127,7 +127,7 @@ def lines(root, models):
                    "tetrahedra, at each model's own stable RK4 step, over fem-linear's: "
                    + ", ".join(f"{m} {fmt(r['cpu_s_per_simulated_s'] / fl, 2)}"
                                for m, r in rows.items() if r and m != "fem-linear")
-                   + " ([bench](bench/report.md)).")
+                   + " ([bench](bench/bench.md)).")
     if art:
         out.append(f"**What causes the bulge/neck?** {art['answer']['cause'][0].upper()}"
                    f"{art['answer']['cause'][1:]}: {_cause_numbers(art)}")
@@ -145,8 +145,8 @@ def _decisive(art):
             "cost": "a step over 10x msm's", "stable": "no flutter"}
     yes = [said[k] for k, v in best["matches"].items() if v]
     no = [said[k] for k, v in best["matches"].items() if not v]
-    return ("matches " + (", ".join(yes) or "none of the paper's observables")
-            + (f"; not {', '.join(no)}" if no else "") + ".")
+    return ("it has " + (", ".join(yes) or "none of the paper's observables")
+            + (f"; it lacks {', '.join(no)}" if no else "") + ".")
 
 
 def _cause_numbers(art):

@@ -1,6 +1,7 @@
 """A report as a list of blocks, rendered to Markdown and to self-contained HTML."""
 import base64
 import html
+import re
 from pathlib import Path
 
 
@@ -52,6 +53,21 @@ class Table:
 
     def __init__(self, title, header, rows):
         self.title, self.header, self.rows = title, list(header), [list(r) for r in rows]
+
+
+_LINK = re.compile(r"\[([^\]]+)\]\(([^)\s]+)\)")
+_BOLD = re.compile(r"\*\*(.+?)\*\*")
+
+
+def _inline_html(text):
+    """A sentence's Markdown links (to .md pages: their .html twins) and bold as HTML."""
+    out = html.escape(text)
+
+    def link(m):
+        href = m.group(2)
+        href = href[:-3] + ".html" if href.endswith(".md") else href
+        return f"<a href='{href}'>{m.group(1)}</a>"
+    return _BOLD.sub(r"<strong>\1</strong>", _LINK.sub(link, out))
 
 
 def _md(c):
@@ -125,9 +141,10 @@ class Document:
             if b[0] == "h":
                 out.append(f"<h{b[1]}>{e(b[2])}</h{b[1]}>")
             elif b[0] == "p":
-                out.append(f"<p>{e(b[1])}</p>")
+                out.append(f"<p>{_inline_html(b[1])}</p>")
             elif b[0] == "ul":
-                out.append("<ul>" + "".join(f"<li>{e(i)}</li>" for i in b[1]) + "</ul>")
+                out.append("<ul>" + "".join(f"<li>{_inline_html(i)}</li>" for i in b[1])
+                           + "</ul>")
             elif b[0] == "table":
                 out.append("<table><tr>" + "".join(f"<th>{e(h)}</th>" for h in b[1]) + "</tr>")
                 out += ["<tr>" + "".join(f"<td>{_html(c)}</td>" for c in r) + "</tr>"

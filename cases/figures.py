@@ -66,20 +66,26 @@ def _finish(fig, ax, path, xlabel, ylabel, title, grid_axis="both"):
     plt.close(fig)
 
 
+def _draw(ax, series, highlight, plot, markers="-s"):
+    """Each (label, data) of ``series`` through ``plot(data, fmt, **style)``: in colour with
+    ``markers`` where ``highlight`` (default: all) holds it, else a thin grey line under one
+    legend entry."""
+    grey = False
+    for label, data in series:
+        if highlight is None or label in highlight:
+            plot(data, markers, ms=4, label=label, zorder=2)
+        else:
+            plot(data, "-", color="0.75", lw=1, zorder=1,
+                 label=None if grey else "the others (close to the reference)")
+            grey = True
+
+
 def profiles(path, layers_mm, series, fem, title, highlight=None, fem_label="FEM P2 (converged)"):
-    """Layer profiles: mean outward lateral displacement per y-layer, models against FEM.
-    Models in ``highlight`` (default: all) are drawn in colour, the rest in grey, unlabelled
-    but for one legend entry."""
+    """Layer profiles: mean outward lateral displacement per y-layer, models against FEM;
+    the models in ``highlight`` (default: all) in colour, the rest in grey."""
     fig, ax = plt.subplots(figsize=(7.5, 4))
     ax.plot(fem, layers_mm, "k-o", lw=2.5, label=fem_label, zorder=3)
-    grey = False
-    for label, prof in series:
-        if highlight is None or label in highlight:
-            ax.plot(prof, layers_mm, "-s", ms=4, label=label, zorder=2)
-        else:
-            ax.plot(prof, layers_mm, "-", color="0.75", lw=1, zorder=1,
-                    label=None if grey else "the others (close to a smooth profile)")
-            grey = True
+    _draw(ax, series, highlight, lambda p, f, **kw: ax.plot(p, layers_mm, f, **kw))
     _finish(fig, ax, path, "mean outward lateral displacement [mm]", "layer y [mm]", title)
 
 
@@ -129,12 +135,13 @@ def reaction_history(path, series, fem_level, fem_transient, title, level_label)
     _finish(fig, ax, path, "time [s]", "reaction on the driven nodes [N]", title)
 
 
-def curves(path, x, fem, fem_label, series, xlabel, ylabel, title, markers="-s"):
-    """Model curves y(x) against the reference's, on one chart."""
-    fig, ax = plt.subplots(figsize=(6, 4))
-    ax.plot(x, fem, "k-o", lw=2.5, label=fem_label)
-    for label, y in series:
-        ax.plot(x, y, markers, ms=4, label=label)
+def curves(path, x, fem, fem_label, series, xlabel, ylabel, title, markers="-s",
+           highlight=None):
+    """Model curves y(x) against the reference's, on one chart; the models in ``highlight``
+    (default: all) in colour, the rest in grey."""
+    fig, ax = plt.subplots(figsize=(7.5, 4))
+    ax.plot(x, fem, "k-o", lw=2.5, label=fem_label, zorder=3)
+    _draw(ax, series, highlight, lambda y, f, **kw: ax.plot(x, y, f, **kw), markers)
     _finish(fig, ax, path, xlabel, ylabel, title)
 
 
