@@ -106,8 +106,15 @@ class Document:
         if run:
             self.ul(run)
 
-    def table(self, header, rows):
-        self.blocks.append(("table", list(header), [list(r) for r in rows]))
+    def table(self, header, rows, keys=1):
+        """A table; one wider than MAX_COLUMNS is split into several that each repeat the
+        first ``keys`` columns (what names a row)."""
+        header, rows = list(header), [list(r) for r in rows]
+        width = MAX_COLUMNS - keys
+        for k in range(keys, max(len(header), keys + 1), width):
+            cols = list(range(keys)) + list(range(k, min(k + width, len(header))))
+            self.blocks.append(("table", [header[c] for c in cols],
+                                [[r[c] for c in cols] for r in rows]))
 
     def img(self, filename, alt):
         self.blocks.append(("img", filename, alt))

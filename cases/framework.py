@@ -438,6 +438,10 @@ class Study(abc.ABC):
         """Sentences for the top of reports/index.md, computed from ``data``."""
         return []
 
+    def definitions(self):
+        """'term: definition' lines of the study's own terms, for the glossary."""
+        return []
+
     def recorded(self, metrics):
         """``(settings, data)`` as a run recorded them in ``metrics`` (its metrics.json), for
         ``pbcm run NAME --rewrite``: the report drawn again from the recorded runs after a

@@ -7,7 +7,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .document import GLOSSARY, MAX_COLUMNS, Cell, Document, Link
+from .document import GLOSSARY, Cell, Document, Link
 from .metrics import PATCH_TOL
 from .output import SWEEP_MARK
 
@@ -199,18 +199,13 @@ def index_documents(root, cases, studies=()):
           "over the meshes [smallest-largest], n of N runs; a patch test reads pass or fail at "
           f"{PATCH_TOL:g}. Colours in the HTML: "
           + ", ".join(f"{label}" for _, _, label in BANDS) + ". Quick-mode cases are marked.")
-    width = MAX_COLUMNS - 2
-    for start in range(0, len(models), width):
-        group = models[start:start + width]
-        rows = []
-        for p in pops:
-            mode = " (quick)" if data[p.case]["parameters"]["quick"] else ""
-            label = p.label + mode + (" (patch test)" if p.patch_test else "")
-            row = [Link(label, f"{p.case}/report.md", f"{p.case}/report.html")
-                   if p.primary else "", p.metric]
-            row += [_score_cell(p, m) for m in group]
-            rows.append(row)
-        doc.table(["case/bc", "metric"] + group, rows)
+    rows = []
+    for p in pops:
+        mode = " (quick)" if data[p.case]["parameters"]["quick"] else ""
+        label = p.label + mode + (" (patch test)" if p.patch_test else "")
+        rows.append([Link(label, f"{p.case}/report.md", f"{p.case}/report.html")
+                     if p.primary else "", p.metric] + [_score_cell(p, m) for m in models])
+    doc.table(["case/bc", "metric"] + models, rows, keys=2)
     for line in conclusion(pops, models):
         doc.p(line)
     doc.p("Each case folder holds metrics.json, report.md, report.html and the figures; "
@@ -257,6 +252,11 @@ def glossary_documents():
     doc = Document("pbcm glossary")
     doc.h(2, "Terms")
     doc.ul(f"{k}: {v}" for k, v in TERMS.items())
+    from .registry import studies
+    for name, study in studies().items():
+        if study.definitions():
+            doc.h(2, f"The {name} study")
+            doc.ul(study.definitions())
     doc.h(2, "Metrics")
     doc.table(["label", "name", "unit", "definition"],
               [[m.label, m.name, m.shown[0] if m.shown else m.unit, m.definition]

@@ -13,7 +13,7 @@ import numpy as np
 from model.compose import slug
 from model.mesh import write as write_mesh
 from . import costs, figures
-from .document import GLOSSARY, MAX_COLUMNS, Document, fmt
+from .document import GLOSSARY, Document, fmt
 from . import catalogue
 from . import rankings
 from .runner import jsonable
@@ -183,20 +183,13 @@ def _tables(doc, case, s, runs):
                 doc.p(f"Linear regime: the loads times {fmt(rs[0]['linear_scale'], 3)} (largest "
                       "strain of the linear reference 1e-4), each model's answer divided by "
                       "it again, against linear FEM:")
-            for part in _column_groups(shown):
-                doc.table(["model"] + [m.header for m in part],
-                          [[r["model"]] + [case.cell(m, r) for m in part] for r in rs])
+            doc.table(["model"] + [m.header for m in shown],
+                      [[r["model"]] + [case.cell(m, r) for m in shown] for r in rs])
             _finite_table(doc, case, rs)
             bad = [r for r in rs if r["static_failed"]]
             if bad:
                 doc.p("No equilibrium in the linear regime (its metrics are n/a): " + "; ".join(
                     f"{r['model']}: {r['static_failed']}" for r in bad) + ".")
-
-
-def _column_groups(metrics):
-    """The metric columns in groups that keep a table (model first) within MAX_COLUMNS."""
-    width = MAX_COLUMNS - 1
-    return [metrics[k:k + width] for k in range(0, len(metrics), width)]
 
 
 def _finite_table(doc, case, rs):

@@ -359,3 +359,19 @@ def test_the_sliding_cube_is_a_patch_test_passed_by_fem_alone(quick):
     assert runs[("six", "pbcm-variational")]["disp_rel_l2_p2"] > 10 * PATCH_TOL
     md = (quick / "report.md").read_text()
     assert "passed by fem-corotated, fem-linear, fem-neohookean; failed by" in md
+
+
+def test_a_wide_table_is_split_and_each_part_keeps_the_row_names():
+    from cases.document import MAX_COLUMNS, Document, _inline_html
+    d = Document("t")
+    d.table(["model"] + [f"m{k}" for k in range(20)], [["a"] + list(range(20))])
+    parts = [b for b in d.blocks if b[0] == "table"]
+    assert [len(b[1]) for b in parts] == [10, 10, 3]
+    assert all(b[1][0] == "model" and b[2][0][0] == "a" for b in parts)
+    assert parts[2][1] == ["model", "m18", "m19"] and parts[2][2] == [["a", 18, 19]]
+    d2 = Document("t")
+    d2.table(["case", "metric"] + list("abcdefghij"), [["c", "m"] + list(range(10))], keys=2)
+    assert [b[1][:2] for b in d2.blocks] == [["case", "metric"]] * 2
+    assert max(len(b[1]) for b in d2.blocks) <= MAX_COLUMNS
+    assert _inline_html("**A** [b](x/report.md) <c>") == (
+        "<strong>A</strong> <a href='x/report.html'>b</a> &lt;c&gt;")

@@ -12,7 +12,7 @@ from ...metrics import ALTERNATION_CLEAR
 from ...report import environment, write_study
 from ...runner import jsonable
 from . import analysis
-from .study import LINEAR_SCALE, READINGS, YARDSTICK
+from .study import LINEAR_SCALE, READINGS, YARDSTICK, short
 
 GATED = catalogue.gated("alternation_rel", "disp_rel_l2")
 
@@ -61,9 +61,11 @@ def build(out, study, s, doc):
           f"Meshes: {', '.join(s.meshes)} (Delaunay-374: the lattice's Delaunay tetrahedra, "
           "joggled by seed, flat ones dropped, non-conforming; five/six mix: conforming, 10 "
           "cells in five and 54 in six).",
-          f"Models: {len(s.models)}, each shear reading calibrated and literal (c = 1), each "
-          "with and without each normal-stress term, msm, msm with a shear term and "
-          f"{YARDSTICK} (the control: constant-strain FEM on the same tetrahedra).",
+          f"Models: {len(s.models)}: each shear reading calibrated and literal (c = 1), each "
+          "calibrated one with each normal-stress term (beside a literal shear the fit sets "
+          "the normal constant to 0), msm, msm with the variational shear at c = 1 (with c "
+          f"fitted it is 0 beside the springs) and {YARDSTICK} (the control: constant-strain "
+          "FEM on the same tetrahedra).",
           f"Bases: {', '.join(s.bcs)}; loads: the paper's push and {LINEAR_SCALE:g} of it (the "
           "linear regime). The reference: " + "; ".join(
               f"{r['bc']}/{r['load']} error estimate {fmt(r['error_estimate'])}"
@@ -119,7 +121,7 @@ def _figures(d, out, s, doc):
             if all(v is None for v in grid.values()):
                 continue
             name = f"alternation_{bc}.png"
-            figures.heatmap(out / name, models, meshes,
+            figures.heatmap(out / name, [short(m) for m in models], meshes,
                             [[grid.get((m, x)) for x in meshes] for m in models],
                             f"alternation rel, {bc} base, the paper's push (grey: n/a)",
                             "alternation rel (+: the paper's sign)", 5 * ALTERNATION_CLEAR)
@@ -133,10 +135,12 @@ def _figures(d, out, s, doc):
                      if analysis.pattern(c) in ("paper", "reversed")}
         name = f"profiles_{mesh}.png"
         layers = list(range(0, 33, 32 // (len(rows[0]["bulge_profile_mm"]) - 1)))
-        figures.profiles(out / name, layers, [(c["model"], c["bulge_profile_mm"]) for c in rows],
+        figures.profiles(out / name, layers,
+                         [(short(c["model"]), c["bulge_profile_mm"]) for c in rows],
                          rows[0]["bulge_profile_fem_mm"], f"Layer profiles on {mesh}, sliding "
                          "base, the paper's push (colour: an alternation of 0.01 or more)",
-                         highlight=deviating, fem_label="reference (neo-Hookean P2)")
+                         highlight={short(m) for m in deviating},
+                         fem_label="reference (neo-Hookean P2)")
         d.img(name, f"Layer profiles on {mesh}")
 
 
@@ -160,7 +164,7 @@ def cells_document(doc, s):
         c.h(2, f"{mesh} ({next(iter(first.values()))['tets']} tetrahedra)")
         c.table(["model"] + [f"{bc}/{load}" for bc, load in combos],
                 [["reference, mean lateral [mm]"] + [_scale(first.get(k)) for k in combos]]
-                + [[m] + [_cell(r.get(k)) for k in combos] for m, r in rows.items()])
+                + [[short(m)] + [_cell(r.get(k)) for k in combos] for m, r in rows.items()])
     return c
 
 

@@ -57,6 +57,16 @@ def model_specs(quick=False):
     return out
 
 
+def short(model):
+    """The name tables and figures use: 'pbcm-balanced +normal_edge' for a reading with a
+    normal term, 'msm +shear (c = 1)' for msm with the shear term, else the model."""
+    for r in READINGS:
+        for form in NORMAL_FORMS:
+            if model == label(f"pbcm-{r} + {form}(c=auto)"):
+                return f"pbcm-{r} +{form}"
+    return "msm +shear (c = 1)" if model == MSM_SHEAR else model
+
+
 def mesh_specs(quick=False):
     """{mesh name: (builder kind, nodes per side, seed)}: the paper-size meshes (the lattice's
     three splits, the Delaunay-374 reconstructions and the conforming five/six mixes) and the

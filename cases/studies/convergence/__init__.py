@@ -32,6 +32,9 @@ class Convergence(Study):
     def write(self, out, s, data):
         return report.write(out, self, s, data)
 
+    def definitions(self):
+        return report.definitions()
+
     def headline(self, data):
         """The conclusion of a written metrics.json, as the report opens with it."""
         p = data["parameters"]

@@ -4,7 +4,7 @@ sentence is computed from the data it is written with."""
 import numpy as np
 
 from ... import catalogue
-from ...document import Document, fmt
+from ...document import GLOSSARY, Document, fmt
 from ...report import environment, write_study
 from ...runner import jsonable
 from . import plots
@@ -44,6 +44,41 @@ def metrics_document(study, s, data):
                      **data, "gate_runs": gate_rows(data)})
 
 
+def definitions():
+    """The study's terms, for the glossary (reports/glossary.md)."""
+    return [
+        "disp error: ||u_model - u_ref|| / ||u_ref|| over all nodes and components, u_ref the "
+        "reference's displacement at the model mesh's nodes.",
+        "stiffness (reaction) ratio: model over FEM for a force (paper cube: the top force; "
+        "torsion: the torque), FEM over model for a displacement under a given load "
+        "(cantilever: the tip deflection), so that above 1 is always stiffer.",
+        "order: p of e = e_inf + C h^p observed on the three finest levels (Richardson); with "
+        "two levels log(e1 / e2) / log(h1 / h2), the order if e_inf were 0.",
+        "e_inf +- err: the extrapolated limit of the error and Roache's grid convergence index "
+        "(safety factor 1.25 with three levels or more; with two, first order assumed and "
+        "factor 3); with four levels or more the least-squares fit of all, with the larger "
+        "uncertainty.",
+        f"verdict: 'exact' when every error is below {EXACT:g} (the reference's own level: "
+        "the static solver's tolerance and the nonlinearity left at the scaled load); 'floor' when e_inf - err > 0 and e_inf > 0.2 x the finest error (a "
+        "consistency error no refinement removes); 'diverges' when the finest error exceeds "
+        "the coarsest by 10 %; 'not asymptotic' on a family whose meshes are not "
+        "self-similar (unstructured: never extrapolated) or where the extrapolated limit lies "
+        "below zero beyond its uncertainty (a limit is never below 0; a stiffness ratio's "
+        "limit never at or below 0); otherwise 'converges' (with the order when one is "
+        "observed). 'cancellation' marks a series whose error is not monotone in h or whose "
+        "stiffness ratio crosses 1: an error falling through zero is small at one level by "
+        "accident, so such a run is never on a cost front.",
+        "C_eff: 6 x 6 in Voigt order (xx, yy, zz, yz, xz, xy), engineering shear; E_i = "
+        "1 / S_ii, nu_ij = -S_ij / S_ii, G = 1 / S_44.. with S = C_eff^-1 (symmetric part); "
+        "A_U = 5 G_V / G_R + K_V / K_R - 6 (0 for isotropy); K/K and mu_k/2G: the bulk "
+        "modulus and the five deviatoric Kelvin moduli (ascending) over the target's, and "
+        "moduli err the largest relative error of the six (the isotropy criterion); asymmetry "
+        "||C_eff - C_eff^T|| / ||C_eff|| (zero for a model with an energy).",
+        "step cost: microseconds per RK4 step of the model on the run's mesh, fem-linear's "
+        "bench time interpolated log-log in the tetrahedron count times the model's step "
+        "ratio to fem-linear (medians of interleaved rounds)."]
+
+
 # ---------------------------------------------------------------------- sentences
 def _by_model(fits, models):
     return {m: [f for f in fits if f["model"] == m and f.get("verdict") in
@@ -60,12 +95,14 @@ def conclusion(s, data):
     floors = {m: [f for f in by[m] if f["verdict"] == "floor"] for m in models}
     floored = [m for m in models if floors[m]]
     out = []
-    total = len(by[models[0]]) if by[models[0]] else 0
+    # every (problem, bc, family) fitted, whatever its verdict: the denominator of each count
+    total = len({(f["case"], f["bc"], f["mesh"]) for f in data["fits"]})
     out.append(
         f"Convergence (h = {', '.join(f'{h:.3g}' for h in s.h_mm)} mm, {total} problem x mesh "
         f"family combinations): converging everywhere: {', '.join(conv) or 'none'}; stopping "
         "at a floor that no refinement removes: " + ("; ".join(
-            f"{m} in {len(floors[m])} of {len(by[m])} (median floor "
+            f"{m} in {len(floors[m])} of {total} ({len(by[m])} with a limit or a trend; "
+            "median floor "
             f"{np.median([f['e_inf'] for f in floors[m]]):.2g})" for m in floored) or "none")
         + f" (loads scaled by {s.load_scale:g}: the linear regime, so that a floor is the "
         "model's consistency error, not geometric nonlinearity).")
@@ -203,38 +240,7 @@ def build(out, study, s, data):
         f"Material E = {s.E:g} Pa, nu = {s.nu:g}.",
         "Quick mode." if s.quick else "Full mode."])
     doc.p(_reference_margin(data))
-    doc.h(2, "Definitions")
-    doc.ul([
-        "disp error: ||u_model - u_ref|| / ||u_ref|| over all nodes and components, u_ref the "
-        "reference's displacement at the model mesh's nodes.",
-        "stiffness (reaction) ratio: model over FEM for a force (paper cube: the top force; "
-        "torsion: the torque), FEM over model for a displacement under a given load "
-        "(cantilever: the tip deflection), so that above 1 is always stiffer.",
-        "order: p of e = e_inf + C h^p observed on the three finest levels (Richardson); with "
-        "two levels log(e1 / e2) / log(h1 / h2), the order if e_inf were 0.",
-        "e_inf +- err: the extrapolated limit of the error and Roache's grid convergence index "
-        "(safety factor 1.25 with three levels or more; with two, first order assumed and "
-        "factor 3); with four levels or more the least-squares fit of all, with the larger "
-        "uncertainty.",
-        f"verdict: 'exact' when every error is below {EXACT:g} (the reference's own level: "
-        "the static solver's tolerance and the nonlinearity left at the scaled load); 'floor' when e_inf - err > 0 and e_inf > 0.2 x the finest error (a "
-        "consistency error no refinement removes); 'diverges' when the finest error exceeds "
-        "the coarsest by 10 %; 'not asymptotic' on a family whose meshes are not "
-        "self-similar (unstructured: never extrapolated) or where the extrapolated limit lies "
-        "below zero beyond its uncertainty (a limit is never below 0; a stiffness ratio's "
-        "limit never at or below 0); otherwise 'converges' (with the order when one is "
-        "observed). 'cancellation' marks a series whose error is not monotone in h or whose "
-        "stiffness ratio crosses 1: an error falling through zero is small at one level by "
-        "accident, so such a run is never on a cost front.",
-        "C_eff: 6 x 6 in Voigt order (xx, yy, zz, yz, xz, xy), engineering shear; E_i = "
-        "1 / S_ii, nu_ij = -S_ij / S_ii, G = 1 / S_44.. with S = C_eff^-1 (symmetric part); "
-        "A_U = 5 G_V / G_R + K_V / K_R - 6 (0 for isotropy); K/K and mu_k/2G: the bulk "
-        "modulus and the five deviatoric Kelvin moduli (ascending) over the target's, and "
-        "moduli err the largest relative error of the six (the isotropy criterion); asymmetry "
-        "||C_eff - C_eff^T|| / ||C_eff|| (zero for a model with an energy).",
-        "step cost: microseconds per RK4 step of the model on the run's mesh, fem-linear's "
-        "bench time interpolated log-log in the tetrahedron count times the model's step "
-        "ratio to fem-linear (medians of interleaved rounds)."])
+    doc.p(f"Definitions of every term and metric: [glossary](../{GLOSSARY}).")
     doc.h(2, "Convergence")
     for name in s.problems:
         for bc in PROBLEMS[name].bcs:
