@@ -7,6 +7,7 @@ from pathlib import Path
 
 MAX_COLUMNS = 10            # a table wider than this is split (a report reads in a minute)
 GLOSSARY = "glossary.md"    # the one list of definitions, at the top of the reports folder
+CONCLUSION_LINES = 3        # a report opens with at most this many lines
 
 
 def fmt(v, digits=3):
@@ -71,7 +72,8 @@ def _inline_html(text):
 
 
 def _md(c):
-    return c.markdown() if isinstance(c, (Link, Cell)) else str(c)
+    """A Markdown table cell: a '|' inside it (|gamma|) escaped, so it cannot split the row."""
+    return (c.markdown() if isinstance(c, (Link, Cell)) else str(c)).replace("|", "\\|")
 
 
 def _html(c):
@@ -90,6 +92,16 @@ class Document:
 
     def ul(self, items):
         self.blocks.append(("ul", list(items)))
+
+    def opening(self, lines):
+        """The first CONCLUSION_LINES of ``lines`` as the report's opening paragraphs, a link
+        to the glossary, and the rest under a heading of their own."""
+        for line in lines[:CONCLUSION_LINES]:
+            self.p(line)
+        self.p(f"Definitions: [glossary](../{GLOSSARY}).")
+        if lines[CONCLUSION_LINES:]:
+            self.h(2, "More findings")
+            self.ul(lines[CONCLUSION_LINES:])
 
     def items(self, items):
         """Findings: runs of sentences as lists, each Table as its title and a table."""
@@ -129,7 +141,7 @@ class Document:
             elif b[0] == "ul":
                 out += [f"- {i}" for i in b[1]] + [""]
             elif b[0] == "table":
-                out += ["| " + " | ".join(b[1]) + " |", "|" + "---|" * len(b[1])]
+                out += ["| " + " | ".join(map(_md, b[1])) + " |", "|" + "---|" * len(b[1])]
                 out += ["| " + " | ".join(map(_md, r)) + " |" for r in b[2]] + [""]
             elif b[0] == "img":
                 out += [f"![{b[2]}]({b[1]})", ""]

@@ -52,10 +52,8 @@ def conclusion(doc):
 def build(out, study, s, doc):
     out = Path(out)
     d = Document(f"pbcm report: {study.name}")
-    for line in conclusion(doc):
-        d.p(line)
-    d.p(f"Definitions: [glossary](../{GLOSSARY}). Every cell's numbers: [cells.md](cells.md). "
-        "Regenerate with `pbcm run artefact`.")
+    d.opening(conclusion(doc))
+    d.p("Every cell's numbers: [cells.md](cells.md). Regenerate with `pbcm run artefact`.")
     d.h(2, "What was run")
     d.ul([study.title + ".",
           f"Meshes: {', '.join(s.meshes)} (Delaunay-374: the lattice's Delaunay tetrahedra, "
