@@ -185,9 +185,10 @@ def test_study_metrics_do_not_depend_on_the_workers(study, tmp_path):
         assert mine == two[key], key
 
 
-def test_index_leads_with_the_study_headline(study, tmp_path, capsys):
-    """`pbcm index` rewrites the index from the folders present: the convergence study's
-    conclusion first, then the cases' conclusion and scorecard."""
+def test_index_opens_with_the_answers_and_lists_the_study(study, tmp_path, capsys):
+    """`pbcm index` rewrites the index from the folders present: the answers first (the
+    consistency error from the convergence study's patch-test fits), their table, then the
+    studies (this one in quick mode, linked) and the scorecard; a missing case is refused."""
     from cases.registry import CASES
     for name in CASES:
         (tmp_path / name).symlink_to(ROOT / "reports" / name, target_is_directory=True)
@@ -195,8 +196,13 @@ def test_index_leads_with_the_study_headline(study, tmp_path, capsys):
     assert main(["index", "--out", str(tmp_path)]) == 0
     md = (tmp_path / "index.md").read_text()
     first = md.split("\n\n")[1]
-    assert first.startswith("**convergence (quick mode)**") and "Convergence (h = 8, 4 mm" in first
-    assert md.index("Convergence (h =") < md.index("## Scorecard")
+    assert first.startswith("**Which reading?** Not computed: run `pbcm run artefact`.")
+    assert "**How far from the continuum?** Consistency error" in md
+    assert md.index("**How far") < md.index("| model | consistency error") \
+        < md.index("## Studies") < md.index("## Scorecard")
+    assert "| [convergence](convergence/report.md) |" in md and "| quick |" in md
+    assert len(md.split("| model | consistency error")[0].split()) < 300
+    assert (tmp_path / "glossary.md").is_file()
     (tmp_path / "torsion").unlink()
     assert main(["index", "--out", str(tmp_path)]) == 2
     assert "lacks the metrics.json of torsion" in capsys.readouterr().err

@@ -68,9 +68,10 @@ def test_quick_case_writes_report_and_finite_metrics(library, name):
         for v in floats_in(r):
             assert math.isfinite(v)
     md = (out / "report.md").read_text()
-    # three lines of conclusion before anything else
-    head = md.split("## ")[0].strip().splitlines()[1:]
-    assert len([line for line in head if line.strip()]) >= 4   # conclusion + provenance
+    # at most three lines of conclusion, then the glossary's link, before anything else
+    head = [line for line in md.split("## ")[0].strip().splitlines()[1:] if line.strip()]
+    assert 2 <= len(head) <= 5 and any("[glossary](../glossary.md)" in line for line in head)
+    assert "## Definitions" not in md                           # one glossary for all
     assert "## Findings" in md and "### " in md                # grouped findings
     for img in [line.split("](")[1].rstrip(")") for line in md.splitlines()
                 if line.startswith("![")]:
@@ -205,8 +206,10 @@ def test_cantilever_metrics_carry_the_issue_fields(library):
 def test_scorecard_index(library):
     from cases.index import index_documents
     md, html = index_documents(library, list(CASES))
-    lines = md.split("## Scorecard")[0].strip().splitlines()
-    assert len([line for line in lines[1:] if line.strip()]) == 5
+    assert md.split("\n\n")[1].startswith("**Which reading?**")
+    answers = md.split("## Scorecard")[0]
+    assert all(f"| {m} |" in answers for m in json.loads(
+        (library / "paper-cube" / "metrics.json").read_text())["parameters"]["models"])
     # one row per population: each case's first boundary condition links its report
     assert all(f"[{name}/" in md and f"({name}/report.md)" in md for name in CASES)
     assert "(quick)" in md
