@@ -130,7 +130,7 @@ def lines(root, models):
                    + " ([bench](bench/bench.md)).")
     if art:
         out.append(f"**What causes the bulge/neck?** {art['answer']['cause'][0].upper()}"
-                   f"{art['answer']['cause'][1:]}: {_cause_numbers(art)}")
+                   f"{art['answer']['cause'][1:]}. {_cause_numbers(art)}")
     return out
 
 
@@ -152,9 +152,9 @@ def _decisive(art):
 def _cause_numbers(art):
     a = art["answer"]
     five, other, msm = a["five"], a["other_splits"], a["msm"]
-    return (f"the layers alternate in {five[0]} of {five[1]} cells on the mirrored five split "
-            f"and in {other[0]} of {other[1]} on the others; in {msm[0]} of {msm[1]} of msm's, "
-            "whose forces are all normal.")
+    return (f"The layers alternate in {five[0]} of {five[1]} cells on the mirrored five split "
+            f"and in {other[0]} of {other[1]} on the other splits; in {msm[0]} of {msm[1]} of "
+            "msm's, whose forces are all normal ([artefact study](artefact/report.md)).")
 
 
 __all__ = ["lines", "table"]

@@ -70,3 +70,26 @@ def floats_in(x):
             yield from floats_in(v)
     elif isinstance(x, float):
         yield x
+
+
+@pytest.fixture(scope="session")
+def library(tmp_path_factory, quick):
+    """Every case of the library run in quick mode into one folder, with the paper cube's
+    quick run beside them (as `pbcm report --quick` would write them)."""
+    from cases.cli import main
+    from cases.registry import CASES
+    root = tmp_path_factory.mktemp("library")
+    for name in CASES:
+        if name != "paper-cube":
+            assert main(["run", name, "--quick", "--out", str(root / name)]) == 0
+    (root / "paper-cube").symlink_to(quick, target_is_directory=True)
+    return root
+
+
+@pytest.fixture(scope="session")
+def quick_artefact(tmp_path_factory):
+    """`pbcm run artefact --quick`, once per test session."""
+    from cases.cli import main
+    out = tmp_path_factory.mktemp("artefact") / "artefact"
+    assert main(["run", "artefact", "--quick", "--out", str(out)]) == 0
+    return out

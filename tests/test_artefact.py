@@ -4,7 +4,6 @@ gold with the controls that must hold whatever the models do."""
 import json
 from pathlib import Path
 
-import pytest
 
 from cases.studies.artefact import analysis
 
@@ -90,14 +89,6 @@ def test_the_reading_verdict_counts_the_papers_observables_and_its_margin():
     tie = analysis.reading_verdict(analysis.reading_table(cells, {"a": 8.0, "b": 12.0},
                                                           ["a", "b"]))
     assert tie["sure"] == "weak" and tie["model"] == "a"     # pattern and stability: 2 to 1
-
-
-@pytest.fixture(scope="module")
-def quick_artefact(tmp_path_factory):
-    from cases.cli import main
-    out = tmp_path_factory.mktemp("artefact") / "artefact"
-    assert main(["run", "artefact", "--quick", "--out", str(out)]) == 0
-    return out
 
 
 def test_the_quick_study_holds_its_gold_and_its_controls(quick_artefact, capsys):

@@ -25,17 +25,6 @@ BASELINE = Path(__file__).parent / "data" / "paper_cube_quick_before_framework.j
 LIBRARY = [name for name in CASES if name != "paper-cube"]   # the paper cube: `quick`
 
 
-@pytest.fixture(scope="session")
-def library(tmp_path_factory, quick):
-    """Every case of the library run in quick mode into one folder, with the paper cube's
-    quick run beside them (as `pbcm report --quick` would write them)."""
-    root = tmp_path_factory.mktemp("library")
-    for name in LIBRARY:
-        assert main(["run", name, "--quick", "--out", str(root / name)]) == 0
-    (root / "paper-cube").symlink_to(quick, target_is_directory=True)
-    return root
-
-
 def test_every_case_declares_the_contract():
     for name, case in CASES.items():
         assert isinstance(case, Case) and case.name == name
