@@ -96,13 +96,15 @@ def lines(root, models):
     out = []
     if art and art["verdict"]["sure"] == "undecided":
         v = art["verdict"]
-        out.append(f"**Which reading?** Undecided between {' and '.join(v['tied'])} "
-                   f"([artefact study](artefact/report.md)): {v['model']} "
-                   f"{_decisive(art)}")
+        out.append(f"**Which reading?** Undecided between {', '.join(v['tied'])} "
+                   f"([artefact study](artefact/report.md)): "
+                   + ("each " if len({json.dumps(r["matches"], sort_keys=True)
+                                      for r in art["readings"] if r["model"] in v["tied"]}) == 1
+                      else f"{v['model']} ") + _decisive(art))
     elif art:
         v = art["verdict"]
         out.append(f"**Which reading?** {v['model']} ({v['sure']} verdict, "
-                   f"[artefact study](artefact/report.md)): {_decisive(art)}")
+                   f"[artefact study](artefact/report.md)): it {_decisive(art)}")
     else:
         out.append("**Which reading?** Not computed: run `pbcm run artefact`.")
     if conv:
@@ -145,8 +147,8 @@ def _decisive(art):
             "cost": "a step over 10x msm's", "stable": "no flutter"}
     yes = [said[k] for k, v in best["matches"].items() if v]
     no = [said[k] for k, v in best["matches"].items() if not v]
-    return ("it has " + (", ".join(yes) or "none of the paper's observables")
-            + (f"; it lacks {', '.join(no)}" if no else "") + ".")
+    return ("has " + (", ".join(yes) or "none of the paper's observables")
+            + (f"; lacks {', '.join(no)}" if no else "") + ".")
 
 
 def _cause_numbers(art):

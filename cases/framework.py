@@ -434,10 +434,6 @@ class Study(abc.ABC):
         """Write metrics.json (with ``gate_runs``: rows keyed by mesh, bc and model, and
         ``gated``), the report and the figures into the folder ``out``."""
 
-    def headline(self, data):
-        """Sentences for the top of reports/index.md, computed from ``data``."""
-        return []
-
     def definitions(self):
         """'term: definition' lines of the study's own terms, for the glossary."""
         return []

@@ -86,6 +86,10 @@ def test_the_reading_verdict_counts_the_papers_observables_and_its_margin():
     v = analysis.reading_verdict(table)
     assert (v["model"], v["sure"], v["margin"]) == ("a", "clear", 3)
     assert table[0]["consistency_median"] == 0.05 and table[1]["flutter"] == [1, 1]
+    # on a mesh where the FEM control alternates too, a model's pattern is not resolved
+    fem = cell("d", "Delaunay-374", "fem-linear", -0.02, family="fem", paper_size=True)
+    blind = analysis.reading_table(cells + [fem], {"a": 12.0, "b": 8.0}, ["a", "b"])
+    assert blind[0]["pattern"] == [0, 0] and blind[0]["score"] == 2
     tie = analysis.reading_verdict(analysis.reading_table(cells, {"a": 8.0, "b": 12.0},
                                                           ["a", "b"]))
     assert tie["sure"] == "weak" and tie["model"] == "a"     # pattern and stability: 2 to 1

@@ -27,9 +27,6 @@ class Artefact(Study):
     def write(self, out, s, data):
         return report.write(out, self, s, data)
 
-    def headline(self, data):
-        return report.conclusion(data)
-
     def recorded(self, metrics):
         p = metrics["parameters"]
         s = self.settings(quick=p["quick"], E=p["E_Pa"], nu=p["nu"], rho=p["rho_kg_m3"])

@@ -174,12 +174,17 @@ def _pct(x):
 
 def reading_table(cells, step_vs_msm, readings):
     """One row per reading (calibrated and literal): the paper's observables on the paper-size
-    meshes and how many it matches."""
+    meshes and how many it matches; the pattern is read only on meshes where the FEM control
+    does not alternate (elsewhere the mesh cannot tell a model's pattern from its own)."""
+    # where the FEM control alternates the mesh itself makes a pattern: no model's is resolved
+    unresolved = {(c["mesh"], c["bc"], c["load"]) for c in cells
+                  if c["family"] == "fem" and alternating(c)}
     rows = []
     for model in readings:
         mine = [c for c in cells if c["model"] == model and c["paper_size"]]
         sliding = [c for c in mine if c["bc"] == "sliding" and c["load"] == "paper"
-                   and pattern(c) is not None]
+                   and pattern(c) is not None
+                   and (c["mesh"], c["bc"], c["load"]) not in unresolved]
         shows = sum(pattern(c) == "paper" for c in sliding)
         clamped = {c["mesh"]: c for c in mine if c["bc"] == "clamped"}
         rates = [c["growth_rate_1_s"] for c in clamped.values()

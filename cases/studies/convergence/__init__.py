@@ -35,15 +35,6 @@ class Convergence(Study):
     def definitions(self):
         return report.definitions()
 
-    def headline(self, data):
-        """The conclusion of a written metrics.json, as the report opens with it."""
-        p = data["parameters"]
-        s = ConvergenceSettings(E=p["E_Pa"], nu=p["nu"], rho=p["rho_kg_m3"],
-                                problems=tuple(p["problems"]), meshes=tuple(p["meshes"]),
-                                models=tuple(p["models"]), h_mm=tuple(p["h_mm"]),
-                                load_scale=p["load_scale"], patch_n=p["patch_n"],
-                                quick=p["quick"])
-        return report.conclusion(s, data)
 
 
 STUDY = Convergence()

@@ -7,7 +7,7 @@ from ... import catalogue
 from ...document import Document, fmt
 from ...report import environment, write_study
 from ...runner import jsonable
-from . import plots
+from .plots import directional_young, error_vs_h, pareto
 from .elasticity import ANGLES_DEG, PATCH_MM
 from .problems import PROBLEMS
 from .fit import EXACT
@@ -298,7 +298,7 @@ def _problem_section(doc, out, s, data, name, bc):
                            else f"n/a ({f.get('ratio_why') or 'no ratio'})"])
     doc.table(header, rows)
     png = f"convergence_{name}_{bc}.png"
-    plots.error_vs_h(out / png, f"{name}, {bc}: displacement error against h",
+    error_vs_h(out / png, f"{name}, {bc}: displacement error against h",
                      list(s.meshes), list(s.models), series, FEM_P1)
     doc.img(png, f"{name}, {bc}: error against h, per mesh family (FEM P1 in black)")
 
@@ -323,7 +323,7 @@ def _elasticity_section(doc, out, s, data):
                                                   for e in failed) + ".")
     doc.h(3, "What the tensors explain")
     doc.ul(ties(s, data))
-    plots.directional_young(out / "directional_young.png", ANGLES_DEG, list(s.meshes),
+    directional_young(out / "directional_young.png", ANGLES_DEG, list(s.meshes),
                             list(s.models), {(e["mesh"], e["model"]): e["E_xy_plane"]
                                              for e in eff}, s.E)
     doc.img("directional_young.png", "Directional Young's modulus per lattice and model")
@@ -355,7 +355,7 @@ def _cost_section(doc, out, s, data):
           "in h, or its stiffness ratio crossing 1) is never on the front nor the cheapest.")
     doc.table(["problem", "runs", "front", f"cheapest with e <= {BUDGETS[0]:g}",
                f"cheapest with e <= {BUDGETS[1]:g}"], rows)
-    plots.pareto(out / "pareto.png", c["groups"], list(s.models), EXACT)
+    pareto(out / "pareto.png", c["groups"], list(s.models), EXACT)
     doc.img("pareto.png", "Error against the cost of one RK4 step, with the Pareto front "
             f"(errors below {EXACT:g}, exact, drawn on the dotted line)")
 

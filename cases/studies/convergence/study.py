@@ -17,7 +17,8 @@ from ...store import OFF, key
 from ...framework import MESH_FAMILIES
 from ...runner import FINDINGS, free_components, jsonable
 from ...workers import one_blas_thread
-from . import cost, elasticity
+from .cost import accuracy_per_cost
+from .elasticity import table as elasticity_table
 from .fit import EXACT, cancellation, fit, observed_order, ratio_limit
 from .problems import PROBLEMS
 
@@ -398,14 +399,14 @@ def run(s, workers=None, log=True, bench=None, store=OFF):
                                             " ".join(jobs[i][:3])),
                     [weights[name][fam] for name, _, fam, *_ in jobs])
         with one_blas_thread():
-            eff = elasticity.table(s, store)
+            eff = elasticity_table(s, store)
         track.advance(elastic_weight, "effective elasticity")
     runs = [r for rs in rows for r in rs]
     fitted = fits(runs)
     cancelling = {(f["case"], f["mesh"], f["bc"], f["model"]) for f in fitted
                   if f.get("cancellation")}
     data = {"runs": runs, "fits": fitted, "references": [ref.summary() for ref in refs],
-            "elasticity": eff, "cost": cost.accuracy_per_cost(runs, bench, EXACT, cancelling)}
+            "elasticity": eff, "cost": accuracy_per_cost(runs, bench, EXACT, cancelling)}
     return jsonable(data)
 
 

@@ -29,9 +29,6 @@ class Extensions(Study):
     def write(self, out, s, data):
         return report.write(out, self, s, data)
 
-    def headline(self, data):
-        return report.conclusion(data)
-
     def recorded(self, metrics):
         p = metrics["parameters"]
         s = self.settings(quick=p["quick"], models=tuple(p["models"]), E=p["E_Pa"], nu=p["nu"],
