@@ -148,7 +148,9 @@ DESCRIPTORS = frozenset({
     "finite_failed",
     # the artefact study's factors: the mesh split and size, the model's parts, the load
     "split", "nodes_per_side", "unmatched_faces", "paper_size", "load", "family", "reading",
-    "constant", "normal", "flutter"})
+    "constant", "normal", "flutter",
+    # the truth-cube study's factors: the plate assumption, the measured state
+    "variant", "plates", "travel", "nu", "state", "strain"})
 
 # ---------------------------------------------------------------- the standard static metrics
 declare("disp_rel_l2_p1", "1", "disp L2 P1",
@@ -365,6 +367,37 @@ declare("homogeneous_force_law_n_steps", "N", "neo-Hookean law force(steps)",
 declare("homogeneous_force_dev_max", "1", "law deviation",
          "the largest |F_model / F_law - 1| of the homogeneous compression over the steps: "
          "how far the model's own law is from neo-Hookean (a constitutive check, not ranked).")
+
+# ---------------------------------------------------------------- the Truth Cube: measured beads
+declare("bead_rms_mm", "mm", "bead RMS",
+        "RMS over the 343 measured beads of |u_model - u_measured| at one measured state, the "
+        "measurement's rigid in-plane motion removed (the model at the rest bead positions: "
+        "P1 on its mesh, a FEM reference by its own basis).", "max")
+declare("bead_max_mm", "mm", "bead max",
+        "the largest |u_model - u_measured| over the beads.", "max")
+declare("bead_axial_rms_mm", "mm", "bead axial RMS",
+        "RMS over the beads of the axial (z, the compression's) component of the error.",
+        "max")
+declare("bead_lateral_rms_mm", "mm", "bead lateral RMS",
+        "RMS over the beads of the length of the lateral (x, y) part of the error.", "max")
+declare("bead_rms_rel", "1", "bead RMS rel",
+        "bead RMS over the RMS measured displacement |u_measured|.", "max")
+declare("bead_axial_rel", "1", "bead axial rel",
+        "bead axial RMS over the RMS measured axial displacement.", "max")
+declare("bead_lateral_rel", "1", "bead lateral rel",
+        "bead lateral RMS over the RMS measured lateral displacement.", "max")
+declare("bead_raw_rms_mm", "mm", "bead RMS raw",
+        "bead RMS against the measurement as scanned (its rigid in-plane motion kept).")
+declare("layer_axial_mm", "mm", "layer axial",
+        "the mean axial displacement of each bead layer k = 1..7 (1 at the fixed plate).")
+declare("layer_lateral_mm", "mm", "layer lateral",
+        "the mean outward lateral displacement of each layer's 24 outer beads (the barrel).")
+declare("travel_mm", "mm", "travel",
+        "the moving plate's travel at the state (nominal strain x 80 mm, or fitted).",
+        digits=4)
+declare("error_estimate", "1", "reference estimate",
+        "a reference's own error estimate: its relative change over the last refinement, "
+        "Richardson-extrapolated where an order can be observed.")
 
 # ---------------------------------------------------------------- convergence and extensions
 declare("response", "1", "response",

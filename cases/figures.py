@@ -151,3 +151,33 @@ def loglog(path, series, xlabel, ylabel, title):
     for label, x, y in series:
         ax.loglog(x, y, "-o", ms=3, label=label)
     _finish(fig, ax, path, xlabel, ylabel, title)
+
+
+def measured_layers(path, layers, columns, title, highlight=None):
+    """Measured against modelled quantities per bead layer: one column per entry of
+    ``columns`` = (column title, rows), each row (ylabel, measured, floor, references,
+    models): the measurement with its noise (``floor``) as error bars, the references ((label, values))
+    in black, the models ((label, values)) in colour where ``highlight`` holds them (default:
+    all), else grey. ``layers`` the layer positions on the x axis."""
+    n_rows = len(columns[0][1])
+    fig, axes = plt.subplots(n_rows, len(columns), figsize=(3.3 * len(columns) + 2.4,
+                                                            2.9 * n_rows), squeeze=False)
+    for c, (column, rows) in enumerate(columns):
+        for r, (ylabel, measured, floor, references, models) in enumerate(rows):
+            ax = axes[r][c]
+            ax.errorbar(layers, measured, yerr=floor, fmt="ko", ms=5, capsize=3, zorder=4,
+                        label="measured (bars: its noise)")
+            for (label, values), style in zip(references, ("k-", "k--", "k:")):
+                ax.plot(layers, values, style, lw=1.6, label=label, zorder=3)
+            _draw(ax, models, highlight, lambda v, f, **kw: ax.plot(layers, v, f, **kw))
+            ax.set_title(column if r == 0 else "", fontsize=9)
+            ax.set_ylabel(ylabel if c == 0 else "", fontsize=8)
+            ax.set_xlabel("bead layer k (1: fixed plate)" if r == n_rows - 1 else "",
+                          fontsize=8)
+            ax.grid(alpha=0.3)
+    handles, labels = axes[0][0].get_legend_handles_labels()
+    fig.legend(handles, labels, fontsize=7, loc="upper left", bbox_to_anchor=(0.79, 0.95))
+    fig.suptitle(title, fontsize=10)
+    fig.tight_layout(rect=(0, 0, 0.78, 0.95))
+    fig.savefig(path, dpi=90)
+    plt.close(fig)

@@ -16,6 +16,7 @@ STUDY_MODULES = {
     "convergence": "cases.studies.convergence",
     "extensions": "cases.studies.extensions",
     "artefact": "cases.studies.artefact",
+    "truth-cube": "cases.studies.truthcube",
 }
 
 CASES = {name: importlib.import_module(module).CASE for name, module in MODULES.items()}

@@ -64,6 +64,24 @@ def bc_arrays(bc, n_nodes):
     return mask, vals
 
 
+def load_fractions(load_steps):
+    """The load fractions of ``load_steps``: k / n for an int n, or the given increasing
+    fractions in (0, 1] ending at 1 (steps of unequal size, e.g. to stop at measured states)."""
+    if isinstance(load_steps, (int, np.integer)) and not isinstance(load_steps, bool):
+        if load_steps < 1:
+            raise ModelError(f"load_steps must be a positive integer, got {load_steps!r}")
+        return np.arange(1, load_steps + 1) / load_steps
+    try:
+        f = np.asarray(load_steps, dtype=float).ravel()
+    except (TypeError, ValueError):
+        f = np.array([np.nan])
+    if f.size == 0 or not np.all(np.isfinite(f)) or f[0] <= 0 or np.any(np.diff(f) <= 0) \
+            or f[-1] != 1.0:
+        raise ModelError(f"load_steps must be a positive integer or increasing fractions in "
+                         f"(0, 1] ending at 1, got {load_steps!r}")
+    return f
+
+
 class Ramp:
     """A ``bc_of_t``: ``nodes`` move linearly to ``displacement`` (ux, uy, uz; None for free)
     over ``t_ramp`` seconds and then hold; ``fixed`` nodes stay at zero and ``held`` (a bc

@@ -147,6 +147,36 @@ class TetMesh:
         tol = 1e-6 * self.size if tol is None else tol
         return self.nodes_where(lambda p: np.abs(p[:, ax] - value) <= tol)
 
+    def locate(self, points, candidates=32):
+        """``(tets, bary)``: for each of ``points`` (k, 3) [m] at rest, the tetrahedron that
+        holds it and its barycentric coordinates (k, 4) there, so that a nodal field u is
+        ``(bary[:, :, None] * u[tets_nodes]).sum(1)``: P1 interpolation (see
+        :meth:`interpolate`). The ``candidates`` tetrahedra with the nearest centroids are
+        tried; a point in none of them is outside the mesh, an error."""
+        pts = np.asarray(points, float).reshape(-1, 3)
+        centroids = self.points[self.tets].mean(axis=1)
+        _, near = cKDTree(centroids).query(pts, k=min(candidates, self.n_tets))
+        near = near.reshape(len(pts), -1)
+        corners = self.points[self.tets[near]]                   # (k, c, 4, 3)
+        # solve [x1-x0, x2-x0, x3-x0] l = p - x0 for every candidate
+        A = np.swapaxes(corners[:, :, 1:] - corners[:, :, :1], -1, -2)
+        lam = np.linalg.solve(A, (pts[:, None, :] - corners[:, :, 0])[..., None])[..., 0]
+        bary = np.concatenate([1 - lam.sum(-1, keepdims=True), lam], axis=-1)
+        worst = bary.min(axis=-1)                                # >= 0 inside
+        pick = worst.argmax(axis=1)
+        rows = np.arange(len(pts))
+        outside = np.flatnonzero(worst[rows, pick] < -1e-9)
+        if outside.size:
+            raise MeshError(f"points {_first(outside)} are outside the mesh (first at "
+                            f"{pts[outside[0]].tolist()} m); give points inside it at rest")
+        return near[rows, pick], bary[rows, pick]
+
+    def interpolate(self, u, located):
+        """The nodal field ``u`` (n, d) at the points ``located`` = :meth:`locate`'s answer,
+        by the P1 basis of the holding tetrahedron."""
+        tets, bary = located
+        return np.einsum("kj,kjd->kd", bary, np.asarray(u)[self.tets[tets]])
+
 
 # ---------------------------------------------------------------- structured generators
 

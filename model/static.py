@@ -6,7 +6,7 @@ import numpy as np
 import scipy.sparse as sp
 from scipy.sparse.linalg import splu
 
-from .bc import bc_arrays
+from .bc import bc_arrays, load_fractions
 from .errors import ConvergenceError, DegenerateTetError, ModelError
 
 
@@ -110,11 +110,13 @@ def force_scale(model):
     return model.material.E * h * h
 
 
-def solve(model, bc, f_ext=None, rtol=RTOL, max_iter=50, load_steps=1):
+def solve(model, bc, f_ext=None, rtol=RTOL, max_iter=50, load_steps=1, on_step=None):
     """Solve f_int(x) + f_ext = 0 on the free components, prescribed ones set from ``bc``.
 
     Newton with a backtracking line search on the residual norm, in ``load_steps`` equal
-    increments of the prescribed displacement and of ``f_ext``; converged when the largest
+    increments of the prescribed displacement and of ``f_ext`` (or at the load fractions
+    ``load_steps`` lists, see ``model.bc.load_fractions``); ``on_step(step, x)``, when given, is
+    called with the positions after every converged step; converged when the largest
     free-node residual is below ``rtol * E h^2``. A step first tries the last factorised
     Jacobian (a chord step) and keeps it when it divides the residual by CHORD_GAIN, which
     saves the finite-difference Jacobian and its factorisation in the last iterations.
@@ -135,8 +137,9 @@ def solve(model, bc, f_ext=None, rtol=RTOL, max_iter=50, load_steps=1):
     def residual(x, s):
         return (model.forces(x) + s * f_ext).ravel()
 
-    for step in range(1, load_steps + 1):
-        s = step / load_steps
+    fractions = load_fractions(load_steps)
+    load_steps = len(fractions)
+    for step, s in enumerate(fractions, start=1):
         x[mask] = mesh.points[mask] + s * vals[mask]
         try:
             r = residual(x, s)
@@ -181,6 +184,8 @@ def solve(model, bc, f_ext=None, rtol=RTOL, max_iter=50, load_steps=1):
                 f"static solve did not converge in {max_iter} Newton iterations at load step "
                 f"{step}/{load_steps}: residual {rn:.3e} N > tol {tol:.3e} N; increase "
                 "load_steps or max_iter")
+        if on_step is not None:
+            on_step(step, x.copy())
     reaction = np.where(mask, -r.reshape(-1, 3), 0.0)
     return StaticResult(x=x, u=x - mesh.points, reaction=reaction,
                         residual=float(np.abs(r[free]).max(initial=0.0)), tol=tol,

@@ -143,10 +143,11 @@ class ParticleModel:
             self._jacobian_pattern = static.JacobianPattern(self.mesh)
         return static.jacobian(self.forces, self.mesh, x, self._jacobian_pattern)
 
-    def solve_static(self, bc, f_ext=None, rtol=static.RTOL, max_iter=50, load_steps=1):
+    def solve_static(self, bc, f_ext=None, rtol=static.RTOL, max_iter=50, load_steps=1,
+                     on_step=None):
         """Equilibrium f_int(x) + f_ext = 0 on the free components (see model.static.solve)."""
         return static.solve(self, bc, f_ext=f_ext, rtol=rtol, max_iter=max_iter,
-                            load_steps=load_steps)
+                            load_steps=load_steps, on_step=on_step)
 
     def simulate(self, bc_of_t, t_end, dt=None, damping=0.0, f_ext=None, frames=101, safety=0.5,
                  x0=None, v0=None, t0=0.0):

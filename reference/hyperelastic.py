@@ -14,7 +14,7 @@ import scipy.sparse as sp
 from scipy.optimize import brentq
 from skfem import Basis, ElementTetP1, FacetBasis
 
-from model.bc import bc_arrays
+from model.bc import bc_arrays, load_fractions
 from model.errors import ConvergenceError, ModelError
 from ._neohookean import neohookean
 from .assembly import scalar_gradients
@@ -46,11 +46,16 @@ class HyperelasticResult:
     energy: float = 0.0
     basis: object = field(default=None, repr=False)
     dofs: np.ndarray = field(default=None, repr=False)
+    kept: dict = field(default_factory=dict, repr=False)
 
-    def at(self, points):
+    def at(self, points, step=None):
         """The displacement (k, 3) at arbitrary ``points`` (k, 3) inside the mesh, by the
-        solution's own basis (what compares it with results on another mesh)."""
-        return probe(self.basis, self.dofs, points)
+        solution's own basis (what compares it with results on another mesh): at the end,
+        or at load ``step`` when the solve kept it (``keep_steps``)."""
+        if step is not None and step not in self.kept:
+            raise ModelError(f"load step {step} was not kept: pass keep_steps=[{step}] to "
+                             f"solve (kept: {sorted(self.kept)})")
+        return probe(self.basis, self.dofs if step is None else self.kept[step], points)
 
 
 class Discretisation:
@@ -117,10 +122,12 @@ class Discretisation:
 
 
 def solve(mesh, E, nu, dirichlet, body_force=None, element="P1", refine=0, dirichlet_fn=None,
-          load_steps=1, rtol=1e-10, max_iter=30, on_step=None, mixed=False, traction=None):
+          load_steps=1, rtol=1e-10, max_iter=30, on_step=None, mixed=False, traction=None,
+          keep_steps=()):
     """Neo-Hookean equilibrium on ``mesh`` (a model.mesh.TetMesh) refined ``refine`` times.
 
-    Newton in ``load_steps`` equal increments of the prescribed displacement, body force and
+    Newton in ``load_steps`` equal increments (or at the load fractions it lists, as
+    ``model.bc.load_fractions`` reads them) of the prescribed displacement, body force and
     ``traction`` (a dead load: force per reference area, the callable
     ``reference.linear.solve`` takes),
     each converged to max |residual| <= rtol * E h^2 (h the mean edge of the solved mesh; the
@@ -129,15 +136,16 @@ def solve(mesh, E, nu, dirichlet, body_force=None, element="P1", refine=0, diric
     ``dirichlet`` and ``dirichlet_fn`` as ``reference.linear.solve`` takes them.
     ``on_step(step, u, reaction)``, when given, is called after every converged step with the
     nodal displacement (n, 3) and reaction (n, 3) at that load (a force-displacement curve in
-    one solve)."""
+    one solve). The displacement dofs of the steps in ``keep_steps`` are kept, for
+    ``HyperelasticResult.at(points, step)``."""
     lam, mu = lame(E, nu)
     if mixed and element != "P2":
         raise ModelError(f"the mixed (u, p) form is Taylor-Hood P2/P1: pass element='P2', got "
                          f"{element!r}")
     if int(refine) != refine or refine < 0:
         raise ModelError(f"refine must be a non-negative integer, got {refine!r}")
-    if int(load_steps) != load_steps or load_steps < 1:
-        raise ModelError(f"load_steps must be a positive integer, got {load_steps!r}")
+    fractions = load_fractions(load_steps)
+    load_steps = len(fractions)
     mask, vals = bc_arrays(dirichlet, mesh.n_nodes)
     if not mask.any():
         raise ModelError("no Dirichlet condition: the problem is singular; prescribe nodes")
@@ -163,8 +171,8 @@ def solve(mesh, E, nu, dirichlet, body_force=None, element="P1", refine=0, diric
     target = np.zeros(d.N)
     target[D] = x_D[D]
     iters = 0
-    for step in range(1, load_steps + 1):
-        s = step / load_steps
+    kept = {}
+    for step, s in enumerate(fractions, start=1):
         for _ in range(max_iter):
             res, K, _ = d.evaluate(x)
             res -= s * f_body
@@ -187,6 +195,8 @@ def solve(mesh, E, nu, dirichlet, body_force=None, element="P1", refine=0, diric
             raise ConvergenceError(f"neo-Hookean Newton did not converge in {max_iter} "
                                    f"iterations at load step {step}/{load_steps}: residual "
                                    f"{rn:.3e} N (pressure {rp:.3e} m^3); increase load_steps")
+        if step in keep_steps:
+            kept[step] = x[:ub.N].copy()
         if on_step is not None:
             on_step(step, x[ub.nodal_dofs[:, :mesh.n_nodes]].T,
                     transfer_to_nodes(ub, W, D, res[D]))
@@ -199,7 +209,7 @@ def solve(mesh, E, nu, dirichlet, body_force=None, element="P1", refine=0, diric
     return HyperelasticResult(
         u=check_finite("displacement", u_all[ub.nodal_dofs[:, :mesh.n_nodes]].T.copy()),
         stress=stress, von_mises=vm, max_shear=tmax, pressure=p, reaction=reaction,
-        iterations=iters, energy=float(energy), basis=ub, dofs=u_all,
+        iterations=iters, energy=float(energy), basis=ub, dofs=u_all, kept=kept,
         info={"element": element, "mixed": bool(mixed), "refine": int(refine),
               "dofs": int(d.N), "load_steps": int(load_steps)})
 

@@ -1,0 +1,328 @@
+"""The Truth Cube study's files: metrics.json (every row, the references, the data's numbers, the
+rows the gate reads), report.md/.html (the answer, the data and its floor, the errors per
+strain and model, the sensitivity to the plates, the travel and nu, figures by layer). Every
+sentence is computed from the rows it is written with."""
+from pathlib import Path
+
+import numpy as np
+
+from ... import catalogue, figures
+from ...document import Document, fmt
+from ...report import environment, write_study
+from ...runner import jsonable
+from .beads import WITHIN, excess, within
+from .study import LINEAR, NH, REF_MESH
+
+GATED = catalogue.gated("bead_axial_rms_mm", "bead_lateral_rms_mm")
+DEFAULT = "bonded"
+COMPONENTS = (("total", "bead_rms_mm"), ("axial", "bead_axial_rms_mm"),
+              ("lateral", "bead_lateral_rms_mm"))
+
+
+def percent(strain):
+    return f"{100 * strain:g} %"
+
+
+def gate_rows(rows):
+    return [{"mesh": r["mesh"], "bc": f"{r['variant']}/{percent(r['strain'])}",
+             "model": r["model"], **{k: r.get(k) for k in GATED}} for r in rows]
+
+
+def floors(data):
+    """{state: {"total"|"axial"|"lateral": floor [mm]}}."""
+    return {s["state"]: s["floor_mm"] for s in data["states"]}
+
+
+def verdicts(rows, data):
+    """{(mesh, variant, model): [(state, within?) ...]}: a run reproduces a state when its
+    total, axial and lateral RMS errors each lie within the floor (``beads.within``)."""
+    fl = floors(data)
+    out = {}
+    for r in rows:
+        ok = None if r.get("failed") else all(within(r[k], fl[r["state"]][c])
+                                              for c, k in COMPONENTS)
+        out.setdefault((r["mesh"], r["variant"], r["model"]), []).append((r["state"], ok))
+    return out
+
+
+def departure(states, strains):
+    """A run's answer in words: within the floor at every state, from the first, or up to the
+    strain at which it departs."""
+    oks = [ok for _, ok in states]
+    if any(ok is None for ok in oks):
+        return "failed"
+    if all(oks):
+        return "within the floor at every state"
+    first = next(i for i, ok in enumerate(oks) if not ok)
+    if first == 0:
+        return f"beyond the floor from {percent(strains[0])}"
+    return f"within up to {percent(strains[first - 1])}, departs at {percent(strains[first])}"
+
+
+def finest(rows):
+    """The finest mesh of the default variant (the most nodes)."""
+    meshes = {r["mesh"]: r["nodes"] for r in rows if r["variant"] == DEFAULT}
+    return max(meshes, key=meshes.get)
+
+
+def analyse(data):
+    rows, refs = data["rows"], data["references"]
+    strains = sorted({r["strain"] for r in rows + refs})
+    v = verdicts(rows + refs, data["data"])
+    mesh = finest(rows)
+    said = {m: departure(v[(mesh, DEFAULT, m)], strains)
+            for (x, var, m) in v if x == mesh and var == DEFAULT}
+    said.update({m: departure(v[("reference", DEFAULT, m)], strains)
+                 for (x, var, m) in v if x == "reference" and var == DEFAULT})
+    return {"finest_mesh": mesh, "departure": said,
+            "within_at_every_state": [m for m, t in said.items()
+                                      if t == "within the floor at every state"]}
+
+
+def write(out, study, s, data):
+    found = analyse(data)
+    doc = jsonable({"case": study.name, "study": True, "parameters": s.describe(),
+                    "problem": s.problem(), "gated": GATED, "environment": environment(),
+                    **data, **found, "gate_runs": gate_rows(data["rows"])})
+    return write_study(out, doc, lambda folder: build(folder, study, s, doc))
+
+
+def _rows(doc, mesh, variant):
+    return [r for r in doc["rows"] + doc["references"]
+            if r["variant"] == variant and r["mesh"] in (mesh, "reference")]
+
+
+def conclusion(doc):
+    """The report's three lines: who reproduces the measurement within its floor, where the
+    others depart, what the continuum and linear elasticity do."""
+    said, mesh = doc["departure"], doc["finest_mesh"]
+    models = [m for m in said if m not in (NH, LINEAR)]
+    within_all = [m for m in models if m in doc["within_at_every_state"]]
+    last = max(s["strain"] for s in doc["data"]["states"])
+    at_last = {r["model"]: r for r in _rows(doc, mesh, DEFAULT) if r["strain"] == last}
+    best = sorted((m for m in models if at_last.get(m, {}).get("bead_rms_mm") is not None),
+                  key=lambda m: at_last[m]["bead_rms_mm"])
+    floor = floors(doc["data"])[len(doc["data"]["states"])]["total"]
+    lines = [f"**Against the measured beads** (bonded plates, nominal travel, {mesh} mesh): "
+             + (f"{', '.join(within_all)} reproduce the measurement within its floor at every "
+                "state" if within_all else "no model reproduces the measurement within its "
+                "floor at every state")
+             + f"; the continuum (neo-Hookean) is {said.get(NH, 'n/a')}, linear P2 "
+             f"{said.get(LINEAR, 'n/a')}."]
+    if best:
+        near = [m for m in best if at_last[m]["bead_rms_mm"]
+                - at_last[best[0]]["bead_rms_mm"] <= floor]
+        lines.append(f"At {percent(last)}: bead RMS error from "
+                     f"{fmt(at_last[best[0]]['bead_rms_mm'])} mm ({best[0]}) to "
+                     f"{fmt(at_last[best[-1]]['bead_rms_mm'])} mm ({best[-1]}), floor "
+                     f"{fmt(floor)} mm; within one floor of the best (not ranked among "
+                     f"themselves): {', '.join(near)}.")
+    return lines
+
+
+def build(out, study, s, doc):
+    out = Path(out)
+    d = Document(f"pbcm report: {study.name}")
+    d.opening(conclusion(doc))
+    d.h(2, "What was run")
+    states = doc["data"]["states"]
+    ref = [r for r in doc["references"] if r["model"] == NH and r["variant"] == DEFAULT
+           and r.get("error_estimate") is not None]
+    d.ul([study.title + ". Data: Kerdok et al., Medical Image Analysis 7(3) 283-291, 2003 "
+          "(in `reference/data/truthcube/` with its attribution).",
+          f"The 80 mm cube on the mirrored five split at {', '.join(f'{h:g} mm' for h in s.spacings_mm)} "
+          "spacing; the moving plate at z = 0 pushed to +z, the fixed one at z = 80 mm, "
+          f"placed on the bead lattice's centre; one static solve through the three states "
+          f"in steps of at most {100 * doc['problem']['step_strain']:g} % strain.",
+          f"nu = {s.nu:g} (the silicone's range is 0.49 to 0.4999: both ends shown below); "
+          f"E = {s.E:g} Pa (the plates prescribe displacement, so the bead field does not "
+          "depend on E; a test checks it).",
+          f"Models: {', '.join(s.models)} (the readings calibrated, c = auto). References: "
+          f"{NH} on the {REF_MESH[0]} split of {REF_MESH[1]} nodes per side refined "
+          f"{s.ref_levels} times (error estimate "
+          + (", ".join(f"{fmt(r['error_estimate'])} at {percent(r['strain'])}" for r in ref[:1])
+             or "n/a") + ") and linear P2 on the same mesh, both at the beads by their own "
+          "basis; the models by P1 interpolation on their own mesh at the measured rest bead "
+          "positions.",
+          "Each measured state's best rigid in-plane motion (translation in x, y and rotation "
+          "about z; the whole cube moves between scans) is removed before comparing; the raw "
+          "error is in the tables beside it."])
+    _data(d, doc)
+    _errors(d, doc)
+    _sensitivity(d, doc, s)
+    _figures(d, out, doc)
+    d.p(f"Environment: {doc['environment']}.")
+    return d
+
+
+def _data(d, doc):
+    data = doc["data"]
+    d.h(2, "The measurement and its floor")
+    d.p("The floor is the noise of a measured displacement component: the RMS residual of a "
+        "degree-4 polynomial of the rest positions fitted to each state's displacement (the "
+        "compressed cube's field is smooth; the beads' scatter about it is not), combined as "
+        "each error is. A model's error beyond the noise is sqrt(rms^2 - floor^2); it "
+        f"reproduces a state when that is at most {WITHIN:g} floor in total, axially and "
+        "laterally.")
+    d.table(["strain", "nominal travel [mm]", "RMS displacement [mm]", "axial", "lateral",
+             "floor total [mm]", "axial", "lateral", "quantisation x, y, z [mm]",
+             "rigid motion removed x, y [mm], z-rotation [deg]"],
+            [[percent(st["strain"]), fmt(t), fmt(st["scale_mm"]["total"]),
+              fmt(st["scale_mm"]["axial"]), fmt(st["scale_mm"]["lateral"]),
+              fmt(st["floor_mm"]["total"]), fmt(st["floor_mm"]["axial"]),
+              fmt(st["floor_mm"]["lateral"]),
+              ", ".join("-" if q is None else fmt(q) for q in st["quantisation_mm"]),
+              ", ".join(fmt(x) for x in st["rigid_removed"])]
+             for st, t in zip(data["states"], doc["nominal_travels_mm"])])
+    q = [v for st in data["states"] for v in st["quantisation_mm"] if v is not None]
+    found = (f"the step found is {fmt(max(q))} mm, whose own RMS error in a displacement is "
+             f"step / sqrt(6) = {fmt(max(q) / np.sqrt(6))} mm" if q else "no coordinate is")
+    d.p("Quantisation: a coordinate is on a grid of steps when most of its values are "
+        f"(coherence at least 0.5); {found}. The rest positions scatter "
+        + ", ".join(f"{fmt(v)} mm" for v in data["rest_scatter_mm"])
+        + " (x, y, z) about the best regular grid (spacing "
+        + ", ".join(f"{fmt(v)}" for v in data["grid_spacing_mm"])
+        + " mm): bead placement, not noise, which is why the measured rest positions are "
+        "used.")
+
+
+def _state_table(d, rows, data, title):
+    fl = floors(data)
+    d.h(3, title)
+    models = list(dict.fromkeys(r["model"] for r in rows))
+    by = {(r["model"], r["state"]): r for r in rows}
+    header = ["model"]
+    for st in data["states"]:
+        p = percent(st["strain"])
+        header += [f"{p} RMS [mm]", f"{p} axial", f"{p} lateral", f"{p} max", f"{p} raw"]
+    body = [["floor"] + [x for st in data["states"] for x in (
+        fmt(fl[st["state"]]["total"]), fmt(fl[st["state"]]["axial"]),
+        fmt(fl[st["state"]]["lateral"]), "", "")]]
+    for m in models:
+        line = [m]
+        for st in data["states"]:
+            r = by.get((m, st["state"]))
+            if r is None or r.get("failed"):
+                line += ["failed" if r else "n/a"] + [""] * 4
+                continue
+            f = fl[st["state"]]
+            mark = "" if all(within(r[k], f[c]) for c, k in COMPONENTS) else " *"
+            line += [fmt(r["bead_rms_mm"]) + mark, fmt(r["bead_axial_rms_mm"]),
+                     fmt(r["bead_lateral_rms_mm"]), fmt(r["bead_max_mm"]),
+                     fmt(r["bead_raw_rms_mm"])]
+        body.append(line)
+    d.table(header, body)
+
+
+def _errors(d, doc):
+    d.h(2, "Bead errors per strain and model")
+    d.p("RMS over the 343 beads of the error vector's length, its axial (z) and lateral (x, y) "
+        "parts and the largest, in mm, against the measurement with its rigid in-plane motion "
+        "removed; raw: the RMS against the measurement as scanned. '*': beyond the floor (the "
+        "error beyond the noise exceeds it in total, axially or laterally). Relative errors "
+        "(over the RMS measured displacement) are in metrics.json.")
+    meshes = sorted({r["mesh"] for r in doc["rows"] if r["variant"] == DEFAULT},
+                    key=lambda m: -float(m.rstrip("m")))
+    for mesh in meshes:
+        _state_table(d, _rows(doc, mesh, DEFAULT), doc["data"],
+                     f"Bonded plates, nominal travel, {mesh} mesh")
+    d.h(3, "Where each departs")
+    d.table(["model", f"{doc['finest_mesh']} mesh"],
+            [[m, t] for m, t in doc["departure"].items()])
+
+
+def _sensitivity(d, doc, s):
+    variants = list(dict.fromkeys(r["variant"] for r in doc["rows"]))
+    if len(variants) < 2:
+        return
+    mesh = next(r["mesh"] for r in doc["rows"] if r["variant"] != DEFAULT)
+    last = max(st["strain"] for st in doc["data"]["states"])
+    floor = floors(doc["data"])[len(doc["data"]["states"])]["total"]
+    d.h(2, "How the answer moves with the plates, the travel and nu")
+    d.p(f"Bead RMS error [mm] at {percent(last)} on the {mesh} mesh, each assumption changed "
+        f"alone (floor {fmt(floor)} mm; '*': beyond it). The continuum's row says how far the "
+        "assumption itself moves the answer.")
+    by = {(r["model"], r["variant"]): r for r in doc["rows"] + doc["references"]
+          if r["strain"] == last and r["mesh"] in (mesh, "reference")}
+    models = list(dict.fromkeys(m for m, _ in by))
+
+    def cell(r):
+        if r is None or r.get("failed"):
+            return "failed" if r else "n/a"
+        return fmt(r["bead_rms_mm"]) + ("" if within(r["bead_rms_mm"], floor) else " *")
+    d.table(["model"] + variants, [[m] + [cell(by.get((m, v))) for v in variants]
+                                   for m in models])
+    fitted = doc["travels_mm"].get("fitted-travel")
+    if fitted:
+        d.p("The fitted travel (the continuum's axial bead displacements closest to the "
+            "measured ones, per state) against the nominal: " + "; ".join(
+                f"{percent(st['strain'])}: {fmt(f)} mm against {fmt(n)} mm"
+                for st, f, n in zip(doc["data"]["states"], fitted,
+                                    doc["nominal_travels_mm"])) + ".")
+    ex = {v: by.get((NH, v)) for v in variants}
+    ok = {v: r for v, r in ex.items() if r and not r.get("failed")}
+    if ok:
+        lo, hi = min(ok, key=lambda v: ok[v]["bead_rms_mm"]), max(
+            ok, key=lambda v: ok[v]["bead_rms_mm"])
+        d.p(f"The continuum's bead RMS error at {percent(last)} ranges from "
+            f"{fmt(ok[lo]['bead_rms_mm'])} mm ({lo}) to {fmt(ok[hi]['bead_rms_mm'])} mm "
+            f"({hi}); its error beyond the noise, {fmt(excess(ok[lo]['bead_rms_mm'], floor))} "
+            f"to {fmt(excess(ok[hi]['bead_rms_mm'], floor))} mm.")
+
+
+def _figures(d, out, doc):
+    mesh = doc["finest_mesh"]
+    data = doc["data"]
+    rows = _rows(doc, mesh, DEFAULT)
+    refs = [m for m in (NH, LINEAR) if any(r["model"] == m for r in rows)]
+    models = [m for m in dict.fromkeys(r["model"] for r in rows) if m not in refs]
+    beyond = {m for m, t in doc["departure"].items() if t != "within the floor at every state"}
+    columns = []
+    for st in data["states"]:
+        here = {r["model"]: r for r in rows if r["state"] == st["state"]
+                and not r.get("failed")}
+        f = st["layer_noise_mm"]
+        columns.append((f"{percent(st['strain'])} compression", [
+            (f"{what} [mm]", st[key], f[comp], [(m, here[m][key]) for m in refs if m in here],
+             [(m, here[m][key]) for m in models if m in here])
+            for what, key, comp in (("mean axial displacement", "layer_axial_mm", "axial"),
+                                    ("outward lateral, outer beads", "layer_lateral_mm",
+                                     "lateral"))]))
+    name = "beads_by_layer.png"
+    figures.measured_layers(out / name, list(range(1, len(data["states"][0]["layer_axial_mm"])
+                                                   + 1)), columns,
+                            f"Measured against modelled, by bead layer (bonded, {mesh} mesh; "
+                            "colour: beyond the floor at some state)", highlight=beyond)
+    d.img(name, "Measured against modelled bead displacements by layer")
+    variants = list(dict.fromkeys(r["variant"] for r in doc["references"]))
+    if len(variants) > 1:
+        columns = []
+        for st in data["states"]:
+            here = {r["variant"]: r for r in doc["references"] if r["model"] == NH
+                    and r["state"] == st["state"] and not r.get("failed")}
+            f = st["layer_noise_mm"]
+            columns.append((f"{percent(st['strain'])} compression", [
+                (f"{what} [mm]", st[key], f[comp], [],
+                 [(v, here[v][key]) for v in variants if v in here])
+                for what, key, comp in (("mean axial displacement", "layer_axial_mm", "axial"),
+                                        ("outward lateral, outer beads", "layer_lateral_mm",
+                                         "lateral"))]))
+        name = "continuum_assumptions.png"
+        figures.measured_layers(out / name, list(range(1, 8)), columns,
+                                f"The continuum ({NH}) under each assumption")
+        d.img(name, "The continuum under each plate, travel and nu assumption")
+
+
+def definitions():
+    return [
+        "measurement floor: the noise of a measured bead displacement component, the RMS "
+        "residual of a degree-4 polynomial of the rest positions fitted to the measured "
+        "displacement of each state; combined over components as each error is.",
+        f"within measurement: a run whose error beyond the noise, sqrt(rms^2 - floor^2), is "
+        f"at most {WITHIN:g} floor (total, axial and lateral); two runs whose RMS errors "
+        "differ by less than the floor are not ranked.",
+        "rigid in-plane motion: the translation in x, y and rotation about z best carrying "
+        "the rest beads to a measured state (2-D Procrustes); removed from each state before "
+        "comparing.",
+        "fitted travel: the moving plate's travel per state whose neo-Hookean continuum "
+        "(bonded) fits the measured axial bead displacements best in least squares."]

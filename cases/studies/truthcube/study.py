@@ -1,0 +1,274 @@
+"""The Truth Cube study's runs: every model on the cube at each spacing and plate variant,
+compressed through the three measured states in one static solve, its displacement at the
+measured rest bead positions (P1 on its mesh) against the measured one; the references (the
+neo-Hookean mixed P2/P1 continuum with its estimate, linear P2) at the beads by their own
+basis; the travel that best fits the measured axial displacements."""
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from model import Material, build
+from model.mesh import cube
+from model.presets import PRESETS
+from reference import hyperelastic, linear
+from reference.linear import converged_from
+from reference import truthcube as T
+from ... import stop
+from ...framework import FINDINGS
+from ...progress import Progress
+from ...runner import jsonable
+from ...store import OFF, key
+from . import problem as P
+from .beads import Measured, errors, layer_axial, layer_lateral
+
+MM = 1e-3
+NU = 0.499                       # RTV 6166: nearly incompressible; the range's middle
+NU_RANGE = (0.49, 0.4999)        # the silicone's range, shown as a sensitivity
+E = 15e3                         # under displacement control the bead field does not depend
+#                                  on E (tested); this only sets the force scale
+SPACINGS_MM = (10.0, 5.0)
+STATIC_RTOL = 1e-10
+# the continuum on the six split of 20 mm refined REF_LEVELS times (quick: QUICK_REF_LEVELS),
+# P2/P1, the estimate from the change between the levels
+REF_MESH, REF_LEVELS, QUICK_REF_LEVELS = ("six", 5), 2, 1
+NH = "neo-Hookean P2/P1"         # the references' names in the tables
+LINEAR = "linear P2"
+# the continuum's load steps: Newton on the neo-Hookean form with its tangent predictor
+# converges from one measured state to the next (3 steps, 11 iterations on the reference
+# mesh), the particle models' explicit forces do not (problem.STEP_STRAIN)
+REF_STEP_STRAIN = 0.1
+FIT_STEP = 0.1                   # the secant of the travel fit: the travel times 1 + this
+
+
+def variants(nu=NU):
+    """{variant: (plates, travel, nu)}: the default (bonded, nominal travel, ``nu``), each
+    assumption changed alone: frictionless plates, the travel fitted to the measured axial
+    displacements, and nu at the ends of the silicone's range."""
+    out = {"bonded": ("bonded", "nominal", nu), "frictionless": ("frictionless", "nominal", nu),
+           "fitted-travel": ("bonded", "fitted", nu)}
+    out.update({f"nu={v:g}": ("bonded", "nominal", v) for v in NU_RANGE if v != nu})
+    return out
+
+
+@dataclass
+class TruthCubeSettings:
+    """The material, the meshes, the variants and the models."""
+
+    E: float = E
+    nu: float = NU
+    quick: bool = False
+    models: tuple = tuple(PRESETS)
+    spacings_mm: tuple = SPACINGS_MM
+    ref_levels: int = REF_LEVELS
+    material: Material = field(init=False, repr=False, compare=False)
+
+    def __post_init__(self):
+        if not 0.45 <= self.nu < 0.5:
+            raise ValueError(f"nu = {self.nu} is not a nearly incompressible silicone's; "
+                             "give 0.45 <= nu < 0.5 (the data's range is 0.49 to 0.4999)")
+        if self.quick:
+            self.spacings_mm = self.spacings_mm[:1]
+            self.ref_levels = min(self.ref_levels, QUICK_REF_LEVELS)
+        self.material = Material(E=self.E, nu=self.nu, rho=1000.0)
+
+    @property
+    def units(self):
+        """Work units a pool could share: one (the study runs in one process)."""
+        return 1
+
+    @property
+    def variants(self):
+        """{variant: (plates, travel, nu)}; quick: the default only."""
+        v = variants(self.nu)
+        return {"bonded": v["bonded"]} if self.quick else v
+
+    def cells(self):
+        """[(spacing, variant)]: every variant on the coarsest mesh, the default on the
+        finer ones."""
+        first = self.spacings_mm[0]
+        return [(first, v) for v in self.variants] + [(h, "bonded")
+                                                      for h in self.spacings_mm[1:]]
+
+    def problem(self):
+        return {"E_Pa": self.E, "nu": self.nu, "side_mm": T.SIDE / MM,
+                "strains": list(T.STRAINS[1:]), "family": P.FAMILY,
+                "step_strain": P.STEP_STRAIN, "static_rtol": STATIC_RTOL,
+                "reference": {"element": "P2/P1 mixed", "mesh": f"{REF_MESH[0]} "
+                              f"{REF_MESH[1]}^3", "refinements": self.ref_levels}}
+
+    def describe(self):
+        return {**self.problem(), "quick": self.quick, "spacings_mm": list(self.spacings_mm),
+                "variants": {k: list(v) for k, v in self.variants.items()},
+                "models": list(self.models)}
+
+
+def mesh_name(spacing_mm):
+    return f"{spacing_mm:g}mm"
+
+
+def reference_mesh():
+    return cube(REF_MESH[1], T.SIDE, REF_MESH[0])
+
+
+def _nh_solves(plates, travels, nu, s, levels):
+    m = reference_mesh()
+    fractions, at = P.schedule(travels, REF_STEP_STRAIN)
+    return [hyperelastic.solve(m, s.E, nu, P.dirichlet(m, plates, travels[-1]), element="P2",
+                               mixed=True, refine=k, load_steps=fractions, keep_steps=at)
+            for k in levels], at
+
+
+def continuum(plates, travels, nu, s, beads):
+    """The neo-Hookean mixed P2/P1 solution through ``travels`` on the reference mesh refined
+    0..``s.ref_levels`` times: (the bead displacements (3, 343, 3) [m] of the finest at the three
+    states, its error estimate)."""
+    sols, at = _nh_solves(plates, travels, nu, s, range(s.ref_levels + 1))
+    conv = converged_from(sols)
+    return np.array([conv.result.at(beads, step) for step in at]), conv.error_estimate
+
+
+def continuum_finest(plates, travels, nu, s, beads):
+    """The finest level alone: the bead displacements (3, 343, 3) [m]."""
+    (sol,), at = _nh_solves(plates, travels, nu, s, [s.ref_levels])
+    return np.array([sol.at(beads, step) for step in at])
+
+
+def linear_reference(plates, travels, nu, s, beads):
+    """Linear P2 through the same travels (it scales with the travel): the bead
+    displacements (3, 343, 3) [m] and its error estimate."""
+    m = reference_mesh()
+    conv = linear.converged(m, s.E, nu, P.dirichlet(m, plates, travels[-1]),
+                            levels=s.ref_levels)
+    u = conv.result.at(beads)
+    return np.array([u * t / travels[-1] for t in travels]), conv.error_estimate
+
+
+def fit_travels(measured, s, nu):
+    """The travel [m] per state whose continuum (bonded, the finest reference level alone)
+    fits the measured axial bead displacements best in least squares: one secant step from
+    the nominal travel (the response is nearly linear in it), with the nominal and fitted
+    axial RMS error [mm]."""
+    nominal = P.nominal_travels()
+    beads = measured.beads
+    u0 = continuum_finest("bonded", nominal, nu, s, beads)
+    u1 = continuum_finest("bonded", [t * (1 + FIT_STEP) for t in nominal], nu, s, beads)
+    fitted = []
+    for k, t in enumerate(nominal):
+        g = (u1[k][:, 2] - u0[k][:, 2]) / (FIT_STEP * t)          # d u_z / d travel
+        r = measured.u(k + 1)[:, 2] - u0[k][:, 2]
+        fitted.append(float(t + (g @ r) / (g @ g)))
+    return fitted
+
+
+def travels_of(kind, measured, s, nu, fitted):
+    if kind == "nominal":
+        return P.nominal_travels()
+    if fitted.get(nu) is None:
+        fitted[nu] = fit_travels(measured, s, nu)
+    return fitted[nu]
+
+
+def bead_displacements(model, mesh, spec, travels, beads, s):
+    """``model`` on ``mesh`` under ``spec`` = (plates, travel, nu) through ``travels``: its
+    displacement (343, 3) [m] at the rest positions ``beads`` (P1 on its mesh) per measured
+    state, in a list (shorter when the solve failed on the way), and the failure or None."""
+    plates, _, nu = spec
+    fractions, at = P.schedule(travels)
+    located = mesh.locate(beads)
+    kept = {}
+    try:
+        pm = build(model, mesh, Material(E=s.E, nu=nu, rho=1000.0))
+        pm.solve_static(P.dirichlet(mesh, plates, travels[-1]), load_steps=fractions,
+                        rtol=STATIC_RTOL,
+                        on_step=lambda step, x: kept.__setitem__(step, x - mesh.points))
+    except FINDINGS as exc:
+        failed = f"{type(exc).__name__}: {exc}"
+    else:
+        failed = None
+    out = [mesh.interpolate(kept[step], located) for step in at if step in kept]
+    return out, failed
+
+
+def model_rows(model, mesh, name, variant, spec, travels, measured, s):
+    """The rows (one per measured state) of ``model`` on ``mesh`` under ``variant``."""
+    plates, travel, nu = spec
+    base = {"mesh": name, "variant": variant, "plates": plates, "travel": travel, "nu": nu,
+            "model": model, "nodes": mesh.n_nodes, "tets": mesh.n_tets}
+    fields, failed = bead_displacements(model, mesh, spec, travels, measured.beads, s)
+    rows = []
+    for state in range(1, len(T.STRAINS)):
+        row = {**base, "state": state, "strain": T.STRAINS[state],
+               "travel_mm": travels[state - 1] / MM, "failed": None}
+        if state > len(fields):
+            rows.append({**row, "failed": failed or "not reached"})
+            continue
+        rows.append({**row, **bead_row(fields[state - 1], state, measured)})
+    return rows
+
+
+def bead_row(u, state, measured):
+    """The errors and layer profiles of a modelled bead displacement at ``state``."""
+    return {**errors(u, measured.u(state), measured.u_raw(state), measured.scale(state)),
+            "layer_axial_mm": layer_axial(measured.data, u),
+            "layer_lateral_mm": layer_lateral(measured.data, u)}
+
+
+def reference_rows(variant, spec, travels, measured, s, store):
+    """The continuum's rows (neo-Hookean, and linear P2 under the default assumptions)."""
+    plates, travel, nu = spec
+    what = {"kind": "truthcube-reference", **s.problem(), "variant": variant,
+            "spec": list(spec), "travels": list(travels)}
+    found = store.get(key(**what))
+    if found is not None:
+        return found
+    out = []
+    todo = [(NH, continuum)] + ([(LINEAR, linear_reference)] if variant == "bonded" else [])
+    for name, solve in todo:
+        stop.checkpoint()
+        base = {"mesh": "reference", "variant": variant, "plates": plates, "travel": travel,
+                "nu": nu, "model": name}
+        try:
+            u, estimate = solve(plates, travels, nu, s, measured.beads)
+        except FINDINGS as exc:
+            out += [{**base, "state": k, "strain": T.STRAINS[k], "failed": str(exc)}
+                    for k in range(1, len(T.STRAINS))]
+            continue
+        out += [{**base, "state": k, "strain": T.STRAINS[k], "travel_mm": travels[k - 1] / MM,
+                 "failed": None, "error_estimate": estimate,
+                 **bead_row(u[k - 1], k, measured)} for k in range(1, len(T.STRAINS))]
+    return store.put(key(**what), out)
+
+
+def run(s, log=True, store=OFF):
+    """Every (spacing, variant) cell's model rows, the references' rows, the fitted travels
+    and the data's own numbers."""
+    measured = Measured(T.load())
+    fitted = {}
+    cells = s.cells()
+    rows, refs, travels_used = [], [], {}
+    with Progress("truth-cube", len(cells) * len(s.models), log=log) as progress:
+        for spacing, variant in cells:
+            spec = s.variants[variant]
+            k = key(kind="truthcube-fit", **s.problem(), nu_fit=spec[2])
+            if spec[1] == "fitted" and spec[2] not in fitted:
+                fitted[spec[2]] = store.get(k) or store.put(k, fit_travels(measured, s, spec[2]))
+            travels = travels_of(spec[1], measured, s, spec[2], fitted)
+            travels_used[variant] = [t / MM for t in travels]
+            if not any(r["variant"] == variant for r in refs):
+                refs += reference_rows(variant, spec, travels, measured, s, store)
+            name, mesh = mesh_name(spacing), None
+            for model in s.models:
+                stop.checkpoint()
+                what = {"kind": "truthcube-cells", **s.problem(), "mesh": name,
+                        "variant": variant, "spec": list(spec), "travels": list(travels),
+                        "model": model}
+                found = store.get(key(**what))
+                if found is None:
+                    mesh = mesh or P.mesh(spacing)
+                    found = store.put(key(**what), model_rows(
+                        model, mesh, name, variant, spec, travels, measured, s))
+                rows += found
+                progress.advance(1)
+    return jsonable({"rows": rows, "references": refs, "travels_mm": travels_used,
+                     "nominal_travels_mm": [t / MM for t in P.nominal_travels()],
+                     "data": measured.summary()})
