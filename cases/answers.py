@@ -1,5 +1,6 @@
-"""The four answers that open reports/index: which reading the paper used, how far each model
-is from the continuum, at what cost, and what causes the bulge/neck artefact; then one
+"""The answers that open reports/index: which reading the paper used, how far each model is
+from the continuum and from a measured body, at what cost, and what causes the bulge/neck
+artefact; then one
 compact table, model by the numbers behind them. Every number is read from the metrics the
 studies, the cases and the bench wrote under the reports folder; an answer whose source is
 missing says which command writes it."""
@@ -15,6 +16,7 @@ from .metrics import PATCH_TOL
 COST_TETS = 1e4          # the mesh size of the cost column (tetrahedra)
 CONSISTENCY = ("paper-cube", "sliding")     # the patch test whose converged limit is the error
 FINITE = "large-compression"                 # the finite-strain case (neo-Hookean reference)
+MEASURED = "truth-cube"                      # the study against measured beads
 
 
 def _load(root, *parts):
@@ -65,9 +67,10 @@ def table(root, models):
     cube = _load(root, "paper-cube", "metrics.json")
     finite = _load(root, FINITE, "metrics.json")
     bench = _load(root, BENCH_FOLDER, BENCH_FILE)
+    measured = (_load(root, MEASURED, "metrics.json") or {}).get("headline")
     header = ["model", "consistency error (largest limit)", "finite-load error",
               "worst isotropy error", "largest |alternation|", "RK4 run",
-              "s per simulated s"]
+              "s per simulated s", "Truth Cube bead RMS [mm]"]
     rows = []
     for m in models:
         el = [e["moduli_rel_err"] for e in (conv or {}).get("elasticity", [])
@@ -84,12 +87,18 @@ def table(root, models):
                      fmt(max(el)) if el else "n/a", fmt(max(alt)) if alt else "n/a",
                      ("flutters" if flutter else "stable") + f" ({clamped - flutter} of "
                      f"{clamped} clamped runs stable)" if clamped else "n/a",
-                     fmt(b["cpu_s_per_simulated_s"]) if b else "n/a"])
+                     fmt(b["cpu_s_per_simulated_s"]) if b else "n/a",
+                     _bead(measured, m)])
     return header, rows
 
 
+def _bead(measured, model):
+    v = (measured or {}).get("models", {}).get(model)
+    return f"{fmt(v['bead_rms_mm'])} at {fmt(100 * measured['strain'], 4)} %" if v else "n/a"
+
+
 def lines(root, models):
-    """At most five short lines: the answers."""
+    """At most six short lines: the answers."""
     art = _load(root, "artefact", "metrics.json")
     conv = _load(root, "convergence", "metrics.json")
     bench = _load(root, BENCH_FOLDER, BENCH_FILE)
@@ -121,6 +130,9 @@ def lines(root, models):
                    + (f"; below {PATCH_TOL:g}: {', '.join(passed)}" if passed else "")
                    + (f"; no limit on {', '.join(nolimit)}" if nolimit else "")
                    + " ([convergence](convergence/report.md)).")
+    measured = (_load(root, MEASURED, "metrics.json") or {}).get("headline")
+    if measured:
+        out.append(_measured_line(measured, models))
     rows = {m: _bench_row(bench, m) for m in models}
     if all(rows.get(k) for k in ("fem-linear", "msm")):
         fl = rows["fem-linear"]["cpu_s_per_simulated_s"]
@@ -134,6 +146,23 @@ def lines(root, models):
         out.append(f"**What causes the bulge/neck?** {art['answer']['cause'][0].upper()}"
                    f"{art['answer']['cause'][1:]}. {_cause_numbers(art)}")
     return out
+
+
+def _measured_line(h, models):
+    NH = h["continuum"]
+    v = h["models"]
+    mine = sorted((m for m in models if m in v), key=lambda m: v[m]["bead_rms_mm"])
+    within = [m for m in mine if v[m]["departure"] == "within the floor at every state"]
+    said = (f"**How far from a measured body?** On the Truth Cube's 343 beads at "
+            f"{fmt(100 * h['strain'], 4)} % compression (bonded plates, {h['mesh']} mesh; the "
+            f"measurement's floor {fmt(h['floor_mm'])} mm): ")
+    if NH in v:
+        said += f"the neo-Hookean continuum is {fmt(v[NH]['bead_rms_mm'])} mm RMS off; "
+    if mine:
+        said += (f"the models from {fmt(v[mine[0]]['bead_rms_mm'])} mm ({mine[0]}) to "
+                 f"{fmt(v[mine[-1]]['bead_rms_mm'])} mm ({mine[-1]}); ")
+    return said + (f"within the floor at every state: {', '.join(within) or 'none'} "
+                   f"([truth-cube]({MEASURED}/report.md)).")
 
 
 def _largest(limit):

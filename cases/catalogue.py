@@ -395,6 +395,9 @@ declare("layer_lateral_mm", "mm", "layer lateral",
 declare("travel_mm", "mm", "travel",
         "the moving plate's travel at the state (nominal strain x 80 mm, or fitted).",
         digits=4)
+declare("bead_change_mm", "mm", "bead change",
+        "a reference's RMS change of the bead displacement over its last refinement: its "
+        "error estimate where it meets the measurement.")
 declare("error_estimate", "1", "reference estimate",
         "a reference's own error estimate: its relative change over the last refinement, "
         "Richardson-extrapolated where an order can be observed.")

@@ -438,6 +438,12 @@ class Study(abc.ABC):
         """'term: definition' lines of the study's own terms, for the glossary."""
         return []
 
+    def scorecard(self, metrics):
+        """Rows the index's scorecard adds for this study, from its ``metrics``
+        (metrics.json): ``[(label, metric, {model: (text, band)})]`` with band 0 (good), 1 or
+        2 (bad); none by default (the scorecard's rows are the cases')."""
+        return []
+
     def recorded(self, metrics):
         """``(settings, data)`` as a run recorded them in ``metrics`` (its metrics.json), for
         ``pbcm run NAME --rewrite``: the report drawn again from the recorded runs after a

@@ -198,13 +198,21 @@ def index_documents(root, cases, studies=()):
           "stiffness error, a force-driven one's displacement error). Each cell is the median "
           "over the meshes [smallest-largest], n of N runs; a patch test reads pass or fail at "
           f"{PATCH_TOL:g}. Colours in the HTML: "
-          + ", ".join(f"{label}" for _, _, label in BANDS) + ". Quick-mode cases are marked.")
+          + ", ".join(f"{label}" for _, _, label in BANDS) + ". Quick-mode cases are marked. "
+          "The last rows are measured against reality (the Truth Cube's beads): green within "
+          "the measurement's floor at every state, yellow at some, red at none.")
     rows = []
     for p in pops:
         mode = " (quick)" if data[p.case]["parameters"]["quick"] else ""
         label = p.label + mode + (" (patch test)" if p.patch_test else "")
         rows.append([Link(label, f"{p.case}/report.md", f"{p.case}/report.html")
                      if p.primary else "", p.metric] + [_score_cell(p, m) for m in models])
+    for n in shown:       # the studies' own rows (the one measured against reality)
+        for label, metric, cells in declared()[n].scorecard(
+                json.loads((root / n / "metrics.json").read_text())):
+            rows.append([Link(label, f"{n}/report.md", f"{n}/report.html"), metric]
+                        + [Cell(cells[m][0], BANDS[cells[m][1]][1]) if m in cells else ""
+                           for m in models])
     doc.table(["case/bc", "metric"] + models, rows, keys=2)
     for line in conclusion(pops, models):
         doc.p(line)

@@ -92,7 +92,8 @@ def test_cases_and_studies_gate_declared_metrics():
     from cases.studies.convergence.report import GATED as CONVERGENCE
     from cases.studies.extensions.report import GATED as EXTENSIONS
     from cases.studies.artefact.report import GATED as ARTEFACT
-    assert set(studies()) == {"convergence", "extensions", "artefact"}
-    for gated in (CONVERGENCE, EXTENSIONS, ARTEFACT):
+    from cases.studies.truthcube.report import GATED as TRUTHCUBE
+    assert set(studies()) == {"convergence", "extensions", "artefact", "truth-cube"}
+    for gated in (CONVERGENCE, EXTENSIONS, ARTEFACT, TRUTHCUBE):
         for name, direction in gated.items():
             assert metric(name).direction == direction

@@ -8,7 +8,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from model import Material, build
+from model import build
 from model.bc import load_fractions
 from model.errors import MeshError, ModelError
 from model.mesh import cube
@@ -190,11 +190,13 @@ def test_load_fractions_and_schedule():
             load_fractions(bad)
     travels = P.nominal_travels()
     assert travels == pytest.approx([0.004, 0.010, 0.0146])
-    fractions, at = P.schedule(travels)
+    assert P.step_strain(P.mesh(10.0)) == pytest.approx(0.0125)
+    assert P.step_strain(P.mesh(5.0)) == pytest.approx(0.00625)
+    fractions, at = P.schedule(travels, 0.0125)
     reached = [fractions[k - 1] * travels[-1] for k in at]
     assert reached == pytest.approx(travels, rel=1e-12)
     steps = np.diff([0.0] + fractions) * travels[-1]
-    assert steps.max() <= P.STEP_STRAIN * T.SIDE * (1 + 1e-12)
+    assert steps.max() <= 0.0125 * T.SIDE * (1 + 1e-12)
     assert at == [4, 10, 15]
     with pytest.raises(ModelError, match="divide"):
         P.mesh(30.0)

@@ -28,6 +28,9 @@ class TruthCube(Study):
     def write(self, out, s, data):
         return report.write(out, self, s, data)
 
+    def scorecard(self, metrics):
+        return report.scorecard(metrics)
+
     def definitions(self):
         return report.definitions()
 

@@ -28,14 +28,15 @@ E = 15e3                         # under displacement control the bead field doe
 #                                  on E (tested); this only sets the force scale
 SPACINGS_MM = (10.0, 5.0)
 STATIC_RTOL = 1e-10
-# the continuum on the six split of 20 mm refined REF_LEVELS times (quick: QUICK_REF_LEVELS),
-# P2/P1, the estimate from the change between the levels
-REF_MESH, REF_LEVELS, QUICK_REF_LEVELS = ("six", 5), 2, 1
+# the continuum on the six split of 20 mm refined REF_LEVELS times, P2/P1, the estimate from
+# the change between the levels: its beads move 0.025-0.12 mm RMS over the refinement, under
+# the measurement's floor (0.30-0.35 mm); one more refinement costs about 10 minutes a solve
+REF_MESH, REF_LEVELS = ("six", 5), 1
 NH = "neo-Hookean P2/P1"         # the references' names in the tables
 LINEAR = "linear P2"
 # the continuum's load steps: Newton on the neo-Hookean form with its tangent predictor
 # converges from one measured state to the next (3 steps, 11 iterations on the reference
-# mesh), the particle models' explicit forces do not (problem.STEP_STRAIN)
+# mesh), the particle models' do not (problem.STEP_OF_SPACING)
 REF_STEP_STRAIN = 0.1
 FIT_STEP = 0.1                   # the secant of the travel fit: the travel times 1 + this
 
@@ -68,7 +69,6 @@ class TruthCubeSettings:
                              "give 0.45 <= nu < 0.5 (the data's range is 0.49 to 0.4999)")
         if self.quick:
             self.spacings_mm = self.spacings_mm[:1]
-            self.ref_levels = min(self.ref_levels, QUICK_REF_LEVELS)
         self.material = Material(E=self.E, nu=self.nu, rho=1000.0)
 
     @property
@@ -92,7 +92,7 @@ class TruthCubeSettings:
     def problem(self):
         return {"E_Pa": self.E, "nu": self.nu, "side_mm": T.SIDE / MM,
                 "strains": list(T.STRAINS[1:]), "family": P.FAMILY,
-                "step_strain": P.STEP_STRAIN, "static_rtol": STATIC_RTOL,
+                "step_of_spacing": P.STEP_OF_SPACING, "static_rtol": STATIC_RTOL,
                 "reference": {"element": "P2/P1 mixed", "mesh": f"{REF_MESH[0]} "
                               f"{REF_MESH[1]}^3", "refinements": self.ref_levels}}
 
@@ -120,11 +120,15 @@ def _nh_solves(plates, travels, nu, s, levels):
 
 def continuum(plates, travels, nu, s, beads):
     """The neo-Hookean mixed P2/P1 solution through ``travels`` on the reference mesh refined
-    0..``s.ref_levels`` times: (the bead displacements (3, 343, 3) [m] of the finest at the three
-    states, its error estimate)."""
+    0..``s.ref_levels`` times: (the bead displacements (3, 343, 3) [m] of the finest at the
+    three states, its error estimate (``reference.linear.estimate``), and per state the RMS
+    change of the bead displacement over the last refinement [m], the estimate where it is
+    compared)."""
     sols, at = _nh_solves(plates, travels, nu, s, range(s.ref_levels + 1))
     conv = converged_from(sols)
-    return np.array([conv.result.at(beads, step) for step in at]), conv.error_estimate
+    fine, coarse = ([np.array([x.at(beads, step) for step in at]) for x in sols[-2:]][::-1])
+    change = np.sqrt(((fine - coarse) ** 2).sum(axis=-1).mean(axis=-1))
+    return fine, conv.error_estimate, change
 
 
 def continuum_finest(plates, travels, nu, s, beads):
@@ -134,13 +138,17 @@ def continuum_finest(plates, travels, nu, s, beads):
 
 
 def linear_reference(plates, travels, nu, s, beads):
-    """Linear P2 through the same travels (it scales with the travel): the bead
-    displacements (3, 343, 3) [m] and its error estimate."""
+    """Linear P2 through the same travels (it scales with the travel), as
+    :func:`continuum` gives the neo-Hookean one."""
     m = reference_mesh()
-    conv = linear.converged(m, s.E, nu, P.dirichlet(m, plates, travels[-1]),
-                            levels=s.ref_levels)
-    u = conv.result.at(beads)
-    return np.array([u * t / travels[-1] for t in travels]), conv.error_estimate
+    bc = P.dirichlet(m, plates, travels[-1])
+    sols = [linear.solve(m, s.E, nu, bc, element="P2", refine=k)
+            for k in range(s.ref_levels + 1)]
+    conv = converged_from(sols)
+    u = sols[-1].at(beads)
+    change = np.sqrt(((u - sols[-2].at(beads)) ** 2).sum(axis=-1).mean())
+    return (np.array([u * t / travels[-1] for t in travels]), conv.error_estimate,
+            [change * t / travels[-1] for t in travels])
 
 
 def fit_travels(measured, s, nu):
@@ -173,7 +181,7 @@ def bead_displacements(model, mesh, spec, travels, beads, s):
     displacement (343, 3) [m] at the rest positions ``beads`` (P1 on its mesh) per measured
     state, in a list (shorter when the solve failed on the way), and the failure or None."""
     plates, _, nu = spec
-    fractions, at = P.schedule(travels)
+    fractions, at = P.schedule(travels, P.step_strain(mesh))
     located = mesh.locate(beads)
     kept = {}
     try:
@@ -228,13 +236,14 @@ def reference_rows(variant, spec, travels, measured, s, store):
         base = {"mesh": "reference", "variant": variant, "plates": plates, "travel": travel,
                 "nu": nu, "model": name}
         try:
-            u, estimate = solve(plates, travels, nu, s, measured.beads)
+            u, estimate, change = solve(plates, travels, nu, s, measured.beads)
         except FINDINGS as exc:
             out += [{**base, "state": k, "strain": T.STRAINS[k], "failed": str(exc)}
                     for k in range(1, len(T.STRAINS))]
             continue
         out += [{**base, "state": k, "strain": T.STRAINS[k], "travel_mm": travels[k - 1] / MM,
                  "failed": None, "error_estimate": estimate,
+                 "bead_change_mm": change[k - 1] / MM,
                  **bead_row(u[k - 1], k, measured)} for k in range(1, len(T.STRAINS))]
     return store.put(key(**what), out)
 
