@@ -152,7 +152,7 @@ def _measured_line(h, models):
     NH = h["continuum"]
     v = h["models"]
     mine = sorted((m for m in models if m in v), key=lambda m: v[m]["bead_rms_mm"])
-    within = [m for m in mine if v[m]["departure"] == "within the floor at every state"]
+    within = [m for m in mine if v[m]["states_within"] == h["states"]]
     said = (f"**How far from a measured body?** On the Truth Cube's 343 beads at "
             f"{fmt(100 * h['strain'], 4)} % compression (bonded plates, {h['mesh']} mesh; the "
             f"measurement's floor {fmt(h['floor_mm'])} mm): ")

@@ -386,6 +386,10 @@ declare("bead_axial_rel", "1", "bead axial rel",
         "bead axial RMS over the RMS measured axial displacement.", "max")
 declare("bead_lateral_rel", "1", "bead lateral rel",
         "bead lateral RMS over the RMS measured lateral displacement.", "max")
+declare("bead_vs_continuum_mm", "mm", "bead vs continuum",
+        "RMS over the beads of |u_model - u_continuum|: the model against the neo-Hookean "
+        "continuum under the same plates, travel and nu, at the measured rest bead positions "
+        "(below the measurement's floor the measurement cannot tell the two apart).", "max")
 declare("bead_raw_rms_mm", "mm", "bead RMS raw",
         "bead RMS against the measurement as scanned (its rigid in-plane motion kept).")
 declare("layer_axial_mm", "mm", "layer axial",

@@ -197,8 +197,10 @@ def bead_displacements(model, mesh, spec, travels, beads, s):
     return out, failed
 
 
-def model_rows(model, mesh, name, variant, spec, travels, measured, s):
-    """The rows (one per measured state) of ``model`` on ``mesh`` under ``variant``."""
+def model_rows(model, mesh, name, variant, spec, travels, measured, s, continuum=None):
+    """The rows (one per measured state) of ``model`` on ``mesh`` under ``variant``, with its
+    distance to the ``continuum``'s bead displacements (3, 343, 3) [m] under the same
+    assumptions where given."""
     plates, travel, nu = spec
     base = {"mesh": name, "variant": variant, "plates": plates, "travel": travel, "nu": nu,
             "model": model, "nodes": mesh.n_nodes, "tets": mesh.n_tets}
@@ -210,8 +212,15 @@ def model_rows(model, mesh, name, variant, spec, travels, measured, s):
         if state > len(fields):
             rows.append({**row, "failed": failed or "not reached"})
             continue
-        rows.append({**row, **bead_row(fields[state - 1], state, measured)})
+        u = fields[state - 1]
+        rows.append({**row, **bead_row(u, state, measured), "bead_vs_continuum_mm": None
+                     if continuum is None else rms_mm(u - continuum[state - 1])})
     return rows
+
+
+def rms_mm(e):
+    """RMS over the beads of the length of ``e`` (343, 3) [m], in mm."""
+    return float(np.sqrt((np.asarray(e) ** 2).sum(axis=-1).mean()) / MM)
 
 
 def bead_row(u, state, measured):
@@ -222,14 +231,16 @@ def bead_row(u, state, measured):
 
 
 def reference_rows(variant, spec, travels, measured, s, store):
-    """The continuum's rows (neo-Hookean, and linear P2 under the default assumptions)."""
+    """The continuum's rows (neo-Hookean, and linear P2 under the default assumptions), and
+    the neo-Hookean bead displacements (3, 343, 3) [m] (None where it failed):
+    ``{"rows": [...], "continuum": ...}``."""
     plates, travel, nu = spec
     what = {"kind": "truthcube-reference", **s.problem(), "variant": variant,
             "spec": list(spec), "travels": list(travels)}
     found = store.get(key(**what))
     if found is not None:
         return found
-    out = []
+    out, field = [], None
     todo = [(NH, continuum)] + ([(LINEAR, linear_reference)] if variant == "bonded" else [])
     for name, solve in todo:
         stop.checkpoint()
@@ -241,11 +252,13 @@ def reference_rows(variant, spec, travels, measured, s, store):
             out += [{**base, "state": k, "strain": T.STRAINS[k], "failed": str(exc)}
                     for k in range(1, len(T.STRAINS))]
             continue
+        if name == NH:
+            field = u.tolist()
         out += [{**base, "state": k, "strain": T.STRAINS[k], "travel_mm": travels[k - 1] / MM,
                  "failed": None, "error_estimate": estimate,
                  "bead_change_mm": change[k - 1] / MM,
                  **bead_row(u[k - 1], k, measured)} for k in range(1, len(T.STRAINS))]
-    return store.put(key(**what), out)
+    return store.put(key(**what), {"rows": out, "continuum": field})
 
 
 def run(s, log=True, store=OFF):
@@ -254,7 +267,7 @@ def run(s, log=True, store=OFF):
     measured = Measured(T.load())
     fitted = {}
     cells = s.cells()
-    rows, refs, travels_used = [], [], {}
+    rows, refs, travels_used, fields = [], [], {}, {}
     with Progress("truth-cube", len(cells) * len(s.models), log=log) as progress:
         for spacing, variant in cells:
             spec = s.variants[variant]
@@ -263,8 +276,11 @@ def run(s, log=True, store=OFF):
                 fitted[spec[2]] = store.get(k) or store.put(k, fit_travels(measured, s, spec[2]))
             travels = travels_of(spec[1], measured, s, spec[2], fitted)
             travels_used[variant] = [t / MM for t in travels]
-            if not any(r["variant"] == variant for r in refs):
-                refs += reference_rows(variant, spec, travels, measured, s, store)
+            if variant not in fields:
+                found = reference_rows(variant, spec, travels, measured, s, store)
+                refs += found["rows"]
+                fields[variant] = None if found["continuum"] is None else np.array(
+                    found["continuum"])
             name, mesh = mesh_name(spacing), None
             for model in s.models:
                 stop.checkpoint()
@@ -275,7 +291,8 @@ def run(s, log=True, store=OFF):
                 if found is None:
                     mesh = mesh or P.mesh(spacing)
                     found = store.put(key(**what), model_rows(
-                        model, mesh, name, variant, spec, travels, measured, s))
+                        model, mesh, name, variant, spec, travels, measured, s,
+                        fields[variant]))
                 rows += found
                 progress.advance(1)
     return jsonable({"rows": rows, "references": refs, "travels_mm": travels_used,
