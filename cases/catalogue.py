@@ -150,7 +150,9 @@ DESCRIPTORS = frozenset({
     "split", "nodes_per_side", "unmatched_faces", "paper_size", "load", "family", "reading",
     "constant", "normal", "flutter",
     # the truth-cube study's factors: the plate assumption, the measured state
-    "variant", "plates", "travel", "nu", "state", "strain"})
+    "variant", "plates", "travel", "nu", "state", "strain",
+    # how a study's reference was solved: its element, spacings, size, extrapolation
+    "element", "ladder_mm", "dofs", "extrapolated"})
 
 # ---------------------------------------------------------------- the standard static metrics
 declare("disp_rel_l2_p1", "1", "disp L2 P1",
@@ -399,6 +401,8 @@ declare("layer_lateral_mm", "mm", "layer lateral",
 declare("travel_mm", "mm", "travel",
         "the moving plate's travel at the state (nominal strain x 80 mm, or fitted).",
         digits=4)
+declare("increments", "1", "increments",
+        "a reference's relative changes between its successive refinement levels.")
 declare("bead_change_mm", "mm", "bead change",
         "a reference's RMS change of the bead displacement over its last refinement: its "
         "error estimate where it meets the measurement.")

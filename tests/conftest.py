@@ -93,3 +93,12 @@ def quick_artefact(tmp_path_factory):
     out = tmp_path_factory.mktemp("artefact") / "artefact"
     assert main(["run", "artefact", "--quick", "--out", str(out)]) == 0
     return out
+
+
+@pytest.fixture(scope="session")
+def quick_truthcube(tmp_path_factory):
+    """`pbcm run truth-cube --quick`, once per test session."""
+    from cases.cli import main
+    out = tmp_path_factory.mktemp("truthcube") / "truth-cube"
+    assert main(["run", "truth-cube", "--quick", "--out", str(out)]) == 0
+    return out

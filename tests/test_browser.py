@@ -55,21 +55,23 @@ def _target(url):
 
 
 @pytest.fixture(scope="module")
-def reports(library, quick_artefact, tmp_path_factory):
+def reports(library, quick_artefact, quick_truthcube, tmp_path_factory):
     """A reports folder as `pbcm report --quick` writes it: the quick cases, the quick
-    artefact study, the index and the glossary."""
+    artefact and truth-cube studies, the index and the glossary."""
     from cases.index import write_index
     from cases.registry import CASES
     root = tmp_path_factory.mktemp("reports")
     for name in CASES:
         (root / name).symlink_to((library / name).resolve(), target_is_directory=True)
     (root / "artefact").symlink_to(quick_artefact, target_is_directory=True)
-    write_index(root, list(CASES), ["artefact"])
+    (root / "truth-cube").symlink_to(quick_truthcube, target_is_directory=True)
+    write_index(root, list(CASES), ["artefact", "truth-cube"])
     return root
 
 
 @pytest.mark.parametrize("page", ["index.html", "paper-cube/report.html",
-                                  "artefact/report.html", "glossary.html"])
+                                  "artefact/report.html", "truth-cube/report.html",
+                                  "glossary.html"])
 def test_a_report_page_renders_with_every_link_and_image_whole(browser, reports, page,
                                                                tmp_path):
     shot = tmp_path / (page.replace("/", "_") + ".png")

@@ -262,18 +262,14 @@ def test_bead_field_does_not_depend_on_E(tc, model):
     assert np.abs(a).max() > 5e-3                  # the 18.25 % state moved the beads
 
 
-def test_settings_refuse_a_compressible_silicone():
+def test_settings_refuse_a_compressible_silicone(tmp_path):
     from cases.studies.truthcube.study import TruthCubeSettings
-    with pytest.raises(ValueError, match="nearly incompressible"):
+    with pytest.raises(ModelError, match="nearly incompressible"):
         TruthCubeSettings(nu=0.3)
-
-
-@pytest.fixture(scope="session")
-def quick_truthcube(tmp_path_factory):
     from cases.cli import main
-    out = tmp_path_factory.mktemp("truthcube") / "truth-cube"
-    assert main(["run", "truth-cube", "--quick", "--out", str(out)]) == 0
-    return out
+    assert main(["run", "truth-cube", "--quick", "--nu", "0.3", "--out",
+                 str(tmp_path / "x")]) == 2
+    assert not (tmp_path / "x").exists()
 
 
 def test_the_quick_study_holds_its_gold_and_its_controls(quick_truthcube, capsys):
@@ -294,3 +290,25 @@ def test_the_quick_study_holds_its_gold_and_its_controls(quick_truthcube, capsys
     md = (quick_truthcube / "report.md").read_text()
     assert "Kerdok" in md and "floor" in md
     assert (quick_truthcube / "beads_by_layer.png").is_file()
+
+
+def test_the_index_answers_and_scores_against_reality(quick_truthcube, tmp_path):
+    """The index's answer on the measured body and its scorecard row come from the study's
+    metrics: every model's cell, none of it in the overall (continuum) ranking."""
+    from cases.cli import main
+    from cases.registry import CASES
+    for name in CASES:
+        (tmp_path / name).symlink_to(ROOT / "reports" / name, target_is_directory=True)
+    (tmp_path / "truth-cube").symlink_to(quick_truthcube, target_is_directory=True)
+    assert main(["index", "--out", str(tmp_path)]) == 0
+    md = (tmp_path / "index.md").read_text()
+    doc = json.loads((quick_truthcube / "metrics.json").read_text())
+    h = doc["headline"]
+    assert "**How far from a measured body?**" in md
+    nh = h["models"]["neo-Hookean P2/P1"]["bead_rms_mm"]
+    assert f"the neo-Hookean continuum is {nh:.3g} mm RMS off" in md
+    row = next(line for line in md.splitlines()
+               if line.startswith("| [truth-cube/bonded, 10mm (measured beads)]"))
+    for m in doc["parameters"]["models"][:8]:       # the first table's models
+        assert f"{h['models'][m]['bead_rms_rel']:.3g} at 18.25 %" in row
+    assert md.index("## Scorecard") < md.index("truth-cube/bonded, 10mm")

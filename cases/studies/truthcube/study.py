@@ -8,6 +8,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from model import Material, build
+from model.errors import ModelError
 from model.mesh import cube
 from model.presets import PRESETS
 from reference import hyperelastic, linear
@@ -65,8 +66,9 @@ class TruthCubeSettings:
 
     def __post_init__(self):
         if not 0.45 <= self.nu < 0.5:
-            raise ValueError(f"nu = {self.nu} is not a nearly incompressible silicone's; "
-                             "give 0.45 <= nu < 0.5 (the data's range is 0.49 to 0.4999)")
+            raise ModelError(f"the truth-cube study: nu = {self.nu} is not a nearly "
+                             "incompressible silicone's; give 0.45 <= nu < 0.5 (the Truth "
+                             "Cube's silicone: 0.49 to 0.4999)")
         if self.quick:
             self.spacings_mm = self.spacings_mm[:1]
         self.material = Material(E=self.E, nu=self.nu, rho=1000.0)
