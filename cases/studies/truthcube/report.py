@@ -196,14 +196,13 @@ def build(out, study, s, doc):
           + ", ".join(f"{h:g} mm" for h in s.spacings_mm) + " spacing; the moving plate at "
           "z = 0 pushed to +z, the fixed one at z = 80 mm, "
           f"placed on the bead lattice's centre; one static solve through the three states "
-          f"in steps of at most {doc['problem']['step_of_spacing']:g} of the mesh spacing "
-          "(Newton stalls on the particle readings with twice that at nu = 0.499).",
+          f"in steps of at most {doc['problem']['step_of_spacing']:g} of the mesh spacing.",
           f"nu = {s.nu:g} (the silicone's range is 0.49 to 0.4999: both ends shown below); "
-          f"E = {s.E:g} Pa (the plates prescribe displacement, so the bead field does not "
-          "depend on E; a test checks it).",
+          f"E = {s.E:g} Pa (the plates prescribe displacement and every force scales with E, "
+          "so E sets only the force scale).",
           f"Models: {', '.join(s.models)} (the readings calibrated, c = auto). References: "
           f"{NH} on the {REF_MESH[0]} split of {REF_MESH[1]} nodes per side refined "
-          f"{s.ref_levels} times (its bead displacement changed by "
+          f"{s.ref_levels} time(s) (its bead displacement changed by "
           + (", ".join(f"{fmt(r['bead_change_mm'])} mm at {percent(r['strain'])}" for r in ref)
              or "n/a") + " RMS over the last refinement; the global estimate "
           + (fmt(ref[-1]["error_estimate"]) if ref else "n/a") + ") and linear P2 on the same "
