@@ -287,6 +287,12 @@ def test_the_quick_study_holds_its_gold_and_its_controls(quick_truthcube, capsys
     # the continuum's axial profile rises from the fixed plate to the moving one, as measured
     nh = [r for r in doc["references"] if r["model"] == "neo-Hookean P2/P1"]
     assert all(np.all(np.diff(r["layer_axial_mm"]) > 0) for r in nh)
+    # linear elasticity's distance from the continuum grows with the strain, from below the
+    # measurement's floor at 5 % (its linearisation error)
+    lin = sorted((r for r in doc["references"] if r["model"] == "linear P2"),
+                 key=lambda r: r["strain"])
+    gap = [r["bead_vs_continuum_mm"] for r in lin]
+    assert gap == sorted(gap) and gap[0] < doc["data"]["states"][0]["floor_mm"]["total"]
     md = (quick_truthcube / "report.md").read_text()
     assert "Kerdok" in md and "floor" in md
     assert (quick_truthcube / "beads_by_layer.png").is_file()

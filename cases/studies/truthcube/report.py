@@ -75,7 +75,8 @@ def against_continuum(rows, data, mesh):
     fl = floors(data)
     out = {}
     for r in sorted(rows, key=lambda r: r["state"]):
-        if r["mesh"] != mesh or r["variant"] != DEFAULT:
+        if r["mesh"] not in (mesh, "reference") or r["variant"] != DEFAULT \
+                or r["model"] == NH:
             continue
         d = r.get("bead_vs_continuum_mm")
         ok = None if d is None else d <= fl[r["state"]]["total"]
@@ -101,7 +102,7 @@ def analyse(data):
                    if r["model"] == NH and r["strain"] == last and not r.get("failed")}
     return {"finest_mesh": mesh, "departure": said,
             "within_at_every_state": [m for m, t in said.items() if t == WITHIN_ALL],
-            "against_continuum": against_continuum(rows, data["data"], mesh),
+            "against_continuum": against_continuum(rows + refs, data["data"], mesh),
             "continuum_by_assumption_mm": assumptions,
             "headline": {"strain": last, "floor_mm": state["floor_mm"]["total"],
                          "continuum": NH, "states": len(data["data"]["states"]),
