@@ -57,6 +57,9 @@ class NormalAxis(CalibratedTerm):
     """Small-strain deviatoric normal strains along the material axes."""
 
     name = "normal_axis"
+    # linear in x: a finite rotation strains it (the conformance gate checks what it claims)
+    rotation_invariant = False
+    angular_momentum = False
 
     def __init__(self, mesh, material, scale=1.0, **params):
         super().__init__(mesh, material, scale, **params)

@@ -102,10 +102,13 @@ def registered():
 
 
 def make_term(name, mesh, material, **params):
-    """Instantiate the registered term ``name`` on ``mesh`` with ``params``."""
+    """Instantiate the registered term ``name`` on ``mesh`` with ``params``, after its
+    conformance checks (``model.conformance``: once per term and options in a process)."""
+    from ..conformance import conform
     _load_all()
     if name not in TERMS:
         raise ModelError(f"unknown force term {name!r}; registered: {', '.join(sorted(TERMS))}")
+    conform(TERMS[name], params)
     return TERMS[name](mesh, material, **params)
 
 
@@ -118,6 +121,10 @@ class Term:
         its registry name and the parameters a user may pass, with their defaults;
     ``conservative``
         whether an energy exists whose negative gradient the forces are;
+    ``momentum``, ``angular_momentum``, ``rotation_invariant``
+        the claims the conformance gate (``model.conformance``) checks: zero net force, zero
+        net torque, forces turned with a rigid rotation (True by default: a term that does
+        not make one says so);
     ``kernel()``
         ``(fn, args)``: a numba function called as ``fn(x, *args, out)`` that adds the term's
         forces at positions ``x`` (n, 3) into ``out`` (n, 3) and returns -1, or the index of
@@ -149,6 +156,9 @@ class Term:
 
     name = ""
     conservative = False
+    momentum = True
+    angular_momentum = True
+    rotation_invariant = True
     # whether the kernel reports every tetrahedron flattened below FLAT V0 (else the
     # integrator checks the volumes itself)
     checks_inversion = False

@@ -123,6 +123,10 @@ class FemLinear(_ConstantStrain):
     """Small-strain linear elastic tetrahedra."""
 
     name = "fem_linear"
+    # small strain: a finite rotation strains it, so its forces neither turn with the body
+    # nor keep the torque zero
+    rotation_invariant = False
+    angular_momentum = False
     _kernel = staticmethod(linear_forces)
 
     def _eps(self, F):

@@ -83,6 +83,10 @@ class Shear(Term):
                              f"{', '.join(READINGS)}")
         self.reading = READINGS[self.p["reading"]]
         self.conservative = self.p["reading"] == "variational"
+        # the corner reading's forces do not sum to zero; the balanced reading's do, but
+        # their torques do not (docs/model.md "Shear force")
+        self.momentum = self.p["reading"] != "corner"
+        self.angular_momentum = self.p["reading"] == "variational"
         c = self.p["c"]
         if c != "auto" and not (isinstance(c, (int, float)) and np.isfinite(c) and c > 0):
             raise ModelError(f"shear c must be 'auto' or a positive number, got {c!r}")
