@@ -417,6 +417,9 @@ class Study(abc.ABC):
 
     name: ClassVar[str]
     title: ClassVar[str]
+    # the command line's selections the study honours; `pbcm run NAME` refuses the others
+    # (`pbcm report` passes them to the studies that take them)
+    selections: ClassVar[tuple] = ("models", "meshes")
 
     @abc.abstractmethod
     def settings(self, quick=False, **kw):

@@ -198,6 +198,7 @@ def _lattice(nx, ny, nz, lx, ly, lz):
         if not isinstance(v, (int, np.integer, float)) or not np.isfinite(v) or v <= 0:
             raise MeshError(f"the length along {axis} (l{axis}) must be a positive length in "
                             f"metres, got {v!r}")
+    nx, ny, nz = int(nx), int(ny), int(nz)
     g = np.meshgrid(np.linspace(0, lx, nx), np.linspace(0, ly, ny), np.linspace(0, lz, nz),
                     indexing="ij")
     pts = np.stack([a.ravel(order="F") for a in g], axis=1)  # index i + nx (j + ny k)

@@ -35,18 +35,11 @@ _CORNERS = np.array([(i, j, k) for k in (0, 1) for j in (0, 1) for i in (0, 1)],
 _FACES = [(a, s) for a in range(3) for s in (0, 1)]
 
 
-def _check(n, size):
-    if not isinstance(n, (int, np.integer)) or n < 2:
-        raise MeshError(f"nodes per side must be an integer >= 2, got {n!r}")
-    if not np.isfinite(size) or size <= 0:
-        raise MeshError(f"the cube's side must be a positive length in metres, got {size!r}")
-
-
 def delaunay_lattice(n, size, seed):
     """The Delaunay tetrahedra of an ``n``^3 lattice of side ``size`` [m], joggled by
     ``seed`` (see the module docstring), flat ones dropped; the nodes are the exact lattice."""
-    _check(n, size)
-    pts, _, _ = _lattice(n, n, n, size, size, size)
+    pts, _, _ = _lattice(n, n, n, size, size, size)     # checks n and size
+    n = int(n)
     h = size / (n - 1)
     d = np.random.default_rng(seed).normal(scale=JOGGLE * h, size=(n, n, n, 3))
     d = d.transpose(2, 1, 0, 3).reshape(-1, 3)      # C order of (i, j, k) -> node i + n j + n^2 k
@@ -99,8 +92,7 @@ def mixed_split(n, size, n_five, seed):
     from scipy.optimize import Bounds, LinearConstraint, milp
     from scipy.sparse import lil_matrix
 
-    _check(n, size)
-    pts, cells, ids = _lattice(n, n, n, size, size, size)
+    pts, cells, ids = _lattice(n, n, n, size, size, size)   # checks n and size
     if not 0 <= n_five <= len(cells):
         raise MeshError(f"n_five must be between 0 and the {len(cells)} cells, got {n_five}")
     tris = cube_triangulations()

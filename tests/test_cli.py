@@ -3,6 +3,7 @@ import sys
 
 import meshio
 import numpy as np
+import pytest
 
 from cases.cli import main
 from model.mesh import cube
@@ -46,3 +47,15 @@ def test_console_script_is_installed():
     out = subprocess.run([sys.executable, "-m", "cases.cli", "--version"], capture_output=True,
                          text=True)
     assert out.returncode == 0 and "pbcm" in out.stdout
+
+
+@pytest.mark.parametrize("study, option, value", [("artefact", "--meshes", "six"),
+                                                   ("artefact", "--models", "msm"),
+                                                   ("truth-cube", "--meshes", "six"),
+                                                   ("extensions", "--meshes", "six")])
+def test_a_study_refuses_a_selection_it_would_ignore(study, option, value, tmp_path, capsys):
+    from cases.cli import main
+    out = tmp_path / study
+    assert main(["run", study, "--quick", option, value, "--out", str(out)]) == 2
+    assert f"{option} does not apply to the {study} study" in capsys.readouterr().err
+    assert not out.exists()

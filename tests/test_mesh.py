@@ -158,3 +158,14 @@ def test_the_mixed_split_is_conforming_with_ten_cells_in_five():
         paper_size_meshes(size, seeds=(0,), mixed_seeds=())
     with pytest.raises(MeshError, match="n_five must be between 0 and the 64 cells"):
         mixed_split(5, size, 65, seed=0)
+
+
+def test_paper_meshes_take_the_lattice_checks():
+    """The reconstructions check their size as every lattice does (one check, in
+    model.mesh), and a whole number given as a float is a number of nodes."""
+    from model.paper_mesh import delaunay_lattice, mixed_split
+    with pytest.raises(MeshError, match=r"nodes along x \(nx\) must be an integer >= 2"):
+        delaunay_lattice(1, 0.032, 7)
+    with pytest.raises(MeshError, match="positive length"):
+        mixed_split(5, -0.032, 10, 0)
+    assert delaunay_lattice(5.0, 0.032, 7).n_tets == delaunay_lattice(5, 0.032, 7).n_tets

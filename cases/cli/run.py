@@ -28,6 +28,12 @@ def run(args):
                          f"the case {args.case}: rerun the case")
     if args.case in STUDY_MODULES:
         study = studies()[args.case]
+        for option in ("models", "meshes"):
+            if getattr(args, option, None) and option not in study.selections:
+                takes = ("it fixes its own" if not study.selections else
+                         f"it takes only --{', --'.join(study.selections)}; not")
+                raise UsageError(f"--{option} does not apply to the {study.name} study: "
+                                 f"{takes} {option}; leave --{option} out")
         cfg = study_config(study, args)
         with StagedFolder(Path(args.out) if args.out else Path("reports") / args.case) as out, \
                 worker_pool(args, {args.case: cfg}) as workers:
