@@ -27,6 +27,9 @@ def _load(root, *parts):
 LIMITED = ("exact", "converges", "floor")   # fit verdicts whose e_inf is a limit
 
 
+REGULAR = ("five", "six", "bcc")     # the lattices as generated; the rest is irregular
+
+
 def consistency(conv, model):
     """{lattice: the converged limit e_inf of the sliding-cube patch test in the linear
     regime, or the fit's verdict where it has no limit (diverging, not asymptotic)}."""
@@ -124,11 +127,13 @@ def lines(root, models):
                       key=lambda m: _largest(limits[m]))
         nolimit = sorted({k for m in rest for k, v in limits[m].items()
                           if not isinstance(v, (int, float))})
-        out.append("**How far from the continuum?** Consistency error, the patch test's limit "
-                   "under refinement (largest over lattices): "
+        out.append("**How far from the continuum?** Consistency error, the sliding cube's limit "
+                   "under refinement (a patch test with traction-free sides; largest over "
+                   "lattices): "
                    + ", ".join(f"{m} {fmt(_largest(limits[m])[1])}" for m in rest)
                    + (f"; below {PATCH_TOL:g}: {', '.join(passed)}" if passed else "")
                    + (f"; no limit on {', '.join(nolimit)}" if nolimit else "")
+                   + _irregular(conv, models)
                    + " ([convergence](convergence/report.md)).")
     measured = (_load(root, MEASURED, "metrics.json") or {}).get("headline")
     if measured:
@@ -163,6 +168,21 @@ def _measured_line(h, models):
                  f"{fmt(v[mine[-1]]['bead_rms_mm'])} mm ({mine[-1]}); ")
     return said + (f"within the floor at every state: {', '.join(within) or 'none'} "
                    f"([truth-cube]({MEASURED}/report.md)).")
+
+
+def _irregular(conv, models):
+    """'; on irregular patches ...': each model's worst patch-test error over the families
+    whose patch is irregular (perturbed lattices, unstructured), where the study ran it."""
+    worst_of = {}
+    for r in conv.get("patch", []):
+        if r["mesh"] in REGULAR or r.get("patch_error") is None or r["model"] not in models:
+            continue
+        worst_of[r["model"]] = max(worst_of.get(r["model"], 0.0), r["patch_error"])
+    if not worst_of:
+        return ""
+    return ("; the patch test with every boundary node prescribed, on irregular patches "
+            "(worst): " + ", ".join(f"{m} {fmt(v)}" for m, v in sorted(
+                worst_of.items(), key=lambda kv: kv[1])))
 
 
 def _largest(limit):

@@ -152,7 +152,11 @@ DESCRIPTORS = frozenset({
     # the truth-cube study's factors: the plate assumption, the measured state
     "variant", "plates", "travel", "nu", "state", "strain",
     # how a study's reference was solved: its element, spacings, size, extrapolation
-    "element", "ladder_mm", "dofs", "extrapolated"})
+    "element", "ladder_mm", "dofs", "extrapolated",
+    # the verification ladder's declaration: a manufactured ladder's name, levels, formal
+    # order, bound and tolerance, its verdict; a patch's interior node count
+    "ladder", "cells", "formal_order", "finest_bound", "tolerance", "passed", "interior",
+    "one_sided", "dt_s", "steps", "failed_divisor"})
 
 # ---------------------------------------------------------------- the standard static metrics
 declare("disp_rel_l2_p1", "1", "disp L2 P1",
@@ -423,6 +427,32 @@ declare("ratio_inf", "1", "ratio_inf",
          "the response ratio model / reference extrapolated to h -> 0.")
 declare("ratio_inf_err", "1", "ratio_inf uncertainty", "the fit's uncertainty of ratio_inf.")
 declare("order", "1", "order", "the fitted order of convergence of the error in h.")
+declare("mms_errors", "1", "MMS L2 per level",
+         "||u_h - u|| / ||u|| in L2 against the manufactured field, at each level of a ladder.")
+declare("mms_orders", "1", "orders per pair",
+         "log(e1 / e2) / log(h1 / h2) of each successive pair of a manufactured ladder.")
+declare("mms_order", "1", "observed order",
+         "the observed L2 order of a manufactured ladder on its finest pair of levels.",
+         "signed")
+declare("mms_rel_l2", "1", "finest MMS L2",
+         "||u_h - u|| / ||u|| in L2 against the manufactured field on a ladder's finest "
+         "level.", "max")
+declare("dt_errors", "1", "step error per step size",
+         "||x - x_ref|| / ||x_ref - X|| at the end of the paper cube's push, at the case's RK4 "
+         "step and its half, x_ref the push at an eighth of the step.")
+declare("dt_error", "1", "step error",
+         "the paper cube's end-of-push displacement at the case's RK4 step against the push at "
+         "an eighth of it, relative to the displacement.", "max")
+declare("dt_order", "1", "step order",
+         "the observed order of the step error when the step is halved (RK4's is 4); none "
+         "where the half step's error is at round-off.", "signed")
+declare("patch_errors", "1", "patch error per strain",
+         "the RMS over the tetrahedra of |eps_h - eps| / |eps| for each of the six unit "
+         "strains of the patch test (Voigt order).")
+declare("patch_error", "1", "patch error",
+         "the patch test's consistency error: the worst over the six unit strains of the RMS "
+         "over the tetrahedra of |eps_h - eps| / |eps|, eps_h the relaxed solution's strain.",
+         "max")
 declare("C_eff_Pa", "Pa", "C_eff",
          "the lattice's effective elasticity tensor (Voigt 6 x 6) from six homogeneous "
          "strains.")

@@ -74,3 +74,14 @@ def dihedral_angles(points, tets):
     pairs = [(0, 1), (0, 2), (0, 3), (1, 2), (1, 3), (2, 3)]
     cos = np.stack([-np.einsum("ij,ij->i", n[:, i], n[:, j]) for i, j in pairs], axis=1)
     return np.degrees(np.arccos(np.clip(cos, -1.0, 1.0)))
+
+
+def displacement_gradients(points, tets, u):
+    """The constant displacement gradient du_i / dx_k (m, 3, 3) of the linear interpolation of
+    the nodal ``u`` (n, 3) over each tetrahedron: with the edge matrices D = x_a - x_0 and
+    dU = u_a - u_0 (a = 1..3), dU = D (grad u)^T."""
+    x = np.asarray(points, float)[tets]
+    d = np.asarray(u, float)[tets]
+    D = x[:, 1:] - x[:, :1]
+    dU = d[:, 1:] - d[:, :1]
+    return np.swapaxes(np.linalg.solve(D, dU), 1, 2)

@@ -248,6 +248,31 @@ def cube(n, size, scheme="five", seed=0):
     return box(n, n, n, size, size, size, scheme, seed)
 
 
+def perturbed(mesh, amplitude=0.2, seed=0):
+    """``mesh`` with each interior node moved at random, every coordinate by up to
+    ``amplitude`` x its shortest edge, the connectivity and the boundary nodes kept (an
+    irregular patch of the same lattice: ``lattice`` is kept, so a model is calibrated on the
+    regular lattice as it would be). Deterministic for a given seed; refused when a
+    tetrahedron would invert."""
+    if not 0.0 <= amplitude < 0.5:
+        raise MeshError(f"amplitude must be in [0, 0.5) of the shortest edge, got {amplitude!r}")
+    lo, hi = mesh.points.min(axis=0), mesh.points.max(axis=0)
+    tol = 1e-9 * mesh.size
+    inner = ~((np.abs(mesh.points - lo) < tol) | (np.abs(mesh.points - hi) < tol)).any(axis=1)
+    e = mesh.edges
+    length = np.linalg.norm(mesh.points[e[:, 0]] - mesh.points[e[:, 1]], axis=1)
+    shortest = np.full(mesh.n_nodes, np.inf)
+    np.minimum.at(shortest, e[:, 0], length)
+    np.minimum.at(shortest, e[:, 1], length)
+    rng = np.random.default_rng(seed)
+    d = rng.uniform(-amplitude, amplitude, mesh.points.shape) * shortest[:, None]
+    pts = mesh.points + np.where(inner[:, None], d, 0.0)
+    if np.any(geometry.signed_volumes(pts, mesh.tets) <= 0):
+        raise MeshError(f"perturbing by {amplitude} of the shortest edge inverts a tetrahedron: "
+                        "take a smaller amplitude")
+    return TetMesh(pts, mesh.tets, lattice=mesh.lattice)
+
+
 def _bcc(pts, cells, ids, n, length):
     """Body-centred cubic tetrahedra: for each interior face, four tetrahedra between the two
     cell centres and the face's edges; each boundary face is a half-pyramid pair on its centre."""

@@ -13,7 +13,7 @@ from cases.registry import CASES, studies
 ROOT = Path(__file__).resolve().parents[1]
 # the sections of a metrics.json whose rows carry metrics
 ROW_SECTIONS = ("runs", "gate_runs", "case_runs", "fits", "elasticity", "cells", "rows",
-                "references")
+                "references", "manufactured", "patch", "steps")
 
 
 def _rows(data):

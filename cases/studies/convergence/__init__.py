@@ -12,6 +12,10 @@ from ...store import OFF
 from . import report
 from .study import ConvergenceSettings, run
 
+# what metrics.json records of a run, all the report is drawn from
+RECORDED = ("runs", "fits", "references", "elasticity", "cost", "manufactured", "patch",
+            "steps")
+
 
 class Convergence(Study):
     name = "convergence"
@@ -35,6 +39,14 @@ class Convergence(Study):
     def definitions(self):
         return report.definitions()
 
+    def recorded(self, metrics):
+        """The settings and data a run recorded, for ``pbcm run convergence --rewrite``."""
+        p = metrics["parameters"]
+        s = ConvergenceSettings(
+            E=p["E_Pa"], nu=p["nu"], rho=p["rho_kg_m3"], problems=tuple(p["problems"]),
+            meshes=tuple(p["meshes"]), models=tuple(p["models"]), h_mm=tuple(p["h_mm"]),
+            load_scale=p["load_scale"], patch_n=p["patch_n"], quick=p["quick"])
+        return s, {k: metrics[k] for k in RECORDED}
 
 
 STUDY = Convergence()

@@ -21,6 +21,7 @@ from .cost import accuracy_per_cost
 from .elasticity import table as elasticity_table
 from .fit import EXACT, cancellation, fit, observed_order, ratio_limit
 from .problems import PROBLEMS
+from . import manufactured, patch, steps
 
 FEM_P1 = "FEM P1"              # the yardstick: scikit-fem P1 on the model's own mesh
 MAX_NODES = 10_000             # a level is run where its mesh fits: Newton's sparse LU on a
@@ -386,7 +387,7 @@ def run(s, workers=None, log=True, bench=None, store=OFF):
     weights = {name: _weights(name, s) for name in s.problems}
     total = sum(sum(weights[name].values()) for name, _ in pairs)
     ref_weight, elastic_weight = 0.05 * total, 0.05 * total
-    with Progress("convergence", total + ref_weight + elastic_weight, log=log,
+    with Progress("convergence", total + ref_weight + 2 * elastic_weight, log=log,
                   width=36) as track:
         refs = _map(reference_unit, [(name, bc, s, store) for name, bc in pairs], workers,
                     lambda i: track.advance(ref_weight / len(pairs),
@@ -401,12 +402,22 @@ def run(s, workers=None, log=True, bench=None, store=OFF):
         with one_blas_thread():
             eff = elasticity_table(s, store)
         track.advance(elastic_weight, "effective elasticity")
+        with one_blas_thread():
+            verification = {
+                "manufactured": manufactured.table(s.meshes, s.quick, store),
+                "patch": patch.table((FEM_P1,) + tuple(s.models), s.meshes, s.E, s.nu, store),
+                # quick: the first family only (a minute a family for every model)
+                "steps": steps.table(s.models, s.meshes[:1] if s.quick else s.meshes, s.E,
+                                     s.nu, s.rho, store)}
+        track.advance(elastic_weight, "verification: manufactured solutions, patch test, "
+                      "step convergence")
     runs = [r for rs in rows for r in rs]
     fitted = fits(runs)
     cancelling = {(f["case"], f["mesh"], f["bc"], f["model"]) for f in fitted
                   if f.get("cancellation")}
     data = {"runs": runs, "fits": fitted, "references": [ref.summary() for ref in refs],
-            "elasticity": eff, "cost": accuracy_per_cost(runs, bench, EXACT, cancelling)}
+            "elasticity": eff, "cost": accuracy_per_cost(runs, bench, EXACT, cancelling),
+            **verification}
     return jsonable(data)
 
 

@@ -1,0 +1,122 @@
+"""Manufactured solutions (reference.manufactured): the loads against finite differences and
+closed forms, the L2 error against a closed form, and every ladder of the verification spec
+(cases/studies/convergence/verification.toml) on every family: the observed L2 order of the
+finest pair within the tolerance of the element's formal order (P1 2, P2 3), the finest error
+under its bound."""
+import numpy as np
+import pytest
+
+from model.errors import ModelError
+from model.mesh import cube
+from reference import linear
+from reference.fem import lame
+from reference.manufactured import l2_error, manufactured, prescribed_faces, solve, waves
+from cases.studies.convergence.manufactured import orders, run_entry
+from cases.studies.convergence.verification import spec
+
+L, E, NU = 0.02, 10e3, 0.3
+
+
+def _fd_divergence(stress, x, h):
+    div = np.zeros(x.shape)
+    for k in range(3):
+        e = np.zeros(3)
+        e[k] = h
+        div += (stress(x + e)[:, :, k] - stress(x - e)[:, :, k]) / (2 * h)
+    return div
+
+
+@pytest.mark.parametrize("material,amplitude", [("linear", 1e-3), ("neo-Hookean", 0.05)])
+def test_body_force_is_minus_the_divergence_of_the_stress(material, amplitude):
+    p = manufactured(waves(L, amplitude), material, E, NU)
+    x = np.random.default_rng(0).uniform(0, L, (20, 3))
+    b = p.body_force(x)
+    assert np.abs(b + _fd_divergence(p.stress, x, 1e-5 * L)).max() <= 1e-7 * np.abs(b).max()
+    n = np.array([0.0, 0.6, 0.8])
+    assert np.allclose(p.traction(x, np.tile(n, (20, 1))), p.stress(x) @ n, rtol=1e-14)
+
+
+def test_hessian_is_the_gradient_of_the_gradient():
+    f = waves(L)
+    x = np.random.default_rng(1).uniform(0, L, (10, 3))
+    h = 1e-5 * L
+    fd = np.stack([(f.grad(x + h * e) - f.grad(x - h * e)) / (2 * h) for e in np.eye(3)], -1)
+    assert np.abs(f.hessian(x) - fd).max() <= 1e-8 * np.abs(fd).max()
+
+
+def test_the_two_stresses_in_closed_form():
+    """Linear: lam tr(eps) I + 2 mu eps of a worked strain; neo-Hookean: zero at rest, and the
+    uniaxial stretch's P_11 = mu (s - 1/s) + lam ln(s) / s."""
+    lam, mu = lame(E, NU)
+    g = np.array([[1e-3, 2e-3, 0.0], [0.0, -1e-3, 0.0], [0.0, 0.0, 0.0]])
+    sig = manufactured(waves(L), "linear", E, NU).material.stress(g)
+    assert sig[0, 1] == pytest.approx(mu * 2e-3) and sig[2, 2] == pytest.approx(0.0, abs=1e-12)
+    assert sig[0, 0] == pytest.approx(2 * mu * 1e-3)      # tr eps = 0
+    nh = manufactured(waves(L), "neo-Hookean", E, NU).material
+    assert np.abs(nh.stress(np.zeros((3, 3)))).max() < 1e-12 * E
+    s = 1.2
+    P = nh.stress(np.diag([s - 1, 0.0, 0.0]))
+    assert P[0, 0] == pytest.approx(mu * (s - 1 / s) + lam * np.log(s) / s, rel=1e-12)
+    with pytest.raises(ModelError, match="inverts"):
+        nh.stress(np.diag([-1.5, 0.0, 0.0]))
+
+
+def test_l2_error_of_a_constant_offset_is_its_norm_times_root_volume():
+    m = cube(3, L, "five")
+    bc = {i: (0.0, 0.0, 0.0) for i in range(m.n_nodes)}
+    r = linear.solve(m, E, NU, bc, element="P2")
+    c = np.array([1e-4, -2e-4, 2e-4])
+    err, norm = l2_error(r.basis, r.dofs, lambda x: np.broadcast_to(c, x.shape))
+    assert err == pytest.approx(np.linalg.norm(c) * L ** 1.5, rel=1e-12)
+    assert norm == pytest.approx(err, rel=1e-12)
+
+
+def test_orders_of_a_power_law_are_its_exponent():
+    assert orders([4, 8, 16], [1.0, 0.25, 0.0625]) == pytest.approx([2.0, 2.0])
+
+
+def test_bad_problems_are_refused():
+    with pytest.raises(ModelError, match="unknown material"):
+        manufactured(waves(L), "rubber", E, NU)
+    p = manufactured(waves(L), "linear", E, NU)
+    with pytest.raises(ModelError, match="no node of the mesh lies on the faces"):
+        solve(cube(3, L, "five"), p, 2 * L, faces="X")
+    with pytest.raises(ModelError, match="no mixed form"):
+        solve(cube(3, L, "five"), p, L, mixed=True)
+
+
+SPEC = spec()
+LADDERS = [(e, fam) for e in SPEC["manufactured"] for fam in e.cells]
+
+
+@pytest.mark.parametrize("entry,family", LADDERS,
+                         ids=[f"{e.name}-{f}" for e, f in LADDERS])
+def test_observed_order_is_the_formal_order(entry, family):
+    row = run_entry(entry, family, SPEC["size"], SPEC["E"], SPEC["tolerance"])
+    order, formal, tol = row["mms_order"], entry.formal_order, SPEC["tolerance"]
+    assert order >= formal - tol, row
+    if family not in entry.faster:
+        assert order <= formal + tol, row
+    assert row["mms_rel_l2"] <= entry.finest_bound, row
+    assert row["passed"]
+    # the errors fall monotonically: no level is lucky
+    assert all(a > b for a, b in zip(row["mms_errors"], row["mms_errors"][1:]))
+
+
+def test_the_neo_hookean_field_is_at_finite_strain():
+    """The neo-Hookean ladders' field strains the cube by more than 10 %: linear P2 under the
+    same loads misses it by over 10x the neo-Hookean ladder's finest bound."""
+    entry = next(e for e in SPEC["manufactured"] if e.material == "neo-Hookean")
+    size = SPEC["size"]
+    p = entry.problem(size, SPEC["E"])
+    x = np.random.default_rng(0).uniform(0, size, (4000, 3))
+    assert np.abs(p.field.grad(x)).max() > 0.1
+    mesh = cube(entry.cells["five"][1] + 1, size, "five")
+    on = prescribed_faces(mesh.points, size, entry.faces)
+    bc = {int(i): tuple(p.field.u(mesh.points[i])) for i in np.flatnonzero(on)}
+    r = linear.solve(mesh, SPEC["E"], entry.nu, bc, body_force=p.body_force,
+                     traction=p.traction, element="P2",
+                     dirichlet_fn=lambda q: np.where(
+                         prescribed_faces(q, size, entry.faces)[:, None], p.field.u(q), np.nan))
+    e, n = l2_error(r.basis, r.dofs, p.field.u)
+    assert e / n > 10 * entry.finest_bound
