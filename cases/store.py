@@ -10,7 +10,10 @@ to any source file therefore misses every entry: nothing stale is ever served.
 The entries live in a diskcache (SQLite and files) in ``$PBCM_CACHE``, by default the user's
 cache directory; an entry is committed in one transaction after its value is written, so a run
 killed while writing leaves no entry that a later run would trust. ``--no-cache`` (or
-``PBCM_NO_CACHE=1``) bypasses the store.
+``PBCM_NO_CACHE=1``) bypasses the store. ``PBCM_CACHE_KINDS`` (a comma-separated list of
+kinds, e.g. the FEM references: ``reference,convergence-reference``) keeps and finds only
+entries of those kinds: every model run is computed, the references solved once (the test
+suite runs so).
 """
 import hashlib
 import json
@@ -20,6 +23,10 @@ from pathlib import Path
 
 ENV = "PBCM_CACHE"
 ENV_OFF = "PBCM_NO_CACHE"
+ENV_KINDS = "PBCM_CACHE_KINDS"
+# the kinds that hold FEM references only: what no model, and no patch of a model, changes
+REFERENCE_KINDS = ("reference", "convergence-reference", "convergence-reference-at",
+                   "artefact-reference", "truthcube-reference", "truthcube-fit")
 PACKAGES = ("model", "reference", "cases")
 ROOT = Path(__file__).resolve().parents[1]
 SKIP = {"__pycache__"}
@@ -58,27 +65,42 @@ def source_hash(root):
 
 
 def key(**what):
-    """The key of a result determined by ``what`` (plain values) and the source."""
+    """The key of a result determined by ``what`` (plain values) and the source: its kind, a
+    colon, and the hash of the rest (the kind readable, for ``PBCM_CACHE_KINDS``)."""
     text = json.dumps({**what, "source": fingerprint()}, sort_keys=True, default=repr)
-    return hashlib.sha256(text.encode()).hexdigest()
+    return f"{what.get('kind', '')}:{hashlib.sha256(text.encode()).hexdigest()}"
+
+
+def kind_of(k):
+    """The kind a key was made with ('' for a key made without one)."""
+    return k.split(":", 1)[0] if ":" in k else ""
 
 
 class RunStore:
     """The store in ``folder`` (default ``default_folder()``); ``enabled=False`` finds nothing
     and keeps nothing. Picklable: a worker process opens the same folder. ``found`` and
-    ``kept`` count this process's hits and writes."""
+    ``kept`` count this process's hits and writes. ``kinds`` (default ``$PBCM_CACHE_KINDS``,
+    else every kind): the kinds of entry kept and found; any other key finds nothing and
+    keeps nothing."""
 
-    def __init__(self, folder=None, enabled=True):
+    def __init__(self, folder=None, enabled=True, kinds=None):
         self.folder = Path(folder) if folder else default_folder()
         self.enabled = enabled and not os.environ.get(ENV_OFF)
+        if kinds is None and os.environ.get(ENV_KINDS):
+            kinds = [k.strip() for k in os.environ[ENV_KINDS].split(",") if k.strip()]
+        self.kinds = None if kinds is None else frozenset(kinds)
         self._cache = None
         self.found = self.kept = 0
 
     def __getstate__(self):
-        return {"folder": self.folder, "enabled": self.enabled}
+        return {"folder": self.folder, "enabled": self.enabled,
+                "kinds": None if self.kinds is None else sorted(self.kinds)}
 
     def __setstate__(self, state):
-        self.__init__(state["folder"], state["enabled"])
+        self.__init__(state["folder"], state["enabled"], state.get("kinds"))
+
+    def _keeps(self, k):
+        return self.enabled and (self.kinds is None or kind_of(k) in self.kinds)
 
     def _open(self):
         if self._cache is None:
@@ -91,7 +113,7 @@ class RunStore:
 
     def get(self, k):
         """The value stored under key ``k``, or None."""
-        if not self.enabled:
+        if not self._keeps(k):
             return None
         value = self._open().get(k)
         if value is not None:
@@ -100,7 +122,7 @@ class RunStore:
 
     def put(self, k, value):
         """Keep ``value`` under key ``k`` (committed whole, or not at all)."""
-        if self.enabled:
+        if self._keeps(k):
             self._open().set(k, value)
             self.kept += 1
         return value
@@ -113,4 +135,5 @@ class RunStore:
 
 OFF = RunStore(enabled=False)
 
-__all__ = ["RunStore", "OFF", "key", "fingerprint", "source_hash", "default_folder", "ENV", "ENV_OFF"]
+__all__ = ["RunStore", "OFF", "key", "kind_of", "fingerprint", "source_hash", "default_folder",
+           "ENV", "ENV_OFF", "ENV_KINDS", "REFERENCE_KINDS"]

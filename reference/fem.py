@@ -25,6 +25,11 @@ INTORDER = {"P1": 1, "P2": 2}  # exact for the stiffness, and for a constant bod
 DIRECT_MAX_DOFS = 4_000
 # peak memory of that direct solve of a P2 cube with 101 277 unknowns, measured: 5.8 GiB (245 s)
 DIRECT_BYTES_AT_1E5 = 5.8 * 2**30
+# where the default aggregation stagnates ("auto"), a system up to this many unknowns goes to the
+# direct solver rather than to the second aggregation: such systems are slender, bending
+# bodies whose LU fills little (the quick cantilever's neo-Hookean Newton step on five refined
+# once, 47 808 unknowns: direct 5.5 s, evolution-strength AMG-CG 38 s after the stagnated try)
+DIRECT_AFTER_STAGNATION_DOFS = 60_000
 # tried in order: the default (cheap to set up), then one that converges on thin slabs
 AMG_SETTINGS = (("default aggregation", {}),
                 ("evolution strength, energy prolongation",
@@ -212,9 +217,10 @@ def linear_solve(A, b, doflocs, comp, solver="auto", rtol=1e-10, accept=1e-8):
     ``solver``: "direct" (scipy's sparse LU), "amg" (CG preconditioned by pyamg smoothed
     aggregation with the rigid-body modes as near-null space) or "auto": direct up to
     DIRECT_MAX_DOFS unknowns, AMG-CG beyond. CG runs until it converges or stagnates, with no
-    fixed iteration count; if it stagnates with the default aggregation it starts again with
-    evolution strength and energy-minimising prolongation (what thin, bending-dominated bodies
-    need); if that stagnates too, "auto" falls back to the direct solver when its estimated
+    fixed iteration count; if it stagnates with the default aggregation, "auto" solves directly
+    up to DIRECT_AFTER_STAGNATION_DOFS unknowns (where the memory fits) and otherwise starts
+    again with evolution strength and energy-minimising prolongation (what thin,
+    bending-dominated bodies need); if that stagnates too, "auto" falls back to the direct solver when its estimated
     memory fits in the memory available, and otherwise a ConvergenceError advises
     ``solver="direct"``. ``doflocs`` (N, 3) and ``comp`` (N,) locate each unknown.
     """
@@ -236,6 +242,10 @@ def linear_solve(A, b, doflocs, comp, solver="auto", rtol=1e-10, accept=1e-8):
         tried.append(f"{name}: relative residual {rel:.2e} after {iterations} iterations")
         if rel <= rtol:
             return x, {"solver": f"amg-cg ({name})", "iterations": total, "residual": float(rel)}
+        if (solver == "auto" and n <= DIRECT_AFTER_STAGNATION_DOFS
+                and direct_memory_estimate(n) < 0.5 * available_memory()):
+            return spd_factor(A).solve(b), {"solver": f"direct ({name} stagnated)",
+                                           "iterations": total, "amg": tried}
     if rel <= accept:   # both stagnated close to rtol: the rounding floor of this system
         return x, {"solver": f"amg-cg ({name})", "iterations": total, "residual": float(rel)}
     need, have = direct_memory_estimate(n), available_memory()

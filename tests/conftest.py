@@ -9,10 +9,52 @@ settings.register_profile("pbcm", derandomize=True, deadline=None, database=None
 settings.load_profile("pbcm")
 
 import os
-# the commands' run store stays out of the tests: each test computes what it checks (a test
-# that patches the physics in-process would otherwise be served the unpatched results); the
-# store's own tests (test_store.py) turn it on in a folder of their own
-os.environ["PBCM_NO_CACHE"] = "1"
+import shutil
+import tempfile
+from pathlib import Path
+
+from filelock import FileLock
+
+from cases import store as S
+
+# The commands' run store keeps the FEM references only, in a folder of this test session
+# (shared by its xdist workers): every model run is computed by the test that checks it (a
+# test that patches a model in-process is never served the unpatched run), and a reference,
+# which no model changes, is solved once. The store's own tests (test_store.py) turn the
+# whole store on in a folder of their own.
+os.environ.pop(S.ENV_OFF, None)
+os.environ[S.ENV_KINDS] = ",".join(S.REFERENCE_KINDS)
+
+
+def pytest_configure(config):
+    """The session's reference store: made by the controlling process, inherited by the
+    xdist workers it starts (and by the worker processes the commands start)."""
+    if not hasattr(config, "workerinput"):
+        config._pbcm_store = tempfile.mkdtemp(prefix="pbcm-test-store-")
+        os.environ[S.ENV] = config._pbcm_store
+
+
+def pytest_unconfigure(config):
+    folder = getattr(config, "_pbcm_store", None)
+    if folder:
+        shutil.rmtree(folder, ignore_errors=True)
+
+
+def shared(tmp_path_factory, name, make):
+    """The folder ``name`` made once per test session by ``make(folder)``, whichever xdist
+    worker asks first; the others wait for it and read the same folder."""
+    root = tmp_path_factory.getbasetemp()
+    if os.environ.get("PYTEST_XDIST_WORKER"):
+        root = root.parent
+    out = Path(root) / "shared" / name / name      # its parent holds it alone (`pbcm check`)
+    out.parent.mkdir(parents=True, exist_ok=True)
+    done = out.parent / (name + ".done")
+    with FileLock(str(out.parent / (name + ".lock"))):
+        if not done.exists():
+            shutil.rmtree(out, ignore_errors=True)
+            make(out)
+            done.touch()
+    return out
 
 from model import Material
 from model.mesh import TetMesh, cube
@@ -51,13 +93,18 @@ def rotation(axis, angle):
     return np.eye(3) + np.sin(angle) * K + (1 - np.cos(angle)) * K @ K
 
 
+def _run(*args):
+    from cases.cli import main
+
+    def make(out):
+        assert main(["run", *args, "--out", str(out)]) == 0
+    return make
+
+
 @pytest.fixture(scope="session")
 def quick(tmp_path_factory):
     """`pbcm run paper-cube --quick`, once per test session (the CI run of the case)."""
-    from cases.cli import main
-    out = tmp_path_factory.mktemp("quick") / "paper-cube"
-    assert main(["run", "paper-cube", "--quick", "--out", str(out)]) == 0
-    return out
+    return shared(tmp_path_factory, "paper-cube", _run("paper-cube", "--quick"))
 
 
 def floats_in(x):
@@ -76,29 +123,31 @@ def floats_in(x):
 def library(tmp_path_factory, quick):
     """Every case of the library run in quick mode into one folder, with the paper cube's
     quick run beside them (as `pbcm report --quick` would write them)."""
-    from cases.cli import main
     from cases.registry import CASES
-    root = tmp_path_factory.mktemp("library")
-    for name in CASES:
-        if name != "paper-cube":
-            assert main(["run", name, "--quick", "--out", str(root / name)]) == 0
-    (root / "paper-cube").symlink_to(quick, target_is_directory=True)
-    return root
+
+    def make(root):
+        root.mkdir(parents=True)
+        for name in CASES:
+            if name != "paper-cube":
+                _run(name, "--quick")(root / name)
+        (root / "paper-cube").symlink_to(quick, target_is_directory=True)
+    return shared(tmp_path_factory, "library", make)
 
 
 @pytest.fixture(scope="session")
 def quick_artefact(tmp_path_factory):
     """`pbcm run artefact --quick`, once per test session."""
-    from cases.cli import main
-    out = tmp_path_factory.mktemp("artefact") / "artefact"
-    assert main(["run", "artefact", "--quick", "--out", str(out)]) == 0
-    return out
+    return shared(tmp_path_factory, "artefact", _run("artefact", "--quick"))
 
 
 @pytest.fixture(scope="session")
 def quick_truthcube(tmp_path_factory):
     """`pbcm run truth-cube --quick`, once per test session."""
-    from cases.cli import main
-    out = tmp_path_factory.mktemp("truthcube") / "truth-cube"
-    assert main(["run", "truth-cube", "--quick", "--out", str(out)]) == 0
-    return out
+    return shared(tmp_path_factory, "truth-cube", _run("truth-cube", "--quick"))
+
+
+@pytest.fixture(scope="session")
+def quick_convergence(tmp_path_factory):
+    """`pbcm run convergence --quick` on one worker, once per test session."""
+    return shared(tmp_path_factory, "convergence",
+                  _run("convergence", "--quick", "--workers", "1"))

@@ -91,11 +91,9 @@ def test_reference_is_evaluated_off_its_nodes_by_its_basis():
 
 
 # ---------------------------------------------------------------------- the quick study
-@pytest.fixture(scope="session")
-def study(tmp_path_factory):
-    out = tmp_path_factory.mktemp("convergence") / "convergence"
-    assert main(["run", "convergence", "--quick", "--out", str(out), "--workers", "1"]) == 0
-    return out
+@pytest.fixture
+def study(quick_convergence):
+    return quick_convergence
 
 
 def test_quick_study_writes_its_report_and_the_rows_asked_for(study):

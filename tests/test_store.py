@@ -25,6 +25,7 @@ SMALL = ["--quick", "--meshes", "five", "--bcs", "clamped", "--models", "pbcm-va
 def cache(tmp_path, monkeypatch):
     """The store on, in a folder of this test's own."""
     monkeypatch.delenv(S.ENV_OFF, raising=False)
+    monkeypatch.delenv(S.ENV_KINDS, raising=False)
     monkeypatch.setenv(S.ENV, str(tmp_path / "cache"))
     return tmp_path / "cache"
 
@@ -173,7 +174,7 @@ def test_a_study_run_again_computes_nothing(cache, monkeypatch):
     store the second time, equal to the first; a model added later is the only thing
     computed (the extensions study's case: the P2 reference ladder is not solved again)."""
     from cases.registry import studies
-    from cases.studies.convergence import elasticity, study as conv
+    from cases.studies.convergence import elasticity, manufactured, patch, steps, study as conv
     st = studies()["convergence"]
     s = st.settings(quick=True, problems=("cantilever",), meshes=("five",), models=("msm",),
                     h_mm=(8.0, 4.0), patch_n=3)
@@ -183,12 +184,18 @@ def test_a_study_run_again_computes_nothing(cache, monkeypatch):
         m.setattr(conv, "build", _refuse)
         m.setattr(conv.linear, "solve", _refuse)
         m.setattr(elasticity, "entry", _refuse)
+        m.setattr(manufactured.mms, "solve", _refuse)
+        m.setattr(patch, "solve", _refuse)
+        m.setattr(steps, "push", _refuse)
         again = S.RunStore(cache)
         assert st.run(s, log=False, store=again) == first
     assert again.kept == 0
     # each run is looked up twice (its reference unit asks whether it needs the reference's
-    # values there, its family unit reads it), the reference's summary and the elasticity once
-    assert again.found == 2 * len(first["runs"]) + 1 + len(first["elasticity"])
+    # values there, its family unit reads it), the reference's summary, the elasticity and
+    # each row of the verification once
+    assert again.found == 2 * len(first["runs"]) + 1 + sum(
+        len(first[k]) for k in ("elasticity", "manufactured", "patch", "steps"))
+    assert len(first["patch"]) == 4 and len(first["steps"]) == 1
     monkeypatch.setattr(conv, "solve_reference", _refuse)
     built = []
     real = conv.build
@@ -199,3 +206,23 @@ def test_a_study_run_again_computes_nothing(cache, monkeypatch):
     assert set(built) == {"pbcm-variational"}
     old = [r for r in more["runs"] if r["model"] != "pbcm-variational"]
     assert old == first["runs"]
+
+
+def test_kinds_keep_and_find_only_entries_of_those_kinds(tmp_path, monkeypatch):
+    """`PBCM_CACHE_KINDS` (the test suite's setting: the FEM references only): a key of another
+    kind is neither kept nor found; the restriction survives pickling to a worker."""
+    import pickle
+    ref, run = S.key(kind="reference", mesh="five"), S.key(kind="run", mesh="five")
+    assert S.kind_of(ref) == "reference" and S.kind_of(run) == "run"
+    store = S.RunStore(tmp_path, kinds=["reference"])
+    store.put(ref, {"u": 1})
+    store.put(run, {"u": 2})
+    assert store.kept == 1
+    assert store.get(ref) == {"u": 1} and store.get(run) is None
+    everything = S.RunStore(tmp_path, kinds=None)
+    assert everything.get(ref) == {"u": 1} and everything.get(run) is None   # never kept
+    monkeypatch.setenv(S.ENV_KINDS, "run, reference-fields")
+    from_env = S.RunStore(tmp_path)
+    assert from_env.kinds == {"run", "reference-fields"}
+    assert from_env.get(ref) is None
+    assert pickle.loads(pickle.dumps(from_env)).kinds == from_env.kinds
