@@ -28,8 +28,16 @@ os.environ[S.ENV_KINDS] = ",".join(S.REFERENCE_KINDS)
 
 def pytest_configure(config):
     """The session's reference store: made by the controlling process, inherited by the
-    xdist workers it starts (and by the worker processes the commands start)."""
-    if not hasattr(config, "workerinput"):
+    xdist workers it starts (and by the worker processes the commands start). Each xdist
+    worker keeps to a core of its own, so that a command it runs takes one process (the
+    default of --workers is the cores available) and compiles each model's step once per
+    session rather than once per command's worker process."""
+    worker = getattr(config, "workerinput", None)
+    if worker is not None and hasattr(os, "sched_setaffinity"):
+        cores = sorted(os.sched_getaffinity(0))
+        index = int(worker["workerid"].removeprefix("gw"))
+        os.sched_setaffinity(0, {cores[index % len(cores)]})
+    if worker is None:
         config._pbcm_store = tempfile.mkdtemp(prefix="pbcm-test-store-")
         os.environ[S.ENV] = config._pbcm_store
 
