@@ -50,7 +50,8 @@ class handling:
         return self
 
     def _unraisable(self, unraisable):
-        if not (_received and isinstance(unraisable.exc_value, tuple(_EXCEPTIONS.values()))):
+        if not (_received and (isinstance(unraisable.exc_value, tuple(_EXCEPTIONS.values()))
+                               or _in_finaliser(unraisable))):
             self._hook(unraisable)
 
     def __exit__(self, *exc):
@@ -59,3 +60,20 @@ class handling:
         if self._hook is not None:
             sys.unraisablehook = self._hook
         _received.clear()
+
+
+def quiet_finalisers():
+    """For the rest of this process, no report of an exception raised in a ``__del__``: after a
+    stop, a finaliser the signal cut off half-way fails again when its object is collected
+    (llvmlite's ObjectRef.__del__, an AttributeError, when Ctrl-C lands while numba compiles in
+    the main process), after the command has said in one line that it stopped."""
+    hook = sys.unraisablehook
+
+    def quiet(unraisable):
+        if not _in_finaliser(unraisable):
+            hook(unraisable)
+    sys.unraisablehook = quiet
+
+
+def _in_finaliser(unraisable):
+    return getattr(unraisable.object, "__name__", "") == "__del__"

@@ -381,3 +381,24 @@ def test_help_and_list(capsys):
     assert main(["list"]) == 0
     first = capsys.readouterr().out.split("  meshes:")[0]
     assert " ".join(first.split()).endswith("boundary condition and model.")
+
+
+def test_after_a_stop_a_finaliser_cut_off_half_way_is_not_reported(monkeypatch, capfd):
+    """`pbcm` stopped by a signal: a __del__ that fails again later (llvmlite's, when Ctrl-C
+    landed while numba compiled) prints nothing after the one-line message; other unraisable
+    exceptions are still reported."""
+    import gc
+    from cases import stop
+    seen = []
+    monkeypatch.setattr(sys, "unraisablehook", seen.append)
+    stop.quiet_finalisers()
+
+    class HalfClosed:
+        def __del__(self):
+            raise AttributeError("'PassBuilder' object has no attribute '_as_parameter_'")
+    HalfClosed()
+    gc.collect()
+    assert seen == []
+    elsewhere = type("U", (), {"object": print, "exc_value": ValueError("x")})()
+    sys.unraisablehook(elsewhere)
+    assert seen == [elsewhere]

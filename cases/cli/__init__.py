@@ -39,6 +39,15 @@ def main(argv=None):
         return _main(argv)
 
 
+def console(argv=None):
+    """The ``pbcm`` process: :func:`main`, and after a stop no report from a finaliser the
+    signal cut off (the process is ending; its one line has been printed)."""
+    status = main(argv)
+    if status in (130, 143):
+        stop.quiet_finalisers()
+    return status
+
+
 def _kept(args):
     """What an interrupted command leaves behind, for its last line."""
     if getattr(args, "command", None) == "sweep":
@@ -75,4 +84,4 @@ def _main(argv):
 
 
 if __name__ == "__main__":
-    sys.exit(main())
+    sys.exit(console())

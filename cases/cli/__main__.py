@@ -1,6 +1,6 @@
 """``python -m cases.cli``: the pbcm command."""
 import sys
 
-from . import main
+from . import console
 
-sys.exit(main())
+sys.exit(console())
