@@ -21,6 +21,7 @@ failure too: a run that failed now succeeds, or the reverse.
 """
 from dataclasses import dataclass, field
 import json
+import os
 import math
 from pathlib import Path
 import tomllib
@@ -226,14 +227,25 @@ def _in_sweep(path, root):
                if d == root or root in d.parents)
 
 
+def _metrics_files(folder):
+    """Every metrics.json under ``folder``, sorted, through symbolic links to folders too (a
+    reports folder assembled from links: pathlib's ``**`` does not follow them, and the case
+    behind a link went unchecked)."""
+    found = []
+    for root, dirs, files in os.walk(folder, followlinks=True):
+        dirs.sort()
+        if "metrics.json" in files:
+            found.append(Path(root) / "metrics.json")
+    return sorted(found)
+
+
 def measured(metrics_dir):
     """The Measurements of every metrics.json under a folder (or of one file)."""
     p = Path(metrics_dir)
     if not p.exists():
         raise CheckError(f"--metrics {p} does not exist; run `pbcm run CASE --out {p}/CASE` "
                          "first, or give the folder that holds the metrics.json files")
-    files = [p] if p.is_file() else [f for f in sorted(p.glob("**/metrics.json"))
-                                      if not _in_sweep(f, p)]
+    files = [p] if p.is_file() else [f for f in _metrics_files(p) if not _in_sweep(f, p)]
     if not files:
         raise CheckError(f"no metrics.json under {p}; run `pbcm run CASE` first")
     values, problems, directions, rows, sources = {}, {}, {}, set(), {}

@@ -270,3 +270,13 @@ def test_a_regression_that_turns_a_null_into_a_number_fails(tmp_path, monkeypatc
     assert flips, text.out[-2000:]
     assert all(("was n/a, now " in l) != (", now n/a:" in l) for l in flips)
     assert "pbcm bless` to set" not in text.out + text.err
+
+
+def test_a_case_folder_behind_a_link_is_checked(quick, tmp_path, capsys):
+    """A metrics folder assembled from symbolic links (as a reports folder may be): the case
+    behind the link is gated, not skipped."""
+    (tmp_path / "m").mkdir()
+    (tmp_path / "m" / "paper-cube").symlink_to(quick, target_is_directory=True)
+    assert main(["check", "--metrics", str(tmp_path / "m"), "--gold", str(ROOT / "gold"),
+                 "--allow-new"]) == 0
+    assert "paper-cube/five/clamped/" in capsys.readouterr().out
