@@ -59,6 +59,34 @@ def _ignore_interrupt():
     signal.signal(signal.SIGINT, signal.SIG_IGN)
 
 
+def _indexed(item):
+    fn, i, job = item
+    with one_blas_thread():
+        return i, fn(job)
+
+
+def dearest_first(fn, jobs, workers, done=lambda i: None, cost=None):
+    """``fn(job)`` for every job, in this process or on ``workers`` (a started executor), the
+    dearest first (``cost``: one expected cost per job, so that the longest unit does not
+    start last and run alone); ``done(i)`` as each finishes; the results in the jobs'
+    order. A stop (cases.stop) is honoured between units."""
+    from . import stop
+    results = [None] * len(jobs)
+    order = sorted(range(len(jobs)), key=lambda i: -(cost[i] if cost is not None else 0))
+    if workers is None:
+        with one_blas_thread():
+            for i in order:
+                stop.checkpoint()
+                results[i] = fn(jobs[i])
+                done(i)
+    else:
+        for i, result in workers.unordered(_indexed, [(fn, i, jobs[i]) for i in order]):
+            stop.checkpoint()
+            results[i] = result
+            done(i)
+    return results
+
+
 def _call(fn, item):
     with one_blas_thread():
         return fn(item)

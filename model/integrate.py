@@ -16,6 +16,7 @@ from numba.core.errors import NumbaExperimentalFeatureWarning
 from .bc import Ramp, bc_arrays
 from .errors import BlowUpError, DegenerateTetError, ModelError
 from .geometry import min_signed_volume
+from .step_cache import step_for
 
 
 @dataclass
@@ -293,12 +294,12 @@ def simulate(model, bc_of_t, t_end, dt=None, damping=0.0, f_ext=None, frames=101
     record(0, x)
     if isinstance(bc_of_t, Ramp):   # the whole step compiled, forces included
         _, start, moving = bc_of_t.parts(mesh.n_nodes)
-        kernels = model.kernels()
+        step_fn, kernels = step_for(model.kernels(), rk4_ramp)
         check = not any(t.checks_inversion for t in model.terms)
         buf = np.empty((STEP_BUFFERS,) + x.shape)
         done = 0
         for k in frame_steps[1:]:
-            status, at, term, bad, speed = rk4_ramp(
+            status, at, term, bad, speed = step_fn(
                 kernels, x, v, t0 + done * dt, dt, int(k - done), mesh.points, model.mass,
                 f_ext, float(damping), mask, start, moving, bc_of_t.t_ramp, mesh.tets, check,
                 vmax, buf)

@@ -18,14 +18,17 @@ from model.bc import bc_arrays, load_fractions
 from model.errors import ConvergenceError, ModelError
 from ._neohookean import neohookean
 from .assembly import scalar_gradients
-from .fem import (INTORDER, check_finite, dirichlet_dofs, element_basis, lame, linear_solve,
-                  probe, refine_with_data, saddle_solve, skfem_mesh, stress_measures,
+from .fem import (INTORDER, NewtonSolver, check_finite, dirichlet_dofs, element_basis, lame,
+                  parent_of, probe, refine_with_data, saddle_solve, skfem_mesh, stress_measures,
                   stress_on_input)
 from .linear import body_load, converged_from, dof_component, traction_load, transfer_to_nodes
 
 # above this Poisson ratio ``converged(mixed="auto")`` solves the mixed (u, p) form: the
 # displacement form's volumetric locking grows with lam / mu (9 at nu = 0.45, 49 at 0.49)
 MIXED_ABOVE_NU = 0.45
+# Newton from a coarser level's field (nested iteration) is given up after this many
+# iterations for the load steps from rest
+NESTED_MAX_ITER = 10
 
 
 @dataclass
@@ -47,6 +50,8 @@ class HyperelasticResult:
     basis: object = field(default=None, repr=False)
     dofs: np.ndarray = field(default=None, repr=False)
     kept: dict = field(default_factory=dict, repr=False)
+    p_basis: object = field(default=None, repr=False)     # the mixed form's pressure
+    p_dofs: np.ndarray = field(default=None, repr=False)
 
     def at(self, points, step=None):
         """The displacement (k, 3) at arbitrary ``points`` (k, 3) inside the mesh, by the
@@ -123,7 +128,7 @@ class Discretisation:
 
 def solve(mesh, E, nu, dirichlet, body_force=None, element="P1", refine=0, dirichlet_fn=None,
           load_steps=1, rtol=1e-10, max_iter=30, on_step=None, mixed=False, traction=None,
-          keep_steps=()):
+          keep_steps=(), start=None):
     """Neo-Hookean equilibrium on ``mesh`` (a model.mesh.TetMesh) refined ``refine`` times.
 
     Newton in ``load_steps`` equal increments (or at the load fractions it lists, as
@@ -137,7 +142,12 @@ def solve(mesh, E, nu, dirichlet, body_force=None, element="P1", refine=0, diric
     ``on_step(step, u, reaction)``, when given, is called after every converged step with the
     nodal displacement (n, 3) and reaction (n, 3) at that load (a force-displacement curve in
     one solve). The displacement dofs of the steps in ``keep_steps`` are kept, for
-    ``HyperelasticResult.at(points, step)``."""
+    ``HyperelasticResult.at(points, step)``.
+
+    ``start``, the result of the same problem on a coarser level (nested iteration; only
+    where no step is reported or kept): Newton starts from its field, interpolated here, and
+    takes the whole load at once; where that does not converge or inverts an element, the
+    load steps run from rest as without it. The solution is the same to the tolerance."""
     lam, mu = lame(E, nu)
     if mixed and element != "P2":
         raise ModelError(f"the mixed (u, p) form is Taylor-Hood P2/P1: pass element='P2', got "
@@ -172,6 +182,127 @@ def solve(mesh, E, nu, dirichlet, body_force=None, element="P1", refine=0, diric
     target[D] = x_D[D]
     iters = 0
     kept = {}
+    newton_solve = NewtonSolver()
+    x0, schedule = x, fractions
+    if start is not None and on_step is None and not keep_steps:
+        x0, schedule = _interpolated(start, d), [1.0]
+    try:     # from a coarser level's field, Newton converges in a few iterations or not
+        x, iters, res, kept = _newton(d, x0, schedule, D, I, Iu, Ip, target, f_body,
+                                      floor_u, floor_p, max_iter if schedule is fractions
+                                      else min(max_iter, NESTED_MAX_ITER), newton_solve,
+                                      keep_steps, on_step, ub, W, mesh)
+    except ConvergenceError:
+        if schedule is fractions:
+            raise
+        x, iters, res, kept = _newton(d, x, fractions, D, I, Iu, Ip, target, f_body,
+                                      floor_u, floor_p, max_iter, newton_solve, keep_steps,
+                                      on_step, ub, W, mesh)
+    res, _, energy = d.evaluate(x, tangent=False)
+    res -= f_body
+    reaction = transfer_to_nodes(ub, W, D, res[D])
+    stress, _ = stress_on_input(ub, W, mesh, d.cauchy(x))
+    vm, tmax, p = stress_measures(stress)
+    u_all = x[:ub.N]
+    return HyperelasticResult(
+        u=check_finite("displacement", u_all[ub.nodal_dofs[:, :mesh.n_nodes]].T.copy()),
+        stress=stress, von_mises=vm, max_shear=tmax, pressure=p, reaction=reaction,
+        iterations=iters, energy=float(energy), basis=ub, dofs=u_all, kept=kept,
+        p_basis=d.pb, p_dofs=x[ub.N:].copy() if mixed else None,
+        info={"element": element, "mixed": bool(mixed), "refine": int(refine),
+              "dofs": int(d.N), "load_steps": int(load_steps)})
+
+
+def _interpolated(coarse, d):
+    """The unknowns of discretisation ``d`` from the ``coarse`` result's field (and pressure)
+    at its dofs: exact where the spaces nest (one uniform refinement, :func:`prolong`)."""
+    ub = d.ub
+    x = np.zeros(d.N)
+    nested = prolong(coarse.basis, coarse.dofs, ub)
+    if nested is None:
+        comp = dof_component(ub)
+        x[:ub.N] = probe(coarse.basis, coarse.dofs, ub.doflocs.T)[np.arange(ub.N), comp]
+    else:
+        x[:ub.N] = nested
+    if d.mixed and coarse.p_dofs is not None:
+        pc, pf = coarse.p_basis, d.pb
+        if _one_refinement(pc.mesh, pf.mesh):   # P1 at the new vertices: their edges' means
+            p = np.zeros(pf.N)
+            p[pf.nodal_dofs[0]] = _hats(pc.mesh) @ coarse.p_dofs[pc.nodal_dofs[0]]
+        else:
+            p = pc.probes(np.ascontiguousarray(pf.doflocs)) @ coarse.p_dofs
+        x[ub.N:] = p
+    return x
+
+
+def _one_refinement(mc, mf):
+    return (mf.nvertices == mc.nvertices + mc.edges.shape[1]
+            and mf.nelements == 8 * mc.nelements)
+
+
+def _hats(mc):
+    """(fine vertices x coarse vertices): the coarse P1 hats at the vertices of ``mc``
+    refined once (its vertices, then its edges' midpoints)."""
+    e0, e1 = mc.edges
+    eye = sp.identity(mc.nvertices, format="csr")
+    return sp.vstack([eye, 0.5 * (eye[e0] + eye[e1])], format="csr")
+
+
+# the vertex pairs of a tetrahedron's six edges in scikit-fem's order (MeshTet.t2e)
+TET_EDGES = ((0, 1), (1, 2), (0, 2), (0, 3), (1, 3), (2, 3))
+
+
+def prolong(coarse_basis, dofs, fine_basis):
+    """The vector field ``dofs`` of ``coarse_basis`` (P1 or P2) as the dofs of ``fine_basis``
+    (the same element on the coarse mesh refined once): each fine element's nodes evaluated
+    in its parent by barycentric coordinates, exact (the coarse space is inside the fine
+    one). None where the meshes are not one refinement apart."""
+    mc, mf = coarse_basis.mesh, fine_basis.mesh
+    p2 = coarse_basis.edge_dofs.size > 0
+    if not _one_refinement(mc, mf) or p2 != (fine_basis.edge_dofs.size > 0):
+        return None
+    parent = parent_of(mf, _hats(mc), mc.t.T)
+    tP = mc.t[:, parent]                                               # (4, nf)
+    pairs = np.sort(mc.edges[:, mc.t2e[:, 0]], axis=0).T
+    if [tuple(r) for r in pairs] != [tuple(sorted((mc.t[a, 0], mc.t[b, 0])))
+                                     for a, b in TET_EDGES]:
+        raise AssertionError("scikit-fem's local edge order is not TET_EDGES")
+    nodal = dofs[coarse_basis.nodal_dofs]                               # (3, nv)
+    values = [nodal[:, tP]]                                            # (3, 4, nf)
+    if p2:
+        values.append(dofs[coarse_basis.edge_dofs][:, mc.t2e[:, parent]])
+    values = np.concatenate(values, axis=1)                            # (3, 4 or 10, nf)
+    X0 = mc.p[:, tP[0]]
+    A = np.stack([mc.p[:, tP[k]] - X0 for k in (1, 2, 3)], axis=-1)   # (3, nf, 3): edges
+    Ainv = np.linalg.inv(np.moveaxis(A, 1, 0))                         # (nf, 3, 3)
+
+    def at(points):                                  # (3, k, nf) -> field (3, k, nf)
+        lam = np.einsum("fij,jkf->ikf", Ainv, points - X0[:, None, :])
+        lam = np.concatenate([1.0 - lam.sum(axis=0, keepdims=True), lam])   # (4, k, nf)
+        shape = [lam]
+        if p2:
+            shape = [lam * (2 * lam - 1)] + [4 * lam[a] * lam[b] for a, b in TET_EDGES]
+            shape = [shape[0]] + [s[None] for s in shape[1:]]
+        N = np.concatenate(shape)                                      # (4 or 10, k, nf)
+        return np.einsum("cnf,nkf->ckf", values, N)
+
+    out = np.zeros(fine_basis.N)
+    tf = mf.t
+    out[fine_basis.nodal_dofs[:, tf]] = at(mf.p[:, tf])
+    if p2:
+        mids = 0.5 * (mf.p[:, mf.edges[0, mf.t2e]] + mf.p[:, mf.edges[1, mf.t2e]])
+        out[fine_basis.edge_dofs[:, mf.t2e]] = at(mids)
+    return out
+
+
+def _newton(d, x, fractions, D, I, Iu, Ip, target, f_body, floor_u, floor_p, max_iter,
+            newton_solve, keep_steps, on_step, ub, W, mesh):
+    """Newton through the load ``fractions`` from ``x``: (x, iterations, residual, kept)."""
+    load_steps = len(fractions)
+    iters = 0
+    kept = {}
+    mixed = d.mixed
+    comp = dof_component(ub)
+    rn = rp = np.inf
     for step, s in enumerate(fractions, start=1):
         for _ in range(max_iter):
             res, K, _ = d.evaluate(x)
@@ -187,7 +318,7 @@ def solve(mesh, E, nu, dirichlet, body_force=None, element="P1", refine=0, diric
             b = -res[I] - K[I][:, D] @ dx[D]
             A = K[I][:, I]
             dx[I] = (saddle_solve(A, b) if mixed else
-                     linear_solve(A, b, ub.doflocs.T[I], comp[I])[0])
+                     newton_solve(A, b, ub.doflocs.T[I], comp[I])[0])
             x = x + dx
             x[D] = s * target[D]
             iters += 1
@@ -200,18 +331,7 @@ def solve(mesh, E, nu, dirichlet, body_force=None, element="P1", refine=0, diric
         if on_step is not None:
             on_step(step, x[ub.nodal_dofs[:, :mesh.n_nodes]].T,
                     transfer_to_nodes(ub, W, D, res[D]))
-    res, _, energy = d.evaluate(x, tangent=False)
-    res -= f_body
-    reaction = transfer_to_nodes(ub, W, D, res[D])
-    stress, _ = stress_on_input(ub, W, mesh, d.cauchy(x))
-    vm, tmax, p = stress_measures(stress)
-    u_all = x[:ub.N]
-    return HyperelasticResult(
-        u=check_finite("displacement", u_all[ub.nodal_dofs[:, :mesh.n_nodes]].T.copy()),
-        stress=stress, von_mises=vm, max_shear=tmax, pressure=p, reaction=reaction,
-        iterations=iters, energy=float(energy), basis=ub, dofs=u_all, kept=kept,
-        info={"element": element, "mixed": bool(mixed), "refine": int(refine),
-              "dofs": int(d.N), "load_steps": int(load_steps)})
+    return x, iters, res, kept
 
 
 def uniaxial(stretch, E, nu):
@@ -238,8 +358,11 @@ def converged(mesh, E, nu, dirichlet, levels=1, element="P2", mixed=True, **kw):
         mixed = nu > MIXED_ABOVE_NU
     if levels < 1:
         raise ModelError(f"converged needs levels >= 1 to estimate its error, got {levels}")
-    return converged_from([solve(mesh, E, nu, dirichlet, element=element, mixed=mixed,
-                                 refine=k, **kw) for k in range(levels + 1)])
+    sols = []
+    for k in range(levels + 1):     # each level started from the one before (nested)
+        sols.append(solve(mesh, E, nu, dirichlet, element=element, mixed=mixed, refine=k,
+                          start=sols[-1] if sols else None, **kw))
+    return converged_from(sols)
 
 
 __all__ = ["solve", "converged", "uniaxial", "HyperelasticResult", "Discretisation"]

@@ -207,3 +207,48 @@ def test_auto_takes_the_mixed_form_above_the_locking_threshold(nu, mixed):
     mesh = cube(2, L, "six")
     conv = hyperelastic.converged(mesh, E, nu, sliding_cube(mesh, 0.99), mixed="auto")
     assert conv.result.info["mixed"] is mixed
+
+
+@pytest.mark.parametrize("element", ["P1", "P2"])
+@pytest.mark.parametrize("family", ["six", "unstructured"])
+def test_prolongation_to_the_refined_mesh_is_exact_for_the_coarse_space(element, family):
+    """A linear (P1) or quadratic (P2) vector field given on the coarse mesh is reproduced at
+    every dof of the mesh refined once, to round-off; the P1 pressure by the hats too."""
+    from reference.fem import element_basis
+    from reference.hyperelastic import _hats, prolong
+    from reference.linear import dof_component
+    m = skfem_mesh(cube(3, L, family))
+    mf = m.refined()
+
+    def field(b):
+        x, y, z = b.doflocs / L
+        v = np.array([1 + 2 * x - y, 3 * z + x, y - z])
+        if element == "P2":
+            v = v + np.array([x * x + 2 * y * z, y * y - 3 * x * z, z * x + y * y])
+        return v[dof_component(b), np.arange(b.N)]
+
+    coarse, fine = element_basis(m, element), element_basis(mf, element)
+    assert np.abs(prolong(coarse, field(coarse), fine) - field(fine)).max() < 1e-13
+    x, y, z = m.p / L
+    assert np.allclose(_hats(m) @ (x - 2 * y + z), (mf.p[0] - 2 * mf.p[1] + mf.p[2]) / L,
+                       atol=1e-13)
+    assert prolong(coarse, field(coarse), element_basis(mf.refined(), element)) is None
+
+
+@pytest.mark.parametrize("mixed", [False, True])
+def test_a_level_started_from_the_coarser_one_reaches_the_same_solution(mixed, monkeypatch):
+    """Nested iteration: the refined level started from the coarse solution takes the load
+    at once and converges in fewer iterations to the solution of the load steps from rest
+    (the same to the Newton tolerance); where the start fails, the load steps run."""
+    mesh = cube(3, L, "five")
+    bc = {int(i): (0.0, 0.0, 0.0) for i in mesh.nodes_on_plane("z", 0.0)}   # a barrel
+    bc.update({int(i): (0.0, 0.0, -0.15 * L) for i in mesh.nodes_on_plane("z", L)})
+    kw = dict(element="P2", mixed=mixed, load_steps=3)
+    coarse = hyperelastic.solve(mesh, E, 0.45, bc, **kw)
+    plain = hyperelastic.solve(mesh, E, 0.45, bc, refine=1, **kw)
+    nested = hyperelastic.solve(mesh, E, 0.45, bc, refine=1, start=coarse, **kw)
+    assert np.abs(nested.dofs - plain.dofs).max() < 1e-9 * np.abs(plain.dofs).max()
+    assert nested.iterations < plain.iterations
+    monkeypatch.setattr(hyperelastic, "NESTED_MAX_ITER", 0)     # the start gives up at once
+    fallen = hyperelastic.solve(mesh, E, 0.45, bc, refine=1, start=coarse, **kw)
+    assert np.array_equal(fallen.dofs, plain.dofs) and fallen.iterations == plain.iterations

@@ -386,6 +386,27 @@ def test_iterative_solver_converges_on_a_thin_bending_slab():
     assert 0.9 < tip / d.u[np.isclose(coarse.points[:, 0], 0.048), 1].mean() < 1.2
 
 
+def test_a_newton_solve_goes_direct_after_the_first_stagnation(monkeypatch):
+    """The tangents of one Newton solve: once AMG stagnated and the direct solver took over,
+    the later ones are solved directly at once; a converged AMG solve changes nothing."""
+    from reference import fem
+    asked = []
+
+    def fake(A, b, doflocs, comp, solver="auto"):
+        asked.append(solver)
+        said = {1: "amg-cg (default aggregation)", 2: "direct (default aggregation stagnated)"}
+        return b, {"solver": said.get(len(asked), "direct")}
+
+    monkeypatch.setattr(fem, "linear_solve", fake)
+    solve = fem.NewtonSolver()
+    for _ in range(4):
+        solve(None, np.zeros(3), None, None)
+    assert asked == ["auto", "auto", "direct", "direct"]
+    asked.clear()
+    fem.NewtonSolver("amg")(None, np.zeros(3), None, None)
+    assert asked == ["amg"]
+
+
 def test_solver_falls_back_or_names_the_direct_solver(monkeypatch):
     from reference import fem
     mesh = cube(3, L, "five")

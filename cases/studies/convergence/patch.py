@@ -90,16 +90,22 @@ def run_model(model, family, spec, material, size, rtol, store=OFF):
     return store.put(k, row)
 
 
-def table(models, lattices, E, nu, store=OFF):
-    """Every one of ``models`` ("FEM P1" for the scikit-fem reference) on every patch family
-    of ``lattices``, as the spec's [patch] declares the test, on the spec's cube."""
+def units(models, lattices, E, nu, store=OFF):
+    """The table's rows as work units ``(run_model, args, cost)``: every one of ``models``
+    ("FEM P1" for the scikit-fem reference) on every patch family of ``lattices``, as the
+    spec's [patch] declares the test, on the spec's cube (cost: one each)."""
     s = verification_spec()
     spec = dict(s["patch"])
     rtol = spec.pop("rtol")
     material = Material(E=E, nu=nu)
-    return [run_model(m, fam, spec, material, s["size"], rtol, store)
+    return [(run_model, (m, fam, spec, material, s["size"], rtol, store), 1.0)
             for fam in families(lattices) for m in models]
 
 
+def table(models, lattices, E, nu, store=OFF):
+    """The rows of :func:`units`, computed here."""
+    return [fn(*args) for fn, args, _ in units(models, lattices, E, nu, store)]
+
+
 __all__ = ["unit_strains", "families", "patch_mesh", "strain_error", "solve", "run_model",
-           "table", "PERTURBED"]
+           "units", "table", "PERTURBED"]

@@ -16,7 +16,7 @@ from ...progress import Progress
 from ...store import OFF, key
 from ...framework import MESH_FAMILIES
 from ...runner import FINDINGS, free_components, jsonable
-from ...workers import one_blas_thread
+from ...workers import dearest_first, one_blas_thread
 from .cost import accuracy_per_cost
 from .elasticity import table as elasticity_table
 from .fit import EXACT, cancellation, fit, observed_order, ratio_limit
@@ -307,10 +307,11 @@ def family_unit(job):
     return family_runs(problem, bc, family, s, ref, levels(problem, family, s), store)
 
 
-def _in_worker(item):
-    fn, i, job = item
-    with one_blas_thread():
-        return i, fn(job)
+def _verification_unit(job):
+    """One row of a verification table (manufactured solutions, patch test, step
+    convergence): ``(fn, args)`` from its module's ``units``."""
+    fn, args = job
+    return fn(*args)
 
 
 def _weights(name, s):
@@ -356,26 +357,6 @@ def fits(runs):
     return out
 
 
-def _map(fn, jobs, workers, done, cost):
-    """``fn`` over ``jobs`` in this process or on ``workers``, the dearest first (``cost``
-    one expected cost per job: the longest unit then does not start last and run alone);
-    ``done(i)`` as each finishes; the results in the jobs' order."""
-    results = [None] * len(jobs)
-    order = sorted(range(len(jobs)), key=lambda i: -cost[i])
-    if workers is None:
-        with one_blas_thread():
-            for i in order:
-                stop.checkpoint()
-                results[i] = fn(jobs[i])
-                done(i)
-    else:
-        for i, result in workers.unordered(_in_worker, [(fn, i, jobs[i]) for i in order]):
-            stop.checkpoint()
-            results[i] = result
-            done(i)
-    return results
-
-
 def run(s, workers=None, log=True, bench=None, store=OFF):
     """Run the study with settings ``s``: the metrics document (runs, fits, references,
     effective elasticity, accuracy per cost from the ``bench`` document). ``workers`` (a
@@ -389,28 +370,33 @@ def run(s, workers=None, log=True, bench=None, store=OFF):
     ref_weight, elastic_weight = 0.05 * total, 0.05 * total
     with Progress("convergence", total + ref_weight + 2 * elastic_weight, log=log,
                   width=36) as track:
-        refs = _map(reference_unit, [(name, bc, s, store) for name, bc in pairs], workers,
-                    lambda i: track.advance(ref_weight / len(pairs),
-                                            f"{pairs[i][0]} {pairs[i][1]}: reference"),
-                    [PROBLEMS[name].reference_cost() for name, _ in pairs])
+        refs = dearest_first(
+            reference_unit, [(name, bc, s, store) for name, bc in pairs], workers,
+            lambda i: track.advance(ref_weight / len(pairs),
+                                    f"{pairs[i][0]} {pairs[i][1]}: reference"),
+            [PROBLEMS[name].reference_cost() for name, _ in pairs])
         jobs = [(name, bc, fam, s, store, ref) for (name, bc), ref in zip(pairs, refs)
                 for fam in s.meshes]
-        rows = _map(family_unit, jobs, workers,
-                    lambda i: track.advance(weights[jobs[i][0]][jobs[i][2]],
-                                            " ".join(jobs[i][:3])),
-                    [weights[name][fam] for name, _, fam, *_ in jobs])
+        rows = dearest_first(
+            family_unit, jobs, workers,
+            lambda i: track.advance(weights[jobs[i][0]][jobs[i][2]], " ".join(jobs[i][:3])),
+            [weights[name][fam] for name, _, fam, *_ in jobs])
         with one_blas_thread():
             eff = elasticity_table(s, store)
         track.advance(elastic_weight, "effective elasticity")
-        with one_blas_thread():
-            verification = {
-                "manufactured": manufactured.table(s.meshes, s.quick, store),
-                "patch": patch.table((FEM_P1,) + tuple(s.models), s.meshes, s.E, s.nu, store),
-                # quick: the first family only (a minute a family for every model)
-                "steps": steps.table(s.models, s.meshes[:1] if s.quick else s.meshes, s.E,
-                                     s.nu, s.rho, store)}
-        track.advance(elastic_weight, "verification: manufactured solutions, patch test, "
-                      "step convergence")
+        tables = {
+            "manufactured": manufactured.units(s.meshes, s.quick, store),
+            "patch": patch.units((FEM_P1,) + tuple(s.models), s.meshes, s.E, s.nu, store),
+            # quick: the first family only (a minute a family for every model)
+            "steps": steps.units(s.models, s.meshes[:1] if s.quick else s.meshes, s.E, s.nu,
+                                 s.rho, store)}
+        work = [(name, unit) for name, us in tables.items() for unit in us]
+        checked = dearest_first(
+            _verification_unit, [(fn, args) for _, (fn, args, _) in work], workers,
+            lambda i: track.advance(elastic_weight / len(work), f"verification: {work[i][0]}"),
+            [cost for _, (_, _, cost) in work])
+        verification = {name: [r for (n, _), r in zip(work, checked) if n == name]
+                        for name in tables}
     runs = [r for rs in rows for r in rs]
     fitted = fits(runs)
     cancelling = {(f["case"], f["mesh"], f["bc"], f["model"]) for f in fitted

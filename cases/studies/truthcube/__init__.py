@@ -24,7 +24,7 @@ class TruthCube(Study):
                                                  if k in keep and v is not None})
 
     def run(self, s, workers=None, log=True, bench=None, store=None):
-        return run(s, log=log, store=store or OFF)
+        return run(s, log=log, store=store or OFF, workers=workers)
 
     def write(self, out, s, data):
         return report.write(out, self, s, data)

@@ -19,6 +19,7 @@ from ...framework import FINDINGS
 from ...progress import Progress
 from ...runner import jsonable
 from ...store import OFF, key
+from ...workers import dearest_first
 from . import problem as P
 from .beads import Measured, errors, layer_axial, layer_lateral
 
@@ -75,8 +76,9 @@ class TruthCubeSettings:
 
     @property
     def units(self):
-        """Work units a pool could share: one (the study runs in one process)."""
-        return 1
+        """Work units a pool could share: each model on each cell (and before them each
+        variant's references)."""
+        return len(self.cells()) * len(self.models)
 
     @property
     def variants(self):
@@ -170,14 +172,6 @@ def fit_travels(measured, s, nu):
     return fitted
 
 
-def travels_of(kind, measured, s, nu, fitted):
-    if kind == "nominal":
-        return P.nominal_travels()
-    if fitted.get(nu) is None:
-        fitted[nu] = fit_travels(measured, s, nu)
-    return fitted[nu]
-
-
 def bead_displacements(model, mesh, spec, travels, beads, s):
     """``model`` on ``mesh`` under ``spec`` = (plates, travel, nu) through ``travels``: its
     displacement (343, 3) [m] at the rest positions ``beads`` (P1 on its mesh) per measured
@@ -266,40 +260,57 @@ def reference_rows(variant, spec, travels, measured, s, store):
                                     else field.tolist()})
 
 
-def run(s, log=True, store=OFF):
-    """Every (spacing, variant) cell's model rows, the references' rows, the fitted travels
-    and the data's own numbers."""
+def _reference_unit(job):
+    """The references of one variant (after fitting its travels where it asks for them):
+    (travels [m], {"rows", "continuum"})."""
+    variant, s, store = job
     measured = Measured(T.load())
-    fitted = {}
+    plates, travel, nu = spec = s.variants[variant]
+    if travel == "fitted":
+        k = key(kind="truthcube-fit", **s.problem(), nu_fit=nu)
+        travels = store.get(k) or store.put(k, fit_travels(measured, s, nu))
+    else:
+        travels = P.nominal_travels()
+    return travels, reference_rows(variant, spec, travels, measured, s, store)
+
+
+def _cell_unit(job):
+    """One model's rows on one (spacing, variant) cell."""
+    spacing, variant, travels, model, continuum, s, store = job
+    spec = s.variants[variant]
+    name = mesh_name(spacing)
+    what = {"kind": "truthcube-cells", **s.problem(), "mesh": name, "variant": variant,
+            "spec": list(spec), "travels": list(travels), "model": model}
+    found = store.get(key(**what))
+    if found is not None:
+        return found
+    return store.put(key(**what), model_rows(model, P.mesh(spacing), name, variant, spec,
+                                             travels, Measured(T.load()), s, continuum))
+
+
+def run(s, log=True, store=OFF, workers=None):
+    """Every (spacing, variant) cell's model rows, the references' rows, the fitted travels
+    and the data's own numbers: first each variant's references (a unit each, on
+    ``workers`` where given), then each (cell, model) (a unit each)."""
+    measured = Measured(T.load())
     cells = s.cells()
-    rows, refs, travels_used, fields = [], [], {}, {}
-    with Progress("truth-cube", len(cells) * len(s.models), log=log) as progress:
-        for spacing, variant in cells:
-            spec = s.variants[variant]
-            k = key(kind="truthcube-fit", **s.problem(), nu_fit=spec[2])
-            if spec[1] == "fitted" and spec[2] not in fitted:
-                fitted[spec[2]] = store.get(k) or store.put(k, fit_travels(measured, s, spec[2]))
-            travels = travels_of(spec[1], measured, s, spec[2], fitted)
-            travels_used[variant] = [t / MM for t in travels]
-            if variant not in fields:
-                found = reference_rows(variant, spec, travels, measured, s, store)
-                refs += found["rows"]
-                fields[variant] = None if found["continuum"] is None else np.array(
-                    found["continuum"])
-            name, mesh = mesh_name(spacing), None
-            for model in s.models:
-                stop.checkpoint()
-                what = {"kind": "truthcube-cells", **s.problem(), "mesh": name,
-                        "variant": variant, "spec": list(spec), "travels": list(travels),
-                        "model": model}
-                found = store.get(key(**what))
-                if found is None:
-                    mesh = mesh or P.mesh(spacing)
-                    found = store.put(key(**what), model_rows(
-                        model, mesh, name, variant, spec, travels, measured, s,
-                        fields[variant]))
-                rows += found
-                progress.advance(1)
-    return jsonable({"rows": rows, "references": refs, "travels_mm": travels_used,
+    variants = list(dict.fromkeys(v for _, v in cells))
+    with Progress("truth-cube", len(variants) + len(cells) * len(s.models),
+                  log=log) as progress:
+        found = dearest_first(_reference_unit, [(v, s, store) for v in variants], workers,
+                              lambda i: progress.advance(1, f"{variants[i]}: references"),
+                              [2 if s.variants[v][1] == "fitted" else 1 for v in variants])
+        travels_used = {v: [t / MM for t in tr] for v, (tr, _) in zip(variants, found)}
+        refs = [row for _, ref in found for row in ref["rows"]]
+        fields = {v: None if ref["continuum"] is None else np.array(ref["continuum"])
+                  for v, (_, ref) in zip(variants, found)}
+        travels = {v: tr for v, (tr, _) in zip(variants, found)}
+        jobs = [(spacing, variant, travels[variant], model, fields[variant], s, store)
+                for spacing, variant in cells for model in s.models]
+        rows = dearest_first(_cell_unit, jobs, workers,
+                             lambda i: progress.advance(1, " ".join(map(str, jobs[i][:2]))),
+                             [1.0 / job[0] ** 3 for job in jobs])
+    return jsonable({"rows": [r for rs in rows for r in rs], "references": refs,
+                     "travels_mm": travels_used,
                      "nominal_travels_mm": [t / MM for t in P.nominal_travels()],
                      "data": measured.summary()})
