@@ -409,7 +409,10 @@ def run(case, s, log=True, workers=None, store=OFF, reuse_full=False):
                                       reuse_full)
         else:
             bar.advance(0, f"{case.name}: {len(s.meshes)} meshes on {workers.n} workers")
-            jobs = [(case, s, mesh_name, store, reuse_full) for mesh_name in s.meshes]
+            # the largest mesh first, so that it does not start last and run alone
+            mesh_of = _built_once(case, s)
+            order = sorted(s.meshes, key=lambda name: -mesh_of(name).n_tets)
+            jobs = [(case, s, mesh_name, store, reuse_full) for mesh_name in order]
             for mesh_name, done in workers.unordered(_mesh_in_worker, jobs):
                 stop.checkpoint()
                 for bc, result in zip(s.bcs, done):

@@ -138,6 +138,7 @@ def library(tmp_path_factory, quick):
     names = [n for n in CASES if n != "paper-cube"]
     if os.environ.get("PYTEST_XDIST_WORKER", "gw0") != "gw0":
         names.reverse()
+    # the same folders as quick_cantilever's and the other fixtures of one case
     runs = {n: shared(tmp_path_factory, n, _run(n, "--quick")) for n in names}
 
     def make(root):
@@ -146,6 +147,14 @@ def library(tmp_path_factory, quick):
             (root / name).symlink_to(quick if name == "paper-cube" else runs[name],
                                      target_is_directory=True)
     return shared(tmp_path_factory, "library", make)
+
+
+@pytest.fixture(scope="session")
+def quick_cantilever(tmp_path_factory):
+    """`pbcm run cantilever --quick`, once per test session (the library's own): a test that
+    runs the cantilever again (other models, workers, a cluster) then finds its FEM
+    references in the session's store rather than solving them beside another worker."""
+    return shared(tmp_path_factory, "cantilever", _run("cantilever", "--quick"))
 
 
 @pytest.fixture(scope="session")

@@ -60,7 +60,7 @@ def test_example_composes_and_calibrates(example, small_mesh, mat):
     assert pm.info["normal_axis_c"] == pytest.approx(sbd.info["normal_sbd_c"], rel=1e-6)
 
 
-def test_pbcm_run_with_a_term_file_on_two_workers(tmp_path):
+def test_pbcm_run_with_a_term_file_on_two_workers(tmp_path, quick_cantilever):
     """The README's worked example: a user term file, composed on the command line, run on two
     worker processes (which load the file from PBCM_TERMS)."""
     out = tmp_path / "run"

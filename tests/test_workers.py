@@ -15,7 +15,7 @@ from cases.workers import Cluster, Workers, WorkerLost, RETRIES
 UNITS = ["--quick", "--meshes", "five", "six", "--models", "msm", "fem-linear"]
 
 
-def test_workers_write_the_metrics_of_one_process(tmp_path):
+def test_workers_write_the_metrics_of_one_process(tmp_path, quick_cantilever):
     for n in ("1", "2"):
         assert main(["run", "cantilever", *UNITS, "--workers", n,
                      "--out", str(tmp_path / n)]) == 0
@@ -24,7 +24,7 @@ def test_workers_write_the_metrics_of_one_process(tmp_path):
     assert one.index(b'"mesh": "five"') < one.index(b'"mesh": "six"')   # declared order
 
 
-def test_a_dask_cluster_writes_the_metrics_of_one_process(tmp_path):
+def test_a_dask_cluster_writes_the_metrics_of_one_process(tmp_path, quick_cantilever):
     """`--scheduler ADDRESS`: the same units on a Dask cluster, the same bytes."""
     from distributed import LocalCluster
     assert main(["run", "cantilever", *UNITS, "--workers", "1",
@@ -44,7 +44,9 @@ def test_scheduler_and_workers_together_are_refused_before_computing(capsys, tmp
     assert not (tmp_path / "c").exists()
 
 
-def test_an_unreachable_scheduler_is_one_line(capsys, tmp_path):
+def test_an_unreachable_scheduler_is_one_line(capsys, tmp_path, monkeypatch):
+    from cases import workers
+    monkeypatch.setattr(workers, "CONNECT_TIMEOUT_S", 1)     # nothing answers port 9
     assert main(["run", "cantilever", "--quick", "--scheduler", "tcp://127.0.0.1:9",
                  "--out", str(tmp_path / "c")]) == 2
     err = capsys.readouterr().err

@@ -1,6 +1,7 @@
 """The artefact study's runs: every (mesh, model, base, load) cell of the paper's cube, its layer
 profile and alternation against the continuum's, and per (mesh, model) the linearised growth
 rate of the paper's clamped RK4 run."""
+import functools
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -12,12 +13,12 @@ from model.mesh import cube
 from model.paper_mesh import paper_size_meshes, unmatched_faces
 from reference import hyperelastic, linear
 from ... import metrics as M
-from ... import stop
 from ...framework import FINDINGS
 from ...library import paper_cube as P
 from ...progress import Progress
 from ...runner import free_components, jsonable
 from ...store import OFF, key
+from ...workers import dearest_first
 
 READINGS = ("corner", "balanced", "variational")
 YARDSTICK = "fem-linear"      # constant-strain FEM on the same tetrahedra: the control
@@ -80,7 +81,10 @@ def mesh_specs(quick=False):
     return out
 
 
+@functools.lru_cache(maxsize=16)
 def make_mesh(name, spec):
+    """The mesh ``name`` of ``spec`` (built once per process: a worker runs its models one by
+    one; callers do not modify it)."""
     kind, n, seed = spec
     size = P.SIZE_MM * P.MM
     if kind in ("five", "six", "bcc"):
@@ -131,7 +135,9 @@ class ArtefactSettings:
 
     @property
     def units(self):
-        return 1
+        """Work units a pool could share: each model on each mesh (and before them each
+        reference)."""
+        return len(self.meshes) * len(self.models)
 
     def describe(self):
         return {**self.problem(), "quick": self.quick, "bcs": list(self.bcs),
@@ -160,12 +166,12 @@ def _free_layers(bc, n_layers):
     return free
 
 
-def cell(pm, mesh, n, bc, load, ref):
-    """One cell: the model's static layer profile (``n`` node planes), the reference's on the
-    same nodes, the alternation and the displacement error over the free components."""
+def cell(pm, mesh, n, bc, load, u_ref):
+    """One cell: the model's static layer profile (``n`` node planes), the reference's
+    (``u_ref`` (n_nodes, 3) [m], the continuum at the mesh's nodes) on the same nodes, the
+    alternation and the displacement error over the free components."""
     layers = [y * P.MM for y in P.layers_mm(n)]
     dirichlet = P.static_bc(mesh, bc, push_mm(load))
-    u_ref = ref.result.at(mesh.points)
     ref_profile = M.layer_profile(mesh.points, u_ref, layers, P.SIZE_MM * P.MM) / P.MM
     free_layers = _free_layers(bc, len(layers))
     out = {"bulge_profile_fem_mm": ref_profile.tolist(), "failed": None}
@@ -181,27 +187,12 @@ def cell(pm, mesh, n, bc, load, ref):
             "alternation_rel": relative, "disp_rel_l2": M.rel_l2(st.u, u_ref, free)}
 
 
-def mesh_rows(name, spec, s, refs, store=OFF, progress=None):
-    """Every model's cells on one mesh (the model built, and calibrated, once), and its
-    growth rate on the clamped paper cube; rows taken from ``store`` where kept."""
-    what = {"kind": "artefact-cells", **s.problem(), "mesh": name,
-            "bcs": list(s.bcs), "loads": list(s.loads)}
-    mesh = None
-    rows = []
-    for model, factors in s.models.items():
-        stop.checkpoint()
-        k = key(**what, model=model)
-        found = store.get(k)
-        if found is None:
-            mesh = mesh or make_mesh(name, spec)
-            found = store.put(k, _model_rows(model, factors, name, spec, mesh, s, refs))
-        rows += found
-        if progress:
-            progress.advance(1)
-    return rows
+def _cells_key(s, name, model):
+    return key(kind="artefact-cells", **s.problem(), mesh=name, bcs=list(s.bcs),
+               loads=list(s.loads), model=model)
 
 
-def _model_rows(model, factors, name, spec, mesh, s, refs):
+def _model_rows(model, factors, name, spec, mesh, s, u_refs):
     base = {"mesh": name, **mesh_factors(name, spec, mesh), "model": model, **factors}
     try:
         pm = build(model, mesh, s.material)
@@ -214,38 +205,58 @@ def _model_rows(model, factors, name, spec, mesh, s, refs):
     rate = P.growth_rate(pm, mesh, "clamped") if spec[1] == P.NODES_PER_SIDE else None
     return [{**base, "bc": bc, "load": load, "growth_rate_1_s": rate,
              "flutter": None if rate is None else rate > s.damping / 2,
-             **cell(pm, mesh, spec[1], bc, load, refs[(bc, load)])}
+             **cell(pm, mesh, spec[1], bc, load, u_refs[(bc, load)])}
             for bc in s.bcs for load in s.loads]
 
 
-class References(dict):
-    """{(bc, load): the reference}, each solved when first asked for (a run whose cells are
-    all stored solves none)."""
+def _reference_unit(job):
+    """The continuum of one (bc, load) at the nodes of each mesh that ``names`` lists, and
+    its error estimate."""
+    bc, load, names, s = job
+    ref = reference(bc, load, s)
+    return {"at": {name: ref.result.at(make_mesh(name, s.meshes[name]).points)
+                   for name in names}, "error_estimate": ref.error_estimate}
 
-    def __init__(self, s):
-        super().__init__()
-        self.s = s
 
-    def __missing__(self, k):
-        stop.checkpoint()
-        self[k] = reference(*k, self.s)
-        return self[k]
+def _cell_unit(job):
+    """One model's rows on one mesh (the model built, and calibrated, once), kept in the
+    store."""
+    name, model, s, u_refs, store = job
+    spec = s.meshes[name]
+    return store.put(_cells_key(s, name, model), _model_rows(
+        model, s.models[model], name, spec, make_mesh(name, spec), s, u_refs))
 
 
 def run(s, workers=None, log=True, bench=None, store=OFF):
-    """Every mesh's cells, and the references' error estimates (stored apart)."""
-    refs = References(s)
-    rows = []
-    with Progress("artefact", len(s.meshes) * len(s.models), log=log) as progress:
-        for name, spec in s.meshes.items():
-            rows += mesh_rows(name, spec, s, refs, store=store, progress=progress)
-    ref_info = []
-    for bc in s.bcs:
-        for load in s.loads:
-            k = key(kind="artefact-reference", **s.problem(), bc=bc, load=load)
-            ref_info.append(store.get(k) or store.put(k, {
-                "bc": bc, "load": load, "error_estimate": refs[(bc, load)].error_estimate}))
-    return jsonable({"cells": rows, "references": ref_info,
+    """Every mesh's cells, and the references' error estimates (stored apart): first the
+    references a missing cell or estimate needs (a unit each, on ``workers`` where given),
+    then each (mesh, model) not stored (a unit each)."""
+    pairs = [(bc, load) for bc in s.bcs for load in s.loads]
+    cells = [(name, model) for name in s.meshes for model in s.models]
+    found = {c: store.get(_cells_key(s, *c)) for c in cells}
+    todo = [c for c in cells if found[c] is None]
+    info_keys = {p: key(kind="artefact-reference", **s.problem(), bc=p[0], load=p[1])
+                 for p in pairs}
+    infos = {p: store.get(k) for p, k in info_keys.items()}
+    with Progress("artefact", len(pairs) + len(cells), log=log) as progress:
+        progress.advance(len(cells) - len(todo))
+        need = [p for p in pairs if todo or infos[p] is None]
+        names = list(dict.fromkeys(name for name, _ in todo))
+        refs = dict(zip(need, dearest_first(
+            _reference_unit, [(bc, load, names, s) for bc, load in need], workers,
+            lambda i: progress.advance(1, f"{need[i][0]} {need[i][1]}: reference"))))
+        progress.advance(len(pairs) - len(need))
+        for p in need:
+            infos[p] = infos[p] or store.put(info_keys[p], {
+                "bc": p[0], "load": p[1], "error_estimate": refs[p]["error_estimate"]})
+        made = dearest_first(
+            _cell_unit, [(name, model, s, {p: refs[p]["at"][name] for p in pairs}, store)
+                         for name, model in todo], workers,
+            lambda i: progress.advance(1, " ".join(todo[i])),
+            [s.meshes[name][1] ** 3 for name, _ in todo])
+    found.update(zip(todo, made))
+    return jsonable({"cells": [r for c in cells for r in found[c]],
+                     "references": [infos[p] for p in pairs],
                      "step_vs_msm": step_costs(bench, list(s.models))})
 
 
