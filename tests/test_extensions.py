@@ -185,3 +185,13 @@ def test_fit_reports_the_worst_change_on_the_cases_left_out():
     assert worst_change(rows + [{"problem": "c", "before": 0.1, "after": "failed: x"}])[
         "problem"] == "c"
     assert worst_change([]) is None
+
+
+def test_the_extensions_run_no_verification_they_do_not_read():
+    """The extensions study reads the convergence study's fits and elasticity alone: its
+    convergence run leaves out the verification ladder (minutes of a full report), which
+    the convergence study itself runs."""
+    s = STUDY.settings(quick=True)
+    assert s.convergence_settings().verification is False
+    from cases.registry import studies
+    assert studies()["convergence"].settings(quick=True).verification is True

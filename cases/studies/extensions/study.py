@@ -43,8 +43,9 @@ class ExtensionSettings:
                 if self.cases is None or name in self.cases}
 
     def convergence_settings(self):
-        return studies()["convergence"].settings(quick=self.quick, models=self.models, E=self.E, nu=self.nu,
-                                    rho=self.rho, problems=self.problems)
+        return studies()["convergence"].settings(
+            quick=self.quick, models=self.models, E=self.E, nu=self.nu, rho=self.rho,
+            problems=self.problems, verification=False)    # its fits and elasticity alone
 
     def problem(self):
         """What the gate compares: each case's problem and the convergence study's."""
