@@ -272,9 +272,12 @@ class NewtonSolver:
 
     def __init__(self, solver="auto"):
         self.solver = solver
+        self.cg_iterations = 0
 
-    def __call__(self, A, b, doflocs, comp):
-        x, info = linear_solve(A, b, doflocs, comp, self.solver)
+    def __call__(self, A, b, doflocs, comp, rtol=1e-10):
+        """:func:`linear_solve` to ``rtol`` (an inexact Newton's forcing term)."""
+        x, info = linear_solve(A, b, doflocs, comp, self.solver, rtol=rtol)
+        self.cg_iterations += info["iterations"]
         if self.solver == "auto" and info["solver"].startswith("direct ("):
             self.solver = "direct"
         return x, info
@@ -300,10 +303,12 @@ def _cg_until_stagnant(ml, A, b, x, rtol, chunk=100, gain=10.0):
     bn = max(np.linalg.norm(b), 1e-300)
     iterations, rel = 0, np.linalg.norm(b - A @ x) / bn
     while True:
+        history = []                      # the residual of each iteration: how many it took
         with warnings.catch_warnings():   # CG's "indefinite ... aborting": a stagnation here
             warnings.simplefilter("ignore", UserWarning)
-            x_new = ml.solve(b, x0=x, tol=0.1 * rtol, accel="cg", maxiter=chunk)
-        iterations += chunk
+            x_new = ml.solve(b, x0=x, tol=0.1 * rtol, accel="cg", maxiter=chunk,
+                             residuals=history)
+        iterations += max(len(history) - 1, 0)
         rel_new = np.linalg.norm(b - A @ x_new) / bn
         if rel_new <= rtol:
             return x_new, iterations, rel_new

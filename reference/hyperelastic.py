@@ -29,6 +29,13 @@ MIXED_ABOVE_NU = 0.45
 # Newton from a coarser level's field (nested iteration) is given up after this many
 # iterations for the load steps from rest
 NESTED_MAX_ITER = 10
+# inexact Newton (Eisenstat and Walker's second choice): an iteration's tangent is solved to a
+# relative residual eta of at most ETA_MAX, tighter as Newton's residual falls, and never
+# tighter than the step to the tolerance needs (ETA_FLOOR_SHARE x tolerance / residual) or
+# than fem.linear_solve's own 1e-10: AMG-CG does a third of the iterations, the solution
+# is the same to the tolerance
+ETA_MAX = 1e-3
+ETA_FLOOR_SHARE = 0.1
 
 
 @dataclass
@@ -209,7 +216,8 @@ def solve(mesh, E, nu, dirichlet, body_force=None, element="P1", refine=0, diric
         iterations=iters, energy=float(energy), basis=ub, dofs=u_all, kept=kept,
         p_basis=d.pb, p_dofs=x[ub.N:].copy() if mixed else None,
         info={"element": element, "mixed": bool(mixed), "refine": int(refine),
-              "dofs": int(d.N), "load_steps": int(load_steps)})
+              "dofs": int(d.N), "load_steps": int(load_steps),
+              "cg_iterations": int(newton_solve.cg_iterations)})
 
 
 def _interpolated(coarse, d):
@@ -235,8 +243,15 @@ def _interpolated(coarse, d):
 
 
 def _one_refinement(mc, mf):
-    return (mf.nvertices == mc.nvertices + mc.edges.shape[1]
-            and mf.nelements == 8 * mc.nelements)
+    """Whether ``mf`` is ``mc`` refined once: its vertices ``mc``'s, then ``mc``'s edges'
+    midpoints (the counts alone can agree by chance: the five lattice of 2 cells and of 4)."""
+    nv = mc.nvertices
+    if mf.nvertices != nv + mc.edges.shape[1] or mf.nelements != 8 * mc.nelements:
+        return False
+    mids = 0.5 * (mc.p[:, mc.edges[0]] + mc.p[:, mc.edges[1]])
+    scale = np.abs(mc.p).max()
+    return bool(np.allclose(mf.p[:, :nv], mc.p, rtol=0, atol=1e-12 * scale)
+                and np.allclose(mf.p[:, nv:], mids, rtol=0, atol=1e-12 * scale))
 
 
 def _hats(mc):
@@ -304,6 +319,7 @@ def _newton(d, x, fractions, D, I, Iu, Ip, target, f_body, floor_u, floor_p, max
     comp = dof_component(ub)
     rn = rp = np.inf
     for step, s in enumerate(fractions, start=1):
+        last = None
         for _ in range(max_iter):
             res, K, _ = d.evaluate(x)
             res -= s * f_body
@@ -311,6 +327,10 @@ def _newton(d, x, fractions, D, I, Iu, Ip, target, f_body, floor_u, floor_p, max
             rp = np.abs(res[Ip]).max(initial=0.0)
             if rn <= floor_u and rp <= floor_p and np.array_equal(x[D], s * target[D]):
                 break
+            # the first iteration of a step carries the load increment: its residual is no
+            # measure of how far the solution is, so the step's forcing starts from there
+            eta = ETA_MAX if last is None else forcing(rn, last, floor_u)
+            last = rn
             # Newton step; its prescribed part carries the load increment (a tangent
             # predictor, so that the interior follows the boundary instead of inverting)
             dx = np.zeros(d.N)
@@ -318,7 +338,7 @@ def _newton(d, x, fractions, D, I, Iu, Ip, target, f_body, floor_u, floor_p, max
             b = -res[I] - K[I][:, D] @ dx[D]
             A = K[I][:, I]
             dx[I] = (saddle_solve(A, b) if mixed else
-                     newton_solve(A, b, ub.doflocs.T[I], comp[I])[0])
+                     newton_solve(A, b, ub.doflocs.T[I], comp[I], rtol=eta)[0])
             x = x + dx
             x[D] = s * target[D]
             iters += 1
@@ -332,6 +352,18 @@ def _newton(d, x, fractions, D, I, Iu, Ip, target, f_body, floor_u, floor_p, max
             on_step(step, x[ub.nodal_dofs[:, :mesh.n_nodes]].T,
                     transfer_to_nodes(ub, W, D, res[D]))
     return x, iters, res, kept
+
+
+def forcing(rn, rn_last, floor):
+    """The relative tolerance of the next tangent solve (Eisenstat and Walker 1996, choice 2,
+    gamma 0.9, alpha 2): 0.9 (rn / rn_last)^2, at most ETA_MAX, and at least
+    ETA_FLOOR_SHARE floor / rn (the accuracy a step to the tolerance ``floor`` needs) and
+    1e-10; ETA_MAX where either residual is zero (the first iteration of a step from rest
+    has none inside: its load is all in the prescribed increment)."""
+    if not (rn > 0 and rn_last > 0):
+        return ETA_MAX
+    return float(max(min(0.9 * (rn / rn_last) ** 2, ETA_MAX), ETA_FLOOR_SHARE * floor / rn,
+                     1e-10))
 
 
 def uniaxial(stretch, E, nu):

@@ -172,11 +172,14 @@ def prescribed_faces(points, size, faces="xyz"):
     return on
 
 
-def solve(mesh, problem, size, element="P1", mixed=False, faces="xyz", load_steps=1):
+def solve(mesh, problem, size, element="P1", mixed=False, faces="xyz", load_steps=1,
+          start=None):
     """The FEM solution of ``problem`` (a Manufactured) on ``mesh``, the cube [0, size]^3: the
     field prescribed on ``faces``, its traction on the others, its body force inside; linear
     FEM for the linear material, Newton in ``load_steps`` for the neo-Hookean one
-    (displacement form, or Taylor-Hood P2/P1 when ``mixed``).
+    (displacement form, or Taylor-Hood P2/P1 when ``mixed``), or from ``start``, the result
+    on a coarser mesh of the same cube (``reference.hyperelastic.solve``'s nested iteration:
+    the same solution to Newton's tolerance in fewer iterations).
     Returns (||u_h - u|| / ||u|| in L2, the result)."""
     from . import hyperelastic, linear
     u = problem.field.u
@@ -196,7 +199,7 @@ def solve(mesh, problem, size, element="P1", mixed=False, faces="xyz", load_step
         res = linear.solve(mesh, problem.E, problem.nu, bc, **kw)
     else:
         res = hyperelastic.solve(mesh, problem.E, problem.nu, bc, mixed=mixed,
-                                 load_steps=load_steps, **kw)
+                                 load_steps=load_steps, start=start, **kw)
     e, n = l2_error(res.basis, res.dofs[:res.basis.N], u)
     return e / n, res
 

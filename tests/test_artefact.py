@@ -1,6 +1,7 @@
 """The artefact study: the pattern classifier, the factor contrasts and the two answers
 (computed on cells written here, whose answer is known), and the quick study against its
 gold with the controls that must hold whatever the models do."""
+import pytest
 import json
 from pathlib import Path
 
@@ -127,3 +128,30 @@ def test_the_quick_study_holds_its_gold_and_its_controls(quick_artefact, capsys)
     md = (quick_artefact / "report.md").read_text()
     assert doc["answer"]["text"] in md and doc["verdict"]["text"] in md
     assert (quick_artefact / "cells.md").is_file()
+
+
+class _Stagnating:
+    """A model whose Newton converges only with ``needs`` or more load steps."""
+
+    def __init__(self, needs):
+        self.needs, self.asked = needs, []
+
+    def solve_static(self, bc, rtol, load_steps):
+        from model.errors import ConvergenceError
+        self.asked.append(load_steps)
+        if load_steps < self.needs:
+            raise ConvergenceError(f"stagnated in {load_steps} steps")
+        return f"solved in {load_steps}"
+
+
+def test_a_cell_splits_the_load_where_newton_from_rest_stagnates():
+    from cases.studies.artefact.study import LOAD_SPLITS, solve_split
+    from model.errors import ConvergenceError
+    pm = _Stagnating(2)
+    assert solve_split(pm, {}) == ("solved in 2", 2) and pm.asked == [1, 2]
+    pm = _Stagnating(1)
+    assert solve_split(pm, {}) == ("solved in 1", 1) and pm.asked == [1]
+    pm = _Stagnating(LOAD_SPLITS[-1] + 1)       # no split converges: the last one's error
+    with pytest.raises(ConvergenceError, match=f"in {LOAD_SPLITS[-1]} steps"):
+        solve_split(pm, {})
+    assert pm.asked == list(LOAD_SPLITS)

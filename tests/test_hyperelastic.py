@@ -9,7 +9,7 @@ from scipy.optimize import brentq
 from model.errors import ConvergenceError, ModelError
 from model.mesh import box, cube
 from reference import hyperelastic, linear
-from reference.fem import lame, skfem_mesh
+from reference.fem import DIRECT_MAX_DOFS, lame, skfem_mesh
 from reference.hyperelastic import Discretisation
 
 E, L = 10e3, 0.01
@@ -252,3 +252,40 @@ def test_a_level_started_from_the_coarser_one_reaches_the_same_solution(mixed, m
     monkeypatch.setattr(hyperelastic, "NESTED_MAX_ITER", 0)     # the start gives up at once
     fallen = hyperelastic.solve(mesh, E, 0.45, bc, refine=1, start=coarse, **kw)
     assert np.array_equal(fallen.dofs, plain.dofs) and fallen.iterations == plain.iterations
+
+
+def test_the_forcing_term_follows_the_residual_between_its_bounds():
+    """Eisenstat-Walker's choice 2 (gamma 0.9, alpha 2), worked by hand."""
+    from reference.hyperelastic import ETA_MAX, forcing
+    assert forcing(1e-3, 1e-1, 1e-12) == pytest.approx(0.9 * 1e-4)     # 0.9 (1e-2)^2
+    assert forcing(0.5, 1.0, 1e-12) == ETA_MAX                       # 0.225: capped
+    assert forcing(1e-9, 1e-5, 1e-10) == pytest.approx(0.1 * 1e-10 / 1e-9)   # near the end
+    assert forcing(1e-20, 1.0, 1e-30) == 1e-10                       # linear_solve's own
+    assert forcing(1e-3, 0.0, 1e-12) == forcing(0.0, 1e-3, 1e-12) == ETA_MAX
+
+
+def test_inexact_newton_reaches_the_solution_of_exact_tangent_solves(monkeypatch):
+    """A barrel on 5 943 unknowns (AMG-CG): with the forcing term, the same solution to the
+    Newton tolerance for fewer CG iterations than with every tangent solved to 1e-10."""
+    mesh = cube(7, L, "five")
+    bc = {int(i): (0.0, 0.0, 0.0) for i in mesh.nodes_on_plane("z", 0.0)}
+    bc.update({int(i): (0.0, 0.0, -0.15 * L) for i in mesh.nodes_on_plane("z", L)})
+    inexact = hyperelastic.solve(mesh, E, 0.4, bc, element="P2", load_steps=2)
+    monkeypatch.setattr(hyperelastic, "ETA_MAX", 1e-10)
+    monkeypatch.setattr(hyperelastic, "forcing", lambda *a: 1e-10)
+    exact = hyperelastic.solve(mesh, E, 0.4, bc, element="P2", load_steps=2)
+    assert inexact.info["dofs"] == exact.info["dofs"] > DIRECT_MAX_DOFS     # AMG-CG
+    assert np.abs(inexact.dofs - exact.dofs).max() < 1e-8 * np.abs(exact.dofs).max()
+    assert inexact.info["cg_iterations"] < 0.6 * exact.info["cg_iterations"]
+
+
+def test_a_finer_lattice_is_not_taken_for_a_refinement():
+    """The six (Kuhn) lattice of 2 cells and of 4 have the counts of one refinement (125 =
+    27 + 98 vertices, 384 = 8 x 48 tetrahedra) but not its vertices: only the refined mesh
+    is one."""
+    from reference.hyperelastic import _one_refinement
+    coarse, finer = skfem_mesh(cube(3, L, "six")), skfem_mesh(cube(5, L, "six"))
+    assert finer.nvertices == coarse.nvertices + coarse.edges.shape[1]
+    assert finer.nelements == 8 * coarse.nelements
+    assert not _one_refinement(coarse, finer)
+    assert _one_refinement(coarse, coarse.refined())

@@ -120,3 +120,20 @@ def test_the_neo_hookean_field_is_at_finite_strain():
                          prescribed_faces(q, size, entry.faces)[:, None], p.field.u(q), np.nan))
     e, n = l2_error(r.basis, r.dofs, p.field.u)
     assert e / n > 10 * entry.finest_bound
+
+
+def test_a_neo_hookean_level_started_from_the_one_below_is_the_same_solution():
+    """The ladders' nested iteration across lattices that do not nest (2 then 4 cells of
+    five: the coarse field probed at the fine dofs): the solution of Newton from rest to the
+    tolerance, in fewer iterations."""
+    entry = next(e for e in SPEC["manufactured"] if e.material == "neo-Hookean"
+                 and not e.mixed)
+    size = SPEC["size"]
+    p = entry.problem(size, SPEC["E"])
+    args = (p, size, entry.element, entry.mixed, entry.faces, entry.load_steps)
+    _, coarse = solve(cube(3, size, "five"), *args)
+    e_rest, rest = solve(cube(5, size, "five"), *args)
+    e_nested, nested = solve(cube(5, size, "five"), *args, start=coarse)
+    assert np.abs(nested.dofs - rest.dofs).max() < 1e-9 * np.abs(rest.dofs).max()
+    assert e_nested == pytest.approx(e_rest, rel=1e-6)
+    assert nested.iterations < rest.iterations

@@ -26,11 +26,12 @@ def run_entry(entry, family, size, E, tolerance, store=OFF):
     if found is not None:
         return found
     problem = entry.problem(size, E)
-    errors = []
+    errors, coarser = [], None
     for c in entry.cells[family]:
         stop.checkpoint()
-        e, _ = mms.solve(cube(c + 1, size, family), problem, size, entry.element,
-                         entry.mixed, entry.faces, entry.load_steps)
+        # each neo-Hookean level's Newton starts from the level below (nested iteration)
+        e, coarser = mms.solve(cube(c + 1, size, family), problem, size, entry.element,
+                               entry.mixed, entry.faces, entry.load_steps, start=coarser)
         errors.append(float(e))
     obs = orders(entry.cells[family], errors)
     row = {"ladder": entry.name, "mesh": family, "element": entry.element,
