@@ -362,28 +362,23 @@ def cook_slab(n, thickness=1e-3):
 
 
 def test_iterative_solver_converges_on_a_thin_bending_slab():
-    """P2 on Cook's membrane one element thick, 19 881 unknowns (and 8 649): the default
-    aggregation stagnates there, as it does at 1.27e5 unknowns (measured: 16, 20, 24, 30, 40
-    and 60 elements a side all fall through); the solver goes on to the aggregation that
-    converges, with no iteration wall, and agrees with the direct one."""
-    mesh = cook_slab(24)
-    bc = {int(i): (0.0, 0.0, 0.0) for i in mesh.nodes_on_plane("x", 0.0)}
+    """P2 on Cook's membrane one element thick, 8 649 unknowns: the default aggregation
+    stagnates there, as it does up to 1.27e5 unknowns (measured: 16, 20, 24, 30, 40 and 60
+    elements a side all fall through); the solver goes on to the aggregation that converges,
+    with no iteration wall, and agrees with the direct one."""
+    coarse = cook_slab(16)
+    bc_c = {int(i): (0.0, 0.0, 0.0) for i in coarse.nodes_on_plane("x", 0.0)}
 
     def shear(x, n):
         t = np.zeros_like(x)
         t[..., 1] = np.where(np.isclose(x[..., 0], 0.048), 1.0, 0.0)
         return t
 
-    r = linear.solve(mesh, E, 0.45, bc, traction=shear, element="P2", solver="amg")
-    assert r.info["dofs"] >= 1.9e4 and r.info["solver"].startswith("amg-cg (evolution")
-    coarse = cook_slab(16)
-    bc_c = {int(i): (0.0, 0.0, 0.0) for i in coarse.nodes_on_plane("x", 0.0)}
     a = linear.solve(coarse, E, 0.45, bc_c, traction=shear, element="P2", solver="amg")
     d = linear.solve(coarse, E, 0.45, bc_c, traction=shear, element="P2", solver="direct")
+    assert a.info["dofs"] > 8000
     assert a.info["solver"].startswith("amg-cg (evolution")
     assert rel(a.u, d.u) < 1e-7
-    tip = r.u[np.isclose(mesh.points[:, 0], 0.048), 1].mean()
-    assert 0.9 < tip / d.u[np.isclose(coarse.points[:, 0], 0.048), 1].mean() < 1.2
 
 
 def test_a_newton_solve_goes_direct_after_the_first_stagnation(monkeypatch):
