@@ -149,6 +149,8 @@ DESCRIPTORS = frozenset({
     # the artefact study's factors: the mesh split and size, the model's parts, the load
     "split", "nodes_per_side", "unmatched_faces", "paper_size", "load", "family", "reading",
     "constant", "normal", "flutter",
+    # how the artefact study's static solve was run: the equal load steps that converged
+    "load_steps",
     # the truth-cube study's factors: the plate assumption, the measured state
     "variant", "plates", "travel", "nu", "state", "strain",
     # how a study's reference was solved: its element, spacings, size, extrapolation
