@@ -43,7 +43,8 @@ class HyperelasticResult:
     """``u`` (n, 3) [m] at the input nodes; ``stress`` (m, 3, 3) Cauchy stress per input
     tetrahedron (volume average); ``von_mises``, ``max_shear``, ``pressure`` (m,); ``reaction``
     (n, 3) [N]; ``energy`` the stored energy [J]; ``iterations`` Newton iterations in all;
-    ``info`` element, formulation, refinement, dofs, load steps."""
+    ``info`` element, formulation, refinement, dofs, load steps and the AMG-CG iterations of
+    its tangent solves (``cg_iterations``, 0 where they were solved directly)."""
 
     u: np.ndarray
     stress: np.ndarray
