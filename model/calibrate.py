@@ -20,7 +20,7 @@ with them.
 import numpy as np
 from scipy.optimize import least_squares, nnls
 
-from . import static
+from .static import JacobianPattern, jacobian
 from .errors import ModelError
 from .homogenize import condensed_stiffness, kelvin_moduli
 from .mesh import box
@@ -104,12 +104,12 @@ def _stiffnesses(terms, patch, material):
     c = 1 (the same term built on the patch), every term at scale 1 (scale multiplies after
     the fit)."""
     from .terms import make_term
-    pattern = static.JacobianPattern(patch)
+    pattern = JacobianPattern(patch)
     fixed, unit = None, []
     for t in terms:
         params = {**t.p, "c": 1.0} if t.calibrate else dict(t.p)
         on_patch = make_term(t.name, patch, material, **params)
-        K = -static.jacobian(on_patch.forces, patch, patch.points, pattern).tocsc()
+        K = -jacobian(on_patch.forces, patch, patch.points, pattern).tocsc()
         if t.calibrate:
             unit.append(K)
         else:

@@ -9,7 +9,7 @@ import numpy as np
 from scipy.spatial import Delaunay, cKDTree
 
 from .errors import MeshError
-from . import geometry
+from .geometry import dihedral_angles, edges as unique_edges, radius_ratio, signed_volumes
 
 # relative to the bounding-box diagonal
 DUPLICATE_TOL = 1e-9
@@ -80,7 +80,7 @@ class TetMesh:
         if len(pairs):
             raise MeshError(f"duplicate nodes (coincident within {DUPLICATE_TOL:g} of the size): "
                             + ", ".join(f"{a}={b}" for a, b in pairs[:10]))
-        vol = geometry.signed_volumes(pts, tets)
+        vol = signed_volumes(pts, tets)
         deg = np.flatnonzero(np.abs(vol) <= DEGENERATE_VOLUME_TOL * np.abs(vol).mean())
         if deg.size:
             raise MeshError(f"tetrahedra {_first(deg)} have zero volume (degenerate); "
@@ -103,14 +103,14 @@ class TetMesh:
     @property
     def volumes(self):
         """Rest volume of each tetrahedron (positive)."""
-        return geometry.signed_volumes(self.points, self.tets)
+        return signed_volumes(self.points, self.tets)
 
     @property
     def edges(self):
         """Unique undirected edges (k, 2), read-only; sorted once per ``tets`` array (the
         convergence study asked 612 times for them: 23 s of sorting)."""
         if self._edges is None or self._edges[0] is not self.tets:
-            e = geometry.edges(self.tets)
+            e = unique_edges(self.tets)
             e.flags.writeable = False
             self._edges = (self.tets, e)
         return self._edges[1]
@@ -122,8 +122,8 @@ class TetMesh:
 
     def quality(self):
         """Quality summary: volume, radius ratio (1 regular, 0 sliver), dihedral angles."""
-        rr = geometry.radius_ratio(self.points, self.tets)
-        dih = geometry.dihedral_angles(self.points, self.tets)
+        rr = radius_ratio(self.points, self.tets)
+        dih = dihedral_angles(self.points, self.tets)
         return {"nodes": self.n_nodes, "tets": self.n_tets, "volume": float(self.volumes.sum()),
                 "radius_ratio_min": float(rr.min()), "radius_ratio_mean": float(rr.mean()),
                 "dihedral_min_deg": float(dih.min()), "dihedral_max_deg": float(dih.max())}
@@ -234,7 +234,7 @@ def box(nx, ny, nz, lx, ly, lz, scheme="five", seed=0):
         pts, tets = _perturbed_delaunay(pts, (nx, ny, nz), (lx, ly, lz), seed)
     else:
         raise MeshError(f"unknown mesh scheme {scheme!r}; choose one of {', '.join(SCHEMES)}")
-    neg = geometry.signed_volumes(pts, tets) < 0  # generate right-handed tetrahedra directly
+    neg = signed_volumes(pts, tets) < 0  # generate right-handed tetrahedra directly
     tets[neg] = tets[neg][:, [0, 2, 1, 3]]
     h = tuple(float(v) for v in np.array([lx, ly, lz]) / (np.array([nx, ny, nz]) - 1))
     return TetMesh(pts, tets, lattice=(scheme, int(seed), h))
@@ -267,7 +267,7 @@ def perturbed(mesh, amplitude=0.2, seed=0):
     rng = np.random.default_rng(seed)
     d = rng.uniform(-amplitude, amplitude, mesh.points.shape) * shortest[:, None]
     pts = mesh.points + np.where(inner[:, None], d, 0.0)
-    if np.any(geometry.signed_volumes(pts, mesh.tets) <= 0):
+    if np.any(signed_volumes(pts, mesh.tets) <= 0):
         raise MeshError(f"perturbing by {amplitude} of the shortest edge inverts a tetrahedron: "
                         "take a smaller amplitude")
     return TetMesh(pts, mesh.tets, lattice=mesh.lattice)
@@ -319,10 +319,10 @@ def _perturbed_delaunay(pts, n, length, seed, amplitude=0.35, min_radius_ratio=0
         d[on_bound] = 0.0      # keep boundary nodes on their faces
         p = pts + d
         tets = Delaunay(p, qhull_options="Qbb Qc Qz Q12").simplices
-        vol = np.abs(geometry.signed_volumes(p, tets))
+        vol = np.abs(signed_volumes(p, tets))
         tets = tets[vol > 1e-9 * h.prod()]  # flat hull tetrahedra of coplanar face nodes
-        slivers = geometry.radius_ratio(p, tets) < min_radius_ratio
-        whole = np.isclose(np.abs(geometry.signed_volumes(p, tets)).sum(), np.prod(length))
+        slivers = radius_ratio(p, tets) < min_radius_ratio
+        whole = np.isclose(np.abs(signed_volumes(p, tets)).sum(), np.prod(length))
         return p, tets, slivers, whole
 
     for attempt in range(tries):

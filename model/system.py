@@ -8,7 +8,8 @@ from .errors import ModelError
 from .terms import make_term
 from .terms.shear import Shear
 from .terms._kernels import volume_gradient_numpy
-from . import integrate, static
+from .integrate import simulate as rk4_simulate
+from .static import RTOL as STATIC_RTOL, JacobianPattern, jacobian, solve as static_solve
 
 
 class ParticleModel:
@@ -140,17 +141,17 @@ class ParticleModel:
     def jacobian(self, x):
         """Sparse d f / d x (3n x 3n) by coloured central differences (any reading)."""
         if self._jacobian_pattern is None:  # mesh-only work, once per model
-            self._jacobian_pattern = static.JacobianPattern(self.mesh)
-        return static.jacobian(self.forces, self.mesh, x, self._jacobian_pattern)
+            self._jacobian_pattern = JacobianPattern(self.mesh)
+        return jacobian(self.forces, self.mesh, x, self._jacobian_pattern)
 
-    def solve_static(self, bc, f_ext=None, rtol=static.RTOL, max_iter=50, load_steps=1,
+    def solve_static(self, bc, f_ext=None, rtol=STATIC_RTOL, max_iter=50, load_steps=1,
                      on_step=None):
         """Equilibrium f_int(x) + f_ext = 0 on the free components (see model.static.solve)."""
-        return static.solve(self, bc, f_ext=f_ext, rtol=rtol, max_iter=max_iter,
+        return static_solve(self, bc, f_ext=f_ext, rtol=rtol, max_iter=max_iter,
                             load_steps=load_steps, on_step=on_step)
 
     def simulate(self, bc_of_t, t_end, dt=None, damping=0.0, f_ext=None, frames=101, safety=0.5,
                  x0=None, v0=None, t0=0.0):
         """Classical RK4 dynamics (see model.integrate.simulate)."""
-        return integrate.simulate(self, bc_of_t, t_end, dt=dt, damping=damping, f_ext=f_ext,
+        return rk4_simulate(self, bc_of_t, t_end, dt=dt, damping=damping, f_ext=f_ext,
                                   frames=frames, safety=safety, x0=x0, v0=v0, t0=t0)

@@ -21,7 +21,9 @@ from .cost import accuracy_per_cost
 from .elasticity import table as elasticity_table
 from .fit import EXACT, cancellation, fit, observed_order, ratio_limit
 from .problems import PROBLEMS
-from . import manufactured, patch, steps
+from .manufactured import units as manufactured_units
+from .patch import units as patch_units
+from .steps import units as steps_units
 
 FEM_P1 = "FEM P1"              # the yardstick: scikit-fem P1 on the model's own mesh
 MAX_NODES = 10_000             # a level is run where its mesh fits: Newton's sparse LU on a
@@ -388,10 +390,10 @@ def run(s, workers=None, log=True, bench=None, store=OFF):
             eff = elasticity_table(s, store)
         track.advance(elastic_weight, "effective elasticity")
         tables = {} if not s.verification else {
-            "manufactured": manufactured.units(s.meshes, s.quick, store),
-            "patch": patch.units((FEM_P1,) + tuple(s.models), s.meshes, s.E, s.nu, store),
+            "manufactured": manufactured_units(s.meshes, s.quick, store),
+            "patch": patch_units((FEM_P1,) + tuple(s.models), s.meshes, s.E, s.nu, store),
             # quick: the first family only (a minute a family for every model)
-            "steps": steps.units(s.models, s.meshes[:1] if s.quick else s.meshes, s.E, s.nu,
+            "steps": steps_units(s.models, s.meshes[:1] if s.quick else s.meshes, s.E, s.nu,
                                  s.rho, store)}
         work = [(name, unit) for name, us in tables.items() for unit in us]
         checked = dearest_first(

@@ -2,7 +2,7 @@
 ladders and every model's patch test, each sentence computed from the rows it shows."""
 from ... import catalogue
 from ...document import fmt
-from . import steps
+from .steps import DIVISORS, REFERENCE, ROUNDOFF
 from .verification import spec
 
 
@@ -142,7 +142,7 @@ def steps_section(doc, data):
     orders = [r["dt_order"] for r in ok if r["dt_order"] is not None]
     at_roundoff = sorted({f"{r['model']} ({r['mesh']})" for r in ok if r["dt_order"] is None})
     text = (f"Each model's push of the paper cube (clamped, {len(rows)} runs) at the case's RK4 "
-            f"step ({steps.DIVISORS[0]}x), at its half, and at 1/{steps.REFERENCE} as the "
+            f"step ({DIVISORS[0]}x), at its half, and at 1/{REFERENCE} as the "
             "reference: the end-of-push displacement error.")
     if ok:
         worst = max(ok, key=lambda r: r["dt_error"])
@@ -153,7 +153,7 @@ def steps_section(doc, data):
         text += (f" Halving the step divides it by 2^p with p from {min(orders):.2f} to "
                  f"{max(orders):.2f} (RK4's order is 4).")
     if at_roundoff:
-        text += (f" At round-off (below {steps.ROUNDOFF:g}) already at the half step: "
+        text += (f" At round-off (below {ROUNDOFF:g}) already at the half step: "
                  + ", ".join(at_roundoff) + ".")
     if failed:
         text += " Blown up: " + "; ".join(

@@ -20,7 +20,8 @@ from ...progress import Progress
 from ...runner import jsonable
 from ...store import OFF, key
 from ...workers import dearest_first
-from . import problem as P
+from .problem import (FAMILY, STEP_OF_SPACING, dirichlet as plate_dirichlet,
+                      mesh as spacing_mesh, nominal_travels, schedule, step_strain)
 from .beads import Measured, errors, layer_axial, layer_lateral
 
 MM = 1e-3
@@ -95,8 +96,8 @@ class TruthCubeSettings:
 
     def problem(self):
         return {"E_Pa": self.E, "nu": self.nu, "side_mm": T.SIDE / MM,
-                "strains": list(T.STRAINS[1:]), "family": P.FAMILY,
-                "step_of_spacing": P.STEP_OF_SPACING, "static_rtol": STATIC_RTOL,
+                "strains": list(T.STRAINS[1:]), "family": FAMILY,
+                "step_of_spacing": STEP_OF_SPACING, "static_rtol": STATIC_RTOL,
                 "reference": {"element": "P2/P1 mixed", "mesh": f"{REF_MESH[0]} "
                               f"{REF_MESH[1]}^3", "refinements": self.ref_levels}}
 
@@ -116,8 +117,8 @@ def reference_mesh():
 
 def _nh_solves(plates, travels, nu, s, levels):
     m = reference_mesh()
-    fractions, at = P.schedule(travels, REF_STEP_STRAIN)
-    return [hyperelastic.solve(m, s.E, nu, P.dirichlet(m, plates, travels[-1]), element="P2",
+    fractions, at = schedule(travels, REF_STEP_STRAIN)
+    return [hyperelastic.solve(m, s.E, nu, plate_dirichlet(m, plates, travels[-1]), element="P2",
                                mixed=True, refine=k, load_steps=fractions, keep_steps=at)
             for k in levels], at
 
@@ -145,7 +146,7 @@ def linear_reference(plates, travels, nu, s, beads):
     """Linear P2 through the same travels (it scales with the travel), as
     :func:`continuum` gives the neo-Hookean one."""
     m = reference_mesh()
-    bc = P.dirichlet(m, plates, travels[-1])
+    bc = plate_dirichlet(m, plates, travels[-1])
     sols = [linear.solve(m, s.E, nu, bc, element="P2", refine=k)
             for k in range(s.ref_levels + 1)]
     conv = converged_from(sols)
@@ -160,7 +161,7 @@ def fit_travels(measured, s, nu):
     fits the measured axial bead displacements best in least squares: one secant step from
     the nominal travel (the response is nearly linear in it), with the nominal and fitted
     axial RMS error [mm]."""
-    nominal = P.nominal_travels()
+    nominal = nominal_travels()
     beads = measured.beads
     u0 = continuum_finest("bonded", nominal, nu, s, beads)
     u1 = continuum_finest("bonded", [t * (1 + FIT_STEP) for t in nominal], nu, s, beads)
@@ -177,12 +178,12 @@ def bead_displacements(model, mesh, spec, travels, beads, s):
     displacement (343, 3) [m] at the rest positions ``beads`` (P1 on its mesh) per measured
     state, in a list (shorter when the solve failed on the way), and the failure or None."""
     plates, _, nu = spec
-    fractions, at = P.schedule(travels, P.step_strain(mesh))
+    fractions, at = schedule(travels, step_strain(mesh))
     located = mesh.locate(beads)
     kept = {}
     try:
         pm = build(model, mesh, Material(E=s.E, nu=nu, rho=1000.0))
-        pm.solve_static(P.dirichlet(mesh, plates, travels[-1]), load_steps=fractions,
+        pm.solve_static(plate_dirichlet(mesh, plates, travels[-1]), load_steps=fractions,
                         rtol=STATIC_RTOL,
                         on_step=lambda step, x: kept.__setitem__(step, x - mesh.points))
     except FINDINGS as exc:
@@ -270,7 +271,7 @@ def _reference_unit(job):
         k = key(kind="truthcube-fit", **s.problem(), nu_fit=nu)
         travels = store.get(k) or store.put(k, fit_travels(measured, s, nu))
     else:
-        travels = P.nominal_travels()
+        travels = nominal_travels()
     return travels, reference_rows(variant, spec, travels, measured, s, store)
 
 
@@ -284,7 +285,7 @@ def _cell_unit(job):
     found = store.get(key(**what))
     if found is not None:
         return found
-    return store.put(key(**what), model_rows(model, P.mesh(spacing), name, variant, spec,
+    return store.put(key(**what), model_rows(model, spacing_mesh(spacing), name, variant, spec,
                                              travels, Measured(T.load()), s, continuum))
 
 
@@ -312,5 +313,5 @@ def run(s, log=True, store=OFF, workers=None):
                              [1.0 / job[0] ** 3 for job in jobs])
     return jsonable({"rows": [r for rs in rows for r in rs], "references": refs,
                      "travels_mm": travels_used,
-                     "nominal_travels_mm": [t / MM for t in P.nominal_travels()],
+                     "nominal_travels_mm": [t / MM for t in nominal_travels()],
                      "data": measured.summary()})
