@@ -19,7 +19,7 @@ from model.errors import ConvergenceError, ModelError
 from ._neohookean import neohookean
 from .assembly import scalar_gradients
 from .fem import (INTORDER, NewtonSolver, check_finite, dirichlet_dofs, element_basis, lame,
-                  parent_of, probe, refine_with_data, saddle_solve, skfem_mesh, stress_measures,
+                  parent_of, probe, refine_with_data, SaddleSolver, skfem_mesh, stress_measures,
                   stress_on_input)
 from .linear import body_load, converged_from, dof_component, traction_load, transfer_to_nodes
 
@@ -44,7 +44,8 @@ class HyperelasticResult:
     tetrahedron (volume average); ``von_mises``, ``max_shear``, ``pressure`` (m,); ``reaction``
     (n, 3) [N]; ``energy`` the stored energy [J]; ``iterations`` Newton iterations in all;
     ``info`` element, formulation, refinement, dofs, load steps and the AMG-CG iterations of
-    its tangent solves (``cg_iterations``, 0 where they were solved directly)."""
+    its tangent solves (``cg_iterations``, 0 where they were solved directly); the mixed
+    form's ``factorisations`` and the ``gmres_iterations`` preconditioned by them."""
 
     u: np.ndarray
     stress: np.ndarray
@@ -190,7 +191,7 @@ def solve(mesh, E, nu, dirichlet, body_force=None, element="P1", refine=0, diric
     target[D] = x_D[D]
     iters = 0
     kept = {}
-    newton_solve = NewtonSolver()
+    newton_solve = SaddleSolver() if mixed else NewtonSolver()
     x0, schedule = x, fractions
     if start is not None and on_step is None and not keep_steps:
         x0, schedule = _interpolated(start, d), [1.0]
@@ -218,7 +219,9 @@ def solve(mesh, E, nu, dirichlet, body_force=None, element="P1", refine=0, diric
         p_basis=d.pb, p_dofs=x[ub.N:].copy() if mixed else None,
         info={"element": element, "mixed": bool(mixed), "refine": int(refine),
               "dofs": int(d.N), "load_steps": int(load_steps),
-              "cg_iterations": int(newton_solve.cg_iterations)})
+              "cg_iterations": int(getattr(newton_solve, "cg_iterations", 0)),
+              **({"factorisations": newton_solve.factorisations,
+                  "gmres_iterations": newton_solve.krylov_iterations} if mixed else {})})
 
 
 def _interpolated(coarse, d):
@@ -338,8 +341,8 @@ def _newton(d, x, fractions, D, I, Iu, Ip, target, f_body, floor_u, floor_p, max
             dx[D] = s * target[D] - x[D]
             b = -res[I] - K[I][:, D] @ dx[D]
             A = K[I][:, I]
-            dx[I] = (saddle_solve(A, b) if mixed else
-                     newton_solve(A, b, ub.doflocs.T[I], comp[I], rtol=eta)[0])
+            locs = (None, None) if mixed else (ub.doflocs.T[I], comp[I])
+            dx[I] = newton_solve(A, b, *locs, rtol=eta)[0]
             x = x + dx
             x[D] = s * target[D]
             iters += 1

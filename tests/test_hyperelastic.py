@@ -289,3 +289,26 @@ def test_a_finer_lattice_is_not_taken_for_a_refinement():
     assert finer.nelements == 8 * coarse.nelements
     assert not _one_refinement(coarse, finer)
     assert _one_refinement(coarse, coarse.refined())
+
+
+def test_the_mixed_form_reuses_a_factorisation_and_reaches_the_same_solution(monkeypatch):
+    """A barrel at nu = 0.499 (mixed P2/P1, 30 % compression in 3 steps): GMRES on the last
+    factorisation solves most tangents, to the solution (and the Newton iterations) of a
+    factorisation at every iteration."""
+    from reference import fem
+    mesh = cube(4, L, "six")
+    bc = {int(i): (0.0, 0.0, 0.0) for i in mesh.nodes_on_plane("z", 0.0)}
+    bc.update({int(i): (0.0, 0.0, -0.3 * L) for i in mesh.nodes_on_plane("z", L)})
+    reused = hyperelastic.solve(mesh, E, 0.499, bc, element="P2", mixed=True, load_steps=3)
+
+    class EveryTime(fem.SaddleSolver):
+        def __call__(self, A, b, doflocs=None, comp=None, rtol=1e-10):
+            self.lu = None
+            return super().__call__(A, b, rtol=rtol)
+    monkeypatch.setattr(hyperelastic, "SaddleSolver", EveryTime)
+    every = hyperelastic.solve(mesh, E, 0.499, bc, element="P2", mixed=True, load_steps=3)
+    assert every.info["factorisations"] == every.iterations
+    assert reused.info["factorisations"] < 0.5 * reused.iterations
+    assert reused.info["gmres_iterations"] > 0
+    assert reused.iterations <= every.iterations + 1
+    assert np.abs(reused.dofs - every.dofs).max() < 1e-8 * np.abs(every.dofs).max()
