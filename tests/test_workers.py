@@ -10,30 +10,35 @@ from pathlib import Path
 import pytest
 
 from cases.cli import main
+from conftest import _run, shared
 from cases.workers import Cluster, Workers, WorkerLost, RETRIES
 
 UNITS = ["--quick", "--meshes", "five", "six", "--models", "msm", "fem-linear"]
 
 
-def test_workers_write_the_metrics_of_one_process(tmp_path, quick_cantilever):
-    for n in ("1", "2"):
-        assert main(["run", "cantilever", *UNITS, "--workers", n,
-                     "--out", str(tmp_path / n)]) == 0
-    one, two = ((tmp_path / n / "metrics.json").read_bytes() for n in ("1", "2"))
+@pytest.fixture(scope="session")
+def one_process(tmp_path_factory, quick_cantilever):
+    """The units in one process, once per session: what every executor must write."""
+    return shared(tmp_path_factory, "cantilever-units-one-process",
+                  _run("cantilever", *UNITS, "--workers", "1"))
+
+
+def test_workers_write_the_metrics_of_one_process(tmp_path, one_process):
+    assert main(["run", "cantilever", *UNITS, "--workers", "2",
+                 "--out", str(tmp_path / "2")]) == 0
+    one, two = ((p / "metrics.json").read_bytes() for p in (one_process, tmp_path / "2"))
     assert one == two
     assert one.index(b'"mesh": "five"') < one.index(b'"mesh": "six"')   # declared order
 
 
-def test_a_dask_cluster_writes_the_metrics_of_one_process(tmp_path, quick_cantilever):
+def test_a_dask_cluster_writes_the_metrics_of_one_process(tmp_path, one_process):
     """`--scheduler ADDRESS`: the same units on a Dask cluster, the same bytes."""
     from distributed import LocalCluster
-    assert main(["run", "cantilever", *UNITS, "--workers", "1",
-                 "--out", str(tmp_path / "one")]) == 0
     with LocalCluster(n_workers=2, threads_per_worker=1, processes=True,
                       dashboard_address=":0") as cluster:
         assert main(["run", "cantilever", *UNITS, "--scheduler", cluster.scheduler_address,
                      "--out", str(tmp_path / "dask")]) == 0
-    assert (tmp_path / "one" / "metrics.json").read_bytes() == \
+    assert (one_process / "metrics.json").read_bytes() == \
         (tmp_path / "dask" / "metrics.json").read_bytes()
 
 
