@@ -4,6 +4,7 @@ from dataclasses import dataclass
 
 import numpy as np
 import scipy.sparse as sp
+from numba import njit
 from scipy.sparse.linalg import splu
 
 from .bc import bc_arrays, load_fractions
@@ -24,13 +25,23 @@ def node_adjacency(mesh):
 
 def colour_nodes(adjacency):
     """Greedy colouring in which two nodes of one colour share no neighbour, so perturbing all
-    of a colour at once leaves every force row touched by at most one of them."""
+    of a colour at once leaves every force row touched by at most one of them: each node in
+    turn takes the smallest colour no node within two edges has taken."""
     dist2 = (adjacency.astype(np.int32) @ adjacency.astype(np.int32)).tocsr()
-    colour = np.full(adjacency.shape[0], -1)
-    for i in range(adjacency.shape[0]):
-        taken = colour[dist2.indices[dist2.indptr[i]:dist2.indptr[i + 1]]]
+    return _greedy_colours(dist2.indptr, dist2.indices, adjacency.shape[0])
+
+
+@njit(cache=True)
+def _greedy_colours(indptr, indices, n):
+    colour = np.full(n, -1, np.int64)
+    taken_by = np.full(n + 1, -1, np.int64)     # taken_by[c] == i: c is taken near node i
+    for i in range(n):
+        for p in range(indptr[i], indptr[i + 1]):
+            c = colour[indices[p]]
+            if c >= 0:
+                taken_by[c] = i
         c = 0
-        while c in taken:
+        while taken_by[c] == i:
             c += 1
         colour[i] = c
     return colour

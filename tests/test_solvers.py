@@ -247,3 +247,20 @@ def test_compiled_ramp_step_is_the_plain_rk4_step(preset, mat):
     assert a.steps == b.steps > 20
     assert np.abs(a.x - b.x).max() < 1e-10 * np.abs(a.x - mesh.points).max()
     assert np.abs(a.v - b.v).max() < 1e-10 * np.abs(a.v).max()
+
+
+@pytest.mark.parametrize("scheme", ["five", "six", "bcc", "unstructured"])
+def test_node_colours_share_no_neighbour_and_are_the_smallest_free(scheme):
+    """The finite-difference Jacobian's colouring: no two nodes of one colour are within two
+    edges, and each node took the smallest colour its earlier neighbours left (greedy, so
+    a colour c > 0 is taken near the node for every smaller one)."""
+    from model.static import colour_nodes, node_adjacency
+    mesh = cube(5, L, scheme)
+    adj = node_adjacency(mesh)
+    near = (adj.astype(int) @ adj.astype(int)).tocsr()
+    colour = colour_nodes(adj)
+    for i in range(mesh.n_nodes):
+        others = np.setdiff1d(near.indices[near.indptr[i]:near.indptr[i + 1]], [i])
+        assert colour[i] not in colour[others]
+        earlier = colour[others[others < i]]
+        assert set(range(colour[i])) <= set(earlier)
