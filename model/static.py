@@ -184,14 +184,16 @@ def _predicted(x, r, before, last, s, free, residual):
 def solve(model, bc, f_ext=None, rtol=RTOL, max_iter=50, load_steps=1, on_step=None):
     """Solve f_int(x) + f_ext = 0 on the free components, prescribed ones set from ``bc``.
 
-    Newton with a backtracking line search on the residual norm, in ``load_steps`` equal
-    increments of the prescribed displacement and of ``f_ext`` (or at the load fractions
-    ``load_steps`` lists, see ``model.bc.load_fractions``); ``on_step(step, x)``, when given, is
-    called with the positions after every converged step; converged when the largest
-    free-node residual is below ``rtol * E h^2``. A step first tries the last factorised
-    Jacobian (a chord step) and keeps it when it divides the residual by CHORD_GAIN, which
-    saves the finite-difference Jacobian and its factorisation in the last iterations.
-    Raises ConvergenceError otherwise.
+    Newton in ``load_steps`` equal increments of the prescribed displacement and of ``f_ext``
+    (or at the load fractions ``load_steps`` lists, see ``model.bc.load_fractions``), each
+    started from the last two equilibria extrapolated to its load (:func:`_predicted`);
+    ``on_step(step, x)``, when given, is called with the positions after every converged
+    step; converged when the largest free-node residual is below ``rtol * E h^2``. A step
+    first tries the last factorised Jacobian (a chord step) and keeps it when it divides the
+    residual by CHORD_GAIN, which saves the finite-difference Jacobian and its factorisation
+    in the last iterations. A full Newton step is kept where it raises the residual less than
+    GROWTH times, under a watchdog (WATCH); otherwise, and for the rest of a step whose watch
+    failed, the step is halved until the residual falls. Raises ConvergenceError otherwise.
     """
     mesh = model.mesh
     mask, vals = bc_arrays(bc, mesh.n_nodes)
