@@ -273,6 +273,11 @@ class Case(abc.ABC):
             catalogue.metric(name)      # a KeyError naming where to declare it
 
     # ------------------------------------------------------------------ settings
+    def notes_for(self, s):
+        """The report's notes for settings ``s``: ``notes`` unless a case's setup notes depend
+        on its settings."""
+        return self.notes
+
     def settings(self, quick=False, **kw):
         """The case's Settings: full by default, with ``quick`` overrides, then ``kw``
         (None values ignored: what the user did not give)."""

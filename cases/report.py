@@ -136,9 +136,10 @@ def build_report(case, s, runs, fields, out):
         "--nu, --rho).",
         case.references_line(s),
         "Quick mode." if s.quick else "Full mode."] + _constants(runs))
-    if case.notes:
+    notes = case.notes_for(s)
+    if notes:
         doc.h(2, "Notes")
-        doc.ul(case.notes)
+        doc.ul(notes)
     failed = [r for r in runs if r.get("failed")]
     ok = [r for r in runs if not r.get("failed")]
     groups = dict(case.findings(s, ok))

@@ -26,7 +26,8 @@ ENV_OFF = "PBCM_NO_CACHE"
 ENV_KINDS = "PBCM_CACHE_KINDS"
 # the kinds that hold FEM references only: what no model, and no patch of a model, changes
 REFERENCE_KINDS = ("reference", "convergence-reference", "convergence-reference-at",
-                   "artefact-reference", "truthcube-reference", "truthcube-fit")
+                   "artefact-reference", "truthcube-reference", "truthcube-fit",
+                   "manufactured")
 PACKAGES = ("model", "reference", "cases")
 ROOT = Path(__file__).resolve().parents[1]
 SKIP = {"__pycache__"}

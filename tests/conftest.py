@@ -48,10 +48,10 @@ def pytest_unconfigure(config):
         shutil.rmtree(folder, ignore_errors=True)
 
 
-# tests that run a command on two worker processes of their own and last half a minute: in
-# collection order they come last (test_user_terms, test_workers), where one ran alone while
-# the other xdist worker had nothing left; run first, they overlap the other worker's work
-FIRST = ("tests/test_user_terms.py::test_pbcm_run_with_a_term_file_on_two_workers",
+# tests that run a command on two worker processes of their own: in collection order they
+# come last (test_user_terms, test_workers), where one ran alone while the other xdist worker
+# had nothing left; run first, they overlap the other worker's work
+FIRST = ("tests/test_user_terms.py::test_a_term_file_reaches_two_worker_processes",
          "tests/test_workers.py::test_workers_write_the_metrics_of_one_process")
 
 

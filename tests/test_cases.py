@@ -11,7 +11,7 @@ from cases import metrics as M
 from cases.cli import main
 from cases.library.paper_cube import LAYERS_MM, SIZE_MM, make_mesh, static_bc
 from cases.report import TIMING_KEYS
-from model import PRESETS
+from model import PRESETS, ModelError
 from reference import linear
 
 FILES = ["metrics.json", "report.md", "report.html", "errors.png",
@@ -42,6 +42,10 @@ def test_quick_run_writes_every_file_with_finite_metrics(quick):
         assert (r["modal_rel_err"] is None) == (r["bc"] == "sliding")
         if not r["dyn_failed"]:   # rest is None where the run never came to rest
             assert r["reaction_time_rel_l2"] > 0 and (r["rest_time_s"] or 2.0) > 1.0
+        # quick mode repeats at dt/4 only the runs that blew up at dt
+        assert (r["verdict_changes_dt4"] is None) == (r["dyn_failed"] is None)
+    md = (quick / "report.md").read_text()
+    assert "Only the dynamic runs that blew up at the case's step dt are repeated" in md
     env = data["environment"]
     assert {"python", "numpy", "numba", "scikit-fem"} <= set(env)
     # what changes between identical runs lives in run.json (ignored by git), not here
@@ -50,6 +54,21 @@ def test_quick_run_writes_every_file_with_finite_metrics(quick):
     run = json.loads((quick / "run.json").read_text())
     assert {"git_commit", "date", "timings"} <= set(run) and len(run["timings"]) == len(runs)
     assert len(list((quick / "vtu").glob("*.vtu"))) == 2 * 2 * (len(PRESETS) + 1)   # + FEM
+
+
+def test_the_full_setting_repeats_every_dynamic_run_at_a_quarter_of_the_step():
+    """repeat_dt4 = "every" (the full run's): a run that comes to rest at dt is run again at
+    dt/4, which does not change its verdict; the report says every run was repeated."""
+    from cases.library.paper_cube import CASE
+    from cases.runner import run
+    s = CASE.settings(quick=True, repeat_dt4="every", meshes=("five",), bcs=("clamped",),
+                      models=("msm",))
+    (r,), _ = run(CASE, s, log=False)
+    assert r["dyn_failed"] is None and r["dyn_failed_dt4"] is None
+    assert r["verdict_changes_dt4"] is False
+    assert CASE.notes_for(s)[0].startswith("The dynamic run is repeated at a quarter")
+    with pytest.raises(ModelError, match="repeat_dt4 must be one of 'every', 'blew up'"):
+        CASE.settings(quick=True, repeat_dt4="some")
 
 
 def test_html_parses_and_every_figure_exists(quick):

@@ -36,6 +36,8 @@ def test_blow_ups_are_findings_and_the_report_is_complete(nu, tmp_path, capsys):
     blown = [r for r in runs if r["dyn_failed"]]
     assert {r["model"] for r in blown} == {"pbcm-balanced-literal", "pbcm-corner-literal"}
     assert all("blew up" in r["dyn_failed"] and r["dyn_vs_static_rel_l2"] is None for r in blown)
+    # a blow-up at dt is run again at dt/4 (is the step to blame?), the others are not (quick)
+    assert all((r["verdict_changes_dt4"] is None) == (r not in blown) for r in runs)
     md = (out / "report.md").read_text()
     # a table row, not a sentence per run: model, mesh/bc, where it blew up at dt
     assert "| pbcm-balanced-literal | six/clamped | step " in md

@@ -32,6 +32,16 @@ NOTES = ("The dynamic run is repeated at a quarter of the step (dt/4) to see whe
          "it (no nonlinear transient reference yet).")
 
 
+def notes(cfg):
+    """NOTES, their first line saying which dynamic runs were repeated at dt/4."""
+    if cfg.repeat_dt4 == "every":
+        return NOTES
+    return (("Only the dynamic runs that blew up at the case's step dt are repeated at a quarter "
+             "of it (dt/4), to see whether the step is to blame; 'dt/4 changes verdict' is n/a "
+             "for the others (the full run repeats every one). 'blew up' in dyn vs static is a "
+             "dynamic run that did not finish."),) + NOTES[1:]
+
+
 def cell(metric, run):
     """The table text of the paper cube's cells that say more than a number, else None."""
     if metric.name == "dyn_vs_static_rel_l2" and run["dyn_failed"]:

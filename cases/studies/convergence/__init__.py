@@ -10,6 +10,7 @@ from dataclasses import fields
 from ...framework import Study
 from ...store import OFF
 from . import report
+from .problems import PROBLEMS
 from .study import ConvergenceSettings, run
 
 # what metrics.json records of a run, all the report is drawn from
@@ -21,8 +22,9 @@ class Convergence(Study):
     name = "convergence"
     title = ("h-convergence of every model on the paper cube, cantilever and torsion bar; "
              "effective elasticity of every lattice; accuracy per cost")
-    # --quick: two levels on the two mesh families the paper cube's quick mode keeps
-    quick = {"h_mm": (8.0, 4.0), "meshes": ("five", "six")}
+    # --quick: two levels on the two mesh families the paper cube's quick mode keeps, against
+    # references down to 2 mm
+    quick = {"h_mm": (8.0, 4.0), "meshes": ("five", "six"), "ref_finest_mm": 2.0}
 
     def settings(self, quick=False, **kw):
         kw = {k: v for k, v in kw.items() if v is not None}
@@ -45,8 +47,17 @@ class Convergence(Study):
         s = ConvergenceSettings(
             E=p["E_Pa"], nu=p["nu"], rho=p["rho_kg_m3"], problems=tuple(p["problems"]),
             meshes=tuple(p["meshes"]), models=tuple(p["models"]), h_mm=tuple(p["h_mm"]),
-            load_scale=p["load_scale"], patch_n=p["patch_n"], quick=p["quick"])
+            load_scale=p["load_scale"], patch_n=p["patch_n"], quick=p["quick"],
+            ref_finest_mm=_finest(p["ref_ladders_mm"]))
         return s, {k: metrics[k] for k in RECORDED}
+
+
+def _finest(ladders):
+    """The ``ref_finest_mm`` of the recorded reference ladders {problem: spacings}: None
+    where each is its problem's own ladder, else the finest spacing kept."""
+    if all(tuple(hs) == tuple(PROBLEMS[p].ref_ladder_mm) for p, hs in ladders.items()):
+        return None
+    return min(min(hs) for hs in ladders.values())
 
 
 STUDY = Convergence()

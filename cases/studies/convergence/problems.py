@@ -59,9 +59,9 @@ class Problem:
         first: sparse solves grow about as nodes^1.3."""
         return float(np.prod(self.nodes_per_side(h_mm))) ** 1.3
 
-    def reference_cost(self):
-        """The expected cost of the reference's ladder."""
-        return sum(self.cost(h) for h in self.ref_ladder_mm)
+    def reference_cost(self, ladder=None):
+        """The expected cost of the reference's ladder (or of the spacings ``ladder``)."""
+        return sum(self.cost(h) for h in (ladder or self.ref_ladder_mm))
 
     def dirichlet(self, mesh, bc, s, scale):
         """The case's prescribed displacements of the linear regime times ``scale``."""
