@@ -89,6 +89,8 @@ REGIMES_CHANGED = set(catalogue.STATIC) | {"bulge_profile_mm", "paper_pattern",
 ZIGZAG_RETIRED = {"zigzag", "zigzag_fem"}
 RECALIBRATED = {"pbcm-corner", "pbcm-balanced"}
 SLIDING_DROPPED = {"frequencies_hz", "rest_time_s"}
+# issue 29: quick mode repeats at dt/4 only the runs that blew up at dt (not known elsewhere)
+DT4_REPEATED = {"dyn_failed_dt4", "verdict_changes_dt4"}
 
 
 def test_paper_cube_on_the_framework_matches_the_landed_case(quick):
@@ -115,6 +117,9 @@ def test_paper_cube_on_the_framework_matches_the_landed_case(quick):
             assert k not in TIMING_KEYS
             if k == "step_time_state" or k in FEM_DYNAMICS_CHANGED | REGIMES_CHANGED \
                     | ZIGZAG_RETIRED:
+                continue
+            if k in DT4_REPEATED and new["dyn_failed"] is None:
+                assert new[k] is None, k
                 continue
             if old["bc"] == "sliding" and k in SLIDING_DROPPED:
                 assert new[k] is None, k
