@@ -33,22 +33,34 @@ REGULAR = ("five", "six", "bcc")     # the lattices as generated; the rest is ir
 def consistency(conv, model):
     """{lattice: the converged limit e_inf of the sliding-cube patch test in the linear
     regime, or the fit's verdict where it has no limit (diverging, not asymptotic)}."""
+    return {k: v[0] if isinstance(v, tuple) else v for k, v in limits(conv, model).items()}
+
+
+def limits(conv, model):
+    """{lattice: (e_inf, its fit's +-) of the sliding-cube patch test, or the fit's verdict
+    where it has no limit}."""
     out = {}
     for f in (conv or {}).get("fits", []):
         if (f["case"], f["bc"]) == CONSISTENCY and f["model"] == model:
             limited = f["verdict"] in LIMITED and f.get("e_inf") is not None
-            out[f["mesh"]] = f["e_inf"] if limited else f["verdict"]
+            out[f["mesh"]] = (f["e_inf"], f.get("e_inf_err") or 0.0) if limited \
+                else f["verdict"]
     return out
 
 
+def _pm(v):
+    return f"{fmt(v[0], 2)} +- {fmt(v[1], 1)}"
+
+
 def worst(values):
-    """'largest (lattice)' over the numeric entries, and the lattices without a limit."""
-    nums = {k: v for k, v in values.items() if isinstance(v, (int, float))}
-    other = [f"{v} on {k}" for k, v in values.items() if not isinstance(v, (int, float))]
+    """'largest +- its fit's (lattice)' over the entries with a limit, and the lattices
+    without one."""
+    nums = {k: v for k, v in values.items() if isinstance(v, tuple)}
+    other = [f"{v} on {k}" for k, v in values.items() if not isinstance(v, tuple)]
     if not nums:
         return ", ".join(other) or "n/a"
-    k = max(nums, key=nums.get)
-    return f"{fmt(nums[k])} ({k})" + (f"; {', '.join(other)}" if other else "")
+    k = max(nums, key=lambda k: nums[k][0])
+    return f"{_pm(nums[k])} ({k})" + (f"; {', '.join(other)}" if other else "")
 
 
 def _median(rows, key):
@@ -64,16 +76,18 @@ def _bench_row(bench, model):
     return min(rows, key=lambda r: abs(np.log(r["tets"] / COST_TETS))) if rows else None
 
 
-def table(root, models):
+def table(root, models, pops=()):
     """(header, rows): one row per model of the scorecard."""
+    from . import scorecard
     conv = _load(root, "convergence", "metrics.json")
     cube = _load(root, "paper-cube", "metrics.json")
-    finite = _load(root, FINITE, "metrics.json")
     bench = _load(root, BENCH_FOLDER, BENCH_FILE)
     measured = (_load(root, MEASURED, "metrics.json") or {}).get("headline")
-    header = ["model", "consistency error (largest limit)", "finite-load error",
-              "worst isotropy error", "largest |alternation|", "RK4 run",
-              "s per simulated s", "Truth Cube bead RMS [mm]"]
+    linear, finite = scorecard.overall(pops, models), scorecard.overall(pops, models, True)
+    header = ["model", "model-form error, linear regime", "model-form error, finite load",
+              "consistency limit (largest, +- fit)", "worst isotropy error",
+              "largest |alternation|", "RK4 run", "s per simulated s",
+              "Truth Cube bead RMS [mm]"]
     rows = []
     for m in models:
         el = [e["moduli_rel_err"] for e in (conv or {}).get("elasticity", [])
@@ -83,10 +97,10 @@ def table(root, models):
         flutter = sum(r.get("dyn_verdict") == "unstable (flutter)" for r in mine
                       if r["bc"] == "clamped")
         clamped = sum(r["bc"] == "clamped" for r in mine)
-        fin = [r for r in (finite or {}).get("runs", []) if r["model"] == m]
         b = _bench_row(bench, m)
-        rows.append([m, worst(consistency(conv, m)) if conv else "n/a",
-                     fmt(_median(fin, finite["headline"])) if finite else "n/a",
+        rows.append([m, _overall_cell(linear, m, pops, False),
+                     _overall_cell(finite, m, pops, True),
+                     worst(limits(conv, m)) if conv else "n/a",
                      fmt(max(el)) if el else "n/a", fmt(max(alt)) if alt else "n/a",
                      ("flutters" if flutter else "stable") + f" ({clamped - flutter} of "
                      f"{clamped} clamped runs stable)" if clamped else "n/a",
@@ -95,49 +109,62 @@ def table(root, models):
     return header, rows
 
 
+def _overall_cell(means, model, pops, finite):
+    from . import scorecard
+    if any(p.quantity.p1 == model and p.finite == finite for p in pops):
+        return "FEM P1 itself"
+    return scorecard.describe(means[model]) if model in means else "n/a"
+
+
 def _bead(measured, model):
     v = (measured or {}).get("models", {}).get(model)
     return f"{fmt(v['bead_rms_mm'])} at {fmt(100 * measured['strain'], 4)} %" if v else "n/a"
 
 
-def lines(root, models):
-    """At most six short lines: the answers."""
+def lines(root, models, pops=(), quick=False):
+    """The answers, each a short paragraph, the last what to pick."""
     art = _load(root, "artefact", "metrics.json")
     conv = _load(root, "convergence", "metrics.json")
     bench = _load(root, BENCH_FOLDER, BENCH_FILE)
     out = []
-    if art and art["verdict"]["sure"] == "undecided":
+    if art and art["parameters"]["quick"]:
+        out.append("**Which reading?** Quick: not decided (`pbcm run artefact` decides).")
+    elif art and art["verdict"]["sure"] == "undecided":
         v = art["verdict"]
         out.append(f"**Which reading?** Undecided between {', '.join(v['tied'])} "
-                   f"([artefact study](artefact/report.md)): "
+                   f"([artefact study](artefact/report.md)): in the study's runs "
                    + ("each " if len({json.dumps(r["matches"], sort_keys=True)
                                       for r in art["readings"] if r["model"] in v["tied"]}) == 1
                       else f"{v['model']} ") + _decisive(art))
     elif art:
         v = art["verdict"]
         out.append(f"**Which reading?** {v['model']} ({v['sure']} verdict, "
-                   f"[artefact study](artefact/report.md)): it {_decisive(art)}")
+                   f"[artefact study](artefact/report.md)): in the study's runs it "
+                   f"{_decisive(art)}")
     else:
         out.append("**Which reading?** Not computed: run `pbcm run artefact`.")
+    out.append(_cost_of_replacing(pops, models, quick))
     if conv:
-        limits = {m: consistency(conv, m) for m in models}
-        passed = [m for m, v in limits.items() if v and all(
-            isinstance(x, (int, float)) and x < PATCH_TOL for x in v.values())]
-        rest = sorted((m for m in models if m not in passed),
-                      key=lambda m: _largest(limits[m]))
-        nolimit = sorted({k for m in rest for k, v in limits[m].items()
-                          if not isinstance(v, (int, float))})
-        out.append("**How far from the continuum?** Consistency error, the sliding cube's limit "
-                   "under refinement (a patch test with traction-free sides; largest over "
-                   "lattices): "
-                   + ", ".join(f"{m} {fmt(_largest(limits[m])[1])}" for m in rest)
+        lim = {m: limits(conv, m) for m in models}
+        passed = [m for m, v in lim.items() if v and all(
+            isinstance(x, tuple) and x[0] + x[1] < PATCH_TOL for x in v.values())]
+        rest = sorted((m for m in models if m not in passed), key=lambda m: _largest(lim[m]))
+        nolimit = sorted({k for m in rest for k, v in lim[m].items()
+                          if not isinstance(v, tuple)})
+        out.append("**How far from the continuum?** " + (
+            "Quick: not decided (`pbcm run convergence` decides); " if conv["parameters"][
+                "quick"] else "")
+                   + "The consistency limit, the sliding cube's error as the mesh is refined "
+                   "(a patch test; the largest over the lattices, +- the extrapolation's "
+                   "uncertainty): " + ", ".join(f"{m} {_pm(_worst_limit(lim[m]))}"
+                                                for m in rest if _worst_limit(lim[m]))
                    + (f"; below {PATCH_TOL:g}: {', '.join(passed)}" if passed else "")
                    + (f"; no limit on {', '.join(nolimit)}" if nolimit else "")
                    + _irregular(conv, models)
                    + " ([convergence](convergence/report.md)).")
-    measured = (_load(root, MEASURED, "metrics.json") or {}).get("headline")
-    if measured:
-        out.append(_measured_line(measured, models))
+    truth = _load(root, MEASURED, "metrics.json")
+    if truth and truth.get("headline"):
+        out.append(_measured_line(truth, models))
     rows = {m: _bench_row(bench, m) for m in models}
     if all(rows.get(k) for k in ("fem-linear", "msm")):
         fl = rows["fem-linear"]["cpu_s_per_simulated_s"]
@@ -147,27 +174,175 @@ def lines(root, models):
                    + ", ".join(f"{m} {fmt(r['cpu_s_per_simulated_s'] / fl, 2)}"
                                for m, r in rows.items() if r and m != "fem-linear")
                    + " ([bench](bench/bench.md)).")
-    if art:
+    if art and not art["parameters"]["quick"]:
         out.append(f"**What causes the bulge/neck?** {art['answer']['cause'][0].upper()}"
                    f"{art['answer']['cause'][1:]}. {_cause_numbers(art)}")
+    elif art:
+        out.append("**What causes the bulge/neck?** Quick: not decided (`pbcm run artefact` "
+                   "decides).")
+    out += recommendation(root, models, pops, quick, rows)
     return out
 
 
-def _measured_line(h, models):
+def _worst_limit(lim):
+    nums = [v for v in lim.values() if isinstance(v, tuple)]
+    return max(nums, key=lambda v: v[0]) if nums else None
+
+
+def _cost_of_replacing(pops, models, quick):
+    """The model-form answer: what replacing FEM P1 by each model costs, per regime."""
+    from . import scorecard
+    if quick:
+        return ("**What does replacing FEM cost?** Quick: not decided (`pbcm report` "
+                "decides, on every mesh).")
+    said = []
+    for finite, regime in ((False, "linear regime"), (True, "finite load")):
+        ranked = scorecard.ranked(scorecard.overall(pops, models, finite))
+        if ranked:
+            said.append(f"{regime}: " + ", ".join(
+                f"{m} " + (fmt(e[1]) if e[1] is not None else "n/a")
+                + (f" ({e[2]} failed runs)" if e[2] else "")
+                + (f" (tied with {tie})" if tie else "")
+                for _, m, e, tie in ranked))
+    if not said:
+        return "**What does replacing FEM cost?** No case has a decomposed quantity."
+    return ("**What does replacing FEM cost?** The model-form error, each model against FEM P1 "
+            "with the same law on the same tetrahedra, best mean rank over the cases first "
+            "(beside it the geometric mean over the cases of the median over the meshes; a "
+            "failed run counts against its model): "
+            + "; ".join(said) + " (the scorecard below).")
+
+
+ACCURACY = 0.05     # the stated accuracy of the cost recommendation (model-form, linear)
+
+
+def recommendation(root, models, pops, quick, bench_rows):
+    """At most five lines: what to pick for each stated use, from the model-form errors, the
+    Truth Cube's comparison and the costs."""
+    from . import scorecard
+    head = "**What to pick?**"
+    if quick:
+        return [f"{head} Quick: not decided (`pbcm report` decides)."]
+    out = [head]
+    lin, fin = scorecard.overall(pops, models), scorecard.overall(pops, models, True)
+    p1_lin = next((p.quantity.p1 for p in pops if not p.finite), None)
+    p1_fin = next((p.quantity.p1 for p in pops if p.finite), None)
+
+    def best(means):
+        order = scorecard.ranked(means)
+        return order[0][1] if order else None
+
+    def cost(m):
+        r, fl = bench_rows.get(m), bench_rows.get(p1_lin)
+        return (f", {fmt(r['cpu_s_per_simulated_s'] / fl['cpu_s_per_simulated_s'], 2)} times "
+                f"{p1_lin}'s cost per simulated second") if r and fl else ""
+    if lin and p1_lin:
+        floor = max(p.u_model_form for p in pops if not p.finite)
+        same = [m for m, v in lin.items() if v[1] is not None and v[1] <= floor]
+        approx = {m: v for m, v in lin.items() if m not in same}
+        # equal to P1 within the comparison's floor: a check, not an approximation
+        b = best(approx)
+        out.append(f"- Linear regime: {p1_lin}" + (f" (tied with {', '.join(same)})"
+                                                  if same else "")
+                   + (f"; the closest approximation is {b}, model-form error {fmt(lin[b][1])}"
+                      f"{cost(b)}" if b else "") + ".")
+    if fin and p1_fin:
+        b = best(fin)
+        out.append(f"- Finite strain: {p1_fin} (the reference's law on P1)"
+                   + (f"; the closest other is {b}, model-form error {fmt(fin[b][1])}"
+                      f"{cost(b)}" if b else "") + ".")
+    truth = _load(root, MEASURED, "metrics.json")
+    if truth and truth.get("headline"):
+        v = validation(truth)
+        tied = [m for m in v["tied"] if m in models]
+        out.append(f"- Near incompressibility (the Truth Cube, nu {fmt(truth['parameters']['nu'])}"
+                   f"): not decided by a measurement: {', '.join(tied)} are tied within "
+                   f"u_val {fmt(v['u_val'], 2)} mm of the best; no run compares a model with FEM "
+                   "P1 there.")
+    if lin and bench_rows.get(p1_lin):
+        within = [m for m, val in lin.items() if not val[2] and val[1] is not None
+                  and val[1] <= ACCURACY] + [p1_lin]
+        costed = [m for m in within if bench_rows.get(m)]
+        cheap = min(costed, key=lambda m: bench_rows[m]["cpu_s_per_simulated_s"])
+        cheapest = min((m for m in lin if bench_rows.get(m) and lin[m][1] is not None),
+                       key=lambda m: bench_rows[m]["cpu_s_per_simulated_s"], default=None)
+        line = (f"- Cost at a stated accuracy (model-form error within {ACCURACY:g} in the "
+                f"linear regime): {cheap}, "
+                f"{fmt(bench_rows[cheap]['cpu_s_per_simulated_s'])} s per simulated s")
+        if cheapest and bench_rows[cheapest]["cpu_s_per_simulated_s"] < \
+                bench_rows[cheap]["cpu_s_per_simulated_s"]:
+            line += (f"; {cheapest} is cheaper ("
+                     f"{fmt(bench_rows[cheapest]['cpu_s_per_simulated_s'])}) at model-form "
+                     f"error {fmt(lin[cheapest][1])}")
+        out.append(line + ".")
+    return out[:5] if len(out) > 1 else []
+
+
+def validation(truth):
+    """The Truth Cube's comparison error read against u_val (ASME V&V 20) at the headline
+    state: u_D the beads' noise floor, u_input half the range of the continuum's bead RMS over
+    the unmeasured inputs (plate friction, travel, nu), u_num the reference's change over its
+    last refinement; and the models tied within u_val of the best."""
+    from .error_model import u_val
+    h = truth["headline"]
+    ref = [r for r in truth.get("references", []) if r.get("variant") == "bonded"
+           and abs(r.get("strain", -1) - h["strain"]) < 1e-9]
+    u_num = max((r.get("bead_change_mm") or 0.0 for r in ref), default=0.0)
+    spread = list(truth.get("continuum_by_assumption_mm", {}).values())
+    u_input = (max(spread) - min(spread)) / 2 if spread else 0.0
+    u = u_val(u_num, u_input, h["floor_mm"])
+    rms = {m: v["bead_rms_mm"] for m, v in h["models"].items()}
+    own = [m for m in rms if m in truth["parameters"]["models"]]
+    best = min(own, key=rms.get) if own else None
+    return {"u_val": u, "u_num": u_num, "u_input": u_input, "u_d": h["floor_mm"],
+            "best": best, "tied": [m for m in sorted(own, key=rms.get)
+                                   if rms[m] - rms[best] < u],
+            "within": [m for m in own if rms[m] <= u]}
+
+
+def _measured_line(truth, models):
+    h = truth["headline"]
     NH = h["continuum"]
     v = h["models"]
+    val = validation(truth)
     mine = sorted((m for m in models if m in v), key=lambda m: v[m]["bead_rms_mm"])
-    within = [m for m in mine if v[m]["states_within"] == h["states"]]
     said = (f"**How far from a measured body?** On the Truth Cube's 343 beads at "
-            f"{fmt(100 * h['strain'], 4)} % compression (bonded plates, {h['mesh']} mesh; the "
-            f"measurement's floor {fmt(h['floor_mm'])} mm): ")
+            f"{fmt(100 * h['strain'], 4)} % compression (bonded plates, {h['mesh']} mesh), read "
+            f"against u_val {fmt(val['u_val'], 2)} mm (the beads' noise "
+            f"{fmt(val['u_d'], 2)}, the unmeasured inputs {fmt(val['u_input'], 2)}, the "
+            f"reference {fmt(val['u_num'], 1)}): ")
     if NH in v:
         said += f"the neo-Hookean continuum is {fmt(v[NH]['bead_rms_mm'])} mm RMS off; "
     if mine:
         said += (f"the models from {fmt(v[mine[0]]['bead_rms_mm'])} mm ({mine[0]}) to "
-                 f"{fmt(v[mine[-1]]['bead_rms_mm'])} mm ({mine[-1]}); ")
-    return said + (f"within the floor at every state: {', '.join(within) or 'none'} "
-                   f"([truth-cube]({MEASURED}/report.md)).")
+                 f"{fmt(v[mine[-1]]['bead_rms_mm'])} mm ({mine[-1]}); within u_val: "
+                 f"{', '.join(val['within']) or 'none'}; tied with the closest within u_val: "
+                 f"{', '.join(val['tied'])}. ")
+    sens = _nu_sensitivity(truth, h["strain"])
+    if sens:
+        said += ("Moving nu over its unmeasured range moves the models' bead RMS on the "
+                 f"{sens[0]} mesh by " + ", ".join(f"{m} {fmt(d, 2)} mm" for m, d in sens[1])
+                 + ". ")
+    return said + ("The plates prescribe displacement, so the beads test the deformed shape, "
+                   f"not the stiffness ([truth-cube]({MEASURED}/report.md)).")
+
+
+def _nu_sensitivity(truth, strain):
+    """(mesh, [(model, |bead RMS at the largest nu - at the smallest|)]) over the study's nu
+    variants at ``strain``, or None where it ran none."""
+    variants = {k: v for k, v in truth["parameters"].get("variants", {}).items()
+                if k.startswith("nu=")}
+    if len(variants) < 2:
+        return None
+    lo, hi = min(variants, key=lambda k: variants[k][2]), max(variants,
+                                                              key=lambda k: variants[k][2])
+    rows = [r for r in truth.get("rows", []) if abs(r.get("strain", -1) - strain) < 1e-9
+            and r.get("bead_rms_mm") is not None]
+    mesh = next((r["mesh"] for r in rows if r["variant"] == hi), None)
+    at = {(r["model"], r["variant"]): r["bead_rms_mm"] for r in rows if r["mesh"] == mesh}
+    out = [(m, abs(at[(m, hi)] - at[(m, lo)])) for m in truth["parameters"]["models"]
+           if (m, hi) in at and (m, lo) in at]
+    return (mesh, out) if out else None
 
 
 def _irregular(conv, models):
@@ -186,7 +361,7 @@ def _irregular(conv, models):
 
 
 def _largest(limit):
-    nums = [v for v in limit.values() if isinstance(v, (int, float))]
+    nums = [v[0] for v in limit.values() if isinstance(v, tuple)]
     return (len(nums) < len(limit), max(nums, default=np.inf))
 
 

@@ -317,6 +317,14 @@ declare("modes_unpaired", "count", "unpaired",
         "FEM modes among the first 10 (of each set compared) that no model mode matches in "
         "shape (MAC >= 0.8 with the mode, or with the space of a cluster of equal "
         "frequencies): left out of the frequency errors.", "max")
+declare("modal_rel_err_p1", "1", "modal err P1",
+        "the model-form modal error: the largest relative frequency error of the first 10 "
+        "non-rigid modes of FEM P1 on the same tetrahedra (lumped mass, the case's "
+        "constraints), each against the model mode paired with it by shape (unpaired ones "
+        "counted in modes_unpaired_p1).", "max")
+declare("modes_unpaired_p1", "count", "unpaired P1",
+        "FEM P1 modes among the first 10 that no model mode matches in shape (the same "
+        "pairing as modes_unpaired): failed modes of the model-form comparison.", "max")
 declare("rigid_modes_free", "count", "rigid modes free",
          "zero eigenvalues free-free (6 expected).", "max")
 declare("rest_time_fem_s", "s", "FEM rest",

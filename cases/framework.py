@@ -218,6 +218,10 @@ class Case(abc.ABC):
         floor of its entries in the index's geometric mean).
     patch_tests : the boundary conditions whose problem is a patch test (a field every
         consistent discretisation reproduces exactly): reported pass or fail, never pooled.
+    decomposed : what the error model (``cases.error_model``) splits into model-form error
+        (against FEM P1 with the same law on the same tetrahedra) and discretisation error
+        (FEM P1 against the continuum): a ``Scalar`` quantity or a ``Norm``; None: the case
+        has no continuum reference to decompose against.
     gated : case metrics the CI gate bounds beside the standard ones (catalogue names; the
         catalogue gives their direction).
     columns : case metrics shown in the per-(mesh, bc) table after the standard ones
@@ -248,6 +252,7 @@ class Case(abc.ABC):
     headline_pair: ClassVar[str] = None
     headline_estimate: ClassVar[str] = "p2_error_estimate"
     patch_tests: ClassVar[tuple] = ()
+    decomposed: ClassVar[object] = None
     gated: ClassVar[tuple] = ()
     columns: ClassVar[tuple] = ()
     qoi_errors: ClassVar[tuple] = ()

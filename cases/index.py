@@ -2,13 +2,13 @@
 condition, its headline error and the metric paired with it, per model, coloured by band in
 HTML) and a five-line conclusion written from the numbers."""
 import json
-from dataclasses import dataclass
+import math
 from pathlib import Path
 
 import numpy as np
 
-from .document import GLOSSARY, Cell, Document, Link
-from .metrics import PATCH_TOL
+from . import scorecard
+from .document import GLOSSARY, Cell, Document, Link, fmt
 from .output import SWEEP_MARK
 
 # headline error bands of the scorecard: within 5 %, within 20 %, beyond
@@ -18,154 +18,104 @@ BANDS = ((0.05, "#c8e6c9", "within 5 %"), (0.20, "#fff59d", "within 20 %"),
 
 
 
-@dataclass
-class Population:
-    """One aggregate of the scorecard: a case's runs under one boundary condition, for one
-    metric (its headline or the one paired with it). ``values`` {model: values over the runs
-    that gave one}, ``runs`` {model: runs it had}, ``floor`` the reference's estimate."""
-
-    case: str
-    bc: str
-    metric: str
-    primary: bool
-    patch_test: bool
-    values: dict
-    runs: dict
-    floor: float
-
-    @property
-    def label(self):
-        return f"{self.case}/{self.bc}"
-
-    def complete(self, model):
-        full = max(self.runs.values(), default=0)
-        return len(self.values.get(model, [])) == self.runs.get(model, -1) == full
-
-    def median(self, model):
-        v = self.values.get(model)
-        return float(np.median(v)) if v else None
-
-
 def _declared(case):
     from .registry import CASES
     return CASES[case]
 
 
 def populations(root, cases):
-    """Every scorecard population of the cases' metrics under ``root``, and the loaded
-    metrics: per case and boundary condition, its headline and the metric paired with it."""
-    out, data = [], {}
-    for case in cases:
-        d = json.loads((Path(root) / case / "metrics.json").read_text())
-        data[case] = d
-        declared = _declared(case)
-        metrics = [(d.get("headline") or declared.headline, True)]
-        pair = d.get("headline_pair", declared.headline_pair)
-        if pair:
-            metrics.append((pair, False))
-        est_key = d.get("headline_estimate", declared.headline_estimate)
-        patch = set(d.get("patch_tests", declared.patch_tests))
-        bcs = list(dict.fromkeys(r["bc"] for r in d["runs"]))
-        for bc in bcs:
-            rs = [r for r in d["runs"] if r["bc"] == bc]
-            est = [r[est_key] for r in rs if r.get(est_key) is not None]
-            for metric, primary in metrics:
-                values, had = {}, {}
-                for model in d["parameters"]["models"]:
-                    mine = [r for r in rs if r["model"] == model]
-                    had[model] = len(mine)
-                    values[model] = [r[metric] for r in mine if r.get(metric) is not None]
-                out.append(Population(case, bc, metric, primary, bc in patch, values, had,
-                                      max(est) if est else 0.0))
-    return out, data
-
-
-def _score_cell(p, m):
-    vals, total = p.values.get(m, []), p.runs.get(m, 0)
-    if not total:
-        return ""
-    if not vals:
-        return f"n/a, 0 of {total}"
-    if p.patch_test and p.primary:
-        worst = max(vals)
-        return Cell(("pass" if worst < PATCH_TOL else f"fail {worst:.2g}")
-                    + f", {len(vals)} of {total}",
-                    BANDS[0][1] if worst < PATCH_TOL else BANDS[-1][1])
-    med = float(np.median(vals))
-    return Cell(f"{med:.3g} [{min(vals):.3g}-{max(vals):.3g}] {len(vals)}/{total}",
-                _band(med)[1])
+    """The scorecard's populations (``cases.scorecard``) of the cases' metrics under ``root``,
+    and the loaded metrics."""
+    data = {c: json.loads((Path(root) / c / "metrics.json").read_text()) for c in cases}
+    declared = {c: _declared(c) for c in cases}
+    pops = scorecard.populations(
+        {c: d["runs"] for c, d in data.items()}, declared,
+        {c: d["parameters"]["quick"] for c, d in data.items()},
+        {c: set(d.get("patch_tests", declared[c].patch_tests)) for c, d in data.items()},
+        {c: d.get("headline_estimate", declared[c].headline_estimate)
+         for c, d in data.items()})
+    return pops, data
 
 
 def _band(v):
     return next(b for b in BANDS if v < b[0])
 
 
-def geometric_means(pops, models):
-    """{model: (geometric mean, (low, high) leaving one population out)} over the primary,
-    non-patch-test populations where every model has a value in every run (the others are
-    not comparable), each entry floored at its reference's estimate (an error below what the
-    reference resolves counts as that estimate); and the populations used."""
-    used = [p for p in pops if p.primary and not p.patch_test
-            and all(p.complete(m) for m in models)]
-
-    def gmean(model, ps):
-        vals = [max(p.median(model), p.floor, 1e-300) for p in ps]
-        return float(np.exp(np.mean(np.log(vals)))) if vals else None
-
-    out = {}
-    for m in models:
-        g = gmean(m, used)
-        if g is None:
-            continue
-        loo = [gmean(m, used[:k] + used[k + 1:]) for k in range(len(used))] if len(used) > 1 \
-            else [g]
-        out[m] = (g, (min(loo), max(loo)))
-    return out, used
+def _cell(p, model, part):
+    """The scorecard cell of ``model`` in population ``p`` for one part of the error."""
+    if model not in p.parts:
+        return ""
+    if part == "model_form" and model == p.quantity.p1:
+        return Cell("FEM P1 itself (0 by construction)", BANDS[0][1])
+    rows = {s.model: (s, tie) for _, s, tie in p.standings(part)}
+    s, tie = rows[model]
+    text = scorecard.cell(s, tie if part == "model_form" and math.isfinite(s.score)
+                          else None)
+    if model in p.unpaired and part == "model_form":
+        text += f"; {p.unpaired[model]} modes unpaired over its {s.runs} runs"
+    colour = (BANDS[-1][1] if s.failed or not s.values or p.unpaired.get(model)
+              else _band(float(np.median(s.values)))[1])
+    return Cell(text, colour)
 
 
-def conclusion(pops, models):
-    """Five sentences from the scorecard's populations."""
-    means, used = geometric_means(pops, models)
+def scorecard_rows(pops, data, models):
+    """Two rows per population: the model-form error (what replacing FEM P1 costs: what the
+    scorecard ranks) and the total against the continuum; the shared discretisation error and
+    the uncertainties in the row's own columns."""
+    rows = []
+    for p in pops:
+        mode = " (quick)" if p.quick else ""
+        label = p.label + mode + (" (patch test)" if p.patch_test else "")
+        disc = p.discretisation()
+        law = "neo-Hookean" if p.finite else "linear"
+        shared = (f"{np.median(disc):.3g} [{min(disc):.3g}-{max(disc):.3g}]" if disc
+                  else "no P1 run")
+        u_c = fmt(p.u_continuum) + (" (spread over meshes exceeds the estimate)"
+                                   if p.spread_defect else "")
+        rows.append([Link(label, f"{p.case}/report.md", f"{p.case}/report.html"),
+                     f"{p.quantity.label}: model-form vs FEM P1 ({law})",
+                     shared, f"{p.u_model_form:.1g}"]
+                    + [_cell(p, m, "model_form") for m in models])
+        rows.append(["", f"{p.quantity.label}: total vs the continuum", "", u_c]
+                    + [_cell(p, m, "total") for m in models])
+    return rows
+
+
+def conclusion(pops, models, quick):
+    """The scorecard's closing lines: the ranking of model-form error in each regime (failed
+    runs counted, ties named) and where each model is farthest from FEM P1."""
     out = []
-    primaries = [p for p in pops if p.primary and not p.patch_test]
-    if means:
-        best = min(means, key=lambda m: means[m][0])
-        g, (lo, hi) = means[best]
-        out.append(f"Closest to the continuum overall: {best}, geometric mean of its headline "
-                   f"errors {g:.3g} (from {lo:.3g} to {hi:.3g} leaving one population out) over "
-                   f"the {len(used)} of {len(primaries)} case/boundary-condition populations "
-                   "where every model has a result in every run (entries floored at their "
-                   "reference's estimate).")
-        out.append("Every model so: " + ", ".join(
-            f"{m} {means[m][0]:.3g} [{means[m][1][0]:.3g}-{means[m][1][1]:.3g}]"
-            for m in sorted(means, key=lambda m: means[m][0])) + "; not comparable (a run "
-            "without a result): " + (", ".join(p.label for p in primaries if p not in used)
-                                     or "none") + ".")
-    else:
-        out.append("No population has a result from every model in every run: no overall "
-                   "ranking.")
-        out.append("Every population lacks some model's run.")
+    for finite, regime in ((False, "linear regime"), (True, "finite load")):
+        means = scorecard.overall(pops, models, finite)
+        if not means:
+            continue
+        n = len([p for p in pops if p.finite == finite])
+        if quick:
+            out.append(f"Model-form ranking, {regime}: quick: not decided (run `pbcm report` "
+                       "for every mesh).")
+            continue
+        out.append(f"Model-form ranking, {regime}, over its {n} populations (each model's "
+                   "mean rank, a population ranking its models by the median over the meshes "
+                   "with a failed run counted as infinitely wrong; the geometric mean of its "
+                   "scores beside it, each floored at the comparison's uncertainty; FEM P1 "
+                   "itself is the identity check and not ranked): " + "; ".join(
+                       f"{rank}. {m} ({scorecard.describe(entry)})"
+                       + (f", tied with {tie}" if tie else "")
+                       for rank, m, entry, tie in scorecard.ranked(means)) + ".")
     worst = {}
-    for p in primaries:
-        for m in models:
-            v = p.median(m)
-            if v is not None and (m not in worst or v > worst[m][0]):
-                worst[m] = (v, p)
-    out.append("Where each model is farthest (median headline): " + "; ".join(
-        f"{m} in {p.label} ({p.metric} {v:.3g})" for m, (v, p) in worst.items()) + ".")
-    within = {p.label: [m for m in models if p.complete(m) and max(p.values[m]) < BANDS[0][0]]
-              for p in primaries}
-    patch = [p for p in pops if p.primary and p.patch_test]
-    out.append("Within 5 % of FEM in every run: " + ("; ".join(
-        f"{c}: {', '.join(ms)}" for c, ms in within.items() if ms) or "none") + ". "
-        + " ".join(f"Patch test {p.label}: passed (error below {PATCH_TOL:g}) by "
-                   + (", ".join(m for m in models if p.complete(m)
-                                and max(p.values[m]) < PATCH_TOL) or "none") + "."
-                   for p in patch))
-    missing = [f"{m} in {p.label} ({len(p.values.get(m, []))} of {p.runs.get(m, 0)} runs)"
-               for p in pops if p.primary for m in models if not p.complete(m)]
-    out.append("Every model gave a headline number in every run." if not missing else
-               "Runs without a headline number: " + ", ".join(missing) + ".")
+    for p in pops:
+        for _, s, _ in p.standings():
+            if s.values and math.isfinite(s.score) and (s.model not in worst
+                                                        or s.score > worst[s.model][0]):
+                worst[s.model] = (s.score, p)
+    if worst:
+        out.append("Where each model is farthest from FEM P1 (median model-form error): "
+                   + "; ".join(f"{m} in {p.label} ({v:.3g})" for m, (v, p) in worst.items())
+                   + ".")
+    failed = [f"{s.model} in {p.label} ({s.failed} of {s.runs})" for p in pops
+              for _, s, _ in p.standings() if s.failed]
+    out.append("Runs without a model-form number, counted against their model: "
+               + (", ".join(failed) if failed else "none") + ".")
     return out
 
 
@@ -179,10 +129,11 @@ def index_documents(root, cases, studies=()):
     models = []
     for case in cases:
         models += [m for m in data[case]["parameters"]["models"] if m not in models]
+    quick = any(d["parameters"]["quick"] for d in data.values())
     doc = Document("pbcm reports")
-    for line in answers.lines(root, models):
+    for line in answers.lines(root, models, pops, quick):
         doc.p(line)
-    header, rows = answers.table(root, models)
+    header, rows = answers.table(root, models, pops)
     doc.table(header, rows)
     doc.p(f"Definitions of every column and metric: [glossary]({GLOSSARY}).")
     shown = [n for n in studies if (root / n / "metrics.json").is_file()]
@@ -193,28 +144,29 @@ def index_documents(root, cases, studies=()):
              "quick" if json.loads((root / n / "metrics.json").read_text())["parameters"][
                  "quick"] else "full"] for n in shown])
     doc.h(2, "Scorecard")
-    doc.p("One row per case, boundary condition and metric: the case's headline error against "
-          "its reference, then the metric paired with it (a displacement-driven case's "
-          "stiffness error, a force-driven one's displacement error). Each cell is the median "
-          "over the meshes [smallest-largest], n of N runs; a patch test reads pass or fail at "
-          f"{PATCH_TOL:g}. Colours in the HTML: "
-          + ", ".join(f"{label}" for _, _, label in BANDS) + ". Quick-mode cases are marked. "
-          "The last rows are measured against reality (the Truth Cube's beads): green within "
-          "the measurement's floor at every state, yellow at some, red at none.")
-    rows = []
-    for p in pops:
-        mode = " (quick)" if data[p.case]["parameters"]["quick"] else ""
-        label = p.label + mode + (" (patch test)" if p.patch_test else "")
-        rows.append([Link(label, f"{p.case}/report.md", f"{p.case}/report.html")
-                     if p.primary else "", p.metric] + [_score_cell(p, m) for m in models])
+    doc.p("Two rows per case and boundary condition, on the one error model of the glossary: "
+          "first each model's model-form error, what replacing FEM P1 (the same law on the "
+          "same tetrahedra, the same constraints and load) by it costs, which the scorecard "
+          "ranks; then its total error against the converged continuum. The column 'FEM P1 "
+          "vs continuum' is the discretisation error the meshes themselves make, shared by "
+          "every model on them; 'u_val' is the uncertainty a difference in the row is read "
+          "against (model-form: the distance between FEM laws that coincide in the linear "
+          "regime, or the solver's tolerance; total: the reference's estimate or its spread "
+          "over the meshes, whichever is larger). Each cell is the median over the meshes "
+          "[smallest-largest], n of N runs; a failed run counts against its model; models "
+          "within u_val of the first of a group are named tied with it. Colours in the HTML: "
+          + ", ".join(f"{label}" for _, _, label in BANDS) + ", red also for a failed run. "
+          "Quick-mode cases are marked. The last rows are measured against reality (the "
+          "Truth Cube's beads).")
+    rows = scorecard_rows(pops, data, models)
     for n in shown:       # the studies' own rows (the one measured against reality)
         for label, metric, cells in declared()[n].scorecard(
                 json.loads((root / n / "metrics.json").read_text())):
-            rows.append([Link(label, f"{n}/report.md", f"{n}/report.html"), metric]
+            rows.append([Link(label, f"{n}/report.md", f"{n}/report.html"), metric, "", ""]
                         + [Cell(cells[m][0], BANDS[cells[m][1]][1]) if m in cells else ""
                            for m in models])
-    doc.table(["case/bc", "metric"] + models, rows, keys=2)
-    for line in conclusion(pops, models):
+    doc.table(["case/bc", "error", "FEM P1 vs continuum", "u_val"] + models, rows, keys=4)
+    for line in conclusion(pops, models, quick):
         doc.p(line)
     doc.p("Each case folder holds metrics.json, report.md, report.html and the figures; "
           "regenerate with `pbcm report`.")
@@ -230,12 +182,34 @@ def index_documents(root, cases, studies=()):
 
 # what the index's answer table and the studies call things, beside the catalogue's metrics
 TERMS = {
-    "consistency error": "the error a model keeps under mesh refinement on a problem whose "
+    "model-form error": "what replacing FEM P1 by a model costs: (Q_model - Q_P1) / |Q_c| "
+    "for a case's quantity Q (tip deflection, torque, reaction, punch force, settlement, force "
+    "over the load steps), with FEM P1 the same law on the same tetrahedra under the same "
+    "constraints and load (linear P1 in the linear regime, neo-Hookean P1 at finite load), "
+    "Q_c the converged continuum's; for the modes, the largest relative frequency error "
+    "against P1's modes paired by shape, an unpaired mode a failed mode. What the scorecard "
+    "ranks (cases/error_model.py).",
+    "discretisation error": "(Q_P1 - Q_c) / |Q_c|: how far FEM P1 on a mesh is from the "
+    "converged continuum; the same for every model on that mesh.",
+    "total error": "(Q_model - Q_c) / |Q_c| = model-form error + discretisation error (for a "
+    "quantity over load steps or a set of modes each is its largest component, and the two "
+    "parts bound the total). A small total with a large model-form error is two errors "
+    "cancelling.",
+    "u_val": "the validation uncertainty sqrt(u_num^2 + u_input^2 + u_D^2) (ASME V&V 20) a "
+    "comparison is read against: u_num the reference's estimate or its spread over the meshes "
+    "of one continuum problem, whichever is larger (for a model-form error, the distance "
+    "between FEM laws that coincide in the linear regime, or the solver's tolerance), u_input "
+    "the sensitivity to inputs nobody measured, u_D the measurement's noise. Two errors closer "
+    "than u_val are tied.",
+    "mean rank": "a model's overall standing in one regime: the mean of its rank in every "
+    "population, each population ranking its models by the median over the meshes with a "
+    "failed run counted as infinitely wrong (so a failure never removes a population from "
+    "anyone's comparison).",
+    "consistency limit": "the error a model keeps under mesh refinement on a problem whose "
     "answer every consistent discretisation reproduces exactly: the converged limit e_inf of "
     "the sliding cube (a homogeneous compression, a patch test) in the linear regime, per "
-    "lattice; FEM's is zero to rounding.",
-    "finite-load error": "the headline error of the large-compression case (30 % "
-    "compression), against the converged neo-Hookean reference.",
+    "lattice, +- its extrapolation's uncertainty; FEM's is zero to rounding. The index's "
+    "'how far from the continuum' reads these limits only.",
     "worst isotropy error": "the largest relative error of the six Kelvin moduli of the "
     "model's effective elasticity tensor (a relaxed lattice patch) against the isotropic "
     "target's, over the lattices.",

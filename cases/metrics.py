@@ -185,9 +185,13 @@ def mac(a, B):
     return float(np.linalg.norm(Q.conj().T @ a) ** 2 / np.vdot(a, a).real)
 
 
-def pair_modes(f_model, v_model, f_ref, v_ref, mac_min=MAC_MIN, cluster_tol=CLUSTER_TOL):
+def pair_modes(f_model, v_model, f_ref, v_ref, mac_min=MAC_MIN, cluster_tol=CLUSTER_TOL,
+               count=None):
     """Pair reference modes with model modes by shape: [(i_ref, j_model)] and the unpaired
-    reference indices. ``f_*`` ascending frequencies, ``v_*`` (k, 3n) shapes. The reference
+    reference indices among the first ``count`` (default all). ``f_*`` ascending frequencies,
+    ``v_*`` (k, 3n) shapes; reference modes past ``count`` only complete the space of a
+    cluster that ``count`` would cut (a degenerate pair or triple cut in two has no defined
+    shape). The reference
     modes are grouped into clusters of (near-)equal frequency, whose shapes are only defined
     as a space (the cube's symmetry makes pairs and triples); each cluster takes the unused
     model modes whose subspace MAC with it is at least ``mac_min``, the best matching first,
@@ -208,4 +212,7 @@ def pair_modes(f_model, v_model, f_ref, v_ref, mac_min=MAC_MIN, cluster_tol=CLUS
         used.update(chosen)
         pairs += list(zip(c, chosen))
         unpaired += c[len(chosen):]
+    if count is not None:
+        pairs = [(i, j) for i, j in pairs if i < count]
+        unpaired = [i for i in unpaired if i < count]
     return pairs, unpaired

@@ -294,50 +294,6 @@ def test_energy_norm_of_a_homogeneous_strain_and_of_rigid_motions():
     assert M.energy_rel(1.1 * u, u, K) == pytest.approx(0.1, rel=1e-12)
 
 
-def test_index_keeps_populations_apart_ranks_complete_ones_and_floors_at_the_estimate(tmp_path):
-    """The sliding paper cube is a patch test (pass/fail, never pooled with the clamped cube);
-    a population where some model lacks a run is not comparable and leaves the geometric mean;
-    an entry below its reference's estimate counts as that estimate."""
-    from cases.index import conclusion, index_documents, populations
-
-    def write(case, runs, pair, patch=()):
-        (tmp_path / case).mkdir()
-        (tmp_path / case / "metrics.json").write_text(json.dumps({
-            "headline": "err", "headline_pair": pair, "headline_estimate": "est",
-            "patch_tests": list(patch), "parameters": {"models": ["a", "b"], "quick": True},
-            "runs": runs}))
-    run = dict(mesh="five", err=None, stiff=None, est=0.0)
-    write("paper-cube", [
-        dict(run, model="a", bc="sliding", err=1e-10),
-        dict(run, model="b", bc="sliding", err=0.02),
-        dict(run, model="a", bc="clamped", err=0.05, stiff=0.2),
-        dict(run, model="b", bc="clamped", err=0.03, stiff=0.1),
-        dict(run, mesh="six", model="a", bc="sliding", err=1e-10),
-        dict(run, mesh="six", model="b", bc="sliding", err=0.04),
-        dict(run, mesh="six", model="a", bc="clamped", err=0.07, stiff=0.3),
-        dict(run, mesh="six", model="b", bc="clamped", stiff=0.1)], "stiff", ("sliding",))
-    write("torsion", [dict(run, model="a", bc="clamped", err=0.1, est=0.15),
-                      dict(run, mesh="six", model="a", bc="clamped", err=0.2, est=0.15),
-                      dict(run, model="b", bc="clamped", err=0.3, est=0.15),
-                      dict(run, mesh="six", model="b", bc="clamped", err=0.3, est=0.15)], None)
-    pops, _ = populations(tmp_path, ["paper-cube", "torsion"])
-    assert [(p.label, p.metric) for p in pops] == [
-        ("paper-cube/sliding", "err"), ("paper-cube/sliding", "stiff"),
-        ("paper-cube/clamped", "err"), ("paper-cube/clamped", "stiff"), ("torsion/clamped", "err")]
-    lines = conclusion(pops, ["a", "b"])
-    # only torsion/clamped is complete; a's median 0.15 is at the estimate 0.15; b's 0.3
-    assert lines[0].startswith("Closest to the continuum overall: a, geometric mean of its "
-                               "headline errors 0.15 (from 0.15 to 0.15")
-    assert "the 1 of 2 case/boundary-condition populations" in lines[0]
-    assert "b 0.3" in lines[1] and "not comparable (a run without a result): paper-cube/clamped" \
-        in lines[1]
-    assert "Patch test paper-cube/sliding: passed (error below 0.001) by a." in lines[3]
-    assert "b in paper-cube/clamped (1 of 2 runs)" in lines[4]
-    md, _ = index_documents(tmp_path, ["paper-cube", "torsion"])
-    assert "pass, 2 of 2" in md and "fail 0.04, 2 of 2" in md
-    assert "0.06 [0.05-0.07] 2/2" in md and "0.03 [0.03-0.03] 1/2" in md
-
-
 def test_stiffer_than_fem_is_said_run_by_run():
     """'msm stiffer in torsion' was said of a median though msm was softer on six: a
     statement of direction is made per run."""

@@ -14,6 +14,7 @@ from model.mesh import cube
 from model.terms.shear import Shear
 from .. import metrics as M
 from reference.fem import Region
+from ..error_model import Scalar
 from ..framework import Case, Knob, MM, Settings
 from . import common
 
@@ -88,6 +89,7 @@ class Indentation(Case):
     bcs = ("clamped",)
     headline = "reaction_rel_err"
     headline_pair = "disp_rel_l2_p2"
+    decomposed = Scalar("reaction_n", "reaction_fem_p2_n", "punch force")
     qoi_errors = ("edge_shear_pa",)
     gated = ("edge_shear_rel_err", "profile_rel_err")
     columns = ("reaction_n", "reaction_fem_p2_n", "profile_rel_err", "edge_shear_pa",

@@ -12,6 +12,7 @@ from model.mesh import cube
 from reference import hyperelastic, linear
 from .. import figures
 from .. import metrics as M
+from ..error_model import P1_FINITE, Scalar
 from ..framework import FINDINGS, Case, Knob, MM, Reference, Settings, linear_scale
 from . import common
 
@@ -104,6 +105,7 @@ class LargeCompression(Case):
     bcs = ("clamped",)
     headline = "force_rel_err_max"
     headline_pair = "disp_rel_l2_nh"
+    decomposed = Scalar("force_n_steps", "force_fem_n_steps", "force over the load steps", p1=P1_FINITE)
     headline_estimate = "nh_error_estimate"
     gated = ("force_rel_err_max", "lateral_rel_err_max")
     columns = ("reaction_fem_nh_n", "force_rel_err_max", "lateral_rel_err_max",

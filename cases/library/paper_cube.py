@@ -13,6 +13,7 @@ from model.bc import Ramp, bc_arrays
 from model.mesh import cube
 from .. import metrics as M
 from . import transient
+from ..error_model import Scalar
 from ..framework import Case, Knob, MESH_FAMILIES, Settings, regimes
 from . import common
 from . import paper_cube_report as report
@@ -203,6 +204,7 @@ class PaperCube(Case):
              "repeat_dt4": "blew up"}
     headline = "disp_rel_l2_p2"
     headline_pair = "reaction_rel_err"
+    decomposed = Scalar("reaction_n", "reaction_fem_p2_n", "reaction")
     patch_tests = ("sliding",)   # homogeneous: FEM exact, a consistent model too
     gated = ("alternation_rel", "reaction_time_rel_l2", "disp_end_push_rel_l2", "rest_time_s",
              "modal_rel_err", "modal_rel_err_free", "rigid_modes_free", "modes_unpaired")

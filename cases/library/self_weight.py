@@ -8,6 +8,7 @@ from model.bc import merge
 from model.mesh import cube
 from reference import analytic
 from .. import metrics as M
+from ..error_model import Scalar
 from ..framework import Case, Knob, Loads, MM, Settings
 from . import common
 
@@ -42,6 +43,7 @@ class SelfWeight(Case):
     quick = {"spacing_mm": 8.0}
     headline = "top_settlement_rel_err"
     headline_pair = "disp_rel_l2_p2"
+    decomposed = Scalar("top_settlement_mm", "top_settlement_fem_mm", "top settlement")
     qoi_errors = ("top_settlement_mm",)
     gated = ("top_settlement_rel_err", "top_settlement_cf_rel_err")
     columns = ("top_settlement_mm", "top_settlement_fem_mm", "top_settlement_cf_mm",

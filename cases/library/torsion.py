@@ -5,6 +5,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..error_model import Scalar
 from ..framework import Case, Knob, MM, Settings
 from . import common
 
@@ -49,6 +50,7 @@ class Torsion(Case):
     fem_solver = "direct"   # a slender bar, as the cantilever: AMG-CG stagnates
     headline = "torque_rel_err"
     headline_pair = "disp_rel_l2_p2"
+    decomposed = Scalar("torque_nm", "torque_fem_nm", "torque")
     qoi_errors = ("torque_nm", "warping_mm")
     gated = ("torque_rel_err", "warping_rel_err")
     columns = ("torque_nm", "torque_fem_nm", "torque_rel_err", "warping_mm", "warping_fem_mm",

@@ -10,6 +10,7 @@ from reference import dynamic, modal
 from .. import metrics as M
 
 N_MODES = 10            # non-rigid frequencies compared
+CLUSTER_EXTRA = 2       # modes past them, to complete a pair or triple the tenth one cuts
 RIGID_TOL = 1e-8        # |lambda| below this fraction of the largest is a rigid (zero) mode
 HOLD_CHECK = 0.1        # the particle run checks for rest every 0.1 s of hold: so does FEM
 
@@ -70,9 +71,10 @@ def model_frequencies(pm, free, shapes=False):
 
 def paired_errors(freq, shapes, fem_freq, fem_shapes, name):
     """The largest and the median relative frequency error of the model modes paired by
-    shape with the FEM modes (``metrics.pair_modes``; None and None when no mode pairs: a
-    finding, every FEM mode unpaired) and how many FEM modes found no partner."""
-    pairs, unpaired = M.pair_modes(freq, shapes, fem_freq, fem_shapes)
+    shape with the first N_MODES FEM modes (``metrics.pair_modes``; FEM modes past them only
+    complete a degenerate cluster; None and None when no mode pairs: a finding, every FEM mode
+    unpaired) and how many of them found no partner."""
+    pairs, unpaired = M.pair_modes(freq, shapes, fem_freq, fem_shapes, count=N_MODES)
     if not pairs:
         return None, None, len(unpaired)
     err = np.array([abs(freq[j] / fem_freq[i] - 1) for i, j in pairs])
@@ -109,15 +111,17 @@ def modal_comparison(pm, mesh, static_bc, fem_free, fem_held):
 
 def fem_frequencies(mesh, material, dirichlet, refine=0, skip=0):
     """FEM P2 modes (consistent mass) on ``refine`` refinements of the mesh: the N_MODES
-    after the first ``skip`` (the rigid ones free-free) as (frequencies, shapes (k, 3n) at the
-    mesh nodes), and each frequency's refinement estimate, its relative change over the last
-    refinement (None without one: ``refine`` 0)."""
+    after the first ``skip`` (the rigid ones free-free) and CLUSTER_EXTRA more (which complete
+    a degenerate cluster the N_MODES-th cuts) as (frequencies, shapes (k, 3n) at the mesh
+    nodes), and each of the N_MODES frequencies' refinement estimate, its relative change over
+    the last refinement (None without one: ``refine`` 0)."""
     def solve(level):
         r = modal.frequencies(mesh, material.E, material.nu, material.rho, dirichlet,
-                              k=N_MODES + skip, refine=level)
-        return r.frequencies[skip:], r.modes[skip:].reshape(N_MODES, -1)
+                              k=N_MODES + CLUSTER_EXTRA + skip, refine=level)
+        return r.frequencies[skip:], r.modes[skip:].reshape(N_MODES + CLUSTER_EXTRA, -1)
     freq, shapes = solve(refine)
-    each = np.abs(solve(refine - 1)[0] / freq - 1) if refine >= 1 else None
+    each = (np.abs(solve(refine - 1)[0][:N_MODES] / freq[:N_MODES] - 1) if refine >= 1
+            else None)
     return (freq, shapes), each
 
 

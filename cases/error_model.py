@@ -1,0 +1,205 @@
+"""The error model every verdict reads, written once.
+
+A model run on a mesh is three numbers apart from the continuum, each relative to the
+continuum's value |Q_c| so that they add:
+
+- **model-form error** (Q_model - Q_P1) / |Q_c|: what replacing FEM P1 (the same law on the same
+  tetrahedra, under the same constraints and load) by the model costs;
+- **discretisation error** (Q_P1 - Q_c) / |Q_c|: how far FEM P1 on that mesh is from the
+  converged continuum, shared by every model on the mesh;
+- **total error** (Q_model - Q_c) / |Q_c| = model-form + discretisation.
+
+A case declares what it decomposes (:class:`Scalar` for a quantity of interest, :class:`Norm`
+for an error that is already a norm against P1, where the parts bound the total by the triangle
+inequality instead of summing to it). Every comparison is read against its validation
+uncertainty u_val = sqrt(u_num^2 + u_input^2 + u_D^2) (ASME V&V 20): two errors closer than
+u_val are tied. A run that gave no number counts against its model (:func:`standings`)."""
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+P1_LINEAR = "fem-linear"          # FEM P1 with the linear law: the twin in the linear regime
+P1_FINITE = "fem-neohookean"      # FEM P1 with the reference's law: the twin at finite load
+
+
+class ErrorModelError(ValueError):
+    """Inputs the error model cannot decompose (a zero or non-finite continuum value, shapes
+    that differ, a negative uncertainty)."""
+
+
+@dataclass(frozen=True)
+class Parts:
+    """One run's errors, signed, relative to the continuum (``total`` = ``model_form`` +
+    ``discretisation`` for a scalar; bounded by their magnitudes' sum for a norm)."""
+
+    model_form: float
+    discretisation: float
+    total: float
+
+
+def _array(name, q):
+    a = np.asarray(q, dtype=float)
+    if not np.all(np.isfinite(a)):
+        raise ErrorModelError(f"{name} is not finite ({q!r}): a failed solve has no error")
+    return a
+
+
+def _largest(e):
+    """The signed component of largest magnitude of a sequence's errors (a scalar as is)."""
+    e = np.atleast_1d(e)
+    return float(e[np.argmax(np.abs(e))])
+
+
+def decompose(q_model, q_p1, q_continuum):
+    """:class:`Parts` of a scalar quantity (or of a sequence: load steps, each part its
+    largest-magnitude component) from the model's, FEM P1's and the continuum's values."""
+    qm, qp, qc = (_array(n, q) for n, q in (("the model's value", q_model),
+                                            ("FEM P1's value", q_p1),
+                                            ("the continuum's value", q_continuum)))
+    if not qm.shape == qp.shape == qc.shape:
+        raise ErrorModelError(f"the model's, P1's and the continuum's values differ in shape "
+                              f"({qm.shape}, {qp.shape}, {qc.shape}): compare the same steps")
+    if np.any(qc == 0):
+        raise ErrorModelError("the continuum's value is zero: a relative error is undefined; "
+                              "decompose a quantity the load makes non-zero")
+    scale = np.abs(qc)
+    return Parts(_largest((qm - qp) / scale), _largest((qp - qc) / scale),
+                 _largest((qm - qc) / scale))
+
+
+def u_val(u_num, u_input=0.0, u_d=0.0):
+    """The validation uncertainty sqrt(u_num^2 + u_input^2 + u_D^2) (ASME V&V 20): the
+    numerical solution's, the unmeasured inputs' and the measurement's, in the error's unit."""
+    for name, u in (("u_num", u_num), ("u_input", u_input), ("u_D", u_d)):
+        if not (math.isfinite(u) and u >= 0):
+            raise ErrorModelError(f"{name} = {u!r}: an uncertainty is finite and non-negative")
+    return math.sqrt(u_num ** 2 + u_input ** 2 + u_d ** 2)
+
+
+def u_num(estimate, continuum_values):
+    """The reference's numerical uncertainty for one continuum problem posed on several meshes:
+    the larger of its stated estimate and the relative spread (max - min) / |median| of its
+    values across the meshes, and whether the spread exceeds the estimate (a defect of the
+    reference, to fix by refining)."""
+    vals = np.array([v for v in continuum_values if v is not None], dtype=float)
+    est = 0.0 if estimate is None else float(estimate)
+    if vals.size < 2:
+        return est, False
+    spread = float((vals.max() - vals.min()) / abs(np.median(vals)))
+    return max(est, spread), spread > est
+
+
+@dataclass(frozen=True)
+class Scalar:
+    """A case's decomposed quantity: ``key`` the run key of the model's value (a number or a
+    sequence over load steps), ``continuum`` the run key of the converged continuum's, ``p1``
+    the model whose run on the same mesh is FEM P1 with the same law (``P1_FINITE`` at finite
+    load), ``label`` what it is."""
+
+    key: str
+    continuum: str
+    label: str
+    p1: str = P1_LINEAR
+
+    def parts(self, run, p1_run):
+        """The run's :class:`Parts`, or None where the run or its P1 twin has no value."""
+        vals = run.get(self.key), (p1_run or {}).get(self.key), run.get(self.continuum)
+        if any(v is None for v in vals):
+            return None
+        return decompose(*vals)
+
+
+@dataclass(frozen=True)
+class Norm:
+    """A case's decomposed error that is a norm (a field, a set of paired frequencies):
+    ``model_form`` the run key of the model's error against P1 on the same mesh, ``total`` that
+    against the continuum; the discretisation error is P1's own ``total``; ``unpaired`` the run
+    key of how many of its parts failed (a run with one is a failed run). The parts are
+    magnitudes and bound the total (triangle inequality)."""
+
+    model_form: str
+    total: str
+    label: str
+    p1: str = P1_LINEAR
+    unpaired: str = None      # run key counting the parts that failed (unpaired modes)
+
+    def parts(self, run, p1_run):
+        mf, tot = run.get(self.model_form), run.get(self.total)
+        disc = (p1_run or {}).get(self.total)
+        if any(v is None for v in (mf, tot, disc)):
+            return None
+        if run["model"] == self.p1:
+            mf = 0.0           # P1 against itself, whatever its own run key says
+        return Parts(*(float(_array(n, v)) for n, v in (
+            ("model-form error", mf), ("discretisation error", disc), ("total error", tot))))
+
+
+def decomposed(runs, quantity):
+    """{(mesh, bc, model): Parts or None} over ``runs``, each run paired with the run of
+    ``quantity.p1`` on the same mesh and boundary condition (None: no value, or no P1 twin)."""
+    twins = {(r["mesh"], r["bc"]): r for r in runs if r["model"] == quantity.p1}
+    return {(r["mesh"], r["bc"], r["model"]):
+            quantity.parts(r, twins.get((r["mesh"], r["bc"]))) for r in runs}
+
+
+@dataclass(frozen=True)
+class Standing:
+    """One model in one population: its errors (magnitudes) over the runs that gave one and
+    how many runs it had."""
+
+    model: str
+    values: tuple
+    runs: int
+
+    @property
+    def failed(self):
+        return self.runs - len(self.values)
+
+    @property
+    def score(self):
+        """The median over every run, a failed run counting as infinitely wrong (a failure
+        scores against its model, never removes the population)."""
+        if not self.runs:
+            return math.inf
+        return float(np.median(list(self.values) + [math.inf] * self.failed))
+
+
+def standings(by_model, u, lost=None):
+    """Rank a population: ``by_model`` {model: [error magnitude or None per run]}, ``u`` the
+    validation uncertainty of a difference, ``lost`` {model: failed parts of runs that gave a
+    number (unpaired modes)}, ranked on before the error. Returns [(rank, Standing,
+    tied_with)], best first: a model whose score is within ``u`` of the first of a group (and
+    that lost as many parts) shares that group's rank and names it (tied); failed runs count
+    against their model, and models that all failed their median share the last rank."""
+    lost = lost or {}
+    st = sorted((Standing(m, tuple(abs(v) for v in vs if v is not None), len(vs))
+                 for m, vs in by_model.items()),
+                key=lambda s: (lost.get(s.model, 0), s.score, s.model))
+    out, head, rank = [], None, 0
+    for k, s in enumerate(st):
+        if head is not None and lost.get(s.model, 0) == lost.get(head.model, 0) and (
+                s.score == head.score or abs(s.score - head.score) < u):
+            out.append((rank, s, head.model))
+            continue
+        head, rank = s, k + 1
+        out.append((rank, s, None))
+    return out
+
+
+def mean_rank(ranks):
+    """A model's overall standing over populations: the mean of its rank in each (a failure
+    ranked where it fell), so that every population stays in every model's comparison."""
+    return float(np.mean(ranks)) if ranks else None
+
+
+def geometric_mean(scores, floors):
+    """The geometric mean of a model's population scores, each floored at its population's
+    uncertainty (an error below what the comparison resolves counts as that uncertainty);
+    infinite where any population failed."""
+    vals = [max(s, f, 1e-300) for s, f in zip(scores, floors)]
+    if not vals:
+        return None
+    if any(math.isinf(v) for v in vals):
+        return math.inf
+    return float(np.exp(np.mean(np.log(vals))))

@@ -1,0 +1,166 @@
+"""The scorecard's populations on the error model (``cases.error_model``): per case and
+boundary condition, every model's model-form error against FEM P1 on the same tetrahedra, the
+discretisation error those tetrahedra share, the total against the continuum, and the
+uncertainties a comparison of them is read against; then the rankings across populations, with
+failed runs counted against their model."""
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from model.static import RTOL
+from . import error_model as E
+
+# in the linear regime (strain 1e-4) these laws are P1's own law: their distance to P1 is the
+# numerical floor of a model-form comparison, not a model's error
+SAME_LAW = {E.P1_LINEAR: ("fem-corotated", "fem-neohookean")}
+
+
+@dataclass
+class Population:
+    """One case under one boundary condition: ``parts`` {model: [Parts or None per run]},
+    ``quantity`` the case's decomposed quantity, ``u_model_form`` the uncertainty of a
+    model-form comparison, ``u_continuum`` the reference's (its estimate or, larger, its spread
+    over the meshes) with ``spread_defect`` where the spread exceeds the estimate, ``patch_test``
+    whether it is one, ``quick`` whether its runs are a quick preview."""
+
+    case: str
+    bc: str
+    quantity: object
+    parts: dict
+    u_model_form: float
+    u_continuum: float
+    spread_defect: bool
+    patch_test: bool
+    quick: bool
+    unpaired: dict = field(default_factory=dict)
+
+    @property
+    def label(self):
+        return f"{self.case}/{self.bc}"
+
+    @property
+    def finite(self):
+        """Whether this population is judged at finite load (P1 with the reference's law)."""
+        return self.quantity.p1 != E.P1_LINEAR
+
+    def errors(self, model, part):
+        """[|part| or None per run] of ``model``."""
+        return [None if p is None else abs(getattr(p, part)) for p in self.parts[model]]
+
+    def standings(self, part="model_form"):
+        """``error_model.standings`` of the models other than P1 itself (an identity check)."""
+        u = self.u_model_form if part == "model_form" else self.u_continuum
+        return E.standings({m: self.errors(m, part) for m in self.parts
+                            if part != "model_form" or m != self.quantity.p1}, u,
+                           self.unpaired if part == "model_form" else None)
+
+    def discretisation(self):
+        """FEM P1's |discretisation error| on each mesh (the same for every model there)."""
+        runs = self.parts.get(self.quantity.p1, [])
+        return [abs(p.discretisation) for p in runs if p is not None]
+
+
+def populations(runs_by_case, declared, quick, patch_tests, estimate_keys):
+    """The Populations of every case with a decomposed quantity: ``runs_by_case`` {case: runs},
+    ``declared`` {case: Case}, ``quick`` {case: bool}, ``patch_tests`` {case: bcs},
+    ``estimate_keys`` {case: the run key of its reference's error estimate}."""
+    out = []
+    for case, runs in runs_by_case.items():
+        q = declared[case].decomposed
+        if q is None:
+            continue
+        if not any(_key(q) in r for r in runs):
+            continue                     # metrics written before the case declared it
+        for bc in dict.fromkeys(r["bc"] for r in runs):
+            rs = [r for r in runs if r["bc"] == bc]
+            dec = E.decomposed(rs, q)
+            failed_modes = getattr(q, "unpaired", None)
+            parts, unpaired = {}, {}
+            for r in rs:
+                parts.setdefault(r["model"], []).append(dec[(r["mesh"], r["bc"], r["model"])])
+                if failed_modes:
+                    unpaired[r["model"]] = unpaired.get(r["model"], 0) + (
+                        r.get(failed_modes) or 0)
+            twins = [abs(p.model_form) for m in SAME_LAW.get(q.p1, ()) if m in parts
+                     for p in parts[m] if p is not None]
+            u_mf = max([RTOL] + twins)
+            key = estimate_keys[case]
+            est = [r[key] for r in rs if r.get(key) is not None]
+            cont = {r["mesh"]: r.get(q.continuum) for r in rs} if hasattr(q, "continuum") \
+                else {}
+            cont = [_first(v) for v in cont.values() if v is not None]
+            u_c, defect = E.u_num(max(est) if est else None, cont)
+            out.append(Population(case, bc, q, parts, u_mf, u_c, defect,
+                                  bc in patch_tests[case], quick[case], unpaired))
+    return out
+
+
+def _key(q):
+    """The run key whose presence shows the runs were measured for ``q``."""
+    return getattr(q, "key", None) or q.model_form
+
+
+def _first(v):
+    """A scalar quantity, or the last load step of a sequence (the largest load)."""
+    return float(v[-1]) if isinstance(v, (list, tuple)) else float(v)
+
+
+def cell(standing, tied_with=None):
+    """'median [min-max] n/N' of a standing's runs, with its failed runs and tie named."""
+    s = standing
+    if not s.values:
+        text = f"failed, 0 of {s.runs}"
+    else:
+        text = (f"{np.median(s.values):.3g} [{min(s.values):.3g}-{max(s.values):.3g}] "
+                f"{len(s.values)}/{s.runs}" + (f", {s.failed} failed" if s.failed else ""))
+    return text + (f"; tied with {tied_with}" if tied_with else "")
+
+
+def overall(pops, models, finite=False):
+    """{model: (mean rank, geometric mean of its finite population scores, failed runs,
+    failed populations, populations)} over the populations of one regime (``finite``): every
+    population counts for every model, a failed run against its model; each score floored at
+    its population's model-form uncertainty; P1 itself left out (an identity check)."""
+    used = [p for p in pops if p.finite == finite]
+    out = {}
+    for m in models:
+        mine = [p for p in used if m in p.parts and m != p.quantity.p1]
+        if not mine:
+            continue
+        ranks, scores, floors = [], [], []
+        for p in mine:
+            rank, st = next((r, s) for r, s, _ in p.standings() if s.model == m)
+            ranks.append(rank)
+            if math.isfinite(st.score):
+                scores.append(st.score)
+                floors.append(p.u_model_form)
+        failed = sum(sum(v is None for v in p.parts[m]) for p in mine)
+        out[m] = (E.mean_rank(ranks), E.geometric_mean(scores, floors), failed,
+                  len(mine) - len(scores), len(mine))
+    return out
+
+
+def ranked(means):
+    """[(rank, model, overall's entry, tied_with)], best first by mean rank; equal mean ranks
+    share a rank (tied)."""
+    order = sorted(means, key=lambda m: (means[m][0], means[m][1] or 0.0, m))
+    out, head, rank = [], None, 0
+    for k, m in enumerate(order):
+        if head is not None and means[m][0] == means[head][0]:
+            out.append((rank, m, means[m], head))
+            continue
+        head, rank = m, k + 1
+        out.append((rank, m, means[m], None))
+    return out
+
+
+def describe(entry):
+    """'mean rank r, geometric mean g' with the failed runs and populations of ``overall``."""
+    r, g, failed, lost, n = entry
+    text = f"mean rank {r:.3g}" + (f", geometric mean {g:.3g}" if g is not None else "")
+    if failed:
+        text += f", {failed} failed runs"
+    if lost:
+        text += f" ({lost} of {n} populations failed at the median)"
+    return text

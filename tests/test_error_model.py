@@ -1,0 +1,162 @@
+"""The error model every verdict reads: its decomposition on values whose answer is known, the
+validation uncertainty against a hand value, and the rankings' counting of failed runs."""
+import json
+import math
+
+import pytest
+
+from cases import error_model as E
+from cases import scorecard
+
+
+def test_p1_against_itself_has_no_model_form_error():
+    """FEM P1 compared with itself has model-form error 0, and its total is its
+    discretisation error."""
+    p = E.decompose(0.8, 0.8, 1.0)
+    assert p.model_form == 0.0
+    assert p.total == p.discretisation == pytest.approx(-0.2, abs=1e-15)
+
+
+def test_scalar_parts_sum_to_the_total():
+    """For a scalar, model-form + discretisation = total, each relative to the continuum
+    (the paper cube's case: a model at 0.73 of P1, P1 at 1.23 of the continuum)."""
+    p = E.decompose(0.73 * 1.23, 1.23, 1.0)
+    assert p.model_form == pytest.approx(0.73 * 1.23 - 1.23)
+    assert p.discretisation == pytest.approx(0.23)
+    assert p.total == pytest.approx(p.model_form + p.discretisation, abs=1e-15)
+    assert p.total == pytest.approx(0.73 * 1.23 - 1, abs=1e-15)
+    # a negative quantity (a compressive force) is measured relative to its magnitude
+    q = E.decompose(-1.1, -1.2, -1.0)
+    assert (q.model_form, q.discretisation) == pytest.approx((0.1, -0.2))
+
+
+def test_sequence_parts_are_their_largest_components():
+    """A quantity over load steps: each part is its largest-magnitude component, signed."""
+    p = E.decompose([1.0, 2.5], [1.1, 2.0], [1.0, 2.0])
+    assert p.model_form == pytest.approx(0.25)          # step 2: 0.5 / 2
+    assert p.discretisation == pytest.approx(0.1)        # step 1
+    assert p.total == pytest.approx(0.25)
+
+
+@pytest.mark.parametrize("args, words", [
+    ((1.0, 1.0, 0.0), "zero"), ((float("nan"), 1.0, 1.0), "not finite"),
+    (([1.0, 2.0], [1.0], [1.0, 2.0]), "shape")])
+def test_what_cannot_be_decomposed_is_refused(args, words):
+    """A zero continuum value, a NaN (a failed solve) or mismatched steps are errors, never
+    a number."""
+    with pytest.raises(E.ErrorModelError, match=words):
+        E.decompose(*args)
+
+
+def test_u_val_combines_in_quadrature():
+    """u_val = sqrt(u_num^2 + u_input^2 + u_D^2), by hand: 0.3, 0.4, 1.2 give 1.3."""
+    assert E.u_val(0.3, 0.4, 1.2) == pytest.approx(1.3, abs=1e-15)
+    assert E.u_val(0.5) == 0.5
+    with pytest.raises(E.ErrorModelError, match="non-negative"):
+        E.u_val(-0.1)
+
+
+def test_u_num_is_the_larger_of_estimate_and_spread():
+    """A reference whose values over the meshes of one problem spread more than its estimate
+    carries the spread, flagged as a defect; otherwise its estimate."""
+    assert E.u_num(0.01, [1.0, 1.05, 0.98]) == (pytest.approx(0.07), True)
+    assert E.u_num(0.1, [1.0, 1.05, 0.98]) == (0.1, False)
+    assert E.u_num(0.02, [1.0]) == (0.02, False)
+
+
+def test_a_failed_run_scores_against_its_model_only():
+    """A model with a failed run is scored over every run, the failure infinitely wrong; the
+    population stays in the other models' comparison."""
+    rows = E.standings({"a": [0.1, 0.1, None, 0.1], "b": [0.2] * 4, "c": [0.1, None, None, 0.1]},
+                       u=0.0)
+    by = {s.model: (rank, s) for rank, s, _ in rows}
+    assert by["a"][0] == 1 and by["a"][1].failed == 1 and by["a"][1].score == 0.1
+    assert by["b"][0] == 2 and by["b"][1].score == 0.2
+    assert by["c"][0] == 3 and math.isinf(by["c"][1].score) and by["c"][1].failed == 2
+
+
+def test_differences_below_u_are_ties():
+    """Two models closer than the comparison's uncertainty share a rank and are named tied."""
+    rows = E.standings({"a": [0.10], "b": [0.12], "c": [0.3]}, u=0.05)
+    assert [(r, s.model, t) for r, s, t in rows] == [(1, "a", None), (1, "b", "a"),
+                                                     (3, "c", None)]
+
+
+def test_geometric_mean_floors_and_fails():
+    """A score below its population's uncertainty counts as that uncertainty; a failed
+    population makes the mean infinite."""
+    assert E.geometric_mean([1e-12, 0.4], [0.1, 0.0]) == pytest.approx(0.2)
+    assert math.isinf(E.geometric_mean([0.1, math.inf], [0.0, 0.0]))
+
+
+def _case_folder(tmp_path, case, runs, quick=False):
+    (tmp_path / case).mkdir()
+    (tmp_path / case / "metrics.json").write_text(json.dumps({
+        "parameters": {"models": ["fem-linear", "fem-corotated", "a", "b"], "quick": quick},
+        "runs": runs}))
+
+
+def test_scorecard_decomposes_counts_failures_and_names_identity(tmp_path):
+    """On a synthetic torsion case: P1 is the identity check (never ranked); a model equal to
+    P1 has model-form error 0 and its total is P1's discretisation error; a model's failed run
+    counts against it while the population stays; a model with a failed median is last."""
+    from cases.index import conclusion, index_documents, populations
+
+    def run(mesh, model, q):
+        return {"mesh": mesh, "bc": "clamped", "model": model, "torque_nm": q,
+                "torque_fem_nm": 1.0, "p2_error_estimate": 0.001}
+    runs = []
+    for mesh, p1 in (("five", 1.2), ("six", 1.4)):
+        runs += [run(mesh, "fem-linear", p1), run(mesh, "fem-corotated", p1),
+                 run(mesh, "a", 0.9 * p1), run(mesh, "b", None if mesh == "six" else p1)]
+    _case_folder(tmp_path, "torsion", runs)
+    pops, _ = populations(tmp_path, ["torsion"])
+    (p,) = pops
+    assert p.parts["fem-corotated"][0].model_form == 0.0
+    assert p.parts["fem-corotated"][0].total == pytest.approx(0.2)
+    assert p.parts["a"][1].model_form == pytest.approx(-0.14)
+    assert p.discretisation() == pytest.approx([0.2, 0.4])
+    assert p.u_continuum == 0.001     # the estimate: the continuum values do not spread
+    ranks = {s.model: (r, s) for r, s, _ in p.standings()}
+    assert "fem-linear" not in ranks
+    assert ranks["b"][1].failed == 1 and math.isinf(ranks["b"][1].score)
+    lines = conclusion(pops, ["fem-linear", "fem-corotated", "a", "b"], quick=False)
+    assert "1. fem-corotated (mean rank 1" in lines[0] and "2. a (mean rank 2, geometric " \
+        "mean 0.13)" in lines[0]
+    assert "3. b (mean rank 3, 1 failed runs (1 of 1 populations failed at the median))" \
+        in lines[0]
+    assert "b in torsion/clamped (1 of 2)" in lines[-1]
+    md, _ = index_documents(tmp_path, ["torsion"])
+    assert "FEM P1 itself (0 by construction)" in md
+    assert "0.13 [0.12-0.14] 2/2" in md                    # a's model-form error
+    assert "0.3 [0.2-0.4]" in md                           # the shared discretisation error
+
+
+def test_quick_scorecard_decides_nothing(tmp_path):
+    """A quick run's overall ranking says it is not decided and names the command."""
+    from cases.index import conclusion, populations
+    runs = [{"mesh": "five", "bc": "clamped", "model": m, "torque_nm": q,
+             "torque_fem_nm": 1.0} for m, q in (("fem-linear", 1.2), ("a", 1.0))]
+    _case_folder(tmp_path, "torsion", runs, quick=True)
+    pops, _ = populations(tmp_path, ["torsion"])
+    assert "quick: not decided (run `pbcm report`" in conclusion(pops, ["fem-linear", "a"],
+                                                                   quick=True)[0]
+
+
+def test_an_unpaired_mode_is_failed_and_ranked_first():
+    """A modal run's unpaired P1 modes are failed modes: counted per model and ranked on
+    before the error of the paired ones (a model pairing every mode ranks above one that
+    pairs fewer, whatever their errors)."""
+    q = E.Norm("mf", "tot", "modes", unpaired="lost")
+    run = {"mesh": "five", "bc": "free"}
+    runs = [dict(run, model="fem-linear", mf=0.0, tot=0.05, lost=0),
+            dict(run, model="a", mf=0.02, tot=0.06, lost=3),
+            dict(run, model="b", mf=0.3, tot=0.3, lost=0)]
+
+    class Declared:
+        decomposed = q
+    (p,) = scorecard.populations({"modes": runs}, {"modes": Declared}, {"modes": False},
+                                 {"modes": set()}, {"modes": "est"})
+    assert p.unpaired == {"fem-linear": 0, "a": 3, "b": 0}
+    assert p.parts["fem-linear"][0].discretisation == 0.05
+    assert [(r, s.model) for r, s, _ in p.standings()] == [(1, "b"), (2, "a")]
