@@ -257,8 +257,9 @@ def recommendation(root, models, pops, quick, bench_rows):
         tied = [m for m in v["tied"] if m in models]
         out.append(f"- Near incompressibility (the Truth Cube, nu {fmt(truth['parameters']['nu'])}"
                    f"): not decided by a measurement: {', '.join(tied)} are tied within "
-                   f"u_val {fmt(v['u_val'], 2)} mm of the best; no run compares a model with FEM "
-                   "P1 there.")
+                   f"u_val {fmt(v['u_val'], 2)} mm of the best; no verdict here compares a "
+                   "model with FEM P1 at nu 0.49 or above (a `pbcm sweep` over nu on today's "
+                   "presets would).")
     if lin and bench_rows.get(p1_lin):
         within = [m for m, val in lin.items() if not val[2] and val[1] is not None
                   and val[1] <= ACCURACY] + [p1_lin]

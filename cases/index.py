@@ -74,7 +74,7 @@ def scorecard_rows(pops, data, models):
                                    if p.spread_defect else "")
         rows.append([Link(label, f"{p.case}/report.md", f"{p.case}/report.html"),
                      f"{p.quantity.label}: model-form vs FEM P1 ({law})",
-                     shared, f"{p.u_model_form:.1g}"]
+                     shared, f"{p.u_model_form:.2g}"]
                     + [_cell(p, m, "model_form") for m in models])
         rows.append(["", f"{p.quantity.label}: total vs the continuum", "", u_c]
                     + [_cell(p, m, "total") for m in models])
@@ -170,13 +170,9 @@ def index_documents(root, cases, studies=()):
         doc.p(line)
     doc.p("Each case folder holds metrics.json, report.md, report.html and the figures; "
           "regenerate with `pbcm report`.")
-    sweeps = sorted((root / "sweeps").glob(f"*/{SWEEP_MARK}"))
-    if sweeps:
-        doc.h(2, "Sweeps")
-        doc.table(["sweep", "spec"], [
-            [Link(json.loads(m.read_text())["title"], f"sweeps/{m.parent.name}/report.md"),
-             json.loads(m.read_text())["spec"]] for m in sweeps])
-        doc.p("Each is written by `pbcm sweep SPEC` (not by `pbcm report`).")
+    if sorted((root / "sweeps").glob(f"*/{SWEEP_MARK}")):
+        doc.p("Sweeps (`pbcm sweep SPEC`, under sweeps/) are read by no verdict here: each is "
+              "its own report, valid for the presets it ran.")
     return doc.markdown() + "\n", doc.html(root) + "\n"
 
 

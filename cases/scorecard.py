@@ -111,6 +111,9 @@ def cell(standing, tied_with=None):
     s = standing
     if not s.values:
         text = f"failed, 0 of {s.runs}"
+    elif math.isinf(s.score):
+        text = (f"failed at the median: {len(s.values)} of {s.runs} runs gave "
+                f"{', '.join(f'{v:.3g}' for v in s.values)}")
     else:
         text = (f"{np.median(s.values):.3g} [{min(s.values):.3g}-{max(s.values):.3g}] "
                 f"{len(s.values)}/{s.runs}" + (f", {s.failed} failed" if s.failed else ""))

@@ -185,7 +185,7 @@ def test_study_metrics_do_not_depend_on_the_workers(study, tmp_path):
 
 def test_index_opens_with_the_answers_and_lists_the_study(study, tmp_path, capsys):
     """`pbcm index` rewrites the index from the folders present: the answers first (the
-    consistency error from the convergence study's patch-test fits), their table, then the
+    consistency limits from the convergence study's patch-test fits), their table, then the
     studies (this one in quick mode, linked) and the scorecard; a missing case is refused."""
     from cases.registry import CASES
     for name in CASES:
@@ -195,12 +195,14 @@ def test_index_opens_with_the_answers_and_lists_the_study(study, tmp_path, capsy
     md = (tmp_path / "index.md").read_text()
     first = md.split("\n\n")[1]
     assert first.startswith("**Which reading?** Not computed: run `pbcm run artefact`.")
-    assert "**How far from the continuum?** Consistency error" in md
+    # a quick study decides nothing; its limits are shown as a preview, with their fit's +-
+    assert "**How far from the continuum?** Quick: not decided (`pbcm run convergence` " \
+        "decides); The consistency limit" in md
     # the patch test's irregular patches: msm (springs) misses the strain by over 10 %
     irregular = md.split("on irregular patches (worst): ")[1].split(" ([convergence]")[0]
     worst = dict(item.rsplit(" ", 1) for item in irregular.split(", "))
     assert float(worst["msm"]) > 0.1 and float(worst["fem-linear"]) < 1e-10
-    assert md.index("**How far") < md.index("| model | consistency error") \
+    assert md.index("**How far") < md.index("| model | model-form error, linear regime") \
         < md.index("## Studies") < md.index("## Scorecard")
     assert "| [convergence](convergence/report.md) |" in md and "| quick |" in md
     assert len(md.split("| model | consistency error")[0].split()) < 300
