@@ -228,9 +228,30 @@ def recommendation(root, models, pops, quick, bench_rows):
     p1_lin = next((p.quantity.p1 for p in pops if not p.finite), None)
     p1_fin = next((p.quantity.p1 for p in pops if p.finite), None)
 
-    def best(means):
+    def best(means, finite):
+        """The first of the ranking and what it is not resolved from (ties and orders that
+        reverse without one mesh family)."""
         order = scorecard.ranked(means)
-        return order[0][1] if order else None
+        if not order:
+            return None, []
+        loose = scorecard.unresolved(pops, list(means), finite)
+        top, others = order[0][1], []
+        for (_, m, _, tie), (_, nxt, _, _) in zip(order, order[1:]):
+            if m != top and m not in others:
+                break
+            if tie == top or loose.get((m, nxt)) or any(
+                    t == top for _, x, _, t in order if x == nxt):
+                others.append(nxt)
+            else:
+                break
+        return top, others
+
+    def named(means, b, others):
+        said = f"{b}, model-form error {fmt(means[b][1])}{cost(b)}"
+        if others:
+            said += (f", not resolved from {', '.join(others)} (tied, or an order that "
+                     "reverses when one mesh family is left out)")
+        return said
 
     def cost(m):
         r, fl = bench_rows.get(m), bench_rows.get(p1_lin)
@@ -241,23 +262,24 @@ def recommendation(root, models, pops, quick, bench_rows):
         same = [m for m, v in lin.items() if v[1] is not None and v[1] <= floor]
         approx = {m: v for m, v in lin.items() if m not in same}
         # equal to P1 within the comparison's floor: a check, not an approximation
-        b = best(approx)
+        b, others = best(approx, False)
         out.append(f"- Linear regime: {p1_lin}" + (f" (tied with {', '.join(same)})"
                                                   if same else "")
-                   + (f"; the closest approximation is {b}, model-form error {fmt(lin[b][1])}"
-                      f"{cost(b)}" if b else "") + ".")
+                   + (f"; the closest approximation is {named(lin, b, others)}" if b else "")
+                   + ".")
     if fin and p1_fin:
-        b = best(fin)
+        b, others = best(fin, True)
+        n = len([p for p in pops if p.finite])
         out.append(f"- Finite strain: {p1_fin} (the reference's law on P1)"
-                   + (f"; the closest other is {b}, model-form error {fmt(fin[b][1])}"
-                      f"{cost(b)}" if b else "") + ".")
+                   + (f"; the closest other, on {n} case{'s' if n > 1 else ''}, is "
+                      f"{named(fin, b, others)}" if b else "") + ".")
     truth = _load(root, MEASURED, "metrics.json")
     if truth and truth.get("headline"):
         v = validation(truth)
         tied = [m for m in v["tied"] if m in models]
         out.append(f"- Near incompressibility (the Truth Cube, nu {fmt(truth['parameters']['nu'])}"
                    f"): not decided by a measurement: {', '.join(tied)} are tied within "
-                   f"u_val {fmt(v['u_val'], 2)} mm of the best; no verdict here compares a "
+                   f"u_val ({_span(v['u_val'].values())} mm); no verdict here compares a "
                    "model with FEM P1 at nu 0.49 or above (a `pbcm sweep` over nu on today's "
                    "presets would).")
     if lin and bench_rows.get(p1_lin):
@@ -280,25 +302,40 @@ def recommendation(root, models, pops, quick, bench_rows):
 
 
 def validation(truth):
-    """The Truth Cube's comparison error read against u_val (ASME V&V 20) at the headline
-    state: u_D the beads' noise floor, u_input half the range of the continuum's bead RMS over
-    the unmeasured inputs (plate friction, travel, nu), u_num the reference's change over its
-    last refinement; and the models tied within u_val of the best."""
+    """The Truth Cube's comparison error read against each model's u_val (ASME V&V 20) at the
+    headline state: u_D the beads' noise floor, u_input half the range of the model's own bead
+    RMS over the study's variants of the inputs nobody measured (plate friction, travel, nu; on
+    the mesh they ran on), u_num the reference's change over its last refinement; the models
+    within their u_val, and those tied with the closest (a difference below the larger of the
+    two u_val)."""
     from .error_model import u_val
     h = truth["headline"]
     ref = [r for r in truth.get("references", []) if r.get("variant") == "bonded"
            and abs(r.get("strain", -1) - h["strain"]) < 1e-9]
     u_num = max((r.get("bead_change_mm") or 0.0 for r in ref), default=0.0)
-    spread = list(truth.get("continuum_by_assumption_mm", {}).values())
-    u_input = (max(spread) - min(spread)) / 2 if spread else 0.0
-    u = u_val(u_num, u_input, h["floor_mm"])
-    rms = {m: v["bead_rms_mm"] for m, v in h["models"].items()}
-    own = [m for m in rms if m in truth["parameters"]["models"]]
+    rows = [r for r in truth.get("rows", []) if abs(r.get("strain", -1) - h["strain"]) < 1e-9
+            and r.get("bead_rms_mm") is not None]
+    variants = set(truth["parameters"].get("variants", {}))
+    mesh = next((r["mesh"] for r in rows if r["variant"] != "bonded"), None)
+    own = [m for m in h["models"] if m in truth["parameters"]["models"]]
+    u_input, u = {}, {}
+    for m in own:
+        vals = [r["bead_rms_mm"] for r in rows if r["model"] == m and r["mesh"] == mesh
+                and r["variant"] in variants]
+        u_input[m] = (max(vals) - min(vals)) / 2 if len(vals) > 1 else 0.0
+        u[m] = u_val(u_num, u_input[m], h["floor_mm"])
+    rms = {m: h["models"][m]["bead_rms_mm"] for m in own}
     best = min(own, key=rms.get) if own else None
     return {"u_val": u, "u_num": u_num, "u_input": u_input, "u_d": h["floor_mm"],
-            "best": best, "tied": [m for m in sorted(own, key=rms.get)
-                                   if rms[m] - rms[best] < u],
-            "within": [m for m in own if rms[m] <= u]}
+            "mesh": mesh, "best": best,
+            "tied": [m for m in sorted(own, key=rms.get)
+                     if rms[m] - rms[best] < max(u[m], u[best])],
+            "within": [m for m in own if rms[m] <= u[m]]}
+
+
+def _span(values):
+    v = list(values)
+    return f"{fmt(min(v), 2)}-{fmt(max(v), 2)}" if v else "n/a"
 
 
 def _measured_line(truth, models):
@@ -308,22 +345,27 @@ def _measured_line(truth, models):
     val = validation(truth)
     mine = sorted((m for m in models if m in v), key=lambda m: v[m]["bead_rms_mm"])
     said = (f"**How far from a measured body?** On the Truth Cube's 343 beads at "
-            f"{fmt(100 * h['strain'], 4)} % compression (bonded plates, {h['mesh']} mesh), read "
-            f"against u_val {fmt(val['u_val'], 2)} mm (the beads' noise "
-            f"{fmt(val['u_d'], 2)}, the unmeasured inputs {fmt(val['u_input'], 2)}, the "
+            f"{fmt(100 * h['strain'], 4)} % compression (bonded plates, {h['mesh']} mesh), each "
+            f"model read against its u_val {_span(val['u_val'].values())} mm (the beads' noise "
+            f"{fmt(val['u_d'], 2)}; the model's own spread over the unmeasured plate friction, "
+            f"travel and nu, on the {val['mesh']} mesh, {_span(val['u_input'].values())}; the "
             f"reference {fmt(val['u_num'], 1)}): ")
     if NH in v:
         said += f"the neo-Hookean continuum is {fmt(v[NH]['bead_rms_mm'])} mm RMS off; "
     if mine:
-        said += (f"the models from {fmt(v[mine[0]]['bead_rms_mm'])} mm ({mine[0]}) to "
-                 f"{fmt(v[mine[-1]]['bead_rms_mm'])} mm ({mine[-1]}); within u_val: "
-                 f"{', '.join(val['within']) or 'none'}; tied with the closest within u_val: "
-                 f"{', '.join(val['tied'])}. ")
+        said += (f"the models from {fmt(v[mine[0]]['bead_rms_mm'])} to "
+                 f"{fmt(v[mine[-1]]['bead_rms_mm'])} mm; within their u_val: "
+                 f"{', '.join(val['within']) or 'none'}; tied (a difference below u_val): "
+                 f"{', '.join(val['tied'])}"
+                 + (f"; apart: {', '.join(m for m in mine if m not in val['tied'])}"
+                    if len(val["tied"]) < len(mine) else "") + ". ")
     sens = _nu_sensitivity(truth, h["strain"])
     if sens:
+        blind = [m for m, d in sens[1] if d == 0]
         said += ("Moving nu over its unmeasured range moves the models' bead RMS on the "
                  f"{sens[0]} mesh by " + ", ".join(f"{m} {fmt(d, 2)} mm" for m, d in sens[1])
-                 + ". ")
+                 + (f" ({', '.join(blind)}: blind to nu, a finding, not a certainty)"
+                    if blind else "") + ". ")
     return said + ("The plates prescribe displacement, so the beads test the deformed shape, "
                    f"not the stiffness ([truth-cube]({MEASURED}/report.md)).")
 

@@ -90,6 +90,7 @@ def conclusion(pops, models, quick):
         if not means:
             continue
         n = len([p for p in pops if p.finite == finite])
+        loose = scorecard.unresolved(pops, models, finite)
         if quick:
             out.append(f"Model-form ranking, {regime}: quick: not decided (run `pbcm report` "
                        "for every mesh).")
@@ -98,9 +99,12 @@ def conclusion(pops, models, quick):
                    "mean rank, a population ranking its models by the median over the meshes "
                    "with a failed run counted as infinitely wrong; the geometric mean of its "
                    "scores beside it, each floored at the comparison's uncertainty; FEM P1 "
-                   "itself is the identity check and not ranked): " + "; ".join(
+                   "itself is the identity check and not ranked; an order that reverses "
+                   "when one mesh family is left out is not resolved): " + "; ".join(
                        f"{rank}. {m} ({scorecard.describe(entry)})"
                        + (f", tied with {tie}" if tie else "")
+                       + "".join(f", not resolved from {b} (reverses without {mesh})"
+                                 for (a, b), mesh in loose.items() if a == m)
                        for rank, m, entry, tie in scorecard.ranked(means)) + ".")
     worst = {}
     for p in pops:

@@ -7,6 +7,10 @@ import numpy as np
 
 from .document import Table
 
+# what a ranking by a case's own metric measures: the total error, the mesh's own included
+# (the model-form ranking is the error model's, cases.scorecard)
+AGAINST = " against its reference (total error, the mesh's discretisation error included)"
+
 
 def populations(runs):
     """The runs split by boundary condition: each (case, bc) is one population (a patch test
@@ -77,7 +81,8 @@ def ranking(runs, metric, label, estimate_key="p2_error_estimate"):
             rows.append([bc, k + 1, m, *_stats(by[m], had[m]), tie])
         for m in sorted(set(had) - set(ranked)):
             rows.append([bc, "-", m, *_stats(by.get(m, []), had[m]), "incomplete, not ranked"])
-    return [Table(f"{label[0].upper()}{label[1:]} ({metric}) per model, median over the meshes:",
+    return [Table(f"{label[0].upper()}{label[1:]} ({metric}){AGAINST} per model, median over "
+                  "the meshes:",
                   ["bc", "rank", "model", "median", "range", "runs", "note"], rows)]
 
 
@@ -103,8 +108,8 @@ def best_and_worst(runs, metric, what, exact=False, estimate_key="p2_error_estim
             return f"No model gave {what} in every run."
         med = {m: float(np.median(by[m])) for m in ranked}
         best, worst = min(med, key=med.get), max(med, key=med.get)
-        line = (f"{what}: closest {best} ({cell(by[best], had[best])}), farthest {worst} "
-                f"({cell(by[worst], had[worst])}).")
+        line = (f"{what}{AGAINST}: closest {best} ({cell(by[best], had[best])}), farthest "
+                f"{worst} ({cell(by[worst], had[worst])}).")
         left = sorted(set(had) - set(ranked))
         if left:
             line += (" Not ranked, a run without a value: " + ", ".join(

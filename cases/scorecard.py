@@ -4,7 +4,7 @@ discretisation error those tetrahedra share, the total against the continuum, an
 uncertainties a comparison of them is read against; then the rankings across populations, with
 failed runs counted against their model."""
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
@@ -33,7 +33,20 @@ class Population:
     spread_defect: bool
     patch_test: bool
     quick: bool
-    unpaired: dict = field(default_factory=dict)
+    meshes: dict = field(default_factory=dict)     # {model: [mesh per run]}
+    lost: dict = field(default_factory=dict)       # {model: [unpaired modes per run]}
+
+    @property
+    def unpaired(self):
+        """{model: failed parts (unpaired modes) over its runs}, where the quantity has them."""
+        return {m: sum(v) for m, v in self.lost.items()}
+
+    def without(self, mesh):
+        """The population without its runs on ``mesh`` (the unit of analysis left out)."""
+        keep = {m: [k for k, x in enumerate(self.meshes[m]) if x != mesh] for m in self.parts}
+        return replace(self, parts={m: [self.parts[m][k] for k in ks] for m, ks in keep.items()},
+                       meshes={m: [self.meshes[m][k] for k in ks] for m, ks in keep.items()},
+                       lost={m: [self.lost[m][k] for k in keep[m]] for m in self.lost})
 
     @property
     def label(self):
@@ -76,12 +89,12 @@ def populations(runs_by_case, declared, quick, patch_tests, estimate_keys):
             rs = [r for r in runs if r["bc"] == bc]
             dec = E.decomposed(rs, q)
             failed_modes = getattr(q, "unpaired", None)
-            parts, unpaired = {}, {}
+            parts, meshes, lost = {}, {}, {}
             for r in rs:
                 parts.setdefault(r["model"], []).append(dec[(r["mesh"], r["bc"], r["model"])])
+                meshes.setdefault(r["model"], []).append(r["mesh"])
                 if failed_modes:
-                    unpaired[r["model"]] = unpaired.get(r["model"], 0) + (
-                        r.get(failed_modes) or 0)
+                    lost.setdefault(r["model"], []).append(r.get(failed_modes) or 0)
             twins = [abs(p.model_form) for m in SAME_LAW.get(q.p1, ()) if m in parts
                      for p in parts[m] if p is not None]
             u_mf = max([RTOL] + twins)
@@ -92,7 +105,7 @@ def populations(runs_by_case, declared, quick, patch_tests, estimate_keys):
             cont = [_first(v) for v in cont.values() if v is not None]
             u_c, defect = E.u_num(max(est) if est else None, cont)
             out.append(Population(case, bc, q, parts, u_mf, u_c, defect,
-                                  bc in patch_tests[case], quick[case], unpaired))
+                                  bc in patch_tests[case], quick[case], meshes, lost))
     return out
 
 
@@ -118,6 +131,22 @@ def cell(standing, tied_with=None):
         text = (f"{np.median(s.values):.3g} [{min(s.values):.3g}-{max(s.values):.3g}] "
                 f"{len(s.values)}/{s.runs}" + (f", {s.failed} failed" if s.failed else ""))
     return text + (f"; tied with {tied_with}" if tied_with else "")
+
+
+def unresolved(pops, models, finite=False):
+    """{(upper, lower): mesh} for each pair of neighbours of ``ranked(overall(...))`` whose
+    order reverses when one mesh family is left out of every population (the mesh, not the
+    run, is the unit of analysis): the first such mesh."""
+    order = [m for _, m, _, _ in ranked(overall(pops, models, finite))]
+    meshes = sorted({x for p in pops if p.finite == finite for ms in p.meshes.values()
+                     for x in ms})
+    out = {}
+    for mesh in meshes:
+        alt = overall([p.without(mesh) for p in pops], models, finite)
+        for a, b in zip(order, order[1:]):
+            if (a, b) not in out and a in alt and b in alt and alt[a][0] > alt[b][0]:
+                out[(a, b)] = mesh
+    return out
 
 
 def overall(pops, models, finite=False):
@@ -167,3 +196,79 @@ def describe(entry):
     if lost:
         text += f" ({lost} of {n} populations failed at the median)"
     return text
+
+
+def case_findings(name, decomposed, runs, patch_tests=(), estimate_key="p2_error_estimate"):
+    """(opening lines, tables) of one case's report on the error model: per boundary
+    condition, the closest and farthest model by model-form error with the discretisation
+    error the meshes share, and the models whose total is below P1's only by cancellation;
+    a Table per boundary condition with every model's standing."""
+    from .document import Table
+
+    class Declared:
+        pass
+    Declared.decomposed = decomposed
+    pops = populations({name: runs}, {name: Declared}, {name: False},
+                       {name: set(patch_tests)}, {name: estimate_key})
+    lines, tables = [], []
+    for p in pops:
+        st = p.standings()
+        if not st:
+            continue
+        where = f"[{p.bc}] " if len(pops) > 1 else ""
+        disc = p.discretisation()
+        same = [s.model for _, s, _ in st if s.failed == 0 and s.score <= p.u_model_form]
+        ok = [(r, s, t) for r, s, t in st if math.isfinite(s.score) and s.model not in same]
+        line = (f"{where}What replacing FEM P1 costs ({p.quantity.label}, model-form error, "
+                "median over the meshes): ")
+        if same:
+            line += (f"equal to FEM P1 within u_val {p.u_model_form:.2g}: {', '.join(same)}"
+                     + ("; " if ok else ""))
+        if ok:
+            line += f"closest {ok[0][1].model} ({cell(ok[0][1])}), farthest {ok[-1][1].model} " \
+                    f"({cell(ok[-1][1])})"
+            tied = [s.model for _, s, t in ok if t == ok[0][1].model]
+            if tied:
+                line += f"; tied with {ok[0][1].model} within u_val {p.u_model_form:.2g}: " \
+                        f"{', '.join(tied)}"
+        elif not same:
+            line += "no model gave it on every mesh"
+        failed = [f"{s.model} ({s.failed} of {s.runs})" for _, s, _ in st if s.failed]
+        if failed:
+            line += "; failed runs, counted against their model: " + ", ".join(failed)
+        if disc:
+            line += (f". FEM P1 itself is {np.median(disc):.3g} [{min(disc):.3g}-"
+                     f"{max(disc):.3g}] from the continuum on these meshes (discretisation "
+                     "error)")
+            # |total| < |P1's| with a model-form error: its error opposes P1's
+            cancel = [s.model for _, s, _ in ok
+                      if _median(p.errors(s.model, "total")) is not None
+                      and _median(p.errors(s.model, "total")) < np.median(disc)]
+            if cancel:
+                line += ("; closer to the continuum than P1 only by cancelling its error: "
+                         + ", ".join(cancel))
+        lines.append(line + ".")
+        rows = [[p.bc, rank, s.model, cell(s, tie), _cell_of(p.errors(s.model, "total"))]
+                for rank, s, tie in st]
+        rows.append([p.bc, "-", f"{p.quantity.p1} (FEM P1)", "0 by construction",
+                     _cell_of(disc)])
+        tables.append(Table(f"Model-form error ({p.quantity.label}) per model, against FEM P1 "
+                            "on the same tetrahedra, beside the total against the continuum "
+                            f"(u_val: model-form {p.u_model_form:.2g}, total "
+                            f"{p.u_continuum:.2g}"
+                            + (", the reference's spread over the meshes exceeding its "
+                               "estimate" if p.spread_defect else "") + "):",
+                            ["bc", "rank", "model", "model-form", "total"], rows))
+    return lines, tables
+
+
+def _median(values):
+    v = [x for x in values if x is not None]
+    return float(np.median(v)) if v else None
+
+
+def _cell_of(values):
+    v = [x for x in values if x is not None]
+    if not v:
+        return "n/a"
+    return f"{np.median(v):.3g} [{min(v):.3g}-{max(v):.3g}] {len(v)}/{len(values)}"

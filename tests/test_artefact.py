@@ -86,7 +86,7 @@ def test_the_reading_verdict_counts_the_papers_observables_and_its_margin():
     assert [r["score"] for r in table] == [3, 0]
     v = analysis.reading_verdict(table)
     assert (v["model"], v["sure"], v["margin"]) == ("a", "clear", 3)
-    assert table[0]["consistency_median"] == 0.05 and table[1]["flutter"] == [1, 1]
+    assert table[0]["sliding_disp_median"] == 0.05 and table[1]["flutter"] == [1, 1]
     # on a mesh where the FEM control alternates too, a model's pattern is not resolved
     fem = cell("d", "Delaunay-374", "fem-linear", -0.02, family="fem", paper_size=True)
     blind = analysis.reading_table(cells + [fem], {"a": 12.0, "b": 8.0}, ["a", "b"])

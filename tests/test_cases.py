@@ -255,9 +255,10 @@ def test_rankings_keep_populations_apart_and_rank_only_complete_models():
     assert clamped[2] == ["clamped", "-", "c", "0.05", "0.05-0.05", "1 of 2",
                           "incomplete, not ranked"]
     line = rankings.best_and_worst(runs, "err", "Error")
-    assert "[clamped] Error: closest b" in line and "farthest a" in line
+    assert "[clamped] Error against its reference (total error" in line
+    assert "closest b" in line and "farthest a" in line
     assert "Not ranked, a run without a value: c (1 of 2)" in line
-    assert "[sliding] Error: closest a" in line
+    assert line.index("[sliding]") < line.index("closest a") < line.index("[clamped]")
 
 
 def test_errors_over_free_components_leave_out_what_is_prescribed():

@@ -91,7 +91,7 @@ class Indentation(Case):
     headline_pair = "disp_rel_l2_p2"
     decomposed = Scalar("reaction_n", "reaction_fem_p2_n", "punch force")
     qoi_errors = ("edge_shear_pa",)
-    gated = ("edge_shear_rel_err", "profile_rel_err")
+    gated = ("edge_shear_rel_err", "profile_rel_err")   # the edge shear gated, never ranked
     columns = ("reaction_n", "reaction_fem_p2_n", "profile_rel_err", "edge_shear_pa",
                "edge_shear_fem_pa", "edge_shear_rel_err")
     magnify = 2.0
@@ -150,8 +150,9 @@ class Indentation(Case):
     def conclusion(self, s, runs):
         return [common.best_and_worst(runs, "reaction_rel_err", "Punch force"),
                 common.best_and_worst(runs, "profile_rel_err", "Surface profile"),
-                common.best_and_worst(runs, "edge_shear_rel_err", "Shear under the punch edge")
-                + " " + common.failures(runs)]
+                "The shear under the punch edge is singular in the continuum (it grows "
+                "without bound as the mesh is refined): its values are in the tables, never "
+                "ranked. " + common.failures(runs)]
 
     def findings(self, s, runs):
         stiff = common.per_run(runs, lambda r: None if r.get("reaction_ratio") is None
@@ -159,8 +160,6 @@ class Indentation(Case):
         return {"Punch force": common.ranking(runs, "reaction_rel_err", "force error")
                 + [stiff],
                 "Surface profile": common.ranking(runs, "profile_rel_err", "profile error"),
-                "Shear under the punch edge": common.ranking(runs, "edge_shear_rel_err",
-                                                             "edge shear error"),
                 "Failures": [common.failures(runs)]}
 
 

@@ -201,8 +201,8 @@ def reading_table(cells, step_vs_msm, readings):
                      "pattern_median_rel": _median([c["alternation_rel"] for c in sliding]),
                      "step_vs_msm": cost, "flutter": [flutter, len(clamped)],
                      "growth_max_1_s": max(rates) if rates else None,
-                     "consistency_median": _median(consistency),
-                     "finite_load_median": _median(finite),
+                     "sliding_disp_median": _median(consistency),
+                     "paper_push_disp_median": _median(finite),
                      "matches": matches, "score": sum(matches.values())})
     return rows
 
@@ -216,7 +216,7 @@ def reading_verdict(table):
     """The reading that matches most of the paper's observables, and how sure that is: the
     margin over the runner-up (clear from SURE_MARGIN observables, weak from one, none: a
     tie)."""
-    ranked = sorted(table, key=lambda r: (-r["score"], r["consistency_median"] or np.inf))
+    ranked = sorted(table, key=lambda r: (-r["score"], r["sliding_disp_median"] or np.inf))
     best, second = ranked[0], ranked[1] if len(ranked) > 1 else None
     margin = best["score"] - (second["score"] if second else 0)
     tied = [r["model"] for r in ranked if r["score"] == best["score"]]

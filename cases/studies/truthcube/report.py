@@ -116,13 +116,20 @@ def analyse(data):
 
 def scorecard(doc):
     """The index's row measured against reality: per model its bead RMS error over the RMS
-    measured displacement at the largest strain, and where it departs from the floor; band
-    0 within the floor at every state, 1 at some, 2 at none."""
+    measured displacement at the largest strain, and whether its RMS in mm lies within its
+    validation uncertainty u_val (``cases.answers.validation``); band 0 within, 2 beyond."""
+    from ...answers import validation
     h = doc["headline"]
-    n = len(doc["data"]["states"])
-    cells = {m: (f"{fmt(v['bead_rms_rel'])} at {percent(h['strain'])}, {v['departure']}",
-                 0 if v["states_within"] == n else 1 if v["states_within"] else 2)
-             for m, v in h["models"].items()}
+    val = validation(doc)
+    cells = {}
+    for m, v in h["models"].items():
+        if m not in val["u_val"]:
+            continue
+        u = val["u_val"][m]
+        within = v["bead_rms_mm"] <= u
+        cells[m] = (f"{fmt(v['bead_rms_rel'])} at {percent(h['strain'])}, "
+                    f"{fmt(v['bead_rms_mm'])} mm {'within' if within else 'beyond'} its u_val "
+                    f"{fmt(u, 2)} mm", 0 if within else 2)
     return [(f"truth-cube/bonded, {h['mesh']} (measured beads)", "bead_rms_rel", cells)]
 
 
