@@ -158,8 +158,12 @@ def lines(root, models, pops=(), quick=False):
                    "(a patch test; the largest over the lattices, +- the extrapolation's "
                    "uncertainty): " + ", ".join(f"{m} {_pm(_worst_limit(lim[m]))}"
                                                 for m in rest if _worst_limit(lim[m]))
+                   + _limit_ties([(m, _worst_limit(lim[m])) for m in rest
+                                  if _worst_limit(lim[m])])
                    + (f"; below {PATCH_TOL:g}: {', '.join(passed)}" if passed else "")
                    + (f"; no limit on {', '.join(nolimit)}" if nolimit else "")
+                   + _finest(conv, [m for m in rest if any(
+                       not isinstance(v, tuple) for v in lim[m].values())], nolimit)
                    + _irregular(conv, models)
                    + " ([convergence](convergence/report.md)).")
     truth = _load(root, MEASURED, "metrics.json")
@@ -182,6 +186,36 @@ def lines(root, models, pops=(), quick=False):
                    "decides).")
     out += recommendation(root, models, pops, quick, rows)
     return out
+
+
+def _limit_ties(limits_):
+    """' (tied within their +-: a, b; c, d)': groups of neighbours whose limits differ by less
+    than their uncertainties combined (sqrt(u_a^2 + u_b^2))."""
+    groups, group = [], []
+    for (m, (v, u)), nxt in zip(limits_, limits_[1:] + [None]):
+        group.append(m)
+        if nxt is None or abs(nxt[1][0] - v) >= (u ** 2 + nxt[1][1] ** 2) ** 0.5:
+            if len(group) > 1:
+                groups.append(group)
+            group = []
+    return (" (tied within their +-: " + "; ".join(", ".join(g) for g in groups) + ")"
+            if groups else "")
+
+
+def _finest(conv, models, lattices):
+    """'; there, the error on the finest level: ...': each model's sliding-cube error at the
+    smallest h it ran on the lattices without a limit (a number where no limit exists)."""
+    said = []
+    for lattice in lattices:
+        for m in models:
+            rs = [r for r in conv.get("runs", []) if (r["case"], r["bc"]) == CONSISTENCY
+                  and r["mesh"] == lattice and r["model"] == m
+                  and r.get("disp_rel_l2") is not None]
+            if rs:
+                r = min(rs, key=lambda r: r["h_mm"])
+                said.append(f"{m} {fmt(r['disp_rel_l2'], 2)} at {fmt(r['h_mm'], 3)} mm")
+    return (f"; there, the error at the finest level (no limit: not a consistency limit): "
+            + ", ".join(said)) if said else ""
 
 
 def _worst_limit(lim):

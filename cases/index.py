@@ -89,13 +89,14 @@ def conclusion(pops, models, quick):
         means = scorecard.overall(pops, models, finite)
         if not means:
             continue
-        n = len([p for p in pops if p.finite == finite])
+        n = len([p for p in pops if p.finite == finite and not p.patch_test])
         loose = scorecard.unresolved(pops, models, finite)
         if quick:
             out.append(f"Model-form ranking, {regime}: quick: not decided (run `pbcm report` "
                        "for every mesh).")
             continue
-        out.append(f"Model-form ranking, {regime}, over its {n} populations (each model's "
+        out.append(f"Model-form ranking, {regime}, over its {n} populations other than patch "
+                   "tests (each model's "
                    "mean rank, a population ranking its models by the median over the meshes "
                    "with a failed run counted as infinitely wrong; the geometric mean of its "
                    "scores beside it, each floored at the comparison's uncertainty; FEM P1 "

@@ -153,8 +153,9 @@ def overall(pops, models, finite=False):
     """{model: (mean rank, geometric mean of its finite population scores, failed runs,
     failed populations, populations)} over the populations of one regime (``finite``): every
     population counts for every model, a failed run against its model; each score floored at
-    its population's model-form uncertainty; P1 itself left out (an identity check)."""
-    used = [p for p in pops if p.finite == finite]
+    its population's model-form uncertainty; P1 itself left out (an identity check), and the
+    patch tests (pass or fail, the consistency limit's subject: never pooled with the rest)."""
+    used = [p for p in pops if p.finite == finite and not p.patch_test]
     out = {}
     for m in models:
         mine = [p for p in used if m in p.parts and m != p.quantity.p1]

@@ -160,3 +160,73 @@ def test_an_unpaired_mode_is_failed_and_ranked_first():
     assert p.unpaired == {"fem-linear": 0, "a": 3, "b": 0}
     assert p.parts["fem-linear"][0].discretisation == 0.05
     assert [(r, s.model) for r, s, _ in p.standings()] == [(1, "b"), (2, "a")]
+
+
+def _torsion_runs(values):
+    """Runs of a synthetic torsion case: ``values`` {(mesh, model): torque} against a
+    continuum torque of 1 on every mesh."""
+    return [{"mesh": mesh, "bc": "clamped", "model": model, "torque_nm": q,
+             "torque_fem_nm": 1.0, "p2_error_estimate": 0.001}
+            for (mesh, model), q in values.items()]
+
+
+def test_an_order_that_one_mesh_reverses_is_not_resolved(tmp_path):
+    """The mesh is the unit of analysis: a ranking that reverses when one mesh family is left
+    out names that mesh, one that holds on every subset does not."""
+    from cases.index import populations
+    v = {}
+    for mesh, (a, b, c) in {"five": (1.1, 1.3, 2.0), "six": (1.1, 1.3, 2.0),
+                            "bcc": (1.6, 1.2, 2.0)}.items():
+        v.update({(mesh, "fem-linear"): 1.0, (mesh, "a"): a, (mesh, "b"): b, (mesh, "c"): c})
+    _case_folder(tmp_path, "torsion", _torsion_runs(v))
+    pops, _ = populations(tmp_path, ["torsion"])
+    models = ["fem-linear", "a", "b", "c"]
+    assert [m for _, m, _, _ in scorecard.ranked(scorecard.overall(pops, models))] == \
+        ["a", "b", "c"]
+    # a: 0.1, 0.1, 0.6; b: 0.3, 0.3, 0.2 -> without five (or six) b's median wins
+    assert scorecard.unresolved(pops, models) == {("a", "b"): "five"}
+
+
+def test_case_findings_name_cancellation_and_the_twins():
+    """A case report's opening names the FEM twins equal to P1 within u_val, the closest and
+    farthest approximation, and a model closer to the continuum than P1 only because its
+    error opposes P1's (P1 1.3, the model 1.0 = the continuum: model-form 0.3, total 0)."""
+    runs = [dict(r, bc="clamped") for r in _torsion_runs({
+        ("five", "fem-linear"): 1.3, ("five", "fem-corotated"): 1.3 + 1e-12,
+        ("five", "a"): 1.0, ("five", "b"): 1.35})]
+    lines, tables = scorecard.case_findings("torsion", E.Scalar("torque_nm", "torque_fem_nm",
+                                                                "torque"), runs)
+    (line,) = lines
+    assert "equal to FEM P1 within u_val" in line and "fem-corotated" in line
+    assert "closest b (0.05" in line and "farthest a (0.3" in line
+    assert "FEM P1 itself is 0.3 [0.3-0.3] from the continuum" in line
+    assert line.endswith("closer to the continuum than P1 only by cancelling its error: a.")
+    assert tables[0].rows[-1][2:] == ["fem-linear (FEM P1)", "0 by construction",
+                                      "0.3 [0.3-0.3] 1/1"]
+
+
+def test_truth_cube_u_val_is_per_model_by_hand():
+    """Each model's u_val combines the reference's change, its own half-range over the
+    unmeasured-input variants and the beads' noise; a model within it is named, and models
+    closer than the larger u_val are tied."""
+    from cases.answers import validation
+    rows = [{"mesh": "10mm", "variant": var, "model": m, "strain": 0.2, "bead_rms_mm": v}
+            for m, vals in {"a": (1.0, 1.6), "b": (0.3, 0.3)}.items()
+            for var, v in zip(("bonded", "nu=0.49"), vals)]
+    truth = {"headline": {"strain": 0.2, "floor_mm": 0.4, "models": {
+        "a": {"bead_rms_mm": 1.2}, "b": {"bead_rms_mm": 0.35}}},
+        "references": [{"variant": "bonded", "strain": 0.2, "bead_change_mm": 0.0}],
+        "rows": rows, "parameters": {"models": ["a", "b"], "variants": {
+            "bonded": ["bonded", "nominal", 0.499], "nu=0.49": ["bonded", "nominal", 0.49]}}}
+    v = validation(truth)
+    assert v["u_val"]["a"] == pytest.approx(0.5)          # sqrt(0.3^2 + 0.4^2)
+    assert v["u_val"]["b"] == pytest.approx(0.4)
+    assert v["within"] == ["b"] and v["tied"] == ["b"]     # 1.2 - 0.35 > 0.5
+
+
+def test_consistency_limits_closer_than_their_uncertainty_are_tied():
+    """Neighbouring limits are tied when they differ by less than sqrt(u_a^2 + u_b^2)."""
+    from cases.answers import _limit_ties
+    lims = [("a", (0.19, 0.03)), ("b", (0.192, 0.004)), ("c", (0.59, 0.08)), ("d", (0.9, 0.01))]
+    assert _limit_ties(lims) == " (tied within their +-: a, b)"
+    assert _limit_ties(lims[2:]) == ""

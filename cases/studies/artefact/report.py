@@ -44,9 +44,14 @@ def write(out, study, s, data):
 
 
 def conclusion(doc):
-    """The study's three lines: the cause, the reading, and what the study could not see."""
-    return [f"**What causes the bulge/neck pattern.** {doc['answer']['text']}",
-            f"**Which reading.** {doc['verdict']['text']}"]
+    """The study's three lines: the cause, the reading, and what the study could not see; a
+    quick run's are a preview that decides nothing."""
+    lines = [f"**What causes the bulge/neck pattern.** {doc['answer']['text']}",
+             f"**Which reading.** {doc['verdict']['text']}"]
+    if doc["parameters"].get("quick"):
+        return ["**Quick: not decided** (`pbcm run artefact` decides, on every mesh); what "
+                "the quick cells show, as a preview:"] + lines
+    return lines
 
 
 def build(out, study, s, doc):

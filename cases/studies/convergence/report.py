@@ -100,7 +100,10 @@ def conclusion(s, data):
     out = []
     # every (problem, bc, family) fitted, whatever its verdict: the denominator of each count
     total = len({(f["case"], f["bc"], f["mesh"]) for f in data["fits"]})
+    preview = ("Quick: not decided (`pbcm run convergence` decides, on finer levels and "
+               "references); a preview. " if s.quick else "")
     out.append(
+        preview +
         f"Convergence (h = {', '.join(f'{h:.3g}' for h in s.h_mm)} mm, {total} problem x mesh "
         f"family combinations): converging everywhere: {', '.join(conv) or 'none'}; stopping "
         "at a floor that no refinement removes: " + ("; ".join(
@@ -116,7 +119,8 @@ def conclusion(s, data):
                    + ".")
     div = sorted({f["model"] for f in data["fits"] if f.get("verdict") == "diverges"})
     if div:
-        out.append("Diverging somewhere (error growing as h falls): " + ", ".join(div) + ".")
+        out.append(("Quick, not decided: " if s.quick else "")
+                   + "Diverging somewhere (error growing as h falls): " + ", ".join(div) + ".")
     eff = [e for e in data["elasticity"] if not e.get("failed")]
     exact = [m for m in s.models if all(e["moduli_rel_err"] < ISOTROPIC_TOL for e in eff
                                          if e["model"] == m)]
