@@ -280,8 +280,13 @@ def recommendation(root, models, pops, quick, bench_rows):
                 break
         return top, others
 
+    conv = _load(root, "convergence", "metrics.json")
+
     def named(means, b, others):
         said = f"{b}, model-form error {fmt(means[b][1])}{cost(b)}"
+        limit = _worst_limit(limits(conv, b)) if conv else None
+        if limit and limit[0] >= PATCH_TOL:
+            said += f", consistency limit {_pm(limit)}"
         if others:
             said += (f", not resolved from {', '.join(others)} (tied, or an order that "
                      "reverses when one mesh family is left out)")
@@ -304,9 +309,13 @@ def recommendation(root, models, pops, quick, bench_rows):
     if fin and p1_fin:
         b, others = best(fin, True)
         n = len([p for p in pops if p.finite])
+        order = [m for _, m, _, _ in scorecard.ranked(lin)] if lin else []
+        linear = (f"; in the linear regime it ranks {order.index(b) + 1} of {len(order)}"
+                  + (f" with {lin[b][2]} failed runs" if lin[b][2] else "")
+                  if b in order else "")
         out.append(f"- Finite strain: {p1_fin} (the reference's law on P1)"
                    + (f"; the closest other, on {n} case{'s' if n > 1 else ''}, is "
-                      f"{named(fin, b, others)}" if b else "") + ".")
+                      f"{named(fin, b, others)}{linear}" if b else "") + ".")
     truth = _load(root, MEASURED, "metrics.json")
     if truth and truth.get("headline"):
         v = validation(truth)
