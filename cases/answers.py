@@ -162,6 +162,7 @@ def lines(root, models, pops=(), quick=False):
                                   if _worst_limit(lim[m])])
                    + (f"; below {PATCH_TOL:g}: {', '.join(passed)}" if passed else "")
                    + (f"; no limit on {', '.join(nolimit)}" if nolimit else "")
+                   + _diverging(lim)
                    + _finest(conv, [m for m in rest if any(
                        not isinstance(v, tuple) for v in lim[m].values())], nolimit)
                    + _irregular(conv, models)
@@ -189,17 +190,24 @@ def lines(root, models, pops=(), quick=False):
 
 
 def _limit_ties(limits_):
-    """' (tied within their +-: a, b; c, d)': groups of neighbours whose limits differ by less
-    than their uncertainties combined (sqrt(u_a^2 + u_b^2))."""
-    groups, group = [], []
+    """' (tied within their +-: a, b; c, d)': groups whose limits differ from the group's first
+    by less than their uncertainties combined (sqrt(u_a^2 + u_b^2))."""
+    groups, group, head = [], [], None
     for (m, (v, u)), nxt in zip(limits_, limits_[1:] + [None]):
         group.append(m)
-        if nxt is None or abs(nxt[1][0] - v) >= (u ** 2 + nxt[1][1] ** 2) ** 0.5:
+        head = head or (v, u)
+        if nxt is None or abs(nxt[1][0] - head[0]) >= (head[1] ** 2 + nxt[1][1] ** 2) ** 0.5:
             if len(group) > 1:
                 groups.append(group)
-            group = []
+            group, head = [], None
     return (" (tied within their +-: " + "; ".join(", ".join(g) for g in groups) + ")"
             if groups else "")
+
+
+def _diverging(lim):
+    """' (diverging, a failure: a on x; ...)' for the fits whose error grows as h falls."""
+    bad = [f"{m} on {k}" for m, v in lim.items() for k, x in v.items() if x == "diverges"]
+    return f" (diverging there, a failure: {', '.join(bad)})" if bad else ""
 
 
 def _finest(conv, models, lattices):
@@ -232,11 +240,13 @@ def _cost_of_replacing(pops, models, quick):
     said = []
     for finite, regime in ((False, "linear regime"), (True, "finite load")):
         ranked = scorecard.ranked(scorecard.overall(pops, models, finite))
+        loose = scorecard.unresolved(pops, models, finite)
         if ranked:
             said.append(f"{regime}: " + ", ".join(
                 f"{m} " + (fmt(e[1]) if e[1] is not None else "n/a")
                 + (f" ({e[2]} failed runs)" if e[2] else "")
                 + (f" (tied with {tie})" if tie else "")
+                + "".join(f" (not resolved from {b})" for (a, b) in loose if a == m)
                 for _, m, e, tie in ranked))
     if not said:
         return "**What does replacing FEM cost?** No case has a decomposed quantity."
@@ -302,8 +312,14 @@ def recommendation(root, models, pops, quick, bench_rows):
         approx = {m: v for m, v in lin.items() if m not in same}
         # equal to P1 within the comparison's floor: a check, not an approximation
         b, others = best(approx, False)
-        out.append(f"- Linear regime: {p1_lin}" + (f" (tied with {', '.join(same)})"
-                                                  if same else "")
+        disc = [d for p in pops if not p.finite and not p.patch_test
+                for d in p.discretisation()]
+        out.append(f"- Linear regime: FEM P1 ({p1_lin}"
+                   + (f"; {', '.join(same)} coincide with it there" if same else "")
+                   + ": 0 model-form error by construction, an identity check)"
+                   + (f", whose discretisation error on these meshes, {fmt(np.median(disc))} "
+                      f"[{fmt(min(disc))}-{fmt(max(disc))}], is what every model on them pays "
+                      "as well" if disc else "")
                    + (f"; the closest approximation is {named(lin, b, others)}" if b else "")
                    + ".")
     if fin and p1_fin:
@@ -313,9 +329,18 @@ def recommendation(root, models, pops, quick, bench_rows):
         linear = (f"; in the linear regime it ranks {order.index(b) + 1} of {len(order)}"
                   + (f" with {lin[b][2]} failed runs" if lin[b][2] else "")
                   if b in order else "")
-        out.append(f"- Finite strain: {p1_fin} (the reference's law on P1)"
-                   + (f"; the closest other, on {n} case{'s' if n > 1 else ''}, is "
-                      f"{named(fin, b, others)}{linear}" if b else "") + ".")
+        fails = finite_failures(root)
+        said = (f"; not decided on {n} case{'s' if n > 1 else ''} between "
+                f"{', '.join([b] + others)} (tied, or an order that reverses when one mesh "
+                "family is left out)" if others else
+                f"; the closest other, on {n} case{'s' if n > 1 else ''}, is "
+                f"{named(fin, b, others)}{linear}") if b else ""
+        cands = [b] + others if b else []
+        failing = [f"{m} in {', '.join(f'{c} {k} of {t}' for c, (k, t) in fails[m].items())}"
+                   for m in cands if fails.get(m)]
+        out.append(f"- Finite strain: {p1_fin} (the reference's law on P1){said}"
+                   + ("; no equilibrium at a case's load for " + "; ".join(failing)
+                      if failing else "") + ".")
     truth = _load(root, MEASURED, "metrics.json")
     if truth and truth.get("headline"):
         v = validation(truth)
@@ -333,8 +358,9 @@ def recommendation(root, models, pops, quick, bench_rows):
         cheapest = min((m for m in lin if bench_rows.get(m) and lin[m][1] is not None),
                        key=lambda m: bench_rows[m]["cpu_s_per_simulated_s"], default=None)
         line = (f"- Cost at a stated accuracy (model-form error within {ACCURACY:g} in the "
-                f"linear regime): {cheap}, "
-                f"{fmt(bench_rows[cheap]['cpu_s_per_simulated_s'])} s per simulated s")
+                f"linear regime): {cheap}"
+                + (" (FEM P1 itself, within it by construction)" if cheap == p1_lin else "")
+                + f", {fmt(bench_rows[cheap]['cpu_s_per_simulated_s'])} s per simulated s")
         if cheapest and bench_rows[cheapest]["cpu_s_per_simulated_s"] < \
                 bench_rows[cheap]["cpu_s_per_simulated_s"]:
             line += (f"; {cheapest} is cheaper ("
@@ -342,6 +368,21 @@ def recommendation(root, models, pops, quick, bench_rows):
                      f"error {fmt(lin[cheapest][1])}")
         out.append(line + ".")
     return out[:5] if len(out) > 1 else []
+
+
+def finite_failures(root):
+    """{model: {case: (runs without an equilibrium at the case's load, runs that tried)}} over
+    every case folder under ``root``."""
+    from .registry import CASES
+    out = {}
+    for case in CASES:
+        d = _load(root, case, "metrics.json")
+        for r in (d or {}).get("runs", []):
+            if "finite_failed" not in r:
+                continue
+            k, t = out.setdefault(r["model"], {}).get(case, (0, 0))
+            out[r["model"]][case] = (k + bool(r["finite_failed"]), t + 1)
+    return {m: {c: v for c, v in by.items() if v[0]} for m, by in out.items()}
 
 
 def validation(truth):

@@ -123,6 +123,7 @@ class Norm:
     label: str
     p1: str = P1_LINEAR
     unpaired: str = None      # run key counting the parts that failed (unpaired modes)
+    count: int = 1            # the parts a run compares (the modes it pairs)
 
     def parts(self, run, p1_run):
         mf, tot = run.get(self.model_form), run.get(self.total)

@@ -9,7 +9,8 @@ from .document import Table
 
 # what a ranking by a case's own metric measures: the total error, the mesh's own included
 # (the model-form ranking is the error model's, cases.scorecard)
-AGAINST = " against its reference (total error, the mesh's discretisation error included)"
+AGAINST = (" against its reference (total error, the mesh's discretisation error included: "
+           "not a ranking of the models, which the model-form error is)")
 
 
 def populations(runs):
@@ -108,12 +109,12 @@ def best_and_worst(runs, metric, what, exact=False, estimate_key="p2_error_estim
             return f"No model gave {what} in every run."
         med = {m: float(np.median(by[m])) for m in ranked}
         best, worst = min(med, key=med.get), max(med, key=med.get)
-        line = (f"{what}{AGAINST}: closest {best} ({cell(by[best], had[best])}), farthest "
+        line = (f"{what}{AGAINST}: smallest {best} ({cell(by[best], had[best])}), largest "
                 f"{worst} ({cell(by[worst], had[worst])}).")
         left = sorted(set(had) - set(ranked))
         if left:
-            line += (" Not ranked, a run without a value: " + ", ".join(
-                f"{m} ({len(by.get(m, []))} of {had[m]})" for m in left) + ".")
+            line += (" Left out, a run without a value: " + ", ".join(
+                f"{m} ({len(by.get(m, []))} of {had[m]} gave one)" for m in left) + ".")
         if est is None:
             return line
         tied = [m for m in sorted(med, key=med.get) if m != best and med[m] - med[best] < est]

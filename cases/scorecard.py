@@ -232,9 +232,14 @@ def case_findings(name, decomposed, runs, patch_tests=(), estimate_key="p2_error
             if tied:
                 line += f"; tied with {ok[0][1].model} within u_val {p.u_model_form:.2g}: " \
                         f"{', '.join(tied)}"
+            loose = population_unresolved(p)
+            first = [f"{b} (reverses without {mesh})" for (a, b), mesh in loose.items()
+                     if a == ok[0][1].model]
+            if first:
+                line += f"; {ok[0][1].model} is not resolved from " + ", ".join(first)
         elif not same:
             line += "no model gave it on every mesh"
-        failed = [f"{s.model} ({s.failed} of {s.runs})" for _, s, _ in st if s.failed]
+        failed = [f"{s.model} ({s.failed} of {s.runs} failed)" for _, s, _ in st if s.failed]
         if failed:
             line += "; failed runs, counted against their model: " + ", ".join(failed)
         if disc:
@@ -244,23 +249,49 @@ def case_findings(name, decomposed, runs, patch_tests=(), estimate_key="p2_error
             # |total| < |P1's| with a model-form error: its error opposes P1's
             cancel = [s.model for _, s, _ in ok
                       if _median(p.errors(s.model, "total")) is not None
-                      and _median(p.errors(s.model, "total")) < np.median(disc)]
+                      and np.median(disc) - _median(p.errors(s.model, "total"))
+                      > p.u_continuum]
+            level = [s.model for _, s, _ in ok if s.model not in cancel
+                     and _median(p.errors(s.model, "total")) is not None
+                     and abs(np.median(disc) - _median(p.errors(s.model, "total")))
+                     <= p.u_continuum]
             if cancel:
                 line += ("; closer to the continuum than P1 only by cancelling its error: "
                          + ", ".join(cancel))
+            if level:
+                line += (f"; as far from the continuum as P1 within u_val {p.u_continuum:.2g}: "
+                         + ", ".join(level))
         lines.append(line + ".")
         rows = [[p.bc, rank, s.model, cell(s, tie), _cell_of(p.errors(s.model, "total"))]
+                + ([f"{p.unpaired.get(s.model, 0)} of {p.quantity.count * s.runs}"]
+                   if p.lost else [])
                 for rank, s, tie in st]
         rows.append([p.bc, "-", f"{p.quantity.p1} (FEM P1)", "0 by construction",
-                     _cell_of(disc)])
+                     _cell_of(disc)] + (["0"] if p.lost else []))
         tables.append(Table(f"Model-form error ({p.quantity.label}) per model, against FEM P1 "
                             "on the same tetrahedra, beside the total against the continuum "
                             f"(u_val: model-form {p.u_model_form:.2g}, total "
                             f"{p.u_continuum:.2g}"
                             + (", the reference's spread over the meshes exceeding its "
                                "estimate" if p.spread_defect else "") + "):",
-                            ["bc", "rank", "model", "model-form", "total"], rows))
+                            ["bc", "rank", "model", "model-form", "total"]
+                            + (["unpaired P1 modes (failed, ranked first)"] if p.lost else []),
+                            rows))
     return lines, tables
+
+
+def population_unresolved(p):
+    """{(upper, lower): mesh} for neighbours of the population's model-form standings whose
+    order reverses when one mesh is left out."""
+    order = [s.model for _, s, _ in p.standings() if math.isfinite(s.score)]
+    meshes = sorted({x for ms in p.meshes.values() for x in ms})
+    out = {}
+    for mesh in meshes:
+        alt = {s.model: (r, s.score) for r, s, _ in p.without(mesh).standings()}
+        for a, b in zip(order, order[1:]):
+            if (a, b) not in out and a in alt and b in alt and alt[a] > alt[b]:
+                out[(a, b)] = mesh
+    return out
 
 
 def _median(values):

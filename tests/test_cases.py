@@ -227,7 +227,7 @@ def test_rankings_tie_models_the_reference_cannot_order():
     assert [r[2] for r in table.rows] == ["a", "b", "c"]
     assert [r[-1] for r in table.rows] == ["", "tied with a (estimate 0.01)", ""]
     line = common.best_and_worst(runs, "err", "Error")
-    assert "closest a" in line and "farthest c" in line and ": b." in line
+    assert "smallest a" in line and "largest c" in line and ": b." in line
     assert "not resolved" not in line           # 0.01 < 0.10 / 5
     coarse = [dict(r, p2_error_estimate=0.03) for r in runs]
     assert "not resolved" in common.best_and_worst(coarse, "err", "Error")
@@ -256,9 +256,9 @@ def test_rankings_keep_populations_apart_and_rank_only_complete_models():
                           "incomplete, not ranked"]
     line = rankings.best_and_worst(runs, "err", "Error")
     assert "[clamped] Error against its reference (total error" in line
-    assert "closest b" in line and "farthest a" in line
-    assert "Not ranked, a run without a value: c (1 of 2)" in line
-    assert line.index("[sliding]") < line.index("closest a") < line.index("[clamped]")
+    assert "smallest b" in line and "largest a" in line
+    assert "Left out, a run without a value: c (1 of 2 gave one)" in line
+    assert line.index("[sliding]") < line.index("smallest a") < line.index("[clamped]")
 
 
 def test_errors_over_free_components_leave_out_what_is_prescribed():

@@ -34,7 +34,7 @@ class Modes(Case):
     quick = {"fem_refine": 0}
     headline = "modal_rel_err"
     decomposed = Norm("modal_rel_err_p1", "modal_rel_err", "first 10 frequencies",
-                      unpaired="modes_unpaired_p1")
+                      unpaired="modes_unpaired_p1", count=N_MODES)
     gated = ("modal_rel_err", "modal_rel_err_median", "rigid_modes", "modes_unpaired")
     columns = ("frequencies_hz", "frequencies_fem_hz", "modal_rel_err", "modal_rel_err_median",
                "modes_unpaired", "modal_rel_err_p1", "modes_unpaired_p1", "rigid_modes")
