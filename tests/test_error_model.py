@@ -230,3 +230,38 @@ def test_consistency_limits_closer_than_their_uncertainty_are_tied():
     lims = [("a", (0.19, 0.03)), ("b", (0.192, 0.004)), ("c", (0.59, 0.08)), ("d", (0.9, 0.01))]
     assert _limit_ties(lims) == " (tied within their +-: a, b)"
     assert _limit_ties(lims[2:]) == ""
+
+
+def test_what_to_pick_is_computed_and_names_what_is_not_decided(tmp_path):
+    """The recommendation names FEM P1 as an identity check with the discretisation error every
+    model pays, the closest approximation in the linear regime, and 'not decided' at finite
+    load where one mesh reverses the order, with the candidates' failures at a case's load."""
+    from cases.answers import recommendation
+    from cases.index import populations
+    lin = {}
+    for mesh in ("five", "six"):
+        lin.update({(mesh, "fem-linear"): 1.2, (mesh, "a"): 1.1, (mesh, "b"): 1.5})
+    _case_folder(tmp_path, "torsion", _torsion_runs(lin))
+    fin = []
+    for mesh, (a, b) in {"five": (1.1, 1.3), "six": (1.4, 1.0)}.items():
+        for model, f in (("fem-neohookean", 1.2), ("fem-linear", 1.0), ("a", a), ("b", b)):
+            fin.append({"mesh": mesh, "bc": "clamped", "model": model, "force_n_steps": [f],
+                        "force_fem_n_steps": [1.0], "nh_error_estimate": 0.01,
+                        "finite_failed": "no equilibrium" if (model, mesh) == ("b", "six")
+                        else None})
+    (tmp_path / "large-compression").mkdir()
+    (tmp_path / "large-compression" / "metrics.json").write_text(json.dumps({
+        "headline_estimate": "nh_error_estimate", "runs": fin,
+        "parameters": {"models": ["fem-neohookean", "fem-linear", "a", "b"], "quick": False}}))
+    pops, _ = populations(tmp_path, ["torsion", "large-compression"])
+    lines = recommendation(tmp_path, ["fem-linear", "fem-neohookean", "a", "b"], pops, False, {})
+    assert lines[0] == "**What to pick?**"
+    assert lines[1].startswith("- Linear regime: FEM P1 (fem-linear: 0 model-form error by "
+                               "construction, an identity check), whose discretisation error "
+                               "on these meshes, 0.2 [0.2-0.2]")
+    assert "the closest approximation is a, model-form error 0.1" in lines[1]
+    # at finite load a's model-form errors are 0.1, 0.2 and b's 0.1, 0.2 (six reversed)
+    assert "not decided on 1 case between" in lines[2]
+    assert "no equilibrium at a case's load for b in large-compression 1 of 2" in lines[2]
+    assert recommendation(tmp_path, ["a"], pops, True, {}) == [
+        "**What to pick?** Quick: not decided (`pbcm report` decides)."]
