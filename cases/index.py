@@ -200,8 +200,10 @@ TERMS = {
     "comparison is read against: u_num the reference's estimate or its spread over the meshes "
     "of one continuum problem, whichever is larger (for a model-form error, the distance "
     "between FEM laws that coincide in the linear regime, or the solver's tolerance), u_input "
-    "the sensitivity to inputs nobody measured, u_D the measurement's noise. Two errors closer "
-    "than u_val are tied.",
+    "the sensitivity to inputs nobody measured (0 for the library's cases, whose material and "
+    "load are given, not measured; the Truth Cube's plate friction, travel and nu), u_D the "
+    "measurement's noise (0 where nothing is measured). Two errors closer than u_val are "
+    "tied.",
     "mean rank": "a model's overall standing in one regime: the mean of its rank in every "
     "population, each population ranking its models by the median over the meshes with a "
     "failed run counted as infinitely wrong (so a failure never removes a population from "
