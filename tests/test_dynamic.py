@@ -256,7 +256,7 @@ def test_fem_frequency_estimates_fall_under_refinement_as_rayleigh_ritz_bounds_d
     """Nested conforming P2 spaces with consistent mass bound each frequency from above, so
     the refined frequencies lie below the coarse ones and each estimate, relative to the refined reference, is f_0 / f_1 - 1 >= 0
     (an estimate of the wrong sign, or taken against the wrong level, goes red)."""
-    from cases.library.transient import N_MODES, fem_frequencies
+    from cases.library.transient import CLUSTER_EXTRA, N_MODES, fem_frequencies
     from model.mesh import cube
     from model.material import Material
     mesh = cube(3, 0.032, "five")
@@ -264,7 +264,8 @@ def test_fem_frequency_estimates_fall_under_refinement_as_rayleigh_ritz_bounds_d
     held = {int(i): (0.0, 0.0, 0.0) for i in mesh.nodes_on_plane("y", 0.0)}
     (f0, _), none = fem_frequencies(mesh, mat, held, refine=0)
     (f1, shapes), each = fem_frequencies(mesh, mat, held, refine=1)
-    assert none is None and shapes.shape == (N_MODES, 3 * mesh.n_nodes)
+    # the modes past N_MODES complete a cluster the tenth cuts; estimates are of the first ten
+    assert none is None and shapes.shape == (N_MODES + CLUSTER_EXTRA, 3 * mesh.n_nodes)
     assert np.all(f1 <= f0 * (1 + 1e-10))
-    assert np.allclose(each, f0 / f1 - 1, rtol=1e-12, atol=0)
+    assert np.allclose(each, f0[:N_MODES] / f1[:N_MODES] - 1, rtol=1e-12, atol=0)
     assert 0 < each.max() < 0.2
