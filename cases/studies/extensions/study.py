@@ -6,6 +6,7 @@ from model import Material
 from model.candidates import BASE, CANDIDATES, NORMAL_FORMS, short  # noqa: F401 (the study's names)
 from ...catalogue import STATIC, err_name
 from ...costs import step_cost_us
+from ...error_model import decomposed
 from ...store import OFF
 from ...registry import studies
 from ...runner import jsonable, run as run_case
@@ -40,7 +41,7 @@ class ExtensionSettings:
         from ...registry import CASES
         return {name: case.settings(quick=self.quick, models=self.models, E=self.E, nu=self.nu,
                                     rho=self.rho) for name, case in CASES.items()
-                if self.cases is None or name in self.cases}
+                if (self.cases is None or name in self.cases) and case.decomposed is not None}
 
     def convergence_settings(self):
         return studies()["convergence"].settings(
@@ -69,15 +70,31 @@ def static_headline(case):
     return case.headline in STATIC or case.headline in {err_name(q) for q in case.qoi_errors}
 
 
-def case_row(case, r):
-    """What the rankings read of one case run."""
-    failed = r.get("failed") or r.get("static_failed")
-    info = r.get("model_info") or {}
-    return {"case": case.name, "mesh": r["mesh"], "bc": r["bc"], "model": r["model"],
-            "metric": case.headline, "error": None if failed else r.get(case.headline),
-            "failed": failed,
-            "alternation_rel": r.get("alternation_rel"),
-            "dropped": info.get("calibration_dropped", [])}
+def with_p1(case, cfg):
+    """The case's settings with the FEM P1 its model-form error is taken against (the same
+    law on the same tetrahedra: neo-Hookean P1 at finite load) among the models."""
+    return replace(cfg, models=tuple(dict.fromkeys((*cfg.models, case.decomposed.p1))))
+
+
+def case_rows(case, runs):
+    """What the rankings read of a case's runs: each run's model-form error on the case's
+    decomposed quantity (the error model's, magnitude), with the discretisation error of FEM
+    P1 on that mesh beside it."""
+    parts = decomposed(runs, case.decomposed)
+    rows = []
+    for r in runs:
+        failed = r.get("failed") or r.get("static_failed")
+        p = parts[(r["mesh"], r["bc"], r["model"])]
+        info = r.get("model_info") or {}
+        rows.append({"case": case.name, "mesh": r["mesh"], "bc": r["bc"], "model": r["model"],
+                     "metric": f"{case.decomposed.label}: model-form",
+                     "error": None if failed or p is None else abs(p.model_form),
+                     "discretisation": None if p is None else abs(p.discretisation),
+                     "failed": failed or (None if p is not None else
+                                          f"no {case.decomposed.label} or no FEM P1 twin"),
+                     "alternation_rel": r.get("alternation_rel"),
+                     "dropped": info.get("calibration_dropped", [])})
+    return rows
 
 
 def costs(bench, models):
@@ -96,16 +113,17 @@ RUN_KEYS = ("case_runs", "fits", "elasticity", "cost_vs_fem_linear", "cost_same_
 
 
 def run(s, workers=None, log=True, bench=None, store=OFF):
-    """Every case with the study's models, then the convergence study with them. The models
-    the cases ran already (the paper's model, fem-linear) come from ``store``; a case whose
-    headline is a static metric runs its static problem only (no dynamics, no modes: no
-    ranking reads them)."""
+    """Every case with the study's models and its FEM P1 twin, then the convergence study
+    with the models. The models the cases ran already (the paper's model, fem-linear) come
+    from ``store``; a case whose headline is a static metric runs its static problem only (no
+    dynamics, no modes: no ranking reads them)."""
     from ...registry import CASES
     rows = []
     for name, cfg in s.case_settings().items():
-        cfg = replace(cfg, static_only=static_headline(CASES[name]))
-        runs, _ = run_case(CASES[name], cfg, workers=workers, store=store, reuse_full=True)
-        rows += [case_row(CASES[name], r) for r in runs]
+        case = CASES[name]
+        cfg = replace(with_p1(case, cfg), static_only=static_headline(case))
+        runs, _ = run_case(case, cfg, workers=workers, store=store, reuse_full=True)
+        rows += case_rows(case, runs)
     conv = studies()["convergence"].run(s.convergence_settings(), workers=workers, log=log,
                                         bench=None, store=store)
     return jsonable({"case_runs": rows, "fits": conv["fits"], "elasticity": [
