@@ -234,3 +234,12 @@ def test_each_case_row_is_the_model_form_error_of_the_cases_decomposed_quantity(
     assert rows[2]["error"] is None and "no FEM P1 twin" in rows[2]["failed"]
     s = with_p1(case, case.settings(quick=True, models=(BASE,)))
     assert s.models == (BASE, p1)
+
+
+def test_a_model_with_no_error_in_one_population_has_geometric_mean_zero():
+    """A model exact in one population (FEM P1 against itself) has geometric mean 0, not the
+    mean over the populations where it has an error."""
+    errs = {"torsion": {BASE: 0.2, "m1": 0.1, "m2": 0.2, YARDSTICK: 0.0},
+            "large-compression": {BASE: 0.2, "m1": 0.1, "m2": 0.2, YARDSTICK: 0.4}}
+    models, data = _doc(errs, {}, {})
+    assert R.rankings(data, models)["overall"][YARDSTICK] == 0.0

@@ -87,8 +87,12 @@ def _complete(errors, models):
 
 
 def _gmean(m, es):
-    r = [e[m] / e[BASE] for e in es if e[BASE] > 0 and e[m] > 0]
-    return float(np.exp(np.mean(np.log(r)))) if r else None
+    """The geometric mean of ``m``'s errors over the paper model's; 0 where ``m`` has no
+    error in some population (FEM P1 against itself), never a mean over its nonzero ones."""
+    r = [e[m] / e[BASE] for e in es if e[BASE] > 0]
+    if not r:
+        return None
+    return 0.0 if min(r) == 0 else float(np.exp(np.mean(np.log(r))))
 
 
 def overall(errors, models):
