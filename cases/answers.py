@@ -495,7 +495,8 @@ def _largest(limit):
 def _decisive(art):
     best = next(r for r in art["readings"] if r["model"] == art["verdict"]["model"])
     said = {"pattern": "the paper's pattern on a 374-tetrahedron mesh",
-            "cost": "a step over 10x msm's", "stable": "no flutter"}
+            "cost": "a step over 10x msm's", "stable": "no flutter (the artefact study's dynamic runs; the paper cube's are the "
+            "scorecard's stability column)"}
     yes = [said[k] for k, v in best["matches"].items() if v]
     no = [said[k] for k, v in best["matches"].items() if not v]
     return ("has " + (", ".join(yes) or "none of the paper's observables")

@@ -243,8 +243,9 @@ def glossary_documents():
             doc.h(2, f"The {name} study")
             doc.ul(study.definitions())
     doc.h(2, "Metrics")
-    doc.table(["label", "name", "unit", "definition"],
-              [[m.label, m.name, m.shown[0] if m.shown else m.unit, m.definition]
+    doc.table(["label", "name", "unit in metrics.json", "definition"],
+              [[m.label, m.name, (f"{m.unit} (tables: {m.shown[0]})" if m.shown else m.unit),
+                m.definition]
                for m in sorted(catalogue.CATALOGUE.values(), key=lambda m: m.name)])
     return doc.markdown() + "\n", doc.html(".") + "\n"
 

@@ -29,14 +29,16 @@ def test_the_punch_is_its_face_and_a_rim_sloping_to_the_free_surface():
     pts = np.array([[c, top, c], [c + half, top, c - half],
                     [c + half + RIM_MM / 2 * MM, top, c],          # half-way down the rim
                     [c + half + RIM_MM * MM, top, c],              # the rim's outer edge
+                    [c + half + RIM_MM * MM + 1e-4, top, c],       # just beyond it
                     [c, top - 1e-3, c], [c, 0.0, c]])
-    assert in_patch(pts).tolist() == [True, True, False, False, False, False]
+    assert in_patch(pts).tolist() == [True, True, False, False, False, False, False]
     u = punch(pts)
     assert np.array_equal(u[0], [0.0, -DEPTH_MM * MM, 0.0])
     assert np.array_equal(u[1], [0.0, -DEPTH_MM * MM, 0.0])
     assert np.allclose(u[2], [0.0, -DEPTH_MM * MM / 2, 0.0], rtol=0, atol=1e-15)
-    assert np.isnan(u[3]).all() and np.isnan(u[4]).all()
-    assert np.array_equal(u[5], [0.0, 0.0, 0.0])
+    assert np.allclose(u[3], 0.0, rtol=0, atol=1e-15)        # held: the surface is closed
+    assert np.isnan(u[4]).all() and np.isnan(u[5]).all()
+    assert np.array_equal(u[6], [0.0, 0.0, 0.0])
 
 
 def test_the_models_prescribe_the_references_field_at_their_nodes():
@@ -63,13 +65,24 @@ def test_every_mesh_poses_the_same_punch():
             assert abs(fa / fb - 1) <= ea + eb, (a, b, forces)
 
 
+def _face_only(points):
+    """The punch's face alone held at full depth (no rim), the base clamped: a patch whose
+    edge falls between the nodes of the coarse lattice."""
+    out = np.full(points.shape, np.nan)
+    out[np.abs(points[:, 1]) <= 1e-9] = 0.0
+    out[in_patch(points)] = (0.0, -DEPTH_MM * MM, 0.0)
+    return out
+
+
 def test_a_region_decides_new_boundary_points_by_where_they_lie():
-    # P2 dofs on the top face inside the punch's face are held, though their facets' other
-    # vertices are free: what a plain dirichlet_fn (the facet rule) does not do
+    # P2 dofs on the top face inside the face are held, though their facets' other vertices
+    # are free: what a plain dirichlet_fn (the facet rule) does not do
     s = CASE.settings(spacing_mm=SPACING)
     mesh = CASE.mesh("five", s)
-    d = CASE.dirichlet(mesh, "clamped", s)
-    for fn, all_held in ((Region(punch), True), (punch, False)):
+    pts = mesh.points
+    given = _face_only(pts)
+    d = {int(i): tuple(given[i]) for i in np.flatnonzero(~np.isnan(given).any(axis=1))}
+    for fn, all_held in ((Region(_face_only), True), (_face_only, False)):
         r = linear.solve(mesh, s.E, s.nu, d, element="P2", dirichlet_fn=fn, solver="direct")
         under = (dof_component(r.basis) == 1) & in_patch(r.basis.doflocs.T)
         assert under.sum() > len(mesh.nodes_on_plane("y", 0.032)[in_patch(

@@ -47,21 +47,29 @@ def in_patch(points, grow=0.0):
             & (np.abs(points[:, 0] - c) <= half) & (np.abs(points[:, 2] - c) <= half))
 
 
+def _from_centre_mm(points):
+    """The distance of points (k, 3) [m] from the top face's centre in the max norm [mm]."""
+    c = SIZE_MM * MM / 2
+    return np.maximum(np.abs(points[:, 0] - c), np.abs(points[:, 2] - c)) / MM
+
+
 def pressed_fraction(points):
     """The punch's depth at points (k, 3) [m] as a fraction of the face's: 1 under the face,
     falling linearly to 0 across the rim, 0 beyond (the top face's (x, z) alone)."""
-    c = SIZE_MM * MM / 2
-    r = np.maximum(np.abs(points[:, 0] - c), np.abs(points[:, 2] - c))
-    return np.clip((PATCH_MM / 2 + RIM_MM - r / MM) / RIM_MM, 0.0, 1.0)
+    return np.clip((PATCH_MM / 2 + RIM_MM - _from_centre_mm(points)) / RIM_MM, 0.0, 1.0)
 
 
 def punch(points):
     """The prescribed displacement by where a boundary point lies: held on the base, pressed
-    down under the punch's face and rim (held there in x and z), free elsewhere (NaN)."""
+    down under the punch's face and rim (held there in x and z), free elsewhere (NaN). The
+    rim's outer edge is held too (at 0): the prescribed surface is closed, as a Dirichlet
+    boundary is, so a node there carries the field's value and every mesh's nodal values
+    interpolate one field."""
     out = np.full(points.shape, np.nan)
     out[np.abs(points[:, 1]) <= 1e-9] = 0.0
     f = pressed_fraction(points)
-    under = (np.abs(points[:, 1] - SIZE_MM * MM) <= 1e-9) & (f > 1e-9)
+    under = ((np.abs(points[:, 1] - SIZE_MM * MM) <= 1e-9)
+             & (_from_centre_mm(points) <= PATCH_MM / 2 + RIM_MM + 1e-6))
     out[under] = 0.0
     out[under, 1] = -DEPTH_MM * MM * f[under]
     return out
