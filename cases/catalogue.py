@@ -491,8 +491,12 @@ declare("anisotropy_AU", "1", "A^U",
 declare("asymmetry", "1", "asymmetry",
          "||C_eff - C_eff^T|| / ||C_eff|| (zero for a model with an energy).")
 declare("error", "1", "case error",
-         "the case's headline metric for one run (the extensions study's ranking unit).",
+         "the model-form error of the case's decomposed quantity for one run, against FEM P1 "
+         "with the same law on the same tetrahedra (the extensions study's ranking unit).",
          "max")
+declare("discretisation", "1", "P1 discretisation",
+         "FEM P1's discretisation error of the case's decomposed quantity on the run's mesh, "
+         "against the converged continuum (the extensions study's failure criterion).")
 del _n
 
 # the standard metrics of a static solution (None when the static solve failed), the ones the

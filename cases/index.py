@@ -97,8 +97,9 @@ def conclusion(pops, models, quick):
             continue
         out.append(f"Model-form ranking, {regime}, over its {n} populations other than patch "
                    "tests (each model's "
-                   "mean rank, a population ranking its models by the median over the meshes "
-                   "with a failed run counted as infinitely wrong; the geometric mean of its "
+                   "mean rank, a population ranking its models first by unpaired modes, then "
+                   "by the median over the meshes with a failed run counted as infinitely "
+                   "wrong; the geometric mean of its "
                    "scores beside it, each floored at the comparison's uncertainty; FEM P1 "
                    "itself is the identity check and not ranked; an order that reverses "
                    "when one mesh family is left out is not resolved): " + "; ".join(
@@ -205,9 +206,10 @@ TERMS = {
     "measurement's noise (0 where nothing is measured). Two errors closer than u_val are "
     "tied.",
     "mean rank": "a model's overall standing in one regime: the mean of its rank in every "
-    "population, each population ranking its models by the median over the meshes with a "
-    "failed run counted as infinitely wrong (so a failure never removes a population from "
-    "anyone's comparison).",
+    "population, each population ranking its models first by the parts they lost (unpaired "
+    "modes), then by the median over the meshes with a failed run counted as infinitely "
+    "wrong (so a failure never removes a population from anyone's comparison); models within "
+    "u_val of the first of a group share its rank.",
     "consistency limit": "the error a model keeps under mesh refinement on a problem whose "
     "answer every consistent discretisation reproduces exactly: the converged limit e_inf of "
     "the sliding cube (a homogeneous compression, a patch test) in the linear regime, per "
