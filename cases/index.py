@@ -91,6 +91,7 @@ def conclusion(pops, models, quick):
             continue
         n = len([p for p in pops if p.finite == finite and not p.patch_test])
         loose = scorecard.unresolved(pops, models, finite)
+        rng = scorecard.spread(pops, models, finite)
         if quick:
             out.append(f"Model-form ranking, {regime}: quick: not decided (run `pbcm report` "
                        "for every mesh).")
@@ -102,8 +103,8 @@ def conclusion(pops, models, quick):
                    "wrong; the geometric mean of its "
                    "scores beside it, each floored at the comparison's uncertainty; FEM P1 "
                    "itself is the identity check and not ranked; an order that reverses "
-                   "when one mesh family is left out is not resolved): " + "; ".join(
-                       f"{rank}. {m} ({scorecard.describe(entry)})"
+                   "when one mesh family or one case is left out is not resolved): " + "; ".join(
+                       f"{rank}. {m} ({scorecard.describe(entry, rng.get(m))})"
                        + (f", tied with {tie}" if tie else "")
                        + "".join(f", not resolved from {b} (reverses without {mesh})"
                                  for (a, b), mesh in loose.items() if a == m)
@@ -209,12 +210,23 @@ TERMS = {
     "population, each population ranking its models first by the parts they lost (unpaired "
     "modes), then by the median over the meshes with a failed run counted as infinitely "
     "wrong (so a failure never removes a population from anyone's comparison); models within "
-    "u_val of the first of a group share its rank.",
+    "u_val of the first of a group share its rank. At finite load a model that found no "
+    "equilibrium at a case's load (a linear case's finite-load phase) ranks after every model "
+    "that found one. Beside it the geometric mean of the population medians, each floored at "
+    "its population's u_val, with its range over the rankings that leave one mesh family out.",
+    "not resolved": "an order of two neighbouring models that reverses when one mesh family "
+    "(every population's runs on it) or one case is left out: the data cannot order them, "
+    "whatever their mean ranks say.",
+    "failed run": "a run that gave no number (no equilibrium, a metric undefined, a run that "
+    "could not start): it counts against its model, as infinitely wrong, in every ranking, "
+    "case table and answer; the population stays in every other model's comparison.",
     "consistency limit": "the error a model keeps under mesh refinement on a problem whose "
     "answer every consistent discretisation reproduces exactly: the converged limit e_inf of "
     "the sliding cube (a homogeneous compression, a patch test) in the linear regime, per "
     "lattice, +- its extrapolation's uncertainty; FEM's is zero to rounding. The index's "
-    "'how far from the continuum' reads these limits only.",
+    "'how far from the continuum' reads these limits only. Two limits are tied when they "
+    "differ by less than their +- combined, pair by pair (ties are not transitive); a model "
+    "that diverges on a lattice is never tied with one that converges everywhere.",
     "worst isotropy error": "the largest relative error of the six Kelvin moduli of the "
     "model's effective elasticity tensor (a relaxed lattice patch) against the isotropic "
     "target's, over the lattices.",

@@ -1,11 +1,15 @@
 """Sentences that rank the models of a case's runs, computed from the runs: one population per
-aggregate (each boundary condition apart), each cell 'median [min-max], n of N runs', only
-models with a value in every run ranked, ties within the reference's error estimate, the
-closest and farthest model, failures, and the case's load against the neo-Hookean
-reference."""
+aggregate (each boundary condition apart), each cell 'median [min-max], n of N runs', a run
+without a value counted against its model (``error_model.standings``), ties within the
+reference's u_num of a group's first, the closest and farthest model, failures of every
+phase, and the case's load against the neo-Hookean reference."""
+import math
+
 import numpy as np
 
+from .catalogue import err_name, ref_name
 from .document import Table
+from .error_model import standings, u_num
 
 # what a ranking by a case's own metric measures: the total error, the mesh's own included
 # (the model-form ranking is the error model's, cases.scorecard)
@@ -20,16 +24,6 @@ def populations(runs):
     for r in runs:
         out.setdefault(r["bc"], []).append(r)
     return out
-
-
-def _by_model(runs, metric):
-    """{model: values} over the runs that gave ``metric``, and {model: runs it had}."""
-    by, had = {}, {}
-    for r in runs:
-        had[r["model"]] = had.get(r["model"], 0) + 1
-        if r.get(metric) is not None:
-            by.setdefault(r["model"], []).append(r[metric])
-    return by, had
 
 
 def cell(values, total):
@@ -48,12 +42,6 @@ def estimate(runs, key="p2_error_estimate"):
     return max(est) if est else None
 
 
-def _complete(by, had):
-    """The models with a value in every run they had (the others are not ranked)."""
-    full = max(had.values(), default=0)
-    return [m for m in by if len(by[m]) == had[m] == full]
-
-
 def _labelled(runs, line_of):
     """``line_of(population runs)`` per boundary condition, prefixed by the bc when there are
     several populations."""
@@ -63,67 +51,112 @@ def _labelled(runs, line_of):
     return [f"[{bc}] {line_of(rs)}" for bc, rs in pops.items()]
 
 
+# the continuum's value behind a relative error whose quantity is not named after it
+CONTINUUM_OF = {"reaction_rel_err": "reaction_fem_p2_n",
+                "reaction_rel_err_nh": "reaction_fem_nh_n"}
+
+
+def _continuum_key(runs, metric):
+    """The run key of the continuum's value whose relative error ``metric`` is, or None (an
+    error that is a norm has none)."""
+    if metric in CONTINUUM_OF:
+        return CONTINUUM_OF[metric]
+    keys = {k for r in runs for k in r}
+    return next((ref_name(q) for q in sorted(keys)
+                 if err_name(q) == metric and ref_name(q) in keys and ref_name(q) != q), None)
+
+
+def uncertainty(runs, metric, estimate_key="p2_error_estimate"):
+    """(u_num, the spread exceeds the estimate) of a comparison of ``metric`` over ``runs`` (one
+    continuum problem on several meshes): the reference's largest estimate, widened to the
+    spread of the continuum's value across the meshes where that is larger
+    (``error_model.u_num``); 0 where the reference states none."""
+    key = _continuum_key(runs, metric)
+    values = {}
+    if key:
+        for r in runs:
+            v = r.get(key)
+            if v is not None:
+                values[r["mesh"]] = float(v[-1]) if isinstance(v, (list, tuple)) else float(v)
+    u, defect = u_num(estimate(runs, estimate_key), list(values.values()))
+    return u, defect
+
+
+def _standings(runs, metric, u):
+    """``error_model.standings`` of ``metric`` over one population: every run a model had
+    counts, a run without a value as infinitely wrong."""
+    by = {}
+    for r in runs:
+        by.setdefault(r["model"], []).append(r.get(metric))
+    return standings(by, u)
+
+
+def _u_text(u, defect):
+    return f"u_num {u:.2g}" + (", the spread over the meshes" if defect else "")
+
+
 def ranking(runs, metric, label, estimate_key="p2_error_estimate"):
     """A table (one item of a report's findings): per population (boundary condition) the
-    models by median ``metric``, best first, with the range and 'n of N runs'; only the models
-    with a value in every run are ranked, the others listed after, unranked; a model within
-    the reference's estimate (``estimate_key``) of the one above is tied with it (the
-    reference cannot order them)."""
+    models by median ``metric`` over every run they had (a run without a value counts against
+    its model, as infinitely wrong), best first, with the range and 'n of N runs'; a model
+    within the reference's u_num (``uncertainty``) of the first of a group is tied with it
+    (the reference cannot order them)."""
     rows = []
     for bc, rs in populations(runs).items():
-        by, had = _by_model(rs, metric)
-        est = estimate(rs, estimate_key)
-        med = {m: float(np.median(v)) for m, v in by.items()}
-        ranked = sorted(_complete(by, had), key=med.get)
-        for k, m in enumerate(ranked):
-            tie = ""
-            if k and est is not None and med[m] - med[ranked[k - 1]] < est:
-                tie = f"tied with {ranked[k - 1]} (estimate {est:.2g})"
-            rows.append([bc, k + 1, m, *_stats(by[m], had[m]), tie])
-        for m in sorted(set(had) - set(ranked)):
-            rows.append([bc, "-", m, *_stats(by.get(m, []), had[m]), "incomplete, not ranked"])
+        u, defect = uncertainty(rs, metric, estimate_key)
+        for rank, s, tie in _standings(rs, metric, u):
+            note = []
+            if tie:
+                note.append(f"tied with {tie} ({_u_text(u, defect)})")
+            if s.failed:
+                note.append(f"{s.failed} failed, counted against it")
+            rows.append([bc, rank, s.model, *_stats(s), "; ".join(note)])
     return [Table(f"{label[0].upper()}{label[1:]} ({metric}){AGAINST} per model, median over "
-                  "the meshes:",
+                  "the meshes, a failed run counted against its model:",
                   ["bc", "rank", "model", "median", "range", "runs", "note"], rows)]
 
 
-def _stats(values, total):
-    if not values:
-        return "n/a", "", f"0 of {total}"
-    return (f"{np.median(values):.3g}", f"{min(values):.3g}-{max(values):.3g}",
-            f"{len(values)} of {total}")
+def _stats(s):
+    """(median, range, 'n of N') of a Standing: the median over every run it had."""
+    if not s.values:
+        return "failed", "", f"0 of {s.runs}"
+    med = "failed at the median" if math.isinf(s.score) else f"{s.score:.3g}"
+    return (med, f"{min(s.values):.3g}-{max(s.values):.3g}", f"{len(s.values)} of {s.runs}")
+
+
+def _cell(s):
+    med, rng, n = _stats(s)
+    return f"median {med}" + (f" [{rng}]" if rng else "") + f", {n} runs"
 
 
 def best_and_worst(runs, metric, what, exact=False, estimate_key="p2_error_estimate"):
     """Per population (boundary condition), one line naming the model closest to FEM and the
-    farthest by median ``metric`` among the models with a value in every run; the models
-    within the reference's estimate (``estimate_key``) of the closest are named tied with it,
-    the line says so where that estimate exceeds a fifth of the smallest error it ranks
-    (``exact``: the metric is against a closed form, which has no estimate), and it names
-    the models left out for a missing run."""
+    farthest by median ``metric`` over every run (a run without a value counts against its
+    model); the models within the reference's u_num (``uncertainty``) of the closest are named
+    tied with it, the line says so where that exceeds a fifth of the smallest error it ranks
+    (``exact``: the metric is against a closed form, which has no estimate), and it names the
+    models with failed runs."""
     def line_of(rs):
-        by, had = _by_model(rs, metric)
-        est = None if exact else estimate(rs, estimate_key)
-        ranked = _complete(by, had)
-        if not ranked:
-            return f"No model gave {what} in every run."
-        med = {m: float(np.median(by[m])) for m in ranked}
-        best, worst = min(med, key=med.get), max(med, key=med.get)
-        line = (f"{what}{AGAINST}: smallest {best} ({cell(by[best], had[best])}), largest "
-                f"{worst} ({cell(by[worst], had[worst])}).")
-        left = sorted(set(had) - set(ranked))
-        if left:
-            line += (" Left out, a run without a value: " + ", ".join(
-                f"{m} ({len(by.get(m, []))} of {had[m]} gave one)" for m in left) + ".")
-        if est is None:
+        u, defect = (0.0, False) if exact else uncertainty(rs, metric, estimate_key)
+        st = _standings(rs, metric, u)
+        if not st or not any(s.values for _, s, _ in st):
+            return f"No model gave {what}."
+        best, worst = st[0][1], st[-1][1]
+        line = (f"{what}{AGAINST}: smallest {best.model} ({_cell(best)}), largest "
+                f"{worst.model} ({_cell(worst)}).")
+        failed = [s for _, s, _ in st if s.failed]
+        if failed:
+            line += (" Failed runs, counted against their model: " + ", ".join(
+                f"{s.model} ({s.failed} of {s.runs})" for s in failed) + ".")
+        if exact:
             return line
-        tied = [m for m in sorted(med, key=med.get) if m != best and med[m] - med[best] < est]
+        tied = [s.model for _, s, t in st if t == best.model]
         if tied:
-            line += (f" Tied with {best} within the reference's estimate {est:.2g}: "
+            line += (f" Tied with {best.model} within the reference's {_u_text(u, defect)}: "
                      f"{', '.join(tied)}.")
-        smallest = min(min(by[m]) for m in ranked)
-        if est > smallest / 5:
-            line += (f" The reference's estimate ({est:.2g}) exceeds a fifth of the smallest "
+        smallest = min(min(s.values) for _, s, _ in st if s.values)
+        if u > smallest / 5:
+            line += (f" The reference's u_num ({u:.2g}) exceeds a fifth of the smallest "
                      f"error ranked ({smallest:.2g}): differences below it are not resolved.")
         return line
     return " ".join(_labelled(runs, line_of))
@@ -146,11 +179,32 @@ def per_run(runs, holds, what):
             f"{'; '.join(some) or 'none'}; in none: {', '.join(never) or 'none'}.")
 
 
-def failures(runs, key="static_failed", where="in the linear regime"):
-    """One line on the runs whose static solve (``key``) failed, or that none did."""
-    bad = [f"{r['model']} on {r['mesh']}/{r['bc']}" for r in runs if r.get(key)]
-    return (f"No static equilibrium {where} for " + ", ".join(bad) + "." if bad
-            else f"Every model found its static equilibrium {where} on every mesh run.")
+def failures(runs, key=None, where="in the linear regime"):
+    """One line on the runs that found no equilibrium: of phase ``key`` (``where`` it is), or
+    by default of every phase (the linear regime, the case's load where a reference of it
+    exists, and the runs that could not start); or that none failed."""
+    if key is not None:
+        bad = [f"{r['model']} on {r['mesh']}/{r['bc']}" for r in runs if r.get(key)]
+        return (f"No static equilibrium {where} for " + ", ".join(bad) + "." if bad
+                else f"Every model found its static equilibrium {where} on every mesh run.")
+    phases = (("static_failed", "in the linear regime", runs),
+              ("finite_failed", "at the case's load",
+               [r for r in runs if r.get("nh_error_estimate") is not None]),
+              ("failed", "could not start", runs))
+    said, checked = [], []
+    for k, label, rs in phases:
+        bad = [f"{r['model']} on {r['mesh']}/{r['bc']}" for r in rs if r.get(k)]
+        if bad:
+            said.append(("Could not start: " if k == "failed" else
+                         f"No static equilibrium {label} for ") + ", ".join(bad))
+        elif rs and any(k in r for r in rs) and k != "failed":
+            checked.append(label)
+    if not said:
+        return ("Every model found its static equilibrium " + " and ".join(checked)
+                + " on every mesh run.")
+    return "; ".join(said) + (f". Every model found its static equilibrium "
+                              f"{' and '.join(checked)} on every mesh run" if checked
+                              else "") + "."
 
 
 def finite_load(runs):

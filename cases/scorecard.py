@@ -35,6 +35,9 @@ class Population:
     quick: bool
     meshes: dict = field(default_factory=dict)     # {model: [mesh per run]}
     lost: dict = field(default_factory=dict)       # {model: [unpaired modes per run]}
+    # {model: [(mesh, no equilibrium at the case's load)]} over the runs with a finite-load
+    # phase and its reference: what the finite-load ranking counts of a linear population
+    load_failed: dict = field(default_factory=dict)
 
     @property
     def unpaired(self):
@@ -46,7 +49,9 @@ class Population:
         keep = {m: [k for k, x in enumerate(self.meshes[m]) if x != mesh] for m in self.parts}
         return replace(self, parts={m: [self.parts[m][k] for k in ks] for m, ks in keep.items()},
                        meshes={m: [self.meshes[m][k] for k in ks] for m, ks in keep.items()},
-                       lost={m: [self.lost[m][k] for k in keep[m]] for m in self.lost})
+                       lost={m: [self.lost[m][k] for k in keep[m]] for m in self.lost},
+                       load_failed={m: [x for x in v if x[0] != mesh]
+                                    for m, v in self.load_failed.items()})
 
     @property
     def label(self):
@@ -89,8 +94,11 @@ def populations(runs_by_case, declared, quick, patch_tests, estimate_keys):
             rs = [r for r in runs if r["bc"] == bc]
             dec = E.decomposed(rs, q)
             failed_modes = getattr(q, "unpaired", None)
-            parts, meshes, lost = {}, {}, {}
+            parts, meshes, lost, load_failed = {}, {}, {}, {}
             for r in rs:
+                if r.get("nh_error_estimate") is not None and "finite_failed" in r:
+                    load_failed.setdefault(r["model"], []).append(
+                        (r["mesh"], bool(r["finite_failed"])))
                 parts.setdefault(r["model"], []).append(dec[(r["mesh"], r["bc"], r["model"])])
                 meshes.setdefault(r["model"], []).append(r["mesh"])
                 if failed_modes:
@@ -105,7 +113,8 @@ def populations(runs_by_case, declared, quick, patch_tests, estimate_keys):
             cont = [_first(v) for v in cont.values() if v is not None]
             u_c, defect = E.u_num(max(est) if est else None, cont)
             out.append(Population(case, bc, q, parts, u_mf, u_c, defect,
-                                  bc in patch_tests[case], quick[case], meshes, lost))
+                                  bc in patch_tests[case], quick[case], meshes, lost,
+                                  load_failed))
     return out
 
 
@@ -134,27 +143,51 @@ def cell(standing, tied_with=None):
 
 
 def unresolved(pops, models, finite=False):
-    """{(upper, lower): mesh} for each pair of neighbours of ``ranked(overall(...))`` whose
-    order reverses when one mesh family is left out of every population (the mesh, not the
-    run, is the unit of analysis): the first such mesh."""
+    """{(upper, lower): what was left out} for each pair of neighbours of
+    ``ranked(overall(...))`` whose order reverses when one mesh family is left out of every
+    population (the mesh, not the run, is the unit of analysis), or one case is left out: the
+    first such mesh, else case."""
     order = [m for _, m, _, _ in ranked(overall(pops, models, finite))]
-    meshes = sorted({x for p in pops if p.finite == finite for ms in p.meshes.values()
-                     for x in ms})
+    cases = sorted({p.case for p in pops if p.finite == finite and not p.patch_test})
+    subsets = [(mesh, [p.without(mesh) for p in pops]) for mesh in _meshes(pops, finite)]
+    if len(cases) > 1:       # the case is a unit too: an order one case decides is not resolved
+        subsets += [(case, [p for p in pops if p.case != case]) for case in cases]
     out = {}
-    for mesh in meshes:
-        alt = overall([p.without(mesh) for p in pops], models, finite)
+    for left_out, subset in subsets:
+        alt = overall(subset, models, finite)
         for a, b in zip(order, order[1:]):
-            if (a, b) not in out and a in alt and b in alt and alt[a][0] > alt[b][0]:
-                out[(a, b)] = mesh
+            if (a, b) not in out and a in alt and b in alt and \
+                    _order(alt[a], a)[:2] > _order(alt[b], b)[:2]:
+                out[(a, b)] = left_out
+    return out
+
+
+def _meshes(pops, finite):
+    return sorted({x for p in pops if p.finite == finite for ms in p.meshes.values()
+                   for x in ms})
+
+
+def spread(pops, models, finite=False):
+    """{model: (smallest, largest) geometric mean} over the rankings that leave one mesh
+    family out of every population: how much the unit of analysis moves the figure."""
+    out = {}
+    for mesh in _meshes(pops, finite):
+        for m, e in overall([p.without(mesh) for p in pops], models, finite).items():
+            if e[1] is not None and math.isfinite(e[1]):
+                lo, hi = out.get(m, (e[1], e[1]))
+                out[m] = (min(lo, e[1]), max(hi, e[1]))
     return out
 
 
 def overall(pops, models, finite=False):
     """{model: (mean rank, geometric mean of its finite population scores, failed runs,
-    failed populations, populations)} over the populations of one regime (``finite``): every
-    population counts for every model, a failed run against its model; each score floored at
-    its population's model-form uncertainty; P1 itself left out (an identity check), and the
-    patch tests (pass or fail, the consistency limit's subject: never pooled with the rest)."""
+    failed populations, populations, {case/bc: (runs without an equilibrium at the case's
+    load, runs tried)})} over the populations of one regime (``finite``): every population counts
+    for every model, a failed run against its model; each score floored at its population's
+    model-form uncertainty; P1 itself left out (an identity check), and the patch tests (pass
+    or fail, the consistency limit's subject: never pooled with the rest). At finite load,
+    the runs of the linear populations' cases that found no equilibrium at the case's load
+    count too (the last entry): such a model ranks after every model that found one."""
     used = [p for p in pops if p.finite == finite and not p.patch_test]
     out = {}
     for m in models:
@@ -169,18 +202,39 @@ def overall(pops, models, finite=False):
                 scores.append(st.score)
                 floors.append(p.u_model_form)
         failed = sum(sum(v is None for v in p.parts[m]) for p in mine)
+        load = {}
+        if finite:
+            for p in pops:
+                if not p.finite and p.load_failed.get(m):
+                    load[p.label] = (sum(f for _, f in p.load_failed[m]),
+                                     len(p.load_failed[m]))
         out[m] = (E.mean_rank(ranks), E.geometric_mean(scores, floors), failed,
-                  len(mine) - len(scores), len(mine))
+                  len(mine) - len(scores), len(mine), {c: v for c, v in load.items() if v[0]})
     return out
 
 
+def largest(pops, model, finite=False):
+    """A model's largest population score (the median over the meshes, a failed run counted
+    as infinitely wrong) over the populations of one regime other than patch tests, or None
+    where it ran in none."""
+    scores = [s.score for p in pops if p.finite == finite and not p.patch_test
+              for _, s, _ in p.standings() if s.model == model]
+    return max(scores) if scores else None
+
+
+def _order(entry, model):
+    """The ranking's order of one model: those that failed to find an equilibrium at a case's
+    load last, then by mean rank, then by geometric mean."""
+    return (bool(entry[5]), entry[0], entry[1] or 0.0, model)
+
+
 def ranked(means):
-    """[(rank, model, overall's entry, tied_with)], best first by mean rank; equal mean ranks
-    share a rank (tied)."""
-    order = sorted(means, key=lambda m: (means[m][0], means[m][1] or 0.0, m))
+    """[(rank, model, overall's entry, tied_with)], best first (``_order``); equal mean ranks
+    in the same failure class share a rank (tied)."""
+    order = sorted(means, key=lambda m: _order(means[m], m))
     out, head, rank = [], None, 0
     for k, m in enumerate(order):
-        if head is not None and means[m][0] == means[head][0]:
+        if head is not None and _order(means[m], m)[:2] == _order(means[head], head)[:2]:
             out.append((rank, m, means[m], head))
             continue
         head, rank = m, k + 1
@@ -188,14 +242,21 @@ def ranked(means):
     return out
 
 
-def describe(entry):
-    """'mean rank r, geometric mean g' with the failed runs and populations of ``overall``."""
-    r, g, failed, lost, n = entry
+def describe(entry, rng=None):
+    """'mean rank r, geometric mean g [range leaving one mesh family out]' with the failed
+    runs and populations of ``overall``."""
+    r, g, failed, lost, n, load = entry
     text = f"mean rank {r:.3g}" + (f", geometric mean {g:.3g}" if g is not None else "")
+    if g is not None and rng:
+        text += f" [{rng[0]:.3g}-{rng[1]:.3g} leaving one mesh family out]"
     if failed:
         text += f", {failed} failed runs"
     if lost:
         text += f" ({lost} of {n} populations failed at the median)"
+    if load:
+        text += ("; no equilibrium at a case's load in " + ", ".join(
+            f"{c} {k} of {t} runs" for c, (k, t) in load.items())
+            + " (ranked after every model that found one)")
     return text
 
 

@@ -27,6 +27,9 @@ def test_bench_writes_table_figure_and_in_round_ratios(tmp_path):
         # a model against itself within one round is exactly 1: the ratios are in-round
         if model in ("msm", "fem-linear"):
             assert r[f"step_vs_{model}"] == 1.0 and r[f"force_vs_{model}"] == 1.0
+        # the rounds' range of a ratio brackets its median
+        lo, hi = r["step_vs_fem-linear_range"]
+        assert lo <= r["step_vs_fem-linear"] <= hi
     assert rows[("pbcm-variational", 625)]["calibration_s"] > 0
     assert rows[("msm", 625)]["calibration_s"] == 0
     # the two-thread mode exists for the shear readings only; where numba has two threads

@@ -219,30 +219,49 @@ def test_paper_cube_conclusion_groups_the_artefact_by_model():
         Config(), [dict(run, paper_pattern_fem=True)])[0]
 
 
-def test_rankings_tie_models_the_reference_cannot_order():
+def test_rankings_tie_models_within_u_num_of_a_groups_first():
+    """A model within the reference's u_num of the first of its group is tied with it, never
+    with the previous model only (no chains): a, b, c at 0.10, 0.105, 0.115 with u 0.01 give
+    b tied with a and c a group of its own; the caveat appears where u_num exceeds a fifth of
+    the smallest error; against a closed form there are no ties."""
     from cases.library import common
-    runs = [{"model": m, "bc": "clamped", "err": e, "p2_error_estimate": 0.01}
-            for m, e in (("a", 0.10), ("b", 0.105), ("c", 0.30))]
+    runs = [{"model": m, "mesh": "five", "bc": "clamped", "err": e, "p2_error_estimate": 0.01}
+            for m, e in (("a", 0.10), ("b", 0.105), ("c", 0.115), ("d", 0.30))]
     (table,) = common.ranking(runs, "err", "error")
-    assert [r[2] for r in table.rows] == ["a", "b", "c"]
-    assert [r[-1] for r in table.rows] == ["", "tied with a (estimate 0.01)", ""]
+    assert [r[2] for r in table.rows] == ["a", "b", "c", "d"]
+    assert [r[-1] for r in table.rows] == ["", "tied with a (u_num 0.01)", "", ""]
+    assert [r[1] for r in table.rows] == [1, 1, 3, 4]
     line = common.best_and_worst(runs, "err", "Error")
-    assert "smallest a" in line and "largest c" in line and ": b." in line
+    assert "smallest a" in line and "largest d" in line and ": b." in line
     assert "not resolved" not in line           # 0.01 < 0.10 / 5
     coarse = [dict(r, p2_error_estimate=0.03) for r in runs]
     assert "not resolved" in common.best_and_worst(coarse, "err", "Error")
-    # against a closed form there is no estimate: no ties, no caveat
     exact = common.best_and_worst(coarse, "err", "Error", exact=True)
     assert "Tied" not in exact and "not resolved" not in exact
 
 
-def test_rankings_keep_populations_apart_and_rank_only_complete_models():
+def test_ties_widen_to_the_continuums_spread_over_the_meshes():
+    """u_num is the larger of the estimate and the continuum's spread over the meshes: two
+    meshes whose references give 1.0 and 1.1 (spread 0.095 > estimate 0.01) tie errors 0.10
+    and 0.15, and the note says the spread set it."""
+    from cases import rankings
+    runs = [{"model": m, "mesh": mesh, "bc": "clamped", "q_rel_err": e, "q_mm": 1.0,
+             "q_fem_mm": ref, "p2_error_estimate": 0.01}
+            for mesh, ref in (("five", 1.0), ("six", 1.1)) for m, e in (("a", 0.10), ("b", 0.15))]
+    u, defect = rankings.uncertainty(runs, "q_rel_err")
+    assert u == pytest.approx(0.1 / 1.05) and defect
+    (table,) = rankings.ranking(runs, "q_rel_err", "error")
+    assert table.rows[1][-1] == "tied with a (u_num 0.095, the spread over the meshes)"
+
+
+def test_rankings_keep_populations_apart_and_count_failed_runs():
     """A patch test (sliding, exact for some) and a clamped cube are never pooled: each bc is
-    ranked on its own, each cell 'median [min-max], n of N runs'; a model with a run that gave
-    no value is listed as incomplete and never named closest, however small its median."""
+    ranked on its own, each cell 'median [min-max], n of N runs'; a run that gave no value
+    counts against its model as infinitely wrong (ranked, never left out), so a model that
+    failed half its runs is never named closest, however small its values."""
     from cases import rankings
     runs = []
-    for mesh, (a, b, c) in (("five", (1e-10, 0.02, 0.05)), ("six", (1e-10, 0.04, None))):
+    for mesh, (a, b, c) in (("five", (1e-10, 0.02, 0.01)), ("six", (1e-10, 0.04, None))):
         runs += [{"model": "a", "mesh": mesh, "bc": "sliding", "err": a},
                  {"model": "b", "mesh": mesh, "bc": "clamped", "err": b},
                  {"model": "c", "mesh": mesh, "bc": "clamped", "err": c},
@@ -252,13 +271,30 @@ def test_rankings_keep_populations_apart_and_rank_only_complete_models():
     clamped = [r for r in table.rows if r[0] == "clamped"]
     assert clamped[0] == ["clamped", 1, "b", "0.03", "0.02-0.04", "2 of 2", ""]
     assert clamped[1][1:4] == [2, "a", "0.06"]
-    assert clamped[2] == ["clamped", "-", "c", "0.05", "0.05-0.05", "1 of 2",
-                          "incomplete, not ranked"]
+    assert clamped[2] == ["clamped", 3, "c", "failed at the median", "0.01-0.01", "1 of 2",
+                          "1 failed, counted against it"]
     line = rankings.best_and_worst(runs, "err", "Error")
     assert "[clamped] Error against its reference (total error" in line
-    assert "smallest b" in line and "largest a" in line
-    assert "Left out, a run without a value: c (1 of 2 gave one)" in line
+    assert "smallest b" in line and "largest c" in line
+    assert "Failed runs, counted against their model: c (1 of 2)" in line
     assert line.index("[sliding]") < line.index("smallest a") < line.index("[clamped]")
+
+
+def test_failures_name_every_phase_that_found_no_equilibrium():
+    """The failures line says which runs found no equilibrium in the linear regime and which
+    at the case's load (where a reference of it exists), and claims 'every model found its
+    equilibrium' only of the phases where none failed."""
+    from cases import rankings
+    ok = {"mesh": "five", "bc": "clamped", "static_failed": None, "finite_failed": None,
+          "nh_error_estimate": 0.01}
+    runs = [dict(ok, model="a"), dict(ok, model="b", finite_failed="no convergence")]
+    line = rankings.failures(runs)
+    assert line == ("No static equilibrium at the case's load for b on five/clamped. Every "
+                    "model found its static equilibrium in the linear regime on every mesh "
+                    "run.")
+    assert rankings.failures([dict(ok, model="a")]) == (
+        "Every model found its static equilibrium in the linear regime and at the case's load "
+        "on every mesh run.")
 
 
 def test_errors_over_free_components_leave_out_what_is_prescribed():

@@ -122,7 +122,7 @@ def test_scorecard_decomposes_counts_failures_and_names_identity(tmp_path):
     assert ranks["b"][1].failed == 1 and math.isinf(ranks["b"][1].score)
     lines = conclusion(pops, ["fem-linear", "fem-corotated", "a", "b"], quick=False)
     assert "1. fem-corotated (mean rank 1" in lines[0] and "2. a (mean rank 2, geometric " \
-        "mean 0.13)" in lines[0]
+        "mean 0.13 [0.12-0.14 leaving one mesh family out])" in lines[0]
     assert "3. b (mean rank 3, 1 failed runs (1 of 1 populations failed at the median))" \
         in lines[0]
     assert "b in torsion/clamped (1 of 2)" in lines[-1]
@@ -206,16 +206,20 @@ def test_case_findings_name_cancellation_and_the_twins():
 
 
 def test_truth_cube_u_val_is_per_model_by_hand():
-    """Each model's u_val combines the reference's change, its own half-range over the
-    unmeasured-input variants and the beads' noise; a model within it is named, and models
+    """Each model's u_val combines the neo-Hookean reference's change (the continuum's, not
+    the linear reference's), its own half-range over the unmeasured-input variants and the
+    beads' noise; a model within it is named, and models
     closer than the larger u_val are tied."""
     from cases.answers import validation
     rows = [{"mesh": "10mm", "variant": var, "model": m, "strain": 0.2, "bead_rms_mm": v}
             for m, vals in {"a": (1.0, 1.6), "b": (0.3, 0.3)}.items()
             for var, v in zip(("bonded", "nu=0.49"), vals)]
-    truth = {"headline": {"strain": 0.2, "floor_mm": 0.4, "models": {
+    truth = {"headline": {"strain": 0.2, "floor_mm": 0.4, "continuum": "nh", "models": {
         "a": {"bead_rms_mm": 1.2}, "b": {"bead_rms_mm": 0.35}}},
-        "references": [{"variant": "bonded", "strain": 0.2, "bead_change_mm": 0.0}],
+        "references": [{"variant": "bonded", "strain": 0.2, "bead_change_mm": 0.0,
+                        "model": "nh"},
+                       {"variant": "bonded", "strain": 0.2, "bead_change_mm": 9.0,
+                        "model": "linear"}],      # not the continuum: not its u_num
         "rows": rows, "parameters": {"models": ["a", "b"], "variants": {
             "bonded": ["bonded", "nominal", 0.499], "nu=0.49": ["bonded", "nominal", 0.49]}}}
     v = validation(truth)
@@ -225,11 +229,14 @@ def test_truth_cube_u_val_is_per_model_by_hand():
 
 
 def test_consistency_limits_closer_than_their_uncertainty_are_tied():
-    """Neighbouring limits are tied when they differ by less than sqrt(u_a^2 + u_b^2)."""
+    """Limits are tied when they differ by less than sqrt(u_a^2 + u_b^2), pair by pair: a
+    model tied with each of two models resolved from each other shares a group with each."""
     from cases.answers import _limit_ties
     lims = [("a", (0.19, 0.03)), ("b", (0.192, 0.004)), ("c", (0.59, 0.08)), ("d", (0.9, 0.01))]
     assert _limit_ties(lims) == " (tied within their +-: a, b)"
     assert _limit_ties(lims[2:]) == ""
+    chain = [("v", (0.19, 0.03)), ("b", (0.25, 0.07)), ("n", (0.32, 0.03))]
+    assert _limit_ties(chain) == " (tied within their +-: v, b; b, n)"   # v, n: 0.13 > 0.042
 
 
 def test_what_to_pick_is_computed_and_names_what_is_not_decided(tmp_path):
@@ -262,6 +269,64 @@ def test_what_to_pick_is_computed_and_names_what_is_not_decided(tmp_path):
     assert "the closest approximation is a, model-form error 0.1" in lines[1]
     # at finite load a's model-form errors are 0.1, 0.2 and b's 0.1, 0.2 (six reversed)
     assert "not decided on 1 case between" in lines[2]
-    assert "no equilibrium at a case's load for b in large-compression 1 of 2" in lines[2]
+    assert "no equilibrium at a case's load for b in large-compression/clamped 1 of 2" in lines[2]
     assert recommendation(tmp_path, ["a"], pops, True, {}) == [
         "**What to pick?** Quick: not decided (`pbcm report` decides)."]
+
+
+def test_no_equilibrium_at_another_cases_load_ranks_a_model_last_at_finite_load(tmp_path):
+    """At finite load a model that found no equilibrium at a linear case's load (its finite
+    phase) ranks after every model that found one, whatever its model-form error, and its
+    overall entry says where and how often; a reference that failed is not the model's
+    failure."""
+    from cases.index import populations
+    lin = [dict(r, finite_failed="no equilibrium" if r["model"] == "a" else None,
+                nh_error_estimate=0.01)
+           for r in _torsion_runs({(mesh, m): 1.2 for mesh in ("five", "six")
+                                   for m in ("fem-linear", "a", "b")})]
+    lin.append(dict(lin[0], model="b", mesh="bcc", finite_failed="no reference",
+                    nh_error_estimate=None))
+    _case_folder(tmp_path, "torsion", lin)
+    fin = [{"mesh": mesh, "bc": "clamped", "model": model, "force_n_steps": [f],
+            "force_fem_n_steps": [1.0], "nh_error_estimate": 0.01, "finite_failed": None}
+           for mesh in ("five", "six")
+           for model, f in (("fem-neohookean", 1.2), ("a", 1.21), ("b", 1.5))]
+    (tmp_path / "large-compression").mkdir()
+    (tmp_path / "large-compression" / "metrics.json").write_text(json.dumps({
+        "headline_estimate": "nh_error_estimate", "runs": fin,
+        "parameters": {"models": ["fem-neohookean", "a", "b"], "quick": False}}))
+    pops, _ = populations(tmp_path, ["torsion", "large-compression"])
+    means = scorecard.overall(pops, ["a", "b"], finite=True)
+    assert means["a"][5] == {"torsion/clamped": (2, 2)} and means["b"][5] == {}
+    assert [m for _, m, _, _ in scorecard.ranked(means)] == ["b", "a"]
+    assert scorecard.describe(means["a"]).endswith(
+        "no equilibrium at a case's load in torsion/clamped 2 of 2 runs (ranked after every model "
+        "that found one)")
+
+
+def test_geometric_mean_range_leaves_one_mesh_family_out(tmp_path):
+    """The geometric mean's range is its smallest and largest value over the rankings that
+    leave one mesh family out: a's model-form errors 0.1 (five), 0.3 (six), 0.2 (bcc) give
+    the medians 0.25, 0.15, 0.2 without five, bcc, six."""
+    from cases.index import populations
+    v = {}
+    for mesh, a in {"five": 1.1, "six": 1.3, "bcc": 1.2}.items():
+        v.update({(mesh, "fem-linear"): 1.0, (mesh, "a"): a})
+    _case_folder(tmp_path, "torsion", _torsion_runs(v))
+    pops, _ = populations(tmp_path, ["torsion"])
+    (lo, hi), = scorecard.spread(pops, ["fem-linear", "a"]).values()
+    assert (lo, hi) == (pytest.approx(0.15), pytest.approx(0.25))
+    assert scorecard.largest(pops, "a") == pytest.approx(0.2)
+
+
+def test_cost_ratio_is_the_in_round_step_ratio_times_the_stable_steps_with_its_range():
+    """A simulated second's cost over fem-linear's is the in-round step ratio (2, rounds 1.5
+    to 3) times fem-linear's stable step over the model's (10 / 5 us): 4 [3-6]."""
+    from cases.answers import ratio_text, sim_ratio
+    fl = {"model": "fem-linear", "stable_dt_us": 10.0, "cpu_s_per_simulated_s": 1.0}
+    row = {"model": "a", "stable_dt_us": 5.0, "cpu_s_per_simulated_s": 3.9,
+           "step_vs_fem-linear": 2.0, "step_vs_fem-linear_range": [1.5, 3.0]}
+    assert sim_ratio(row, fl) == (4.0, [3.0, 6.0])
+    assert ratio_text(row, fl) == "4 [3-6]"
+    old = {k: v for k, v in row.items() if not k.endswith("_range")}
+    assert sim_ratio(old, fl) == (4.0, None)

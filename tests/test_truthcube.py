@@ -318,3 +318,34 @@ def test_the_index_answers_and_scores_against_reality(quick_truthcube, tmp_path)
     for m in doc["parameters"]["models"][:6]:       # the first table's models
         assert f"{h['models'][m]['bead_rms_rel']:.3g} at 18.25 %" in row
     assert md.index("## Scorecard") < md.index("truth-cube/bonded, 10mm")
+
+
+def test_what_the_beads_resolve_combines_their_noise_and_the_references_change():
+    """Two computed fields are told apart by the beads only beyond their floor combined with
+    the neo-Hookean reference's change over its last refinement: floor 0.3, change 0.4 give
+    0.5 mm (the linear reference's change is not the continuum's); a model 0.45 mm from the
+    continuum is within it, one 0.55 mm away is not."""
+    from cases.studies.truthcube.report import DEFAULT, NH, against_continuum, resolved
+    data = {"states": [{"state": 1, "strain": 0.1, "floor_mm": {"total": 0.3}}]}
+    refs = [{"variant": DEFAULT, "model": NH, "strain": 0.1, "bead_change_mm": 0.4},
+            {"variant": DEFAULT, "model": "linear P2", "strain": 0.1, "bead_change_mm": 9.0}]
+    assert resolved(data, refs) == {1: pytest.approx(0.5)}
+    rows = [{"mesh": "5mm", "variant": DEFAULT, "model": m, "state": 1,
+             "bead_vs_continuum_mm": d} for m, d in (("a", 0.45), ("b", 0.55))]
+    said = against_continuum(rows, data, "5mm", refs)
+    assert said["a"] == "within what the beads resolve at every state"
+    assert said["b"].startswith("beyond what the beads resolve from")
+
+
+def test_a_state_is_reproduced_within_the_models_u_val_there():
+    """A run reproduces a state when its total bead RMS is at most its u_val at that state
+    (1.0 against 1.2: yes; 1.3: no); a model without a u_val falls back to the floor."""
+    from cases.studies.truthcube.report import verdicts
+    data = {"states": [{"state": 1, "floor_mm": {"total": 0.3, "axial": 0.1, "lateral": 0.3}}]}
+    rows = [{"mesh": "5mm", "variant": "bonded", "model": m, "state": 1, "bead_rms_mm": v,
+             "bead_axial_rms_mm": 0.1, "bead_lateral_rms_mm": v}
+            for m, v in (("a", 1.0), ("b", 1.3), ("c", 1.0))]
+    v = verdicts(rows, data, {1: {"a": 1.2, "b": 1.2}})
+    assert v[("5mm", "bonded", "a")] == [(1, True)]
+    assert v[("5mm", "bonded", "b")] == [(1, False)]
+    assert v[("5mm", "bonded", "c")] == [(1, False)]      # 1.0 is beyond one floor of noise

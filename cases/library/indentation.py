@@ -115,17 +115,19 @@ class Indentation(Case):
     headline = "reaction_rel_err"
     headline_pair = "disp_rel_l2_p2"
     decomposed = Scalar("reaction_n", "reaction_fem_p2_n", "punch force")
-    qoi_errors = ("edge_shear_pa",)
-    gated = ("edge_shear_rel_err", "profile_rel_err")   # the edge shear gated, never ranked
+    qoi_errors = ()          # the edge shear is singular: no error against a reference
+    # the edge shear gated as each model's own value (a regression), never compared
+    gated = ("edge_shear_pa", "profile_rel_err")
     columns = ("reaction_n", "reaction_fem_p2_n", "profile_rel_err", "edge_shear_pa",
-               "edge_shear_fem_pa", "edge_shear_rel_err")
+               "edge_shear_fem_pa")
     magnify = 2.0
     notes = (
         "The punch force is the reaction on the top face along y (the punch's: the rest of "
         "the top is free).",
         "The prescribed field has kinks at the edges of the punch's face and rim: the "
-        "continuum's shear there is not bounded (it grows as the mesh is refined), so the "
-        "edge shear's error is a mesh-level comparison, gated, never ranked.")
+        "continuum's shear there is not bounded (it grows as the mesh is refined), so no "
+        "error of the edge shear against a reference is taken: each model's own value is "
+        "shown and gated as a regression, never compared or ranked.")
 
     def mesh(self, family, s):
         n = int(round(SIZE_MM / s.spacing_mm)) + 1

@@ -228,6 +228,9 @@ def run(sizes=SIZES, models=None, rounds=7, progress=print, with_engines=True):
                 ref = np.array(samples[base])
                 row[f"force_vs_{base}"] = float(np.median(own[:, 0] / ref[:, 0]))
                 row[f"step_vs_{base}"] = float(np.median(own[:, 1] / ref[:, 1]))
+                # the rounds' spread of the ratio: the uncertainty every cost ratio carries
+                row[f"step_vs_{base}_range"] = [float(np.min(own[:, 1] / ref[:, 1])),
+                                                float(np.max(own[:, 1] / ref[:, 1]))]
             rows.append(row)
         del timed, timers
     return {"machine": _machine(), "sizes": [int(s) for s in sizes], "rows": rows,
@@ -260,6 +263,13 @@ def _machine():
     return {"cpu": cpu, "cores": os.cpu_count(), "python": platform.python_version()}
 
 
+def _ranged(row, key):
+    """'median [smallest-largest over the rounds]' of a ratio (the median alone where the
+    bench predates the range)."""
+    rng = row.get(f"{key}_range")
+    return fmt(row[key]) + (f" [{fmt(rng[0], 2)}-{fmt(rng[1], 2)}]" if rng else "")
+
+
 def write(data, out):
     """bench.json, bench.md (+ html) and step_time.png into the folder ``out``."""
     out.mkdir(parents=True, exist_ok=True)
@@ -276,7 +286,7 @@ def write(data, out):
     doc.p(f"Measured on {m['cpu']} ({m['cores']} cores), Python {m['python']}, serial kernels. "
           f"Times are medians over {rows[0]['rounds']} rounds of thread CPU time; ratios are "
           "the medians of per-round ratios (models timed round-robin), so machine drift "
-          "cancels. The two-thread speed-up (`build(..., threads=2)`, forces equal bit for bit "
+          "cancels; [smallest-largest] over the rounds beside them. The two-thread speed-up (`build(..., threads=2)`, forces equal bit for bit "
           "to serial) is the median ratio of wall-clock times of the serial and the threaded "
           "force evaluation run back to back; '-' where a model has no threaded term.")
     for line in summary(data):
@@ -285,8 +295,8 @@ def write(data, out):
                "step vs msm", "step vs fem-linear", "calibration [s]", "memory [MB]",
                "2-thread force speed-up"],
               [[r["model"], r["tets"], fmt(r["ns_per_tet"]), fmt(r["us_per_step"]),
-                fmt(r["step_over_4_forces"]), fmt(r["step_vs_msm"]),
-                fmt(r["step_vs_fem-linear"]), fmt(r["calibration_s"], 2),
+                fmt(r["step_over_4_forces"]), _ranged(r, "step_vs_msm"),
+                _ranged(r, "step_vs_fem-linear"), fmt(r["calibration_s"], 2),
                 fmt(r["memory_mb"], 3),
                 "-" if r.get("two_thread_speedup") is None else fmt(r["two_thread_speedup"])]
                for r in rows])

@@ -8,6 +8,7 @@ import numpy as np
 
 from ... import catalogue, figures
 from ...document import Document, fmt
+from ...error_model import u_val
 from ...report import environment, write_study
 from ...runner import jsonable
 from .beads import WITHIN, excess, within
@@ -33,24 +34,33 @@ def floors(data):
     return {s["state"]: s["floor_mm"] for s in data["states"]}
 
 
-def verdicts(rows, data):
+def verdicts(rows, data, u=None):
     """{(mesh, variant, model): [(state, within?) ...]}: a run reproduces a state when its
-    total, axial and lateral RMS errors each lie within the floor (``beads.within``)."""
+    total RMS error lies within its u_val at that state (``u`` {state: {model: u_val}},
+    ``cases.answers.u_vals``); where ``u`` does not name the model, when its total, axial and
+    lateral RMS errors each lie within the floor (``beads.within``)."""
     fl = floors(data)
     out = {}
     for r in rows:
-        ok = None if r.get("failed") else all(within(r[k], fl[r["state"]][c])
-                                              for c, k in COMPONENTS)
+        mine = (u or {}).get(r["state"], {}).get(r["model"])
+        if r.get("failed"):
+            ok = None
+        elif mine is not None:
+            ok = r["bead_rms_mm"] <= mine
+        else:
+            ok = all(within(r[k], fl[r["state"]][c]) for c, k in COMPONENTS)
         out.setdefault((r["mesh"], r["variant"], r["model"]), []).append((r["state"], ok))
     return out
 
 
-WITHIN_ALL = "within the floor at every state"
+WITHIN_ALL = "within u_val at every state"
+RESOLVES = "what the beads resolve"          # the floor with the reference's u_num
+WITHIN_RESOLVED = WITHIN_ALL.replace("u_val", RESOLVES)
 
 
 def departure(states, strains):
-    """A run's answer in words: within the floor at every state, from the first, or up to the
-    strain at which it departs."""
+    """A run's answer in words: within u_val at every state, beyond it from the first, or up
+    to the strain at which it departs."""
     oks = [ok for _, ok in states]
     if any(ok is None for ok in oks):
         return "failed"
@@ -58,7 +68,7 @@ def departure(states, strains):
         return WITHIN_ALL
     first = next(i for i, ok in enumerate(oks) if not ok)
     if first == 0:
-        return f"beyond the floor from {percent(strains[0])}"
+        return f"beyond u_val from {percent(strains[0])}"
     return f"within up to {percent(strains[first - 1])}, departs at {percent(strains[first])}"
 
 
@@ -68,27 +78,51 @@ def finest(rows):
     return max(meshes, key=meshes.get)
 
 
-def against_continuum(rows, data, mesh):
-    """{model: its answer against the continuum on ``mesh`` (default assumptions)}: within
-    the measurement's floor of the neo-Hookean continuum at every state (the measurement
-    cannot tell them apart), or the strain from which it is farther."""
+def resolved(data, refs):
+    """{state: what the beads resolve between two computed fields [mm]}: the beads' noise
+    combined with the neo-Hookean reference's change over its last refinement at that state
+    (sqrt(floor^2 + u_num^2))."""
     fl = floors(data)
+    strain_of = {st["strain"]: st["state"] for st in data["states"]}
+    u = {}
+    for r in refs:
+        if r["variant"] == DEFAULT and r["model"] == NH and r.get("bead_change_mm") is not None:
+            k = strain_of.get(r["strain"])
+            u[k] = max(u.get(k, 0.0), r["bead_change_mm"])
+    return {k: float(np.hypot(v["total"], u.get(k, 0.0))) for k, v in fl.items()}
+
+
+def against_continuum(rows, data, mesh, refs=()):
+    """{model: its answer against the continuum on ``mesh`` (default assumptions)}: within
+    what the beads resolve (``resolved``) of the neo-Hookean continuum at every state (the
+    measurement cannot tell them apart), or the strain from which it is farther."""
+    res = resolved(data, refs)
     out = {}
     for r in sorted(rows, key=lambda r: r["state"]):
         if r["mesh"] not in (mesh, "reference") or r["variant"] != DEFAULT \
                 or r["model"] == NH:
             continue
         d = r.get("bead_vs_continuum_mm")
-        ok = None if d is None else d <= fl[r["state"]]["total"]
+        ok = None if d is None else d <= res[r["state"]]
         out.setdefault(r["model"], []).append((r["state"], ok))
     strains = [st["strain"] for st in data["states"]]
-    return {m: departure(v, strains) for m, v in out.items()}
+    return {m: departure(v, strains).replace("u_val", RESOLVES) for m, v in out.items()}
 
 
-def analyse(data):
+def state_u_vals(data, parameters):
+    """{state: {model: u_val}} of every state (``cases.answers.u_vals``), the continuum's
+    included."""
+    from ...answers import u_vals
+    truth = {**data, "parameters": parameters, "headline": {"continuum": NH}}
+    return {st["state"]: u_vals(truth, st["strain"], st["floor_mm"]["total"])[0]
+            for st in data["data"]["states"]}
+
+
+def analyse(data, parameters):
     rows, refs = data["rows"], data["references"]
     strains = sorted({r["strain"] for r in rows + refs})
-    v = verdicts(rows + refs, data["data"])
+    u = state_u_vals(data, parameters)
+    v = verdicts(rows + refs, data["data"], u)
     mesh = finest(rows)
     said = {m: departure(v[(mesh, DEFAULT, m)], strains)
             for (x, var, m) in v if x == mesh and var == DEFAULT}
@@ -102,8 +136,9 @@ def analyse(data):
                    if r["model"] == NH and r["strain"] == last and not r.get("failed")}
     return {"finest_mesh": mesh, "departure": said,
             "within_at_every_state": [m for m, t in said.items() if t == WITHIN_ALL],
-            "against_continuum": against_continuum(rows + refs, data["data"], mesh),
+            "against_continuum": against_continuum(rows + refs, data["data"], mesh, refs),
             "continuum_by_assumption_mm": assumptions,
+            "u_val_by_state": u,
             "headline": {"strain": last, "floor_mm": state["floor_mm"]["total"],
                          "continuum": NH, "states": len(data["data"]["states"]),
                          "mesh": mesh, "models": {
@@ -134,7 +169,7 @@ def scorecard(doc):
 
 
 def write(out, study, s, data):
-    found = analyse(data)
+    found = analyse(data, s.describe())
     doc = jsonable({"case": study.name, "study": True, "parameters": s.describe(),
                     "problem": s.problem(), "gated": GATED, "environment": environment(),
                     **data, **found, "gate_runs": gate_rows(data["rows"])})
@@ -154,7 +189,6 @@ def conclusion(doc):
     models = [m for m in said if m not in (NH, LINEAR)]
     last = max(s["strain"] for s in doc["data"]["states"])
     at_last = {r["model"]: r for r in _rows(doc, mesh, DEFAULT) if r["strain"] == last}
-    floor = floors(doc["data"])[len(doc["data"]["states"])]["total"]
     nh = at_last.get(NH, {}).get("bead_rms_mm")
     from ...answers import validation
     val = validation(doc)
@@ -164,25 +198,34 @@ def conclusion(doc):
             f"stiffness): at {percent(last)}, read against each model's u_val "
             f"(sqrt(u_num^2 + u_input^2 + u_D^2): the beads' noise {fmt(val['u_d'], 2)} mm, the "
             f"model's own spread over the unmeasured friction, travel and nu on the "
-            f"{val['mesh']} mesh, the reference's {fmt(val['u_num'], 1)} mm), "
+            f"{val['mesh']} mesh, the neo-Hookean reference's change over its last refinement "
+            f"{fmt(val['u_num'], 2)} mm), "
             + (f"{', '.join(within)} agree with the measurement" if within else
                "no model agrees with the measurement")
-            + f"; the neo-Hookean continuum, against the beads' floor: {said.get(NH, 'n/a')}"
-            + (f" ({fmt(nh)} mm RMS at {percent(last)}, floor {fmt(floor)} mm)" if nh else ""))
+            )
     by = doc["continuum_by_assumption_mm"]
-    others = {k: v for k, v in by.items() if k != DEFAULT}
-    if others and nh:
-        lo, hi = min(others, key=others.get), max(others, key=others.get)
-        line += (f": the assumptions weigh most, {lo} {fmt(others[lo])} mm, {hi} "
-                 f"{fmt(others[hi])} mm")
+    if nh:
+        # the continuum read as the models are: its u_input the half-range over the
+        # unmeasured plate friction, travel and nu
+        u_in = (max(by.values()) - min(by.values())) / 2 if len(by) > 1 else 0.0
+        u_nh = u_val(val["u_num"], u_in, val["u_d"])
+        line += (f"; the neo-Hookean continuum is {fmt(nh)} mm RMS off at {percent(last)}, "
+                 f"{'within' if nh <= u_nh else 'beyond'} its u_val {fmt(u_nh, 2)} mm")
+        others = {k: v for k, v in by.items() if k != DEFAULT}
+        if others:
+            lo, hi = min(others, key=others.get), max(others, key=others.get)
+            line += (f" (the assumptions weigh most: {lo} {fmt(others[lo])} mm, {hi} "
+                     f"{fmt(others[hi])} mm)")
     lines = [line + "."]
     vs = doc["against_continuum"]
-    close = [m for m, t in vs.items() if t == WITHIN_ALL]
-    far = {m: t for m, t in vs.items() if t != WITHIN_ALL}
-    lines.append("**Against the continuum at the beads:** "
-                 + (f"{', '.join(close)} stay within the floor of it at every state (the "
-                    "measurement cannot tell them from it)" if close else
-                    "no model stays within the floor of it at every state")
+    close = [m for m, t in vs.items() if t == WITHIN_RESOLVED]
+    far = {m: t for m, t in vs.items() if t != WITHIN_RESOLVED}
+    lines.append("**Against the continuum at the beads** (within what the beads resolve: "
+                 "their noise combined with the reference's change over its last "
+                 "refinement): "
+                 + (f"{', '.join(close)} stay within it at every state (the measurement "
+                    "cannot tell them from it)" if close else
+                    "no model stays within it at every state")
                  + ("; " + "; ".join(f"{m} {t.replace('within', 'within it')}"
                                      for m, t in far.items()) if far else "") + ".")
     best = sorted((m for m in models if at_last.get(m, {}).get("bead_rms_mm") is not None),
@@ -238,9 +281,11 @@ def _data(d, doc):
     d.p("The floor is the noise of a measured displacement component: the RMS residual of a "
         "degree-4 polynomial of the rest positions fitted to each state's displacement (the "
         "compressed cube's field is smooth; the beads' scatter about it is not), combined as "
-        "each error is. A model's error beyond the noise is sqrt(rms^2 - floor^2); it "
-        f"reproduces a state when that is at most {WITHIN:g} floor in total, axially and "
-        "laterally.")
+        "each error is. A model's error beyond the noise is sqrt(rms^2 - floor^2) (the '*' "
+        "of the tables: beyond one floor in total, axially or laterally). A model reproduces "
+        "a state when its total RMS error is within its u_val there: the floor, its own "
+        "spread over the inputs nobody measured and the neo-Hookean reference's change over "
+        "its last refinement combined (sqrt(u_num^2 + u_input^2 + u_D^2)).")
     d.table(["strain", "nominal travel [mm]", "RMS displacement [mm]", "axial", "lateral",
              "floor total [mm]", "axial", "lateral", "quantisation x, y, z [mm]",
              "rigid motion removed x, y [mm], z-rotation [deg]"],
@@ -306,7 +351,8 @@ def _errors(d, doc):
     d.h(3, "Where each departs")
     d.p(f"On the {doc['finest_mesh']} mesh: from the measurement (its error beyond the noise "
         "above the floor) and from the neo-Hookean continuum under the same assumptions (the "
-        "RMS distance of their bead displacements above the floor).")
+        "RMS distance of their bead displacements above what the beads resolve: their floor "
+        "combined with the reference's change over its last refinement).")
     vs = doc["against_continuum"]
     d.table(["model", "against the measurement", "against the continuum"],
             [[m, t, vs.get(m, "(the continuum)" if m == NH else "n/a")]
@@ -358,7 +404,7 @@ def _figures(d, out, doc):
     rows = _rows(doc, mesh, DEFAULT)
     refs = [m for m in (NH, LINEAR) if any(r["model"] == m for r in rows)]
     models = [m for m in dict.fromkeys(r["model"] for r in rows) if m not in refs]
-    beyond = {m for m, t in doc["against_continuum"].items() if t != WITHIN_ALL}
+    beyond = {m for m, t in doc["against_continuum"].items() if t != WITHIN_RESOLVED}
     columns = []
     for st in data["states"]:
         here = {r["model"]: r for r in rows if r["state"] == st["state"]
@@ -374,7 +420,7 @@ def _figures(d, out, doc):
     figures.measured_layers(out / name, list(range(1, len(data["states"][0]["layer_axial_mm"])
                                                    + 1)), columns,
                             f"Measured against modelled, by bead layer (bonded, {mesh} mesh; "
-                            "colour: farther than the floor from the continuum)",
+                            f"colour: farther than {RESOLVES} from the continuum)",
                             highlight=beyond)
     d.img(name, "Measured against modelled bead displacements by layer")
     variants = list(dict.fromkeys(r["variant"] for r in doc["references"]))
@@ -401,9 +447,12 @@ def definitions():
         "measurement floor: the noise of a measured bead displacement component, the RMS "
         "residual of a degree-4 polynomial of the rest positions fitted to the measured "
         "displacement of each state; combined over components as each error is.",
-        f"within measurement: a run whose error beyond the noise, sqrt(rms^2 - floor^2), is "
-        f"at most {WITHIN:g} floor (total, axial and lateral); two runs whose RMS errors "
-        "differ by less than the floor are not ranked.",
+        "within measurement: a run whose total RMS error is at most its u_val at that state "
+        "(the floor, the model's spread over the unmeasured plate friction, travel and nu, "
+        "and the neo-Hookean reference's change over its last refinement, combined in "
+        "quadrature); two runs whose RMS errors differ by less than the larger u_val are not "
+        "ranked. '*' in the tables: the error beyond the noise, sqrt(rms^2 - floor^2), "
+        f"exceeds {WITHIN:g} floor in total, axially or laterally.",
         "rigid in-plane motion: the translation in x, y and rotation about z best carrying "
         "the rest beads to a measured state (2-D Procrustes); removed from each state before "
         "comparing.",
