@@ -351,7 +351,8 @@ declare("profile_rel_err", "1", "profile err",
          "relative L2 error of the surface profile against FEM P2.", "max")
 declare("edge_shear_pa", "Pa", "edge shear",
          "the peak of the paper's max |tau| over the tetrahedra touching the punch's edge "
-         "nodes (singular in the continuum: a mesh-level comparison).", digits=4)
+         "nodes (singular in the continuum: each model's own value, gated as a regression, "
+         "never compared with a reference).", "signed", digits=4)
 declare("force_n_steps", "N", "force(steps)",
          "the top force at each compression step.")
 declare("force_fem_n_steps", "N", "neo-Hookean force(steps)",

@@ -276,6 +276,7 @@ class Case(abc.ABC):
         for name in (cls.headline, *cls.gated, *cls.columns, *cls.quantity_compared,
                      *([cls.headline_pair] if cls.headline_pair else [])):
             catalogue.metric(name)      # a KeyError naming where to declare it
+        catalogue.gated(*cls.gated)     # a gated metric needs a direction, before any run
 
     # ------------------------------------------------------------------ settings
     def notes_for(self, s):
