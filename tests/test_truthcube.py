@@ -320,21 +320,16 @@ def test_the_index_answers_and_scores_against_reality(quick_truthcube, tmp_path)
     assert md.index("## Scorecard") < md.index("truth-cube/bonded, 10mm")
 
 
-def test_what_the_beads_resolve_combines_their_noise_and_the_references_change():
-    """Two computed fields are told apart by the beads only beyond their floor combined with
-    the neo-Hookean reference's change over its last refinement: floor 0.3, change 0.4 give
-    0.5 mm (the linear reference's change is not the continuum's); a model 0.45 mm from the
-    continuum is within it, one 0.55 mm away is not."""
-    from cases.studies.truthcube.report import DEFAULT, NH, against_continuum, resolved
+def test_against_the_continuum_a_model_is_read_against_its_u_val():
+    """A model's bead distance from the continuum is within it when at most the model's u_val
+    at that state (0.45 against 0.5: yes; 0.55: no), never against the floor alone."""
+    from cases.studies.truthcube.report import DEFAULT, against_continuum
     data = {"states": [{"state": 1, "strain": 0.1, "floor_mm": {"total": 0.3}}]}
-    refs = [{"variant": DEFAULT, "model": NH, "strain": 0.1, "bead_change_mm": 0.4},
-            {"variant": DEFAULT, "model": "linear P2", "strain": 0.1, "bead_change_mm": 9.0}]
-    assert resolved(data, refs) == {1: pytest.approx(0.5)}
     rows = [{"mesh": "5mm", "variant": DEFAULT, "model": m, "state": 1,
              "bead_vs_continuum_mm": d} for m, d in (("a", 0.45), ("b", 0.55))]
-    said = against_continuum(rows, data, "5mm", refs)
-    assert said["a"] == "within what the beads resolve at every state"
-    assert said["b"].startswith("beyond what the beads resolve from")
+    said = against_continuum(rows, data, "5mm", {1: {"a": 0.5, "b": 0.5}})
+    assert said["a"] == "within u_val at every state"
+    assert said["b"].startswith("beyond u_val from")
 
 
 def test_a_state_is_reproduced_within_the_models_u_val_there():

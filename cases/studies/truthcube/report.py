@@ -54,8 +54,6 @@ def verdicts(rows, data, u=None):
 
 
 WITHIN_ALL = "within u_val at every state"
-RESOLVES = "what the beads resolve"          # the floor with the reference's u_num
-WITHIN_RESOLVED = WITHIN_ALL.replace("u_val", RESOLVES)
 
 
 def departure(states, strains):
@@ -78,35 +76,22 @@ def finest(rows):
     return max(meshes, key=meshes.get)
 
 
-def resolved(data, refs):
-    """{state: what the beads resolve between two computed fields [mm]}: the beads' noise
-    combined with the neo-Hookean reference's change over its last refinement at that state
-    (sqrt(floor^2 + u_num^2))."""
-    fl = floors(data)
-    strain_of = {st["strain"]: st["state"] for st in data["states"]}
-    u = {}
-    for r in refs:
-        if r["variant"] == DEFAULT and r["model"] == NH and r.get("bead_change_mm") is not None:
-            k = strain_of.get(r["strain"])
-            u[k] = max(u.get(k, 0.0), r["bead_change_mm"])
-    return {k: float(np.hypot(v["total"], u.get(k, 0.0))) for k, v in fl.items()}
-
-
-def against_continuum(rows, data, mesh, refs=()):
-    """{model: its answer against the continuum on ``mesh`` (default assumptions)}: within
-    what the beads resolve (``resolved``) of the neo-Hookean continuum at every state (the
-    measurement cannot tell them apart), or the strain from which it is farther."""
-    res = resolved(data, refs)
+def against_continuum(rows, data, mesh, u):
+    """{model: its answer against the continuum on ``mesh`` (default assumptions)}: the RMS
+    distance of its bead displacements from the neo-Hookean continuum's within the model's
+    u_val at every state (``u`` {state: {model: u_val}}: the measurement cannot tell them
+    apart), or the strain from which it is farther."""
     out = {}
     for r in sorted(rows, key=lambda r: r["state"]):
         if r["mesh"] not in (mesh, "reference") or r["variant"] != DEFAULT \
                 or r["model"] == NH:
             continue
         d = r.get("bead_vs_continuum_mm")
-        ok = None if d is None else d <= res[r["state"]]
+        mine = u.get(r["state"], {}).get(r["model"])
+        ok = None if d is None or mine is None else d <= mine
         out.setdefault(r["model"], []).append((r["state"], ok))
     strains = [st["strain"] for st in data["states"]]
-    return {m: departure(v, strains).replace("u_val", RESOLVES) for m, v in out.items()}
+    return {m: departure(v, strains) for m, v in out.items()}
 
 
 def state_u_vals(data, parameters):
@@ -114,8 +99,12 @@ def state_u_vals(data, parameters):
     included."""
     from ...answers import u_vals
     truth = {**data, "parameters": parameters, "headline": {"continuum": NH}}
-    return {st["state"]: u_vals(truth, st["strain"], st["floor_mm"]["total"])[0]
-            for st in data["data"]["states"]}
+    out = {}
+    for st in data["data"]["states"]:
+        u, u_num, _, _ = u_vals(truth, st["strain"], st["floor_mm"]["total"])
+        # the linear reference ran under the default assumptions only: no u_input
+        out[st["state"]] = {LINEAR: float(np.hypot(u_num, st["floor_mm"]["total"])), **u}
+    return out
 
 
 def analyse(data, parameters):
@@ -136,7 +125,7 @@ def analyse(data, parameters):
                    if r["model"] == NH and r["strain"] == last and not r.get("failed")}
     return {"finest_mesh": mesh, "departure": said,
             "within_at_every_state": [m for m, t in said.items() if t == WITHIN_ALL],
-            "against_continuum": against_continuum(rows + refs, data["data"], mesh, refs),
+            "against_continuum": against_continuum(rows + refs, data["data"], mesh, u),
             "continuum_by_assumption_mm": assumptions,
             "u_val_by_state": u,
             "headline": {"strain": last, "floor_mm": state["floor_mm"]["total"],
@@ -218,11 +207,10 @@ def conclusion(doc):
                      f"{fmt(others[hi])} mm)")
     lines = [line + "."]
     vs = doc["against_continuum"]
-    close = [m for m, t in vs.items() if t == WITHIN_RESOLVED]
-    far = {m: t for m, t in vs.items() if t != WITHIN_RESOLVED}
-    lines.append("**Against the continuum at the beads** (within what the beads resolve: "
-                 "their noise combined with the reference's change over its last "
-                 "refinement): "
+    close = [m for m, t in vs.items() if t == WITHIN_ALL]
+    far = {m: t for m, t in vs.items() if t != WITHIN_ALL}
+    lines.append("**Against the continuum at the beads** (the RMS distance of a model's bead "
+                 "displacements from the continuum's, read against the model's u_val): "
                  + (f"{', '.join(close)} stay within it at every state (the measurement "
                     "cannot tell them from it)" if close else
                     "no model stays within it at every state")
@@ -351,8 +339,7 @@ def _errors(d, doc):
     d.h(3, "Where each departs")
     d.p(f"On the {doc['finest_mesh']} mesh: from the measurement (its error beyond the noise "
         "above the floor) and from the neo-Hookean continuum under the same assumptions (the "
-        "RMS distance of their bead displacements above what the beads resolve: their floor "
-        "combined with the reference's change over its last refinement).")
+        "RMS distance of their bead displacements beyond the model's u_val there).")
     vs = doc["against_continuum"]
     d.table(["model", "against the measurement", "against the continuum"],
             [[m, t, vs.get(m, "(the continuum)" if m == NH else "n/a")]
@@ -404,7 +391,7 @@ def _figures(d, out, doc):
     rows = _rows(doc, mesh, DEFAULT)
     refs = [m for m in (NH, LINEAR) if any(r["model"] == m for r in rows)]
     models = [m for m in dict.fromkeys(r["model"] for r in rows) if m not in refs]
-    beyond = {m for m, t in doc["against_continuum"].items() if t != WITHIN_RESOLVED}
+    beyond = {m for m, t in doc["against_continuum"].items() if t != WITHIN_ALL}
     columns = []
     for st in data["states"]:
         here = {r["model"]: r for r in rows if r["state"] == st["state"]
@@ -420,7 +407,7 @@ def _figures(d, out, doc):
     figures.measured_layers(out / name, list(range(1, len(data["states"][0]["layer_axial_mm"])
                                                    + 1)), columns,
                             f"Measured against modelled, by bead layer (bonded, {mesh} mesh; "
-                            f"colour: farther than {RESOLVES} from the continuum)",
+                            "colour: farther than its u_val from the continuum)",
                             highlight=beyond)
     d.img(name, "Measured against modelled bead displacements by layer")
     variants = list(dict.fromkeys(r["variant"] for r in doc["references"]))
