@@ -118,8 +118,8 @@ def grouped_bars(path, groups, labels, values, ylabel, title, log=False):
         ax.bar(np.arange(len(groups)) + i * w, [values[g][i] for g in range(len(groups))], w,
                label=lab)
     ax.set_xticks(np.arange(len(groups)) + 0.4 - w / 2, groups, fontsize=8)
-    if log:
-        ax.set_yscale("log")
+    if log and any(v is not None and v > 0 for row in values for v in row):
+        ax.set_yscale("log")     # a figure of failed runs only has nothing to put on a log axis
     _finish(fig, ax, path, None, ylabel, title, grid_axis="y")
 
 

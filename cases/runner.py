@@ -235,9 +235,19 @@ def model_run(case, mesh_name, mesh, bc, model_name, s, ref):
     return r, fields
 
 
-def failed_runs(mesh_name, bc, models, phase, exc):
-    """The rows of runs that could not start: the reason in ``failed``, every metric absent."""
-    return [{"mesh": mesh_name, "bc": bc, "model": m, "failed": f"{phase}: {exc}"}
+class FailedRun(dict):
+    """The row of a run that could not start: a metric it lacks reads None, and a phase's
+    ``*_failed`` entry the reason it could not start (so that every phase reads as failed)."""
+
+    def __missing__(self, key):
+        return self["failed"] if key.endswith("_failed") else None
+
+
+def failed_runs(mesh_name, bc, models, phase, exc, mesh=None):
+    """The rows of runs that could not start: the reason in ``failed``, the mesh's size where
+    it was built, every metric absent."""
+    size = {} if mesh is None else {"nodes": mesh.n_nodes, "tets": mesh.n_tets}
+    return [FailedRun(mesh=mesh_name, bc=bc, model=m, **size, failed=f"{phase}: {exc}")
             for m in models]
 
 
@@ -347,7 +357,7 @@ def _compute(case, s, mesh_name, bc, mesh_of, step, models, refs=None):
     except FINDINGS as exc:
         step(f"{case.name} {mesh_name}/{bc}: references failed", len(s.models) + 1)
         out["runs"] = {r["model"]: (r, None)
-                       for r in failed_runs(mesh_name, bc, models, "reference", exc)}
+                       for r in failed_runs(mesh_name, bc, models, "reference", exc, mesh)}
         return out
     if ref.p2 is not None:
         out["ref_fields"] = {"mesh": mesh, "u": ref.p2.u, "max_tau": ref.tau,
@@ -359,7 +369,7 @@ def _compute(case, s, mesh_name, bc, mesh_of, step, models, refs=None):
         try:
             r, f = model_run(case, mesh_name, mesh, bc, model_name, s, ref)
         except FINDINGS as exc:   # the model cannot be built on this mesh (calibration)
-            [r], f = failed_runs(mesh_name, bc, [model_name], "model", exc), None
+            [r], f = failed_runs(mesh_name, bc, [model_name], "model", exc, mesh), None
         out["runs"][model_name] = (r, f)
         step(f"{case.name} {mesh_name}/{bc}/{model_name}", 1)
     return out

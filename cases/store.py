@@ -3,9 +3,10 @@ determines it, so that a second `pbcm report`, a study and a sweep find what was
 
 A key is the hash of what determines a result: its kind (a case's reference or model run, a
 study's unit), the case, mesh, bc and model, the settings that define the problem (material,
-geometry, loads, mode, what the run skips), and the fingerprint of the package's source (every
-file of ``model``, ``reference`` and ``cases``) and of the numerical libraries' versions. A change
-to any source file therefore misses every entry: nothing stale is ever served.
+geometry, loads, mode, what the run skips), and the fingerprint of the source a run executes
+(every file of ``model``, ``reference`` and ``cases``, every term file given with ``--term`` and
+every package of the ``pbcm.terms`` entry points) and of the numerical libraries' versions. A
+change to any of these files therefore misses every entry: nothing stale is ever served.
 
 The entries live in a diskcache (SQLite and files) in ``$PBCM_CACHE``, by default the user's
 cache directory; an entry is committed in one transaction after its value is written, so a run
@@ -41,11 +42,45 @@ def default_folder():
     return Path(platformdirs.user_cache_dir("pbcm"))
 
 
-@lru_cache(maxsize=None)
 def fingerprint():
-    """The fingerprint of the source this process runs: taken once (a process runs the code
-    it loaded, whatever happens to the files later)."""
-    return source_hash(ROOT)
+    """The fingerprint of the source this process runs: pbcm's own and every term file and
+    entry-point term package it loads (``PBCM_TERMS``, group ``pbcm.terms``); taken once per
+    set of term files (a process runs the code it loaded, whatever happens to the files
+    later)."""
+    from model.terms import user_files
+    return _fingerprint(tuple(user_files()))
+
+
+@lru_cache(maxsize=None)
+def _fingerprint(term_files):
+    h = hashlib.sha256(source_hash(ROOT).encode())
+    for f in term_sources(term_files):
+        h.update(str(f).encode() + b"\0" + f.read_bytes() + b"\0")
+    return h.hexdigest()
+
+
+def term_sources(term_files=()):
+    """The files of the terms pbcm loads from outside its package: ``term_files`` and every
+    Python file of the packages named in the ``pbcm.terms`` entry-point group, sorted."""
+    import importlib.metadata
+    import importlib.util
+    from model.terms import ENTRY_POINT_GROUP
+    out = {Path(f).resolve() for f in term_files if Path(f).is_file()}
+    for ep in importlib.metadata.entry_points(group=ENTRY_POINT_GROUP):
+        top = ep.value.split(":")[0].split(".")[0]
+        try:
+            spec = importlib.util.find_spec(top)
+        except (ImportError, ValueError):
+            spec = None
+        if spec is None:
+            continue                 # its import fails with its own message when it is used
+        if spec.submodule_search_locations:
+            for folder in spec.submodule_search_locations:
+                out.update(p.resolve() for p in Path(folder).rglob("*.py")
+                           if not SKIP & set(p.parts))
+        elif spec.origin and Path(spec.origin).is_file():
+            out.add(Path(spec.origin).resolve())
+    return sorted(out)
 
 
 def source_hash(root):
@@ -137,4 +172,4 @@ class RunStore:
 OFF = RunStore(enabled=False)
 
 __all__ = ["RunStore", "OFF", "key", "kind_of", "fingerprint", "source_hash", "default_folder",
-           "ENV", "ENV_OFF", "ENV_KINDS", "REFERENCE_KINDS"]
+           "term_sources", "ENV", "ENV_OFF", "ENV_KINDS", "REFERENCE_KINDS"]

@@ -1,4 +1,4 @@
-"""The run store (issue 24): a second run on an unchanged checkout computes nothing and writes
+"""The run store: a second run on an unchanged checkout computes nothing and writes
 the same files; a change to any source file of the package misses every entry; a run killed
 while writing leaves no entry a later run trusts; a static-only study run takes the rows of
 the cases' full runs."""
@@ -114,6 +114,45 @@ def test_a_change_to_any_source_file_misses_every_entry(tmp_path, edited):
     assert S.source_hash(root) != before
     path.write_text(path.read_text().removesuffix("\n# an edit\n"))
     assert S.source_hash(root) == before          # the same source, the same key
+
+
+def test_a_term_files_edit_misses_the_store(tmp_path, monkeypatch):
+    """The key covers every term file a run loads: a user term whose factor goes from 2 to 1
+    gives another key, and the same bytes give the same key again."""
+    def key():              # as a new process takes it (one process keeps what it loaded)
+        S._fingerprint.cache_clear()
+        return S.key(kind="run", case="cantilever")
+    term = tmp_path / "my_term.py"
+    term.write_text("FACTOR = 2\n")
+    monkeypatch.setenv("PBCM_TERMS", str(term))
+    before = key()
+    term.write_text("FACTOR = 1\n")
+    assert key() != before
+    term.write_text("FACTOR = 2\n")
+    assert key() == before
+    monkeypatch.delenv("PBCM_TERMS")
+    assert key() != before                        # without the file
+
+
+def test_an_entry_point_packages_source_is_in_the_key(tmp_path, monkeypatch):
+    """The key covers the packages of the ``pbcm.terms`` entry points: an edit to any module
+    of such a package gives another key."""
+    import importlib.metadata
+    pkg = tmp_path / "site" / "myterms"
+    pkg.mkdir(parents=True)
+    (pkg / "__init__.py").write_text("")
+    (pkg / "spring.py").write_text("K = 2\n")
+    monkeypatch.syspath_prepend(str(tmp_path / "site"))
+    ep = importlib.metadata.EntryPoint("spring", "myterms.spring", "pbcm.terms")
+    monkeypatch.setattr(importlib.metadata, "entry_points",
+                        lambda group=None: [ep] if group == "pbcm.terms" else [])
+    assert (pkg / "spring.py").resolve() in S.term_sources()
+    S._fingerprint.cache_clear()
+    before = S.key(kind="run")
+    (pkg / "spring.py").write_text("K = 1\n")
+    S._fingerprint.cache_clear()                  # a new process
+    assert S.key(kind="run") != before
+    S._fingerprint.cache_clear()
 
 
 def test_keys_depend_on_what_determines_a_result():

@@ -76,8 +76,8 @@ class Cantilever(Case):
         solved = [r for r in runs if r.get("tip_deflection_mm") is not None]
         out = [common.best_and_worst(runs, "tip_deflection_rel_err", "Tip deflection")]
         if solved:
-            fem = runs[0]["tip_deflection_fem_mm"]
-            out.append(f"FEM P2 deflects {fem:.4g} mm ({runs[0]['mesh']}), the closed form "
+            fem = solved[0]["tip_deflection_fem_mm"]
+            out.append(f"FEM P2 deflects {fem:.4g} mm ({solved[0]['mesh']}), the closed form "
                        f"{cf:.4g} mm: a fully clamped root is stiffer than beam theory's.")
             soft = sorted({r["model"] for r in solved
                            if r["tip_deflection_mm"] > r["tip_deflection_fem_mm"]})

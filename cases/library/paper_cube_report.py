@@ -51,6 +51,8 @@ def cell(metric, run):
 
 def _bracket(counts, paper):
     """Whether the tetrahedron counts run bracket the paper's, with their range."""
+    if not counts:
+        return "are not known: no mesh was built"
     lo, hi = min(counts), max(counts)
     return (f"{'bracket' if lo <= paper <= hi else 'do not bracket'} it ({lo} to {hi} "
             "tetrahedra)")
