@@ -27,7 +27,7 @@ from pathlib import Path
 import tomllib
 
 from . import catalogue
-from .output import SWEEP_MARK
+from .output import SWEEP_MARK, TMP_TAG
 
 POLICY = "policy.toml"
 SUFFIX = ".jsonl"
@@ -233,10 +233,20 @@ def _metrics_files(folder):
     behind a link went unchecked)."""
     found = []
     for root, dirs, files in os.walk(folder, followlinks=True):
-        dirs.sort()
+        dirs[:] = sorted(d for d in dirs if not d.startswith("."))   # hidden: never output
         if "metrics.json" in files:
             found.append(Path(root) / "metrics.json")
     return sorted(found)
+
+
+def incomplete(folder):
+    """The staging folders under ``folder``: runs killed while writing (or still writing),
+    whose output is not there to check."""
+    out = []
+    for root, dirs, _ in os.walk(folder, followlinks=True):
+        out += [Path(root) / d for d in dirs if TMP_TAG in d]
+        dirs[:] = [d for d in dirs if not d.startswith(".")]
+    return sorted(out)
 
 
 def measured(metrics_dir):
@@ -246,6 +256,12 @@ def measured(metrics_dir):
         raise CheckError(f"--metrics {p} does not exist; run `pbcm run CASE --out {p}/CASE` "
                          "first, or give the folder that holds the metrics.json files")
     files = [p] if p.is_file() else [f for f in _metrics_files(p) if not _in_sweep(f, p)]
+    left = [] if p.is_file() else incomplete(p)
+    if left:
+        raise CheckError("incomplete run(s) under " + str(p) + ": " + ", ".join(
+            str(f) for f in left) + " (a run killed while writing, or one still writing: its "
+            "output is not there to check); rerun the case into that folder, which removes "
+            "a killed run's staging folder")
     if not files:
         raise CheckError(f"no metrics.json under {p}; run `pbcm run CASE` first")
     values, problems, directions, rows, sources = {}, {}, {}, set(), {}
@@ -261,8 +277,9 @@ def measured(metrics_dir):
             raise CheckError(f"{f} is not a pbcm metrics file of this version (lacks {exc}); "
                              "rerun the case") from None
         if (case, mode) in problems and problems[(case, mode)] != problem:
-            raise CheckError(f"two metrics files of {case} ({mode} mode) under {p} were run at "
-                             "different parameters; check them one at a time")
+            raise CheckError(f"two metrics files of {case} ({mode} mode), {sources[(case, mode)]}"
+                             f" and {f}, were run at different parameters; check them one at "
+                             "a time")
         problems[(case, mode)] = problem
         sources[(case, mode)] = f
         # the file says which metrics are gated; the catalogue says which way
@@ -370,6 +387,9 @@ def check(gold, measurements):
             ok = b.passes(v)
             out.append((b, v, ok))
             status = max(status, 0 if ok else 1)
+    if not out and not flips:
+        raise CheckError("no value was compared with its gold (every gated value is n/a in "
+                         "both): a check that reads nothing passes nothing")
     if new and status == 0:
         status = NEW
     return Verdict(out, flips, [(*k, n) for k, n in sorted(new.items())], status)

@@ -7,7 +7,9 @@ import ctypes
 import ctypes.util
 import errno
 import os
+import re
 import shutil
+import socket
 import signal
 import tempfile
 import threading
@@ -22,6 +24,36 @@ OWNED_MARK = "metrics.json"
 # case metrics, so the gate does not read them
 SWEEP_MARK = "sweep.json"
 TMP_TAG = ".pbcm-tmp-"
+# a staging folder's name: .<target>.pbcm-tmp-<host>.<pid>.<random>[-old]
+_STAGED = re.compile(re.escape(TMP_TAG) + r"(?P<host>.+)\.(?P<pid>\d+)\.[^.]*(-old)?$")
+
+
+def staging_prefix(target):
+    """The prefix of ``target``'s staging folders made by this process."""
+    return f".{Path(target).name}{TMP_TAG}{socket.gethostname()}.{os.getpid()}."
+
+
+def _alive(pid):
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    except PermissionError:
+        return True
+    return True
+
+
+def stale_staging(target):
+    """The staging folders of ``target`` that a run on this machine left behind when it was
+    killed (its process is gone); a folder of a run still going, or of another machine, is
+    never among them."""
+    target = Path(target)
+    out = []
+    for p in sorted(target.parent.glob(f".{target.name}{TMP_TAG}*")):
+        m = _STAGED.search(p.name)
+        if p.is_dir() and m and m["host"] == socket.gethostname() and not _alive(int(m["pid"])):
+            out.append(p)
+    return out
 
 
 class OutputError(PbcmError, OSError):
@@ -85,7 +117,9 @@ class StagedFolder:
                               f"{mark}); pbcm replaces the whole folder it writes, so "
                               "give a new or empty folder")
         parent = writable_folder(self.target.parent, flag=f"{flag} {self.target}: the folder")
-        self.path = Path(tempfile.mkdtemp(prefix=f".{self.target.name}{TMP_TAG}", dir=parent))
+        for left in stale_staging(self.target):    # a killed run's: never its own output
+            shutil.rmtree(left, ignore_errors=True)
+        self.path = Path(tempfile.mkdtemp(prefix=staging_prefix(self.target), dir=parent))
         os.chmod(self.path, 0o777 & ~_umask())
 
     def __enter__(self):

@@ -282,3 +282,75 @@ def test_a_case_folder_behind_a_link_is_checked(quick, tmp_path, capsys):
     assert main(["check", "--metrics", str(tmp_path / "m"), "--gold", str(ROOT / "gold"),
                  "--allow-new"]) == 0
     assert "paper-cube/five/clamped/" in capsys.readouterr().out
+
+
+def test_a_run_killed_while_writing_is_an_incomplete_run_until_rerun(blessed, tmp_path,
+                                                                      capsys):
+    """A run killed (SIGKILL) while its staging folder fills leaves that folder beside the case
+    folder: ``pbcm check`` fails naming it (even with a metrics.json inside: hidden folders
+    are never output), the case folder holds the earlier complete run, and the next run into
+    that folder removes it and passes."""
+    import os
+    import subprocess
+    import sys
+    import time
+    out = tmp_path / "m"
+    shutil.copytree(blessed / "good", out)
+    case = out / "paper-cube"
+    before = (case / "metrics.json").read_bytes()
+    env = dict(os.environ, PYTHONPATH=str(ROOT))
+    p = subprocess.Popen([sys.executable, "-m", "cases.cli", "run", "paper-cube", *SMALL,
+                          "--workers", "1", "--out", str(case)], env=env,
+                         stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    try:
+        deadline = time.monotonic() + 300
+        while time.monotonic() < deadline and p.poll() is None:
+            staged = [d for d in out.glob(".paper-cube.pbcm-tmp-*") if any(d.iterdir())]
+            if staged:
+                break
+            time.sleep(0.05)
+    finally:
+        p.kill()
+        p.wait()
+    assert staged, "the run never wrote into its staging folder"
+    (staged[0] / "metrics.json").write_bytes(before)      # as if killed after writing it
+    assert (case / "metrics.json").read_bytes() == before
+    capsys.readouterr()
+    assert check(out, blessed / "g") == 2
+    err = capsys.readouterr().err
+    assert "incomplete run" in err and staged[0].name in err
+    assert main(["run", "paper-cube", *SMALL, "--workers", "1", "--out", str(case)]) == 0
+    assert not list(out.glob(".paper-cube.pbcm-tmp-*"))
+    assert check(out, blessed / "g") == 0
+
+
+def test_two_metrics_files_at_different_parameters_are_named(blessed, tmp_path, capsys):
+    """Two metrics files of one case and mode run at different parameters: the refusal names
+    both."""
+    a, b = tmp_path / "m" / "a", tmp_path / "m" / "b"
+    shutil.copytree(blessed / "good" / "paper-cube", a)
+    shutil.copytree(blessed / "good" / "paper-cube", b)
+    data = json.loads((b / "metrics.json").read_text())
+    data["problem"]["nu"] = 0.3
+    (b / "metrics.json").write_text(json.dumps(data))
+    assert check(tmp_path / "m", blessed / "g") == 2
+    err = capsys.readouterr().err
+    assert str(a / "metrics.json") in err and str(b / "metrics.json") in err
+
+
+def test_only_a_dead_runs_staging_folder_is_stale(tmp_path):
+    """A staging folder is removed only when the run that made it, on this machine, is gone:
+    a live run's (two runs into one folder) and another machine's are kept."""
+    import socket
+    import subprocess
+    import sys
+    from cases.output import stale_staging, staging_prefix
+    target = tmp_path / "paper-cube"
+    mine = tmp_path / (staging_prefix(target) + "abc")
+    dead = subprocess.run([sys.executable, "-c", "import os; print(os.getpid())"],
+                          capture_output=True, text=True).stdout.strip()
+    gone = tmp_path / f".paper-cube.pbcm-tmp-{socket.gethostname()}.{dead}.xyz"
+    other = tmp_path / f".paper-cube.pbcm-tmp-elsewhere.example.{dead}.xyz"
+    for d in (mine, gone, other):
+        d.mkdir()
+    assert stale_staging(target) == [gone]
