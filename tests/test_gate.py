@@ -100,6 +100,22 @@ def test_worse_model_fails_and_names_the_metric(blessed, tmp_path, capsys, monke
     out = capsys.readouterr().out
     assert "FAIL disp_rel_l2_p2 of paper-cube/five/clamped/pbcm-variational" in out
     assert "msm/" not in "".join(l for l in out.splitlines() if l.startswith("FAIL"))
+    assert "better: bless" not in out        # beside a regression nothing is an improvement
+
+
+def test_beside_a_regression_an_improvement_is_said_to_have_moved_with_it(blessed, tmp_path,
+                                                                           capsys):
+    """One value worse and one better in one check: the better one is listed apart as moved
+    with the regression, never offered for blessing."""
+    edit_gold(blessed / "g", tmp_path / "g1", "pbcm-variational", "disp_rel_l2_p2",
+              lambda v: 2 * v)
+    edit_gold(tmp_path / "g1", tmp_path / "g2", "msm", "disp_rel_l2_p2", lambda v: v / 2)
+    assert check(blessed / "good", tmp_path / "g2") == 1
+    out = capsys.readouterr().out
+    assert "FAIL disp_rel_l2_p2 of paper-cube/five/clamped/msm" in out and "worse" in out
+    assert "moved with the regression: do not bless" in out
+    assert "better: bless" not in out
+    assert "margin: how far inside its band" in out
 
 
 def test_hand_tightened_gold_fails(blessed, tmp_path, capsys):

@@ -41,12 +41,24 @@ def run(args):
         low, high = b.band
         print(f"{name:<66} {value:>11.5g} [{low:>10.5g},{high:>10.5g}] "
               f"{b.margin(value):>8.1%}  {'PASS' if ok else 'FAIL'}")
+    print("margin: how far inside its band a value is, as a fraction of the band's half-width "
+          "(100 % at the gold value, 0 at its edge, negative outside)")
     failed = [r for r in v.rows if not r[2]]
     print(f"{len(v.rows) - len(failed)} passed, {len(failed) + len(v.flips)} failed")
-    for b, value, _ in failed:
+    worse = [r for r in failed if r[0].verdict(r[1]).startswith("worse")]
+    # beside a regression, a value that moved the other way moved with it: not an improvement
+    moved = [r for r in failed if r not in worse] if worse else []
+    for b, value, _ in [r for r in failed if r not in moved]:
         low, high = b.band
         print(f"FAIL {b.metric} of {b.case}/{b.mesh}/{b.bc}/{b.model}: {value:.6g} outside "
               f"[{low:.6g}, {high:.6g}] ({b.verdict(value)})")
+    if moved:
+        print(f"{len(moved)} value(s) moved with the regression above (do not bless them: "
+              "fix the regression first):")
+    for b, value, _ in moved:
+        low, high = b.band
+        print(f"FAIL {b.metric} of {b.case}/{b.mesh}/{b.bc}/{b.model}: {value:.6g} outside "
+              f"[{low:.6g}, {high:.6g}] (moved with the regression: do not bless)")
     for key, gold, now in v.flips:
         print(flip_message(key, gold, now))
     for case, mode, name, n in v.new:
