@@ -23,7 +23,8 @@ from scipy.optimize import least_squares, nnls
 from .static import JacobianPattern, jacobian
 from .errors import ModelError
 from .homogenize import condensed_stiffness, kelvin_moduli
-from .mesh import box
+from .geometry import radius_ratio
+from .mesh import SLIVER_RADIUS_RATIO, _first, box
 
 
 def deviatoric_basis():
@@ -158,9 +159,16 @@ def calibrate(terms, mesh, material, cache=True):
 
 def _fit(terms, auto, mesh, material):
     patch = calibration_patch(mesh)
+    names = ", ".join(t.describe() for t in auto)
+    thin = patch.slivers()
+    if thin.size:
+        ratio = radius_ratio(patch.points, patch.tets[thin]).min()
+        raise ModelError(f"calibration of {names} refused: tetrahedra {_first(thin)} of the "
+                         f"mesh are slivers (radius ratio down to {ratio:.3g}, below "
+                         f"{SLIVER_RADIUS_RATIO:g}), whose stiffness would set c; re-mesh them, "
+                         "or pass a number for c")
     fixed, unit = _stiffnesses(terms, patch, material)
     G = material.G
-    names = ", ".join(t.describe() for t in auto)
 
     def moduli(c):
         K = sum((ci * Ki for ci, Ki in zip(c, unit)), fixed if fixed is not None else 0)
@@ -198,6 +206,10 @@ def _fit(terms, auto, mesh, material):
                          "deviatoric fit on this mesh; pass a number for c")
     bulk, mu = moduli(coefs)
     ratio = mu / (2 * G)
+    if ratio.min() <= 0:
+        raise ModelError(f"calibration of {names} gave a deviatoric modulus {ratio.min():.3g} "
+                         "x 2G <= 0 (a mode with no shear stiffness): the model is unstable on "
+                         "this mesh; pass a number for c")
     out = {"calibration_patch": ("the mesh itself" if patch is mesh else
                                  f"{PATCH_NODES - 1}^3 cells of its lattice"),
            "deviatoric_eig_min": float(ratio.min()), "deviatoric_eig_max": float(ratio.max()),

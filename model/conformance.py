@@ -64,6 +64,10 @@ def checks(term, mesh, x):
     """[(check, value, bound)] of ``term`` (made on ``mesh``) at ``x``: each value a relative
     deviation that passes when at most its bound."""
     f = term.forces(x)
+    bad = int(np.count_nonzero(~np.isfinite(f)))
+    if bad:
+        return [("finite forces at a deformed state", float("nan"),
+                 f"finite ({bad} of {f.size} components are not)")]
     size = np.abs(f).max()
     if not size > 0:
         return [("forces at a deformed state", 0.0, "> 0")]
@@ -100,6 +104,11 @@ def checks(term, mesh, x):
     return out
 
 
+def _show(v):
+    """A check's value as text: a number, or what it is when it is not one."""
+    return f"{v:.3g}" if np.isfinite(v) else f"not finite ({v})"
+
+
 def _probe_params(cls, params):
     p = {**cls.params, **params}
     if p.get("c") == "auto":
@@ -128,8 +137,8 @@ def conform(cls, params=None):
         given = ", ".join(f"{k}={v}" for k, v in p.items()) or "no parameters"
         raise ModelError(
             f"force term {cls.name!r} ({given}) is refused: it fails the conformance check(s) "
-            + "; ".join(f"'{c}': {v:.3g} > {b:g}" if not isinstance(b, str)
-                        else f"'{c}': {v:.3g}, expected {b}" for c, v, b in failed)
+            + "; ".join(f"'{c}': {_show(v)} > {b:g}" if not isinstance(b, str)
+                        else f"'{c}': {_show(v)}, expected {b}" for c, v, b in failed)
             + " (relative). Fix the term, or declare a claim it does not make "
             "(momentum, angular_momentum, rotation_invariant, conservative = False).")
     _passed.add((cls, options))

@@ -15,11 +15,42 @@ from .geometry import dihedral_angles, edges as unique_edges, radius_ratio, sign
 DUPLICATE_TOL = 1e-9
 # relative to the mean |V|: below this a tetrahedron is degenerate
 DEGENERATE_VOLUME_TOL = 1e-10
+# below this radius ratio (1 regular, 0 flat) a tetrahedron is a sliver: its stiffness
+# dominates a calibration and its stable step
+SLIVER_RADIUS_RATIO = 0.05
 
 
 def _first(ids, k=10):
     ids = list(map(int, ids))
     return ", ".join(map(str, ids[:k])) + (f" ... ({len(ids)} in all)" if len(ids) > k else "")
+
+
+def folded_tets(points, tets):
+    """The positively oriented tetrahedra that lie on the same side of a face they share with
+    a neighbour (a fold), or that share a face with more than one other (not a manifold):
+    sorted indices, empty for a valid mesh."""
+    m = len(tets)
+    local = np.array([[1, 2, 3], [0, 2, 3], [0, 1, 3], [0, 1, 2]])
+    faces = np.sort(tets[:, local].reshape(-1, 3), axis=1)
+    opposite = tets.reshape(-1)                     # the vertex opposite face k of tet t
+    owner = np.repeat(np.arange(m), 4)
+    order = np.lexsort(faces.T[::-1])
+    f = faces[order]
+    same = np.all(f[1:] == f[:-1], axis=1)
+    bad = set()
+    triple = same[1:] & same[:-1]                   # three tets on one face
+    bad.update(owner[order[1:-1][triple]].tolist())
+    i = order[:-1][same]
+    j = order[1:][same]
+    p = points
+    a, b, c = (p[faces[i, k]] for k in range(3))
+    normal = np.cross(b - a, c - a)
+    side_i = np.einsum("ij,ij->i", p[opposite[i]] - a, normal)
+    side_j = np.einsum("ij,ij->i", p[opposite[j]] - a, normal)
+    fold = side_i * side_j > 0
+    bad.update(owner[i[fold]].tolist())
+    bad.update(owner[j[fold]].tolist())
+    return np.array(sorted(bad), dtype=np.int64)
 
 
 @dataclass
@@ -88,6 +119,11 @@ class TetMesh:
         neg = vol < 0
         if neg.any():
             tets[neg] = tets[neg][:, [0, 2, 1, 3]]
+        folded = folded_tets(pts, tets)
+        if folded.size:
+            raise MeshError(f"tetrahedra {_first(folded)} overlap a neighbour across a shared "
+                            "face (the mesh is folded: a node pushed through a face); "
+                            "re-orienting them would hide it: fix or re-mesh them")
         self.points, self.tets, self.reoriented = pts, tets, int(neg.sum())
         self.points.flags.writeable = False
         self.tets.flags.writeable = False
@@ -119,6 +155,10 @@ class TetMesh:
     def size(self):
         """Diagonal of the bounding box."""
         return float(np.linalg.norm(self.points.max(axis=0) - self.points.min(axis=0)))
+
+    def slivers(self):
+        """The tetrahedra whose radius ratio is below ``SLIVER_RADIUS_RATIO``, sorted."""
+        return np.flatnonzero(radius_ratio(self.points, self.tets) < SLIVER_RADIUS_RATIO)
 
     def quality(self):
         """Quality summary: volume, radius ratio (1 regular, 0 sliver), dihedral angles."""

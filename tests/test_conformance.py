@@ -166,3 +166,16 @@ def test_a_broken_term_file_is_refused_by_the_command_before_computing(term_file
     assert status == 2
     assert "'forces equal minus the energy gradient'" in err and "refused" in err
     assert not (out / "metrics.json").exists()
+
+
+def test_a_term_with_non_finite_forces_is_refused_saying_so(tmp_path):
+    """A term whose forces hold a NaN is refused with the count of non-finite components,
+    never with a NaN printed as a number ('0')."""
+    path = tmp_path / "edge_springs_nan.py"
+    path.write_text(textwrap.dedent(TEMPLATE.format(bug="nan", **{**SOUND,
+                                                                  "push": "float('nan')"})))
+    model.terms.load_file(path)
+    with pytest.raises(ModelError, match=r"'finite forces at a deformed state': not finite "
+                                         r"\(nan\), expected finite \(\d+ of \d+ components "
+                                         r"are not\)"):
+        make_term("edge_springs_nan", cube(3, 0.02, "six"), Material(E=10e3, nu=0.3, rho=1000.0))

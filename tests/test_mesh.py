@@ -3,7 +3,7 @@ import numpy as np
 import pytest
 
 from model.errors import MeshError
-from model.mesh import SCHEMES, TetMesh, box, cube, read, write
+from model.mesh import SCHEMES, TetMesh, box, cube, folded_tets, read, write
 
 L = 0.032
 
@@ -169,3 +169,34 @@ def test_paper_meshes_take_the_lattice_checks():
     with pytest.raises(MeshError, match="positive length"):
         mixed_split(5, -0.032, 10, 0)
     assert delaunay_lattice(5.0, 0.032, 7).n_tets == delaunay_lattice(5, 0.032, 7).n_tets
+
+
+def test_a_folded_mesh_is_refused_naming_the_tetrahedra():
+    """A node pushed through a face inverts its tetrahedra, which re-orientation would hide
+    (a cube of 32 768 mm^3 measuring more): the mesh is refused, naming them; the four
+    generated families pass."""
+    m = cube(5, 0.032, "six")
+    pts = m.points.copy()
+    i = int(np.argmin(np.linalg.norm(pts - 0.016, axis=1)))
+    pts[i] += [0.009, 0.0, 0.0]
+    with pytest.raises(MeshError, match="folded") as err:
+        TetMesh(pts, m.tets.copy())
+    assert "tetrahedra " in str(err.value)
+    for family in ("five", "six", "bcc", "unstructured"):
+        c = cube(5, 0.032, family)
+        assert folded_tets(c.points, c.tets).size == 0
+
+
+def test_a_sliver_is_named_and_refused_for_calibration():
+    """One nearly flat tetrahedron: ``slivers`` names it and a calibrated
+    model refuses the mesh naming it, instead of a collapsed c; a given c still builds."""
+    from model import build
+    from model.errors import ModelError
+    from model.material import Material
+    pts = np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0], [0, 0, 1], [0.34, 0.33, 0.335]]) * 0.01
+    tets = np.array([[0, 1, 2, 3], [1, 2, 3, 4]])
+    m = TetMesh(pts, tets)
+    assert m.slivers().tolist() == [1]
+    with pytest.raises(ModelError, match="tetrahedra 1 of the mesh are slivers"):
+        build("pbcm-variational", m, Material(10e3, 0.45))
+    build("shear(reading=variational, c=1) + volume", m, Material(10e3, 0.45))
