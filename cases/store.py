@@ -19,6 +19,8 @@ suite runs so).
 import hashlib
 import json
 import os
+import sqlite3
+import sys
 from functools import lru_cache
 from pathlib import Path
 
@@ -32,6 +34,16 @@ REFERENCE_KINDS = ("reference", "convergence-reference", "convergence-reference-
 PACKAGES = ("model", "reference", "cases")
 ROOT = Path(__file__).resolve().parents[1]
 SKIP = {"__pycache__"}
+
+
+_WARNED = set()
+
+
+def _warn(text):
+    """One line on stderr, once per process and text."""
+    if text not in _WARNED:
+        _WARNED.add(text)
+        print(f"pbcm: warning: {text}", file=sys.stderr)
 
 
 def default_folder():
@@ -142,24 +154,62 @@ class RunStore:
         if self._cache is None:
             import diskcache
             self.folder.mkdir(parents=True, exist_ok=True)
-            # no size limit: results are evicted by a change of source, not by age
-            self._cache = diskcache.Cache(str(self.folder), size_limit=2 ** 62,
-                                          eviction_policy="none")
+            db = self.folder / "cache.db"
+            if db.is_file() and db.stat().st_size == 0 and len(list(self.folder.iterdir())) > 1:
+                self._set_aside("its index cache.db is empty")
+            try:
+                # no size limit: results are evicted by a change of source, not by age
+                self._cache = diskcache.Cache(str(self.folder), size_limit=2 ** 62,
+                                              eviction_policy="none")
+                len(self._cache)          # reads the index: a corrupt one raises here
+            except sqlite3.DatabaseError as exc:
+                self._set_aside(f"its index is corrupt ({exc})")
+                self._cache = diskcache.Cache(str(self.folder), size_limit=2 ** 62,
+                                              eviction_policy="none")
         return self._cache
 
+    def _set_aside(self, why):
+        """Move a broken store aside (kept, never rebuilt over its files) and say so once."""
+        if self._cache is not None:
+            self._cache.close()
+            self._cache = None
+        aside = self.folder.with_name(f"{self.folder.name}.broken-{os.getpid()}")
+        os.rename(self.folder, aside)
+        self.folder.mkdir(parents=True)
+        _warn(f"the run store {self.folder}: {why}; moved aside to {aside} (delete it when "
+              "you like) and started empty")
+
+    def _failed(self, what, exc):
+        """The optional store failed: warn once, go on without it (a run never stops for
+        it)."""
+        self.enabled = False
+        _warn(f"the run store {self.folder} could not {what} ({type(exc).__name__}: {exc}); "
+              "going on without it (--no-cache skips it; a corrupt store is moved aside on "
+              "the next run)")
+
     def get(self, k):
-        """The value stored under key ``k``, or None."""
+        """The value stored under key ``k``, or None (also when the store fails: it warns
+        once and is off for the rest of the process)."""
         if not self._keeps(k):
             return None
-        value = self._open().get(k)
+        try:
+            value = self._open().get(k)
+        except (OSError, sqlite3.Error) as exc:
+            self._failed("be read", exc)
+            return None
         if value is not None:
             self.found += 1
         return value
 
     def put(self, k, value):
-        """Keep ``value`` under key ``k`` (committed whole, or not at all)."""
+        """Keep ``value`` under key ``k`` (committed whole, or not at all); a store that cannot
+        keep it warns once and is off for the rest of the process."""
         if self._keeps(k):
-            self._open().set(k, value)
+            try:
+                self._open().set(k, value)
+            except (OSError, sqlite3.Error) as exc:
+                self._failed("keep a result", exc)
+                return value
             self.kept += 1
         return value
 

@@ -131,6 +131,9 @@ def conform(cls, params=None):
     except ModelError as exc:
         raise ModelError(f"force term {cls.name!r} failed its conformance checks: {exc}") \
             from exc
+    except Exception as exc:      # a user term's own error, in its constructor or kernel
+        raise ModelError(f"force term {cls.name!r} raised {type(exc).__name__} in its "
+                         f"conformance checks: {exc}; fix the term") from exc
     failed = [(c, v, b) for c, v, b in found
               if isinstance(b, str) or not (np.isfinite(v) and v <= b)]
     if failed:

@@ -179,3 +179,22 @@ def test_a_term_with_non_finite_forces_is_refused_saying_so(tmp_path):
                                          r"\(nan\), expected finite \(\d+ of \d+ components "
                                          r"are not\)"):
         make_term("edge_springs_nan", cube(3, 0.02, "six"), Material(E=10e3, nu=0.3, rho=1000.0))
+
+
+def test_a_term_that_raises_is_refused_in_one_line(tmp_path):
+    """A user term whose constructor raises its own error (not pbcm's) is refused with a
+    ModelError naming the term and the error, which the command line prints as one line."""
+    path = tmp_path / "raising_term.py"
+    path.write_text(textwrap.dedent('''
+        from model.terms import Term, register
+
+        @register
+        class Raising(Term):
+            name = "raising"
+
+            def __init__(self, mesh, material, scale=1.0, **params):
+                raise ValueError("my table is missing")
+    '''))
+    model.terms.load_file(path)
+    with pytest.raises(ModelError, match="'raising' raised ValueError.*my table is missing"):
+        make_term("raising", cube(3, 0.02, "six"), Material(E=10e3, nu=0.3, rho=1000.0))

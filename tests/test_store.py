@@ -266,3 +266,52 @@ def test_kinds_keep_and_find_only_entries_of_those_kinds(tmp_path, monkeypatch):
     assert from_env.kinds == {"run", "reference-fields"}
     assert from_env.get(ref) is None
     assert pickle.loads(pickle.dumps(from_env)).kinds == from_env.kinds
+
+
+def test_a_corrupt_store_is_moved_aside_and_the_run_goes_on(cache, tmp_path, capsys):
+    """A store whose index is not a database is moved aside (kept, never rebuilt over its
+    value files) with one warning naming where, and a new empty store takes its place."""
+    folder = tmp_path / "store"
+    s = S.RunStore(folder)
+    s.put("k", [1])
+    s.close()
+    (folder / "cache.db").write_bytes(b"not a database" * 100)
+    s = S.RunStore(folder)
+    assert s.get("k") is None
+    s.put("k2", [2])
+    assert S.RunStore(folder).get("k2") == [2]
+    aside = [p for p in tmp_path.iterdir() if p.name.startswith("store.broken-")]
+    assert len(aside) == 1 and (aside[0] / "cache.db").is_file()
+    err = capsys.readouterr().err
+    assert err.count("pbcm: warning:") == 1 and str(aside[0]) in err
+
+
+def test_a_store_that_cannot_keep_a_result_warns_once_and_the_run_goes_on(cache, tmp_path,
+                                                                          capsys, monkeypatch):
+    """A full disk under the optional store never stops a run: the first failed write warns
+    once, the store is off for the rest of the process, and the value is returned."""
+    import diskcache
+    s = S.RunStore(tmp_path / "store")
+
+    def full(*a, **k):
+        raise OSError(28, "No space left on device")
+    monkeypatch.setattr(diskcache.Cache, "set", full)
+    assert s.put("a", 1) == 1 and s.put("b", 2) == 2
+    assert not s.enabled and s.get("a") is None
+    err = capsys.readouterr().err
+    assert err.count("pbcm: warning:") == 1 and "No space left on device" in err
+
+
+def test_an_output_fault_is_one_line_with_exit_2(tmp_path, capsys, monkeypatch):
+    """A fault of the environment while writing (a full disk) ends with one line
+    'pbcm: error: ...' naming the fix, exit 2, no traceback."""
+    from cases.tools import bench
+
+    def full(data, out):
+        raise OSError(28, "No space left on device", str(out / "bench.json"))
+    monkeypatch.setattr(bench, "write", full)
+    status = main(["bench", "--sizes", "100", "--rounds", "1", "--models", "msm",
+                   "--out", str(tmp_path / "bench")])
+    err = capsys.readouterr().err
+    assert status == 2 and err.startswith("pbcm: error:") and "Traceback" not in err
+    assert "No space left on device" in err and "choose another --out" in err

@@ -2,8 +2,9 @@
 and ``run(args)``; ``common`` holds what they share and ``pipeline`` the main job (every case,
 then every study).
 
-Every argument is checked before any computing starts (names, numbers, output paths); errors
-are one line ``pbcm: error: ...`` with exit status 2, Ctrl-C is one line with exit status 130.
+Every argument is checked before any computing starts (names, numbers, output paths); errors,
+and faults of the environment (a full disk, a permission), are one line ``pbcm: error: ...``
+with exit status 2, Ctrl-C is one line with exit status 130.
 """
 import argparse
 import os
@@ -80,6 +81,12 @@ def _main(argv):
     except BrokenPipeError:   # `pbcm check | head`: the reader left; say nothing more
         os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
         return 141
+    except OSError as exc:    # the environment: a full disk, a permission, a vanished mount
+        where = f"{exc.filename}: " if exc.filename else ""
+        print(f"pbcm: error: {where}{exc.strerror or exc} (errno {exc.errno}); free space, fix "
+              "the permission or choose another --out, then run the command again (output "
+              "folders hold what they held before)", file=sys.stderr)
+        return 2
 
 
 

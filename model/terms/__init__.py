@@ -109,7 +109,13 @@ def make_term(name, mesh, material, **params):
     if name not in TERMS:
         raise ModelError(f"unknown force term {name!r}; registered: {', '.join(sorted(TERMS))}")
     conform(TERMS[name], params)
-    return TERMS[name](mesh, material, **params)
+    try:
+        return TERMS[name](mesh, material, **params)
+    except ModelError:
+        raise
+    except Exception as exc:      # a user term's own error on this mesh
+        raise ModelError(f"force term {name!r} raised {type(exc).__name__} when made on a mesh "
+                         f"of {mesh.n_tets} tetrahedra: {exc}; fix the term") from exc
 
 
 class Term:
