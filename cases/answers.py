@@ -10,7 +10,7 @@ from pathlib import Path
 import numpy as np
 
 from .costs import FILE as BENCH_FILE, FOLDER as BENCH_FOLDER
-from .document import fmt
+from .document import fmt, rel
 from .metrics import PATCH_TOL
 
 COST_TETS = 1e4          # the mesh size of the cost column (tetrahedra)
@@ -49,7 +49,10 @@ def limits(conv, model):
 
 
 def _pm(v):
-    return f"{fmt(v[0], 2)} +- {fmt(v[1], 1)}"
+    """'limit +- its uncertainty', or the limit alone where both are round-off."""
+    if rel(v[0] + v[1]).startswith("<"):
+        return rel(v[0] + v[1])
+    return f"{rel(v[0], 2)} +- {rel(v[1], 1)}"
 
 
 def worst(values):
@@ -545,7 +548,7 @@ def _irregular(conv, models):
     if not worst_of:
         return ""
     return ("; the patch test with every boundary node prescribed, on irregular patches "
-            "(worst): " + ", ".join(f"{m} {fmt(v)}" for m, v in sorted(
+            "(worst): " + ", ".join(f"{m} {rel(v)}" for m, v in sorted(
                 worst_of.items(), key=lambda kv: kv[1])))
 
 

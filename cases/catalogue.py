@@ -19,7 +19,7 @@ metrics.json is one or the other.
 """
 from dataclasses import dataclass
 
-from .document import fmt
+from .document import fmt, rel
 
 UNIT_SUFFIXES = ("_mm", "_n", "_nm", "_hz", "_s", "_pa")
 
@@ -57,6 +57,8 @@ class Metric:
             return fmt(value) if not isinstance(value, (list, dict)) else "n/a"
         if isinstance(value, int) and self.unit == "count":
             return str(value)
+        if self.unit == "1" and not self.shown:
+            return rel(value, self.digits)       # a relative value: round-off said as such
         return fmt(value * (self.shown[1] if self.shown else 1), self.digits)
 
     def line(self):

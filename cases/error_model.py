@@ -19,6 +19,12 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from model.static import RTOL
+
+# a relative value within ten times the solvers' tolerance is round-off (a solve stops there,
+# and where it stops differs from one processor to the next): printed as such, and never the
+# difference that decides a tie or a rank
+ROUND_OFF = 10 * RTOL
 P1_LINEAR = "fem-linear"          # FEM P1 with the linear law: the twin in the linear regime
 P1_FINITE = "fem-neohookean"      # FEM P1 with the reference's law: the twin at finite load
 
@@ -174,6 +180,7 @@ def standings(by_model, u, lost=None):
     that lost as many parts) shares that group's rank and names it (tied); failed runs count
     against their model, and models that all failed their median share the last rank."""
     lost = lost or {}
+    u = max(u, ROUND_OFF)       # round-off never orders two models
     st = sorted((Standing(m, tuple(abs(v) for v in vs if v is not None), len(vs))
                  for m, vs in by_model.items()),
                 key=lambda s: (lost.get(s.model, 0), s.score, s.model))

@@ -8,7 +8,7 @@ from pathlib import Path
 import numpy as np
 
 from . import scorecard
-from .document import GLOSSARY, Cell, Document, Link, fmt
+from .document import GLOSSARY, Cell, Document, Link, fmt, rel, rel_range
 from .output import SWEEP_MARK
 
 # headline error bands of the scorecard: within 5 %, within 20 %, beyond
@@ -68,13 +68,13 @@ def scorecard_rows(pops, data, models):
         label = p.label + mode + (" (patch test)" if p.patch_test else "")
         disc = p.discretisation()
         law = "neo-Hookean" if p.finite else "linear"
-        shared = (f"{np.median(disc):.3g} [{min(disc):.3g}-{max(disc):.3g}]" if disc
+        shared = (f"{rel(np.median(disc))} [{rel_range(min(disc), max(disc))}]" if disc
                   else "no P1 run")
-        u_c = fmt(p.u_continuum) + (" (spread over meshes exceeds the estimate)"
+        u_c = rel(p.u_continuum) + (" (spread over meshes exceeds the estimate)"
                                    if p.spread_defect else "")
         rows.append([Link(label, f"{p.case}/report.md", f"{p.case}/report.html"),
                      f"{p.quantity.label}: model-form vs FEM P1 ({law})",
-                     shared, f"{p.u_model_form:.2g}"]
+                     shared, f"{rel(p.u_model_form, 2)}"]
                     + [_cell(p, m, "model_form") for m in models])
         rows.append(["", f"{p.quantity.label}: total vs the continuum", "", u_c]
                     + [_cell(p, m, "total") for m in models])
@@ -117,7 +117,7 @@ def conclusion(pops, models, quick):
                 worst[s.model] = (s.score, p)
     if worst:
         out.append("Where each model is farthest from FEM P1 (median model-form error): "
-                   + "; ".join(f"{m} in {p.label} ({v:.3g})" for m, (v, p) in worst.items())
+                   + "; ".join(f"{m} in {p.label} ({rel(v)})" for m, (v, p) in worst.items())
                    + ".")
     failed = [f"{s.model} in {p.label} ({s.failed} of {s.runs})" for p in pops
               for _, s, _ in p.standings() if s.failed]

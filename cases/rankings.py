@@ -8,7 +8,7 @@ import math
 import numpy as np
 
 from .catalogue import err_name, ref_name
-from .document import Table
+from .document import Table, rel, rel_range
 from .error_model import standings, u_num
 
 # what a ranking by a case's own metric measures: the total error, the mesh's own included
@@ -30,7 +30,7 @@ def cell(values, total):
     """'median [min-max], n of N runs' of one aggregate."""
     if not values:
         return f"no result, 0 of {total} runs"
-    return (f"median {np.median(values):.3g} [{min(values):.3g}-{max(values):.3g}], "
+    return (f"median {rel(np.median(values))} [{rel_range(min(values), max(values))}], "
             f"{len(values)} of {total} runs")
 
 
@@ -92,7 +92,7 @@ def _standings(runs, metric, u):
 
 
 def _u_text(u, defect):
-    return f"u_num {u:.2g}" + (", the spread over the meshes" if defect else "")
+    return f"u_num {rel(u, 2)}" + (", the spread over the meshes" if defect else "")
 
 
 def ranking(runs, metric, label, estimate_key="p2_error_estimate"):
@@ -120,8 +120,9 @@ def _stats(s):
     """(median, range, 'n of N') of a Standing: the median over every run it had."""
     if not s.values:
         return "failed", "", f"0 of {s.runs}"
-    med = "failed at the median" if math.isinf(s.score) else f"{s.score:.3g}"
-    return (med, f"{min(s.values):.3g}-{max(s.values):.3g}", f"{len(s.values)} of {s.runs}")
+    med = "failed at the median" if math.isinf(s.score) else rel(s.score)
+    return (med, f"{rel_range(min(s.values), max(s.values))}",
+            f"{len(s.values)} of {s.runs}")
 
 
 def _cell(s):
@@ -156,8 +157,8 @@ def best_and_worst(runs, metric, what, exact=False, estimate_key="p2_error_estim
                      f"{', '.join(tied)}.")
         smallest = min(min(s.values) for _, s, _ in st if s.values)
         if u > smallest / 5:
-            line += (f" The reference's u_num ({u:.2g}) exceeds a fifth of the smallest "
-                     f"error ranked ({smallest:.2g}): differences below it are not resolved.")
+            line += (f" The reference's u_num ({rel(u, 2)}) exceeds a fifth of the smallest "
+                     f"error ranked ({rel(smallest, 2)}): differences below it are not resolved.")
         return line
     return " ".join(_labelled(runs, line_of))
 

@@ -8,7 +8,7 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
-from model.static import RTOL
+from .document import rel, rel_range
 from . import error_model as E
 
 # in the linear regime (strain 1e-4) these laws are P1's own law: their distance to P1 is the
@@ -105,7 +105,7 @@ def populations(runs_by_case, declared, quick, patch_tests, estimate_keys):
                     lost.setdefault(r["model"], []).append(r.get(failed_modes) or 0)
             twins = [abs(p.model_form) for m in SAME_LAW.get(q.p1, ()) if m in parts
                      for p in parts[m] if p is not None]
-            u_mf = max([RTOL] + twins)
+            u_mf = max([E.ROUND_OFF] + twins)
             key = estimate_keys[case]
             est = [r[key] for r in rs if r.get(key) is not None]
             cont = {r["mesh"]: r.get(q.continuum) for r in rs} if hasattr(q, "continuum") \
@@ -135,9 +135,10 @@ def cell(standing, tied_with=None):
         text = f"failed, 0 of {s.runs}"
     elif math.isinf(s.score):
         text = (f"failed at the median: {len(s.values)} of {s.runs} runs gave "
-                f"{', '.join(f'{v:.3g}' for v in s.values)}")
+                f"{', '.join(f'{rel(v)}' for v in s.values)}")
     else:
-        text = (f"{np.median(s.values):.3g} [{min(s.values):.3g}-{max(s.values):.3g}] "
+        text = (f"{rel(np.median(s.values))} "
+                f"[{rel_range(min(s.values), max(s.values))}] "
                 f"{len(s.values)}/{s.runs}" + (f", {s.failed} failed" if s.failed else ""))
     return text + (f"; tied with {tied_with}" if tied_with else "")
 
@@ -246,9 +247,9 @@ def describe(entry, rng=None):
     """'mean rank r, geometric mean g [range leaving one mesh family out]' with the failed
     runs and populations of ``overall``."""
     r, g, failed, lost, n, load = entry
-    text = f"mean rank {r:.3g}" + (f", geometric mean {g:.3g}" if g is not None else "")
+    text = f"mean rank {r:.3g}" + (f", geometric mean {rel(g)}" if g is not None else "")
     if g is not None and rng:
-        text += f" [{rng[0]:.3g}-{rng[1]:.3g} leaving one mesh family out]"
+        text += f" [{rel(rng[0])}-{rel(rng[1])} leaving one mesh family out]"
     if failed:
         text += f", {failed} failed runs"
     if lost:
@@ -284,14 +285,14 @@ def case_findings(name, decomposed, runs, patch_tests=(), estimate_key="p2_error
         line = (f"{where}What replacing FEM P1 costs ({p.quantity.label}, model-form error, "
                 "median over the meshes): ")
         if same:
-            line += (f"equal to FEM P1 within u_val {p.u_model_form:.2g}: {', '.join(same)}"
+            line += (f"equal to FEM P1 within u_val {rel(p.u_model_form, 2)}: {', '.join(same)}"
                      + ("; " if ok else ""))
         if ok:
             line += f"closest {ok[0][1].model} ({cell(ok[0][1])}), farthest {ok[-1][1].model} " \
                     f"({cell(ok[-1][1])})"
             tied = [s.model for _, s, t in ok if t == ok[0][1].model]
             if tied:
-                line += f"; tied with {ok[0][1].model} within u_val {p.u_model_form:.2g}: " \
+                line += f"; tied with {ok[0][1].model} within u_val {rel(p.u_model_form, 2)}: " \
                         f"{', '.join(tied)}"
             loose = population_unresolved(p)
             first = [f"{b} (reverses without {mesh})" for (a, b), mesh in loose.items()
@@ -304,9 +305,9 @@ def case_findings(name, decomposed, runs, patch_tests=(), estimate_key="p2_error
         if failed:
             line += "; failed runs, counted against their model: " + ", ".join(failed)
         if disc:
-            line += (f". FEM P1 itself is {np.median(disc):.3g} [{min(disc):.3g}-"
-                     f"{max(disc):.3g}] from the continuum on these meshes (discretisation "
-                     "error)")
+            line += (f". FEM P1 itself is {rel(np.median(disc))} "
+                     f"[{rel_range(min(disc), max(disc))}] from the continuum on these meshes "
+                     "(discretisation error)")
             # |total| < |P1's| with a model-form error: its error opposes P1's
             cancel = [s.model for _, s, _ in ok
                       if _median(p.errors(s.model, "total")) is not None
@@ -320,7 +321,7 @@ def case_findings(name, decomposed, runs, patch_tests=(), estimate_key="p2_error
                 line += ("; closer to the continuum than P1 only by cancelling its error: "
                          + ", ".join(cancel))
             if level:
-                line += (f"; as far from the continuum as P1 within u_val {p.u_continuum:.2g}: "
+                line += (f"; as far from the continuum as P1 within u_val {rel(p.u_continuum, 2)}: "
                          + ", ".join(level))
         lines.append(line + ".")
         rows = [[p.bc, rank, s.model, cell(s, tie), _cell_of(p.errors(s.model, "total"))]
@@ -331,8 +332,8 @@ def case_findings(name, decomposed, runs, patch_tests=(), estimate_key="p2_error
                      _cell_of(disc)] + (["0"] if p.lost else []))
         tables.append(Table(f"Model-form error ({p.quantity.label}) per model, against FEM P1 "
                             "on the same tetrahedra, beside the total against the continuum "
-                            f"(u_val: model-form {p.u_model_form:.2g}, total "
-                            f"{p.u_continuum:.2g}"
+                            f"(u_val: model-form {rel(p.u_model_form, 2)}, total "
+                            f"{rel(p.u_continuum, 2)}"
                             + (", the reference's spread over the meshes exceeding its "
                                "estimate" if p.spread_defect else "") + "):",
                             ["bc", "rank", "model", "model-form", "total"]
@@ -364,4 +365,4 @@ def _cell_of(values):
     v = [x for x in values if x is not None]
     if not v:
         return "n/a"
-    return f"{np.median(v):.3g} [{min(v):.3g}-{max(v):.3g}] {len(v)}/{len(values)}"
+    return f"{rel(np.median(v))} [{rel_range(min(v), max(v))}] {len(v)}/{len(values)}"
