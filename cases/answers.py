@@ -42,7 +42,9 @@ def limits(conv, model):
     out = {}
     for f in (conv or {}).get("fits", []):
         if (f["case"], f["bc"]) == CONSISTENCY and f["model"] == model:
-            limited = f["verdict"] in LIMITED and f.get("e_inf") is not None
+            # an irregular family is never extrapolated: its verdict, not a limit
+            limited = (f["verdict"] in LIMITED and f.get("e_inf") is not None
+                       and f["mesh"] in REGULAR)
             out[f["mesh"]] = (f["e_inf"], f.get("e_inf_err") or 0.0) if limited \
                 else f["verdict"]
     return out
@@ -119,14 +121,17 @@ def table(root, models, pops=()):
         flutter = sum(r.get("dyn_verdict") == "unstable (flutter)" for r in mine
                       if r["bc"] == "clamped")
         clamped = sum(r["bc"] == "clamped" for r in mine)
-        b = _bench_row(bench, m)
+        b, fl = _bench_row(bench, m), _bench_row(bench, "fem-linear")
         rows.append([m, _overall_cell(linear, m, pops, False, spread[False]),
                      _overall_cell(finite, m, pops, True, spread[True]),
                      worst(limits(conv, m)) if conv else "n/a",
                      fmt(max(el)) if el else "n/a", fmt(max(alt)) if alt else "n/a",
-                     ("flutters" if flutter else "stable") + f" ({clamped - flutter} of "
-                     f"{clamped} clamped runs stable)" if clamped else "n/a",
-                     fmt(b["cpu_s_per_simulated_s"]) if b else "n/a",
+                     ("grows beyond the damping" if flutter else "stable under the damping")
+                     + f" ({clamped - flutter} of {clamped} clamped runs stable)"
+                     if clamped else "n/a",
+                     (f"{fmt(b['cpu_s_per_simulated_s'])} ({ratio_text(b, fl)} x fem-linear)"
+                      if b and fl and b is not fl else
+                      fmt(b["cpu_s_per_simulated_s"]) if b else "n/a"),
                      _bead(measured, m)])
     return header, rows
 
@@ -135,6 +140,8 @@ def _overall_cell(means, model, pops, finite, spread):
     from . import scorecard
     if any(p.quantity.p1 == model and p.finite == finite for p in pops):
         return "FEM P1 itself"
+    if any(model in p.identity and p.finite == finite for p in pops):
+        return "identity check (P1's law in this regime)"
     return scorecard.describe(means[model], spread.get(model)) if model in means else "n/a"
 
 
@@ -283,7 +290,7 @@ def _cost_of_replacing(pops, models, quick):
                 + (" (no equilibrium at the load of " + ", ".join(
                     f"{c} in {k} of {t} runs" for c, (k, t) in e[5].items()) + ")"
                    if e[5] else "")
-                + (f" (tied with {tie})" if tie else "")
+                + (f" (the same mean rank as {tie})" if tie else "")
                 + "".join(f" (not resolved from {b})" for (a, b) in loose if a == m)
                 for _, m, e, tie in ranked))
     if not said:
@@ -292,8 +299,8 @@ def _cost_of_replacing(pops, models, quick):
             "with the same law on the same tetrahedra, best mean rank over the cases first "
             "(beside it the geometric mean over the cases of the median over the meshes, "
             "[its range when one mesh family is left out]; a failed run counts against its "
-            "model, and at finite load a model that found no equilibrium at a case's load "
-            "ranks after those that did): "
+            "model, and a model with a failed run (no number, or at finite load no "
+            "equilibrium at a case's load) ranks after every model without one): "
             + "; ".join(said) + " (the scorecard below).")
 
 
@@ -328,6 +335,9 @@ def recommendation(root, models, pops, quick, bench_rows):
                 others.append(nxt)
             else:
                 break
+        # a model that comes first when one mesh family or one case is left out
+        others += [m for m in scorecard.contenders(pops, list(means), finite)
+                   if m not in others]
         return top, others
 
     conv = _load(root, "convergence", "metrics.json")
@@ -341,8 +351,8 @@ def recommendation(root, models, pops, quick, bench_rows):
         if limit and limit[0] >= PATCH_TOL:
             said += f", consistency limit {_pm(limit)}"
         if others:
-            said += (f", not resolved from {', '.join(others)} (tied, or an order that "
-                     "reverses when one mesh family or one case is left out)")
+            said += (f", not resolved from {', '.join(others)} (tied, or first when one mesh "
+                     "family or one case is left out)")
         return said
 
     def cost(m):
@@ -350,19 +360,13 @@ def recommendation(root, models, pops, quick, bench_rows):
         return (f", {ratio_text(r, fl)} times "
                 f"{p1_lin}'s cost per simulated second") if r and fl else ""
     if lin and p1_lin:
-        floor = max(p.u_model_form for p in pops if not p.finite)
-        same = [m for m, v in lin.items() if v[1] is not None and v[1] <= floor]
-        approx = {m: v for m, v in lin.items() if m not in same}
-        # equal to P1 within the comparison's floor: a check, not an approximation
-        b, others = best(approx, False)
-        disc = [d for p in pops if not p.finite and not p.patch_test
-                for d in p.discretisation()]
+        same = sorted({m for p in pops if not p.finite for m in p.identity if m in p.parts}
+                      - {p1_lin})
+        b, others = best(lin, False)
         out.append(f"- Linear regime: FEM P1 ({p1_lin}"
                    + (f"; {', '.join(same)} coincide with it there" if same else "")
                    + ": 0 model-form error by construction, an identity check)"
-                   + (f", whose discretisation error on these meshes, {fmt(np.median(disc))} "
-                      f"[{fmt(min(disc))}-{fmt(max(disc))}], is what every model on them pays "
-                      "as well" if disc else "")
+                   + _discretisation(pops, False)
                    + (f"; the closest approximation is {named(lin, b, others)}" if b else "")
                    + ".")
     if fin and p1_fin:
@@ -374,16 +378,29 @@ def recommendation(root, models, pops, quick, bench_rows):
                   if b in order else "")
         fails = finite_failures(root)
         said = (f"; not decided on {n} case{'s' if n > 1 else ''} between "
-                f"{', '.join([b] + others)} (tied, or an order that reverses when one mesh "
-                "family or one case is left out)" if others else
+                f"{', '.join([b] + others)} (tied, or first when one mesh family or one case "
+                "is left out)" if others else
                 f"; the closest other, on {n} case{'s' if n > 1 else ''}, is "
                 f"{named(fin, b, others, True)}{linear}") if b else ""
         cands = [b] + others if b else []
         failing = [f"{m} in {', '.join(f'{c} {k} of {t}' for c, (k, t) in fails[m].items())}"
                    for m in cands if fails.get(m)]
-        out.append(f"- Finite strain: {p1_fin} (the reference's law on P1){said}"
+        # the models a failed run put after the rest, named with what they would have scored
+        def why(e):
+            if e[5]:
+                return "no equilibrium at the load of " + ", ".join(
+                    f"{c} in {k} of {t} runs" for c, (k, t) in e[5].items())
+            return f"{e[2]} failed runs"
+        left = [f"{m} (model-form error "
+                + (rel(e[1]) if e[1] is not None and not e[3] else "failed at the median")
+                + f"; {why(e)})" for m, e in fin.items()
+                if scorecard.failed(e) and m not in cands]
+        out.append(f"- Finite strain: {p1_fin} (the reference's law on P1"
+                   + _discretisation(pops, True) + f"){said}"
                    + ("; no equilibrium at a case's load for " + "; ".join(failing)
-                      if failing else "") + ".")
+                      if failing else "")
+                   + ("; ranked after them for a failed run: " + "; ".join(left)
+                      if left else "") + ".")
     truth = _load(root, MEASURED, "metrics.json")
     if truth and truth.get("headline"):
         v = validation(truth)
@@ -410,10 +427,26 @@ def recommendation(root, models, pops, quick, bench_rows):
         if cheapest and bench_rows[cheapest]["cpu_s_per_simulated_s"] < \
                 bench_rows[cheap]["cpu_s_per_simulated_s"]:
             line += (f"; {cheapest} is cheaper ("
-                     f"{fmt(bench_rows[cheapest]['cpu_s_per_simulated_s'])}) at model-form "
-                     f"error up to {fmt(worst_of[cheapest])} on a case")
+                     f"{fmt(bench_rows[cheapest]['cpu_s_per_simulated_s'])}, "
+                     f"{ratio_text(bench_rows[cheapest], bench_rows[p1_lin])} x {p1_lin}'s) "
+                     f"at model-form error up to {fmt(worst_of[cheapest])} on a case")
         out.append(line + ".")
     return out[:5] if len(out) > 1 else []
+
+
+def _discretisation(pops, finite):
+    """', whose discretisation error ...': FEM P1's discretisation error per population (the
+    median over its meshes), the smallest and largest population named, never pooled."""
+    meds = [(float(np.median(p.discretisation())), p.label) for p in pops
+            if p.finite == finite and not p.patch_test and p.discretisation()]
+    if not meds:
+        return ""
+    (lo, a), (hi, b) = min(meds), max(meds)
+    if len(meds) == 1:
+        return f", whose discretisation error there is {rel(lo)} (median over the meshes)"
+    return (f", whose discretisation error, the median over the meshes of each case, runs "
+            f"from {rel(lo)} ({a}) to {rel(hi)} ({b}): what every model on those meshes pays "
+            "as well")
 
 
 def finite_failures(root):
@@ -500,7 +533,11 @@ def _measured_line(truth, models):
             f"neo-Hookean reference's change over its last refinement "
             f"{fmt(val['u_num'], 2)}): ")
     if NH in v:
-        said += f"the neo-Hookean continuum is {fmt(v[NH]['bead_rms_mm'])} mm RMS off; "
+        u_nh = val.get("continuum_u_val")
+        said += (f"the neo-Hookean continuum is {fmt(v[NH]['bead_rms_mm'])} mm RMS off"
+                 + (f", {'within' if v[NH]['bead_rms_mm'] <= u_nh else 'beyond'} its u_val "
+                    f"{fmt(u_nh, 2)} mm (its spread over the plate assumptions included)"
+                    if u_nh else "") + "; ")
     if mine:
         said += (f"the models from {fmt(v[mine[0]]['bead_rms_mm'])} to "
                  f"{fmt(v[mine[-1]]['bead_rms_mm'])} mm; within their u_val: "

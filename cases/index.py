@@ -47,6 +47,9 @@ def _cell(p, model, part):
         return ""
     if part == "model_form" and model == p.quantity.p1:
         return Cell("FEM P1 itself (0 by construction)", BANDS[0][1])
+    if part == "model_form" and model in p.identity:
+        return Cell("identity check, P1's law here: " + scorecard.cell_of(
+            p.errors(model, "model_form")), BANDS[0][1])
     rows = {s.model: (s, tie) for _, s, tie in p.standings(part)}
     s, tie = rows[model]
     text = scorecard.cell(s, tie if part == "model_form" and math.isfinite(s.score)
@@ -105,20 +108,21 @@ def conclusion(pops, models, quick):
                    "itself is the identity check and not ranked; an order that reverses "
                    "when one mesh family or one case is left out is not resolved): " + "; ".join(
                        f"{rank}. {m} ({scorecard.describe(entry, rng.get(m))})"
-                       + (f", tied with {tie}" if tie else "")
+                       + (f", the same mean rank as {tie}" if tie else "")
                        + "".join(f", not resolved from {b} (reverses without {mesh})"
                                  for (a, b), mesh in loose.items() if a == m)
                        for rank, m, entry, tie in scorecard.ranked(means)) + ".")
     worst = {}
     for p in pops:
         for _, s, _ in p.standings():
-            if s.values and math.isfinite(s.score) and (s.model not in worst
-                                                        or s.score > worst[s.model][0]):
+            if s.runs and (s.model not in worst or s.score > worst[s.model][0]):
                 worst[s.model] = (s.score, p)
     if worst:
-        out.append("Where each model is farthest from FEM P1 (median model-form error): "
-                   + "; ".join(f"{m} in {p.label} ({rel(v)})" for m, (v, p) in worst.items())
-                   + ".")
+        out.append("Where each model is farthest from FEM P1 (median model-form error, a failed "
+                   "run counted as infinitely wrong): " + "; ".join(
+                       f"{m} in {p.label} ("
+                       + ("failed at the median" if math.isinf(v) else rel(v)) + ")"
+                       for m, (v, p) in worst.items()) + ".")
     failed = [f"{s.model} in {p.label} ({s.failed} of {s.runs})" for p in pops
               for _, s, _ in p.standings() if s.failed]
     out.append("Runs without a model-form number, counted against their model: "
@@ -231,10 +235,13 @@ TERMS = {
     "model's effective elasticity tensor (a relaxed lattice patch) against the isotropic "
     "target's, over the lattices.",
     "largest |alternation|": "the largest |alternation rel| of the paper cube's runs.",
-    "RK4 run": "flutters when the linearised growth rate of the clamped paper cube exceeds "
-    "half the mass damping (so that the damped RK4 run grows), else stable.",
+    "RK4 run": "grows beyond the damping when the linearised growth rate of the clamped "
+    "paper cube exceeds half the mass damping (so that the damped RK4 run grows), else stable "
+    "under the damping (a positive growth below it, flutter in the paper cube's tables, is "
+    "damped out).",
     "s per simulated s": "CPU seconds one simulated second costs at the model's own stable "
-    "RK4 step (undamped), from `pbcm bench` at about 1e4 tetrahedra.",
+    "RK4 step (undamped), from `pbcm bench` at about 1e4 tetrahedra; beside it the in-round "
+    "ratio to fem-linear's with its range over the bench's rounds.",
     "calibrated / literal": "a shear reading with c fitted so that its deviatoric moduli are "
     "closest to 2G (calibrated), or with the paper's c = 1 (literal).",
     "patch test": "a problem with a homogeneous exact answer (the sliding cube): a consistent "

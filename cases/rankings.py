@@ -53,7 +53,9 @@ def _labelled(runs, line_of):
 
 # the continuum's value behind a relative error whose quantity is not named after it
 CONTINUUM_OF = {"reaction_rel_err": "reaction_fem_p2_n",
-                "reaction_rel_err_nh": "reaction_fem_nh_n"}
+                "reaction_rel_err_nh": "reaction_fem_nh_n",
+                "force_rel_err_max": "force_fem_n_steps",
+                "lateral_rel_err_max": "lateral_strain_fem_steps"}
 
 
 def _continuum_key(runs, metric):
@@ -113,7 +115,7 @@ def ranking(runs, metric, label, estimate_key="p2_error_estimate"):
             rows.append([bc, rank, s.model, *_stats(s), "; ".join(note)])
     return [Table(f"{label[0].upper()}{label[1:]} ({metric}){AGAINST} per model, median over "
                   "the meshes, a failed run counted against its model:",
-                  ["bc", "rank", "model", "median", "range", "runs", "note"], rows)]
+                  ["bc", "order", "model", "median", "range", "runs", "note"], rows)]
 
 
 def _stats(s):
@@ -143,7 +145,7 @@ def best_and_worst(runs, metric, what, exact=False, estimate_key="p2_error_estim
         if not st or not any(s.values for _, s, _ in st):
             return f"No model gave {what}."
         best, worst = st[0][1], st[-1][1]
-        line = (f"{what}{AGAINST}: smallest {best.model} ({_cell(best)}), largest "
+        line = (f"{what}{AGAINST}: from {best.model} ({_cell(best)}) to "
                 f"{worst.model} ({_cell(worst)}).")
         failed = [s for _, s, _ in st if s.failed]
         if failed:

@@ -62,15 +62,23 @@ class Population:
         """Whether this population is judged at finite load (P1 with the reference's law)."""
         return self.quantity.p1 != E.P1_LINEAR
 
+    @property
+    def identity(self):
+        """The models this population's model-form comparison cannot judge: FEM P1 itself and
+        the laws that coincide with its law here (in the linear regime every FEM law is P1's):
+        identity checks, never ranked."""
+        return {self.quantity.p1, *SAME_LAW.get(self.quantity.p1, ())}
+
     def errors(self, model, part):
         """[|part| or None per run] of ``model``."""
         return [None if p is None else abs(getattr(p, part)) for p in self.parts[model]]
 
     def standings(self, part="model_form"):
-        """``error_model.standings`` of the models other than P1 itself (an identity check)."""
+        """``error_model.standings`` of the models other than the identity checks (P1 itself
+    and the laws that coincide with it)."""
         u = self.u_model_form if part == "model_form" else self.u_continuum
         return E.standings({m: self.errors(m, part) for m in self.parts
-                            if part != "model_form" or m != self.quantity.p1}, u,
+                            if part != "model_form" or m not in self.identity}, u,
                            self.unpaired if part == "model_form" else None)
 
     def discretisation(self):
@@ -136,9 +144,8 @@ def cell(standing, tied_with=None):
     elif math.isinf(s.score):
         text = (f"failed at the median: {len(s.values)} of {s.runs} runs gave "
                 f"{', '.join(f'{rel(v)}' for v in s.values)}")
-    else:
-        text = (f"{rel(np.median(s.values))} "
-                f"[{rel_range(min(s.values), max(s.values))}] "
+    else:     # the median over every run, a failed one counted as infinitely wrong
+        text = (f"{rel(s.score)} [{rel_range(min(s.values), max(s.values))}] "
                 f"{len(s.values)}/{s.runs}" + (f", {s.failed} failed" if s.failed else ""))
     return text + (f"; tied with {tied_with}" if tied_with else "")
 
@@ -188,11 +195,12 @@ def overall(pops, models, finite=False):
     model-form uncertainty; P1 itself left out (an identity check), and the patch tests (pass
     or fail, the consistency limit's subject: never pooled with the rest). At finite load,
     the runs of the linear populations' cases that found no equilibrium at the case's load
-    count too (the last entry): such a model ranks after every model that found one."""
+    count too (the last entry); a model with any failed run ranks after every model without
+    one (``_order``)."""
     used = [p for p in pops if p.finite == finite and not p.patch_test]
     out = {}
     for m in models:
-        mine = [p for p in used if m in p.parts and m != p.quantity.p1]
+        mine = [p for p in used if m in p.parts and m not in p.identity]
         if not mine:
             continue
         ranks, scores, floors = [], [], []
@@ -224,9 +232,16 @@ def largest(pops, model, finite=False):
 
 
 def _order(entry, model):
-    """The ranking's order of one model: those that failed to find an equilibrium at a case's
-    load last, then by mean rank, then by geometric mean."""
-    return (bool(entry[5]), entry[0], entry[1] or 0.0, model)
+    """The ranking's order of one model: those with a failed run (no number in a population,
+    or no equilibrium at a case's load) after every model without one, then by mean rank,
+    then by geometric mean."""
+    return (failed(entry), entry[0], entry[1] or 0.0, model)
+
+
+def failed(entry):
+    """Whether an ``overall`` entry has a failed run (in its populations or at a case's
+    load)."""
+    return bool(entry[2] or entry[5])
 
 
 def ranked(means):
@@ -246,18 +261,19 @@ def ranked(means):
 def describe(entry, rng=None):
     """'mean rank r, geometric mean g [range leaving one mesh family out]' with the failed
     runs and populations of ``overall``."""
-    r, g, failed, lost, n, load = entry
+    r, g, n_failed, lost, n, load = entry
     text = f"mean rank {r:.3g}" + (f", geometric mean {rel(g)}" if g is not None else "")
     if g is not None and rng:
         text += f" [{rel(rng[0])}-{rel(rng[1])} leaving one mesh family out]"
-    if failed:
-        text += f", {failed} failed runs"
+    if n_failed:
+        text += f", {n_failed} failed runs"
     if lost:
         text += f" ({lost} of {n} populations failed at the median)"
     if load:
-        text += ("; no equilibrium at a case's load in " + ", ".join(
+        text += "; no equilibrium at a case's load in " + ", ".join(
             f"{c} {k} of {t} runs" for c, (k, t) in load.items())
-            + " (ranked after every model that found one)")
+    if failed(entry):
+        text += " (ranked after every model without a failed run)"
     return text
 
 
@@ -280,13 +296,16 @@ def case_findings(name, decomposed, runs, patch_tests=(), estimate_key="p2_error
             continue
         where = f"[{p.bc}] " if len(pops) > 1 else ""
         disc = p.discretisation()
-        same = [s.model for _, s, _ in st if s.failed == 0 and s.score <= p.u_model_form]
-        ok = [(r, s, t) for r, s, t in st if math.isfinite(s.score) and s.model not in same]
+        twins = [m for m in sorted(p.identity - {p.quantity.p1}) if m in p.parts]
+        same = [m for m in twins if all(v is not None and v <= p.u_model_form
+                                        for v in p.errors(m, "model_form"))]
+        ok = [(r, s, t) for r, s, t in st if math.isfinite(s.score)]
         line = (f"{where}What replacing FEM P1 costs ({p.quantity.label}, model-form error, "
                 "median over the meshes): ")
-        if same:
-            line += (f"equal to FEM P1 within u_val {rel(p.u_model_form, 2)}: {', '.join(same)}"
-                     + ("; " if ok else ""))
+        if twins:
+            line += (f"identity checks, P1's own law here, not ranked: {', '.join(twins)}"
+                     + (f" (equal to FEM P1 within u_val {rel(p.u_model_form, 2)}: "
+                        f"{', '.join(same)})" if same else "") + ("; " if ok else ""))
         if ok:
             line += f"closest {ok[0][1].model} ({cell(ok[0][1])}), farthest {ok[-1][1].model} " \
                     f"({cell(ok[-1][1])})"
@@ -294,9 +313,8 @@ def case_findings(name, decomposed, runs, patch_tests=(), estimate_key="p2_error
             if tied:
                 line += f"; tied with {ok[0][1].model} within u_val {rel(p.u_model_form, 2)}: " \
                         f"{', '.join(tied)}"
-            loose = population_unresolved(p)
-            first = [f"{b} (reverses without {mesh})" for (a, b), mesh in loose.items()
-                     if a == ok[0][1].model]
+            first = [f"{m} (first without {mesh})"
+                     for m, mesh in population_contenders(p).items() if m not in tied]
             if first:
                 line += f"; {ok[0][1].model} is not resolved from " + ", ".join(first)
         elif not same:
@@ -307,7 +325,10 @@ def case_findings(name, decomposed, runs, patch_tests=(), estimate_key="p2_error
         if disc:
             line += (f". FEM P1 itself is {rel(np.median(disc))} "
                      f"[{rel_range(min(disc), max(disc))}] from the continuum on these meshes "
-                     "(discretisation error)")
+                     "(discretisation error"
+                     + (f"; not resolved: the continuum's own u_num, {rel(p.u_continuum, 2)}, "
+                        "exceeds a fifth of it" if p.u_continuum > np.median(disc) / 5 else "")
+                     + ")")
             # |total| < |P1's| with a model-form error: its error opposes P1's
             cancel = [s.model for _, s, _ in ok
                       if _median(p.errors(s.model, "total")) is not None
@@ -324,12 +345,16 @@ def case_findings(name, decomposed, runs, patch_tests=(), estimate_key="p2_error
                 line += (f"; as far from the continuum as P1 within u_val {rel(p.u_continuum, 2)}: "
                          + ", ".join(level))
         lines.append(line + ".")
-        rows = [[p.bc, rank, s.model, cell(s, tie), _cell_of(p.errors(s.model, "total"))]
+        rows = [[p.bc, rank, s.model, cell(s, tie), cell_of(p.errors(s.model, "total"))]
                 + ([f"{p.unpaired.get(s.model, 0)} of {p.quantity.count * s.runs}"]
                    if p.lost else [])
                 for rank, s, tie in st]
         rows.append([p.bc, "-", f"{p.quantity.p1} (FEM P1)", "0 by construction",
-                     _cell_of(disc)] + (["0"] if p.lost else []))
+                     cell_of(disc)] + (["0"] if p.lost else []))
+        rows += [[p.bc, "-", f"{m} (identity check: P1's law here)",
+                  cell_of(p.errors(m, "model_form")), cell_of(p.errors(m, "total"))]
+                 + ([f"{p.unpaired.get(m, 0)} of {p.quantity.count * len(p.parts[m])}"]
+                    if p.lost else []) for m in twins]
         tables.append(Table(f"Model-form error ({p.quantity.label}) per model, against FEM P1 "
                             "on the same tetrahedra, beside the total against the continuum "
                             f"(u_val: model-form {rel(p.u_model_form, 2)}, total "
@@ -342,27 +367,54 @@ def case_findings(name, decomposed, runs, patch_tests=(), estimate_key="p2_error
     return lines, tables
 
 
-def population_unresolved(p):
-    """{(upper, lower): mesh} for neighbours of the population's model-form standings whose
-    order reverses when one mesh is left out."""
-    order = [s.model for _, s, _ in p.standings() if math.isfinite(s.score)]
-    meshes = sorted({x for ms in p.meshes.values() for x in ms})
+def population_contenders(p):
+    """{model: mesh}: the models other than the closest that come first (or share the first
+    rank) when one mesh is left out: the closest is not resolved from them."""
+    st = p.standings()
+    if not st:
+        return {}
+    top = st[0][1].model
     out = {}
-    for mesh in meshes:
-        alt = {s.model: (r, s.score) for r, s, _ in p.without(mesh).standings()}
-        for a, b in zip(order, order[1:]):
-            if (a, b) not in out and a in alt and b in alt and alt[a] > alt[b]:
-                out[(a, b)] = mesh
+    for mesh in sorted({x for ms in p.meshes.values() for x in ms}):
+        for r, s, _ in p.without(mesh).standings():
+            if r == 1 and s.model != top and s.model not in out:
+                out[s.model] = mesh
+    return out
+
+
+def contenders(pops, models, finite=False):
+    """{model: what was left out}: the models other than the first of
+    ``ranked(overall(...))`` that come first, or share its place, when one mesh family or
+    one case is left out."""
+    order = ranked(overall(pops, models, finite))
+    if not order:
+        return {}
+    top = order[0][1]
+    cases = sorted({p.case for p in pops if p.finite == finite and not p.patch_test})
+    subsets = [(mesh, [p.without(mesh) for p in pops]) for mesh in _meshes(pops, finite)]
+    if len(cases) > 1:
+        subsets += [(case, [p for p in pops if p.case != case]) for case in cases]
+    out = {}
+    for left_out, subset in subsets:
+        alt = ranked(overall(subset, models, finite))
+        for r, m, _, _ in alt:
+            if r == 1 and m != top and m not in out:
+                out[m] = left_out
     return out
 
 
 def _median(values):
-    v = [x for x in values if x is not None]
-    return float(np.median(v)) if v else None
+    """The median over every run, a run without a value counted as infinitely wrong."""
+    if not values or all(x is None for x in values):
+        return None
+    return float(np.median([math.inf if x is None else x for x in values]))
 
 
-def _cell_of(values):
+def cell_of(values):
+    """'median [min-max] n/N' over every run (a failed one counted as infinitely wrong)."""
     v = [x for x in values if x is not None]
     if not v:
         return "n/a"
-    return f"{rel(np.median(v))} [{rel_range(min(v), max(v))}] {len(v)}/{len(values)}"
+    med = _median(values)
+    return ("failed at the median" if math.isinf(med) else rel(med)) + \
+        f" [{rel_range(min(v), max(v))}] {len(v)}/{len(values)}"

@@ -232,7 +232,7 @@ def test_rankings_tie_models_within_u_num_of_a_groups_first():
     assert [r[-1] for r in table.rows] == ["", "tied with a (u_num 0.01)", "", ""]
     assert [r[1] for r in table.rows] == [1, 1, 3, 4]
     line = common.best_and_worst(runs, "err", "Error")
-    assert "smallest a" in line and "largest d" in line and ": b." in line
+    assert "from a (" in line and "to d (" in line and ": b." in line
     assert "not resolved" not in line           # 0.01 < 0.10 / 5
     coarse = [dict(r, p2_error_estimate=0.03) for r in runs]
     assert "not resolved" in common.best_and_worst(coarse, "err", "Error")
@@ -275,9 +275,9 @@ def test_rankings_keep_populations_apart_and_count_failed_runs():
                           "1 failed, counted against it"]
     line = rankings.best_and_worst(runs, "err", "Error")
     assert "[clamped] Error against its reference (total error" in line
-    assert "smallest b" in line and "largest c" in line
+    assert "from b (" in line and "to c (" in line
     assert "Failed runs, counted against their model: c (1 of 2)" in line
-    assert line.index("[sliding]") < line.index("smallest a") < line.index("[clamped]")
+    assert line.index("[sliding]") < line.index("from a (") < line.index("[clamped]")
 
 
 def test_failures_name_every_phase_that_found_no_equilibrium():

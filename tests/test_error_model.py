@@ -97,8 +97,9 @@ def _case_folder(tmp_path, case, runs, quick=False):
 
 
 def test_scorecard_decomposes_counts_failures_and_names_identity(tmp_path):
-    """On a synthetic torsion case: P1 is the identity check (never ranked); a model equal to
-    P1 has model-form error 0 and its total is P1's discretisation error; a model's failed run
+    """On a synthetic torsion case: P1 and the law that coincides with it are identity checks
+    (never ranked); a model equal to P1 has model-form error 0 and its total is P1's
+    discretisation error; a model's failed run
     counts against it while the population stays; a model with a failed median is last."""
     from cases.index import conclusion, index_documents, populations
 
@@ -121,9 +122,11 @@ def test_scorecard_decomposes_counts_failures_and_names_identity(tmp_path):
     assert "fem-linear" not in ranks
     assert ranks["b"][1].failed == 1 and math.isinf(ranks["b"][1].score)
     lines = conclusion(pops, ["fem-linear", "fem-corotated", "a", "b"], quick=False)
-    assert "1. fem-corotated (mean rank 1" in lines[0] and "2. a (mean rank 2, geometric " \
+    assert "fem-corotated" not in ranks and "fem-corotated" not in lines[0]   # identity
+    assert "1. a (mean rank 1, geometric " \
         "mean 0.13 [0.12-0.14 leaving one mesh family out])" in lines[0]
-    assert "3. b (mean rank 3, 1 failed runs (1 of 1 populations failed at the median))" \
+    assert "2. b (mean rank 2, 1 failed runs (1 of 1 populations failed at the median) (ranked " \
+        "after every model without a failed run))" \
         in lines[0]
     assert "b in torsion/clamped (1 of 2)" in lines[-1]
     md, _ = index_documents(tmp_path, ["torsion"])
@@ -201,8 +204,10 @@ def test_case_findings_name_cancellation_and_the_twins():
     assert "closest b (0.05" in line and "farthest a (0.3" in line
     assert "FEM P1 itself is 0.3 [0.3-0.3] from the continuum" in line
     assert line.endswith("closer to the continuum than P1 only by cancelling its error: a.")
-    assert tables[0].rows[-1][2:] == ["fem-linear (FEM P1)", "0 by construction",
+    assert tables[0].rows[-2][2:] == ["fem-linear (FEM P1)", "0 by construction",
                                       "0.3 [0.3-0.3] 1/1"]
+    assert tables[0].rows[-1][2] == "fem-corotated (identity check: P1's law here)"
+    assert "fem-corotated" not in [r[2] for r in tables[0].rows[:-2]]   # never ranked
 
 
 def test_truth_cube_u_val_is_per_model_by_hand():
@@ -265,7 +270,7 @@ def test_what_to_pick_is_computed_and_names_what_is_not_decided(tmp_path):
     assert lines[0] == "**What to pick?**"
     assert lines[1].startswith("- Linear regime: FEM P1 (fem-linear: 0 model-form error by "
                                "construction, an identity check), whose discretisation error "
-                               "on these meshes, 0.2 [0.2-0.2]")
+                               "there is 0.2 (median over the meshes)")
     assert "the closest approximation is a, model-form error 0.1" in lines[1]
     # at finite load a's model-form errors are 0.1, 0.2 and b's 0.1, 0.2 (six reversed)
     assert "not decided on 1 case between" in lines[2]
@@ -301,7 +306,7 @@ def test_no_equilibrium_at_another_cases_load_ranks_a_model_last_at_finite_load(
     assert [m for _, m, _, _ in scorecard.ranked(means)] == ["b", "a"]
     assert scorecard.describe(means["a"]).endswith(
         "no equilibrium at a case's load in torsion/clamped 2 of 2 runs (ranked after every model "
-        "that found one)")
+        "without a failed run)")
 
 
 def test_geometric_mean_range_leaves_one_mesh_family_out(tmp_path):
