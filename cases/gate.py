@@ -321,16 +321,18 @@ class Verdict:
     flips: list
     new: list
     status: int
+    aside: int = 0        # gold rows of runs not in the metrics (``only_run``)
 
 
-def check(gold, measurements):
+def check(gold, measurements, only_run=False):
     """Every measured metric against its gold value (``Verdict``).
 
     Status 0: every value holds; 1: a metric left its band, or was null in the gold and is a
     number now (or the reverse); NEW (3): every value holds but some (case, mode, model) has
     no gold at all: "new, not gated yet". The gold of a case and mode that was not run is set
     aside. Metrics run at other problem parameters than the gold's, a gold row that was not
-    measured, a metric or row the gold lacks for a model it has, or a value that is not
+    measured (unless ``only_run``: a subset of the gold's runs, the others set aside and
+    counted), a metric or row the gold lacks for a model it has, or a value that is not
     finite raise CheckError (exit 2): a missing reference never passes."""
     values, policy = measurements.values, gold.policy
     ran = {k[:2] for k in values} | {k[:2] for k in (measurements.rows or ())}
@@ -366,6 +368,9 @@ def check(gold, measurements):
                              "metric gated since the last bless; bless it on purpose")
     out, flips, status = [], [], 0
     directions = measurements.directions or {}
+    if only_run:     # a subset of the gold's runs: gate what was run, set the rest aside
+        aside = sum(1 for k in rows if k not in measured_rows)
+        rows = {k: v for k, v in rows.items() if k in measured_rows}
     for key5, metrics in sorted(rows.items()):
         if key5 not in measured_rows:
             raise CheckError(f"{'/'.join(key5[2:])} of {key5[0]} ({key5[1]} mode) has gold "
@@ -392,7 +397,8 @@ def check(gold, measurements):
                          "both): a check that reads nothing passes nothing")
     if new and status == 0:
         status = NEW
-    return Verdict(out, flips, [(*k, n) for k, n in sorted(new.items())], status)
+    return Verdict(out, flips, [(*k, n) for k, n in sorted(new.items())], status,
+                   aside if only_run else 0)
 
 
 def flip_message(key, gold, now):

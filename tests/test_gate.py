@@ -370,3 +370,36 @@ def test_only_a_dead_runs_staging_folder_is_stale(tmp_path):
     for d in (mine, gone, other):
         d.mkdir()
     assert stale_staging(target) == [gone]
+
+
+def test_a_five_percent_error_in_the_papers_constant_fails_the_quick_gate(tmp_path, capsys,
+                                                                           monkeypatch):
+    """The mutation probe: the literal reading's shear constant 5 % off (c = 1.05 for the
+    paper's 1), run on the quick paper cube with the store off, fails the committed quick
+    gold on that particle model's values; the run gates a subset of the gold's runs, the
+    others set aside and counted."""
+    from model.presets import NAMED
+    monkeypatch.setitem(NAMED["pbcm-variational-literal"][0][1], "c", 1.05)
+    out = tmp_path / "m" / "paper-cube"
+    assert main(["run", "paper-cube", "--quick", "--meshes", "five", "--bcs", "clamped",
+                 "--models", "pbcm-variational-literal", "--workers", "1", "--no-cache",
+                 "--out", str(out)]) == 0
+    capsys.readouterr()
+    assert main(["check", "--metrics", str(out.parent), "--gold", str(ROOT / "gold"),
+                 "--only-run"]) == 1
+    text = capsys.readouterr().out
+    assert "FAIL " in text and "paper-cube/five/clamped/pbcm-variational-literal" in text
+    assert "gold rows of runs not in the metrics set aside" in text
+
+
+def test_only_run_gates_a_subset_and_a_plain_check_refuses_it(blessed, tmp_path, capsys):
+    """A run of one model of a blessed pair passes with --only-run (the other model's gold
+    rows set aside, counted) and is refused by a plain check (its gold was not measured)."""
+    sub = tmp_path / "sub" / "paper-cube"
+    assert main(["run", "paper-cube", "--quick", "--meshes", "five", "--models", "msm",
+                 "--out", str(sub)]) == 0
+    capsys.readouterr()
+    assert check(sub.parent, blessed / "g") == 2
+    assert main(["check", "--metrics", str(sub.parent), "--gold", str(blessed / "g"),
+                 "--only-run"]) == 0
+    assert "set aside" in capsys.readouterr().out

@@ -20,6 +20,10 @@ def add(sub):
                                    "0).")
     c.add_argument("--allow-new", action="store_true",
                    help="exit 0 rather than 3 when the only news is models without gold")
+    c.add_argument("--only-run", action="store_true",
+                   help="gate only the gold rows of the runs in --metrics (a run of some "
+                        "models, meshes or bcs); the gold's other rows are set aside and "
+                        "counted, never deleted")
     c.add_argument("--metrics", default="reports", help="a metrics.json or a folder of them "
                    "(default reports)")
     c.add_argument("--gold", default="gold",
@@ -31,7 +35,7 @@ def add(sub):
 def run(args):
     from ..gate import NEW, CheckError, check, flip_message, load, measured
     try:
-        v = check(load(args.gold, hint="--gold"), measured(args.metrics))
+        v = check(load(args.gold, hint="--gold"), measured(args.metrics), args.only_run)
     except CheckError as exc:
         print(f"pbcm check: error: {exc}", file=sys.stderr)
         return 2
@@ -44,7 +48,8 @@ def run(args):
     print("margin: how far inside its band a value is, as a fraction of the band's half-width "
           "(100 % at the gold value, 0 at its edge, negative outside)")
     failed = [r for r in v.rows if not r[2]]
-    print(f"{len(v.rows) - len(failed)} passed, {len(failed) + len(v.flips)} failed")
+    print(f"{len(v.rows) - len(failed)} passed, {len(failed) + len(v.flips)} failed"
+          + (f" ({v.aside} gold rows of runs not in the metrics set aside)" if v.aside else ""))
     worse = [r for r in failed if r[0].verdict(r[1]).startswith("worse")]
     # beside a regression, a value that moved the other way moved with it: not an improvement
     moved = [r for r in failed if r not in worse] if worse else []
