@@ -175,8 +175,10 @@ def lines(root, models, pops=(), quick=False):
     out.append(_cost_of_replacing(pops, models, quick))
     if conv:
         lim = {m: limits(conv, m) for m in models}
+        # below the patch tolerance on every lattice, and converging on the irregular ones
         passed = [m for m, v in lim.items() if v and all(
-            isinstance(x, tuple) and x[0] + x[1] < PATCH_TOL for x in v.values())]
+            x[0] + x[1] < PATCH_TOL if isinstance(x, tuple) else x in LIMITED
+            for x in v.values())]
         # a model diverging on a lattice has no consistency limit there: never tied with one
         # that has a limit everywhere it converges
         rest = sorted((m for m in models if m not in passed), key=lambda m: _largest(lim[m]))
