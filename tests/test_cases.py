@@ -30,7 +30,8 @@ def test_quick_run_writes_every_file_with_finite_metrics(quick):
         assert (quick / f).is_file(), f
     data = json.loads((quick / "metrics.json").read_text())
     runs = data["runs"]
-    assert len(runs) == 2 * 2 * len(PRESETS)     # meshes x conditions x every preset
+    # meshes x conditions x every preset and the gated literal reading
+    assert len(runs) == 2 * 2 * (len(PRESETS) + 1)
     assert {r["mesh"] for r in runs} == {"five", "six"}
     for r in runs:
         for k in KEYS:

@@ -39,8 +39,8 @@ def test_blow_ups_are_findings_and_the_report_is_complete(nu, tmp_path, capsys):
     # a blow-up at dt is run again at dt/4 (is the step to blame?), the others are not (quick)
     assert all((r["verdict_changes_dt4"] is None) == (r not in blown) for r in runs)
     md = (out / "report.md").read_text()
-    # a table row, not a sentence per run: model, mesh/bc, where it blew up at dt
-    assert "| pbcm-balanced-literal | six/clamped | step " in md
+    # a table row, not a sentence per run: model, mesh/bc, when it blew up at dt
+    assert "| pbcm-balanced-literal | six/clamped | t = " in md
     for name in [line.split("](")[1].rstrip(")") for line in md.splitlines()
                  if line.startswith("![")]:
         assert (out / name).stat().st_size > 0
