@@ -54,7 +54,8 @@ def test_quick_run_writes_every_file_with_finite_metrics(quick):
     assert not any(k in r for r in runs for k in TIMING_KEYS)
     run = json.loads((quick / "run.json").read_text())
     assert {"git_commit", "date", "timings"} <= set(run) and len(run["timings"]) == len(runs)
-    assert len(list((quick / "vtu").glob("*.vtu"))) == 2 * 2 * (len(PRESETS) + 1)   # + FEM
+    # every preset, the literal reading and FEM P2
+    assert len(list((quick / "vtu").glob("*.vtu"))) == 2 * 2 * (len(PRESETS) + 2)
 
 
 def test_the_full_setting_repeats_every_dynamic_run_at_a_quarter_of_the_step():
