@@ -197,6 +197,9 @@ def lines(root, models, pops=(), quick=False):
                                                 for m in rest if _worst_limit(lim[m]))
                    + _limit_ties([(m, _worst_limit(lim[m])) for m in steady
                                   if _worst_limit(lim[m])])
+                   + _limit_ties([(m, _worst_limit(lim[m])) for m in rest
+                                  if m not in steady and _worst_limit(lim[m])],
+                                 "tied within their +-, both diverging elsewhere")
                    + (f"; below {PATCH_TOL:g}: {', '.join(passed)}" if passed else "")
                    + (f"; no limit on {', '.join(nolimit)}" if nolimit else "")
                    + _diverging(lim)
@@ -227,7 +230,7 @@ def lines(root, models, pops=(), quick=False):
     return out
 
 
-def _limit_ties(limits_):
+def _limit_ties(limits_, said="tied within their +-"):
     """' (tied within their +-: a, b; b, c)': the longest runs of neighbours (in the order
     given, by limit) in which every pair differs by less than their uncertainties combined
     (sqrt(u_a^2 + u_b^2)); a model may share a group with each of two models that are resolved
@@ -242,7 +245,7 @@ def _limit_ties(limits_):
             j += 1
         if j > i and not any(g[0] <= i and j <= g[1] for g in groups):
             groups.append((i, j))
-    return (" (tied within their +-: " + "; ".join(
+    return (f" ({said}: " + "; ".join(
         ", ".join(m for m, _ in limits_[i:j + 1]) for i, j in groups) + ")" if groups else "")
 
 
@@ -285,7 +288,9 @@ def _cost_of_replacing(pops, models, quick):
         loose = scorecard.unresolved(pops, models, finite)
         rng = scorecard.spread(pops, models, finite)
         if ranked:
-            said.append(f"{regime}: " + ", ".join(
+            n = len([p for p in pops if p.finite == finite and not p.patch_test])
+            said.append(f"{regime} (over {n} case/bc population{'s' if n > 1 else ''}"
+                        + (", so one case decides it" if n == 1 else "") + "): " + ", ".join(
                 f"{m} " + (fmt(e[1]) if e[1] is not None else "n/a")
                 + (f" [{fmt(rng[m][0], 2)}-{fmt(rng[m][1], 2)}]" if m in rng else "")
                 + (f" ({e[2]} failed runs)" if e[2] else "")
@@ -397,8 +402,11 @@ def recommendation(root, models, pops, quick, bench_rows):
                 + (rel(e[1]) if e[1] is not None and not e[3] else "failed at the median")
                 + f"; {why(e)})" for m, e in fin.items()
                 if scorecard.failed(e) and m not in cands]
-        out.append(f"- Finite strain: {p1_fin} (the reference's law on P1"
-                   + _discretisation(pops, True) + f"){said}"
+        out.append(f"- Finite strain: {p1_fin} (the reference's law on P1, the identity "
+                   "check of this comparison, not a measured accuracy"
+                   + _discretisation(pops, True)
+                   + ": on these meshes the mesh, not the law, sets the distance to the "
+                   f"continuum; refine before choosing){said}"
                    + ("; no equilibrium at a case's load for " + "; ".join(failing)
                       if failing else "")
                    + ("; ranked after them for a failed run: " + "; ".join(left)
@@ -423,8 +431,8 @@ def recommendation(root, models, pops, quick, bench_rows):
                        key=lambda m: bench_rows[m]["cpu_s_per_simulated_s"], default=None)
         line = (f"- Cost at a stated accuracy (model-form error within {ACCURACY:g} on every "
                 f"case of the linear regime, the median over its meshes): {cheap}"
-                + (" (FEM P1 itself, within it by construction)" if cheap == p1_lin else
-                   f" (at most {fmt(worst_of[cheap])})")
+                + (" (FEM P1 itself: no approximation is within it on every case)"
+                   if cheap == p1_lin else f" (at most {fmt(worst_of[cheap])})")
                 + f", {fmt(bench_rows[cheap]['cpu_s_per_simulated_s'])} s per simulated s")
         if cheapest and bench_rows[cheapest]["cpu_s_per_simulated_s"] < \
                 bench_rows[cheap]["cpu_s_per_simulated_s"]:
@@ -439,8 +447,10 @@ def recommendation(root, models, pops, quick, bench_rows):
 def _discretisation(pops, finite):
     """', whose discretisation error ...': FEM P1's discretisation error per population (the
     median over its meshes), the smallest and largest population named, never pooled."""
-    meds = [(float(np.median(p.discretisation())), p.label) for p in pops
-            if p.finite == finite and not p.patch_test and p.discretisation()]
+    meds = [(float(np.median(p.discretisation())), p.label
+             + (", not resolved there: the continuum's u_num exceeds a fifth of it"
+                if p.u_continuum > np.median(p.discretisation()) / 5 else ""))
+            for p in pops if p.finite == finite and not p.patch_test and p.discretisation()]
     if not meds:
         return ""
     (lo, a), (hi, b) = min(meds), max(meds)

@@ -164,8 +164,9 @@ def unresolved(pops, models, finite=False):
     for left_out, subset in subsets:
         alt = overall(subset, models, finite)
         for a, b in zip(order, order[1:]):
+            # reversed, or level: an order one subset cannot keep is not resolved
             if (a, b) not in out and a in alt and b in alt and \
-                    _order(alt[a], a)[:2] > _order(alt[b], b)[:2]:
+                    _order(alt[a], a)[:2] >= _order(alt[b], b)[:2]:
                 out[(a, b)] = left_out
     return out
 
