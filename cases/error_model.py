@@ -129,6 +129,7 @@ class Norm:
     label: str
     p1: str = P1_LINEAR
     unpaired: str = None      # run key counting the parts that failed (unpaired modes)
+    unpaired_total: str = None   # the same against the continuum (the total's failed parts)
     count: int = 1            # the parts a run compares (the modes it pairs)
 
     def parts(self, run, p1_run):

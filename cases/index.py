@@ -54,9 +54,10 @@ def _cell(p, model, part):
     s, tie = rows[model]
     text = scorecard.cell(s, tie if part == "model_form" and math.isfinite(s.score)
                           else None)
-    if model in p.unpaired and part == "model_form":
-        text += f"; {p.unpaired[model]} of {p.quantity.count * s.runs} modes unpaired"
-    colour = (BANDS[-1][1] if s.failed or not s.values or p.unpaired.get(model)
+    lost = p.unpaired if part == "model_form" else p.unpaired_total
+    if model in lost:
+        text += f"; {lost[model]} of {p.quantity.count * s.runs} modes unpaired"
+    colour = (BANDS[-1][1] if s.failed or not s.values or lost.get(model)
               else _band(float(np.median(s.values)))[1])
     return Cell(text, colour)
 

@@ -84,20 +84,23 @@ def uncertainty(runs, metric, estimate_key="p2_error_estimate"):
     return u, defect
 
 
-def _standings(runs, metric, u):
+def _standings(runs, metric, u, lost_key=None):
     """``error_model.standings`` of ``metric`` over one population: every run a model had
-    counts, a run without a value as infinitely wrong."""
-    by = {}
+    counts, a run without a value as infinitely wrong; ``lost_key`` the run key counting the
+    parts a run lost (unpaired modes), ranked on first."""
+    by, lost = {}, {}
     for r in runs:
         by.setdefault(r["model"], []).append(r.get(metric))
-    return standings(by, u)
+        if lost_key:
+            lost[r["model"]] = lost.get(r["model"], 0) + (r.get(lost_key) or 0)
+    return standings(by, u, lost)
 
 
 def _u_text(u, defect):
     return f"u_num {rel(u, 2)}" + (", the spread over the meshes" if defect else "")
 
 
-def ranking(runs, metric, label, estimate_key="p2_error_estimate"):
+def ranking(runs, metric, label, estimate_key="p2_error_estimate", lost_key=None):
     """A table (one item of a report's findings): per population (boundary condition) the
     models by median ``metric`` over every run they had (a run without a value counts against
     its model, as infinitely wrong), best first, with the range and 'n of N runs'; a model
@@ -106,8 +109,14 @@ def ranking(runs, metric, label, estimate_key="p2_error_estimate"):
     rows = []
     for bc, rs in populations(runs).items():
         u, defect = uncertainty(rs, metric, estimate_key)
-        for rank, s, tie in _standings(rs, metric, u):
+        lost = {}
+        for r in rs:
+            lost[r["model"]] = lost.get(r["model"], 0) + ((r.get(lost_key) or 0) if lost_key
+                                                           else 0)
+        for rank, s, tie in _standings(rs, metric, u, lost_key):
             note = []
+            if lost.get(s.model):
+                note.append(f"{lost[s.model]} unpaired modes (failed, ranked first)")
             if tie:
                 note.append(f"tied with {tie} ({_u_text(u, defect)})")
             if s.failed:
@@ -132,16 +141,18 @@ def _cell(s):
     return f"median {med}" + (f" [{rng}]" if rng else "") + f", {n} runs"
 
 
-def best_and_worst(runs, metric, what, exact=False, estimate_key="p2_error_estimate"):
+def best_and_worst(runs, metric, what, exact=False, estimate_key="p2_error_estimate",
+                   lost_key=None):
     """Per population (boundary condition), one line naming the model closest to FEM and the
     farthest by median ``metric`` over every run (a run without a value counts against its
     model); the models within the reference's u_num (``uncertainty``) of the closest are named
     tied with it, the line says so where that exceeds a fifth of the smallest error it ranks
     (``exact``: the metric is against a closed form, which has no estimate), and it names the
-    models with failed runs."""
+    models with failed runs; ``lost_key``: the run key of the parts a run lost (unpaired
+    modes), ranked on first and named."""
     def line_of(rs):
         u, defect = (0.0, False) if exact else uncertainty(rs, metric, estimate_key)
-        st = _standings(rs, metric, u)
+        st = _standings(rs, metric, u, lost_key)
         if not st or not any(s.values for _, s, _ in st):
             return f"No model gave {what}."
         best, worst = st[0][1], st[-1][1]
@@ -151,6 +162,14 @@ def best_and_worst(runs, metric, what, exact=False, estimate_key="p2_error_estim
         if failed:
             line += (" Failed runs, counted against their model: " + ", ".join(
                 f"{s.model} ({s.failed} of {s.runs})" for s in failed) + ".")
+        if lost_key:
+            lost = {}
+            for r in rs:
+                lost[r["model"]] = lost.get(r["model"], 0) + (r.get(lost_key) or 0)
+            unpaired = [f"{m} ({k})" for m, k in lost.items() if k]
+            if unpaired:
+                line += (" Unpaired modes, failed modes ranked on before the error: "
+                         + ", ".join(unpaired) + ".")
         if exact:
             return line
         tied = [s.model for _, s, t in st if t == best.model]

@@ -35,6 +35,7 @@ class Population:
     quick: bool
     meshes: dict = field(default_factory=dict)     # {model: [mesh per run]}
     lost: dict = field(default_factory=dict)       # {model: [unpaired modes per run]}
+    lost_total: dict = field(default_factory=dict)  # the same against the continuum
     # {model: [(mesh, no equilibrium at the case's load)]} over the runs with a finite-load
     # phase and its reference: what the finite-load ranking counts of a linear population
     load_failed: dict = field(default_factory=dict)
@@ -44,12 +45,19 @@ class Population:
         """{model: failed parts (unpaired modes) over its runs}, where the quantity has them."""
         return {m: sum(v) for m, v in self.lost.items()}
 
+    @property
+    def unpaired_total(self):
+        """{model: failed parts against the continuum (its unpaired modes) over its runs}."""
+        return {m: sum(v) for m, v in self.lost_total.items()}
+
     def without(self, mesh):
         """The population without its runs on ``mesh`` (the unit of analysis left out)."""
         keep = {m: [k for k, x in enumerate(self.meshes[m]) if x != mesh] for m in self.parts}
         return replace(self, parts={m: [self.parts[m][k] for k in ks] for m, ks in keep.items()},
                        meshes={m: [self.meshes[m][k] for k in ks] for m, ks in keep.items()},
                        lost={m: [self.lost[m][k] for k in keep[m]] for m in self.lost},
+                       lost_total={m: [self.lost_total[m][k] for k in keep[m]]
+                                   for m in self.lost_total},
                        load_failed={m: [x for x in v if x[0] != mesh]
                                     for m, v in self.load_failed.items()})
 
@@ -79,7 +87,7 @@ class Population:
         u = self.u_model_form if part == "model_form" else self.u_continuum
         return E.standings({m: self.errors(m, part) for m in self.parts
                             if part != "model_form" or m not in self.identity}, u,
-                           self.unpaired if part == "model_form" else None)
+                           self.unpaired if part == "model_form" else self.unpaired_total)
 
     def discretisation(self):
         """FEM P1's |discretisation error| on each mesh (the same for every model there)."""
@@ -102,7 +110,8 @@ def populations(runs_by_case, declared, quick, patch_tests, estimate_keys):
             rs = [r for r in runs if r["bc"] == bc]
             dec = E.decomposed(rs, q)
             failed_modes = getattr(q, "unpaired", None)
-            parts, meshes, lost, load_failed = {}, {}, {}, {}
+            parts, meshes, lost, load_failed, lost_total = {}, {}, {}, {}, {}
+            failed_total = getattr(q, "unpaired_total", None)
             for r in rs:
                 if r.get("nh_error_estimate") is not None and "finite_failed" in r:
                     load_failed.setdefault(r["model"], []).append(
@@ -111,6 +120,8 @@ def populations(runs_by_case, declared, quick, patch_tests, estimate_keys):
                 meshes.setdefault(r["model"], []).append(r["mesh"])
                 if failed_modes:
                     lost.setdefault(r["model"], []).append(r.get(failed_modes) or 0)
+                if failed_total:
+                    lost_total.setdefault(r["model"], []).append(r.get(failed_total) or 0)
             twins = [abs(p.model_form) for m in SAME_LAW.get(q.p1, ()) if m in parts
                      for p in parts[m] if p is not None]
             u_mf = max([E.ROUND_OFF] + twins)
@@ -122,7 +133,7 @@ def populations(runs_by_case, declared, quick, patch_tests, estimate_keys):
             u_c, defect = E.u_num(max(est) if est else None, cont)
             out.append(Population(case, bc, q, parts, u_mf, u_c, defect,
                                   bc in patch_tests[case], quick[case], meshes, lost,
-                                  load_failed))
+                                  lost_total=lost_total, load_failed=load_failed))
     return out
 
 
@@ -346,7 +357,9 @@ def case_findings(name, decomposed, runs, patch_tests=(), estimate_key="p2_error
                 line += (f"; as far from the continuum as P1 within u_val {rel(p.u_continuum, 2)}: "
                          + ", ".join(level))
         lines.append(line + ".")
-        rows = [[p.bc, rank, s.model, cell(s, tie), cell_of(p.errors(s.model, "total"))]
+        rows = [[p.bc, rank, s.model, cell(s, tie), cell_of(p.errors(s.model, "total"))
+                 + (f"; {p.unpaired_total[s.model]} of {p.quantity.count * s.runs} modes "
+                    "unpaired" if p.unpaired_total.get(s.model) else "")]
                 + ([f"{p.unpaired.get(s.model, 0)} of {p.quantity.count * s.runs}"]
                    if p.lost else [])
                 for rank, s, tie in st]

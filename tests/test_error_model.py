@@ -335,3 +335,28 @@ def test_cost_ratio_is_the_in_round_step_ratio_times_the_stable_steps_with_its_r
     assert ratio_text(row, fl) == "4 [3-6]"
     old = {k: v for k, v in row.items() if not k.endswith("_range")}
     assert sim_ratio(old, fl) == (4.0, None)
+
+
+def test_a_total_with_unpaired_continuum_modes_ranks_after_one_without():
+    """Against the continuum too an unpaired mode is a failed mode: a model whose paired
+    frequencies are closest (0.03) but that left 9 continuum modes unpaired ranks after one
+    that paired every mode (0.2), in the scorecard's total and in the case's own table."""
+    from cases import rankings
+    q = E.Norm("mf", "tot", "modes", unpaired="lost", unpaired_total="lost_c", count=10)
+    run = {"mesh": "six", "bc": "free"}
+    runs = [dict(run, model="fem-linear", mf=0.0, tot=0.05, lost=0, lost_c=0),
+            dict(run, model="a", mf=0.02, tot=0.03, lost=7, lost_c=9),
+            dict(run, model="b", mf=0.3, tot=0.2, lost=0, lost_c=0)]
+
+    class Declared:
+        decomposed = q
+    (p,) = scorecard.populations({"modes": runs}, {"modes": Declared}, {"modes": False},
+                                 {"modes": set()}, {"modes": "est"})
+    assert p.unpaired_total == {"fem-linear": 0, "a": 9, "b": 0}
+    order = [s.model for _, s, _ in p.standings("total")]
+    assert order.index("b") < order.index("a")
+    (table,) = rankings.ranking(runs, "tot", "error", lost_key="lost_c")
+    assert [r[2] for r in table.rows][-1] == "a"
+    assert "9 unpaired modes (failed, ranked first)" in table.rows[-1][-1]
+    line = rankings.best_and_worst(runs, "tot", "Error", lost_key="lost_c")
+    assert "to a (" in line and "Unpaired modes" in line and "a (9)" in line

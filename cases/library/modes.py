@@ -34,7 +34,8 @@ class Modes(Case):
     quick = {"fem_refine": 0}
     headline = "modal_rel_err"
     decomposed = Norm("modal_rel_err_p1", "modal_rel_err", "first 10 frequencies",
-                      unpaired="modes_unpaired_p1", count=N_MODES)
+                      unpaired="modes_unpaired_p1", unpaired_total="modes_unpaired",
+                      count=N_MODES)
     gated = ("modal_rel_err", "modal_rel_err_median", "rigid_modes", "modes_unpaired")
     columns = ("frequencies_hz", "frequencies_fem_hz", "modal_rel_err", "modal_rel_err_median",
                "modes_unpaired", "modal_rel_err_p1", "modes_unpaired_p1", "rigid_modes")
@@ -109,7 +110,8 @@ class Modes(Case):
 
     def conclusion(self, s, runs):
         out = [common.best_and_worst([r for r in runs if r["bc"] == bc], "modal_rel_err",
-                                     f"{bc}: first 10 frequencies") for bc in s.bcs]
+                                     f"{bc}: first 10 frequencies", lost_key="modes_unpaired")
+               for bc in s.bcs]
         odd = [f"{r['model']} on {r['mesh']}/{r['bc']} ({r['rigid_modes']})" for r in runs
                if r["rigid_modes"] != (6 if r["bc"] == "free" else 0)]
         out.append("Zero modes other than the rigid ones: " + ", ".join(odd) + "." if odd else
@@ -118,7 +120,7 @@ class Modes(Case):
 
     def findings(self, s, runs):
         return {f"{bc}": common.ranking([r for r in runs if r["bc"] == bc], "modal_rel_err",
-                                        "largest frequency error")
+                                        "largest frequency error", lost_key="modes_unpaired")
                 for bc in s.bcs}
 
 
