@@ -12,7 +12,7 @@ from model.mesh import cube
 from reference import hyperelastic, linear
 from .. import figures
 from .. import metrics as M
-from ..error_model import P1_FINITE, Scalar
+from ..error_model import P1_FINITE, Scalar, u_num
 from ..framework import FINDINGS, Case, Knob, MM, Reference, Settings, linear_scale
 from . import common
 
@@ -240,10 +240,11 @@ class LargeCompression(Case):
         if len(ref) < 2:
             return ""
         f = [v[0] for v in ref.values()]
-        spread = (max(f) - min(f)) / min(f)
         est = max(v[1] for v in ref.values())
+        # the spread u_num is widened to: one definition (error_model.u_num)
+        spread = u_num(0.0, f)[0]
         return (f"The {len(ref)} meshes' references give {min(f):.4g} to {max(f):.4g} N at "
-                f"the last step (spread {spread:.2g}, "
+                f"the last step (spread {spread:.2g} of their median, "
                 f"{'above' if spread > est else 'within'} their largest estimate {est:.2g}).")
 
     def findings(self, s, runs):

@@ -128,7 +128,9 @@ def conclusion(cfg, runs):
         out.append(rankings.best_and_worst(clamped, "disp_rel_l2_p2",
                                            "Clamped base, displacement against FEM P2"))
     blown = sorted({r["model"] for r in runs if r.get("dyn_failed")})
-    out.append("Dynamic runs blow up for " + ", ".join(blown) + "." if blown
+    out.append("Dynamic runs blow up for " + ", ".join(
+        f"{m} ({sum(bool(r.get('dyn_failed')) for r in runs if r['model'] == m)} of "
+        f"{sum(r['model'] == m for r in runs)} runs)" for m in blown) + "." if blown
                else "Every dynamic run comes to rest.")
     held = [r for r in runs if r.get("modal_rel_err") is not None]
     if held:
