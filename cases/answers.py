@@ -11,6 +11,7 @@ import numpy as np
 
 from .costs import FILE as BENCH_FILE, FOLDER as BENCH_FOLDER
 from .document import fmt, rel
+from .error_model import ROUND_OFF
 from .metrics import PATCH_TOL
 
 COST_TETS = 1e4          # the mesh size of the cost column (tetrahedra)
@@ -255,10 +256,30 @@ def _diverging(lim):
     return f" (diverging there, a failure: {', '.join(bad)})" if bad else ""
 
 
+def _single_runs_u(values, u, what):
+    """'one run each, u_num U (what): ...': the uncertainty single-run errors [(model, error)]
+    are read against (floored at round-off), and whether it resolves every difference between
+    them or which models it ties (the longest runs, in order of error, within u pair by pair)."""
+    u = max(u, ROUND_OFF)
+    vals = sorted(values, key=lambda kv: kv[1])
+    groups, i = [], 0
+    while i < len(vals):
+        j = i
+        while j + 1 < len(vals) and all(abs(vals[k][1] - vals[j + 1][1]) < u
+                                        for k in range(i, j + 1)):
+            j += 1
+        if j > i:
+            groups.append(", ".join(m for m, _ in vals[i:j + 1]))
+        i = j + 1 if j > i else i + 1
+    return (f"one run each, u_num {rel(u)} ({what}): "
+            + (f"tied: {'; '.join(groups)}" if groups else "every difference resolved"))
+
+
 def _finest(conv, models, lattices):
     """'; there, the error on the finest level: ...': each model's sliding-cube error at the
-    smallest h it ran on the lattices without a limit (a number where no limit exists)."""
-    said = []
+    smallest h it ran on the lattices without a limit (a number where no limit exists), read
+    against the reference's stated estimate there."""
+    said, values = [], []
     for lattice in lattices:
         for m in models:
             rs = [r for r in conv.get("runs", []) if (r["case"], r["bc"]) == CONSISTENCY
@@ -267,7 +288,11 @@ def _finest(conv, models, lattices):
             if rs:
                 r = min(rs, key=lambda r: r["h_mm"])
                 said.append(f"{m} {fmt(r['disp_rel_l2'], 2)} at {fmt(r['h_mm'], 3)} mm")
-    return (f"; there, the error at the finest level (no limit: not a consistency limit): "
+                values.append((m, r["disp_rel_l2"]))
+    est = [r.get("error_estimate") or 0.0 for r in conv.get("references", [])
+           if (r["case"], r["bc"]) == CONSISTENCY]
+    return (f"; there, the error at the finest level (no limit: not a consistency limit; "
+            + _single_runs_u(values, max(est, default=0.0), "the reference's estimate") + "): "
             + ", ".join(said)) if said else ""
 
 
@@ -588,17 +613,23 @@ def _nu_sensitivity(truth, strain):
 
 def _irregular(conv, models):
     """'; on irregular patches ...': each model's worst patch-test error over the families
-    whose patch is irregular (perturbed lattices, unstructured), where the study ran it."""
-    worst_of = {}
+    whose patch is irregular (perturbed lattices, unstructured), where the study ran it, read
+    against FEM P1's error on the same patches (the exact answer's numerical floor)."""
+    worst_of, floor = {}, 0.0
     for r in conv.get("patch", []):
-        if r["mesh"] in REGULAR or r.get("patch_error") is None or r["model"] not in models:
+        if r["mesh"] in REGULAR or r.get("patch_error") is None:
             continue
-        worst_of[r["model"]] = max(worst_of.get(r["model"], 0.0), r["patch_error"])
+        if r["model"] == "FEM P1":
+            floor = max(floor, r["patch_error"])
+        if r["model"] in models:
+            worst_of[r["model"]] = max(worst_of.get(r["model"], 0.0), r["patch_error"])
     if not worst_of:
         return ""
+    ordered = sorted(worst_of.items(), key=lambda kv: kv[1])
     return ("; the patch test with every boundary node prescribed, on irregular patches "
-            "(worst): " + ", ".join(f"{m} {rel(v)}" for m, v in sorted(
-                worst_of.items(), key=lambda kv: kv[1])))
+            "(worst, against the exact linear field; "
+            + _single_runs_u(ordered, floor, "FEM P1's own error there") + "): "
+            + ", ".join(f"{m} {rel(v)}" for m, v in ordered))
 
 
 def _largest(limit):

@@ -85,15 +85,15 @@ def u_val(u_num, u_input=0.0, u_d=0.0):
 
 def u_num(estimate, continuum_values):
     """The reference's numerical uncertainty for one continuum problem posed on several meshes:
-    the larger of its stated estimate and the relative spread (max - min) / |median| of its
-    values across the meshes, and whether the spread exceeds the estimate (a defect of the
-    reference, to fix by refining)."""
+    its stated estimate and the relative spread (max - min) / |median| of its values across
+    the meshes, combined in quadrature as independent parts of u_num, and whether the spread
+    exceeds the estimate (a defect of the reference, to fix by refining)."""
     vals = np.array([v for v in continuum_values if v is not None], dtype=float)
     est = 0.0 if estimate is None else float(estimate)
     if vals.size < 2:
         return est, False
     spread = float((vals.max() - vals.min()) / abs(np.median(vals)))
-    return max(est, spread), spread > est
+    return float(np.hypot(est, spread)), spread > est
 
 
 @dataclass(frozen=True)
@@ -176,23 +176,26 @@ class Standing:
 def standings(by_model, u, lost=None):
     """Rank a population: ``by_model`` {model: [error magnitude or None per run]}, ``u`` the
     validation uncertainty of a difference, ``lost`` {model: failed parts of runs that gave a
-    number (unpaired modes)}, ranked on before the error. Returns [(rank, Standing,
-    tied_with)], best first: a model whose score is within ``u`` of the first of a group (and
-    that lost as many parts) shares that group's rank and names it (tied); failed runs count
-    against their model, and models that all failed their median share the last rank."""
+    number (unpaired modes)}, ranked on before the error. Returns [(rank, Standing, tied)],
+    best first: a model whose score is within ``u`` of the first of a group (and that lost as
+    many parts) shares that group's rank; ``tied`` names every other model within ``u`` of it
+    (pair by pair, never chained, so two neighbours across a rank boundary are still said
+    tied); failed runs count against their model, and models that all failed their median
+    share the last rank."""
     lost = lost or {}
     u = max(u, ROUND_OFF)       # round-off never orders two models
     st = sorted((Standing(m, tuple(abs(v) for v in vs if v is not None), len(vs))
                  for m, vs in by_model.items()),
                 key=lambda s: (lost.get(s.model, 0), s.score, s.model))
+    def tie(a, b):
+        return lost.get(a.model, 0) == lost.get(b.model, 0) and (
+            a.score == b.score or abs(a.score - b.score) < u)
+
     out, head, rank = [], None, 0
     for k, s in enumerate(st):
-        if head is not None and lost.get(s.model, 0) == lost.get(head.model, 0) and (
-                s.score == head.score or abs(s.score - head.score) < u):
-            out.append((rank, s, head.model))
-            continue
-        head, rank = s, k + 1
-        out.append((rank, s, None))
+        if head is None or not tie(s, head):
+            head, rank = s, k + 1
+        out.append((rank, s, tuple(o.model for o in st if o is not s and tie(s, o))))
     return out
 
 

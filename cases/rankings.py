@@ -70,9 +70,9 @@ def _continuum_key(runs, metric):
 
 def uncertainty(runs, metric, estimate_key="p2_error_estimate"):
     """(u_num, the spread exceeds the estimate) of a comparison of ``metric`` over ``runs`` (one
-    continuum problem on several meshes): the reference's largest estimate, widened to the
-    spread of the continuum's value across the meshes where that is larger
-    (``error_model.u_num``); 0 where the reference states none."""
+    continuum problem on several meshes): the reference's largest estimate combined in
+    quadrature with the spread of the continuum's value across the meshes
+    (``error_model.u_num``)."""
     key = _continuum_key(runs, metric)
     values = {}
     if key:
@@ -97,15 +97,15 @@ def _standings(runs, metric, u, lost_key=None):
 
 
 def _u_text(u, defect):
-    return f"u_num {rel(u, 2)}" + (", the spread over the meshes" if defect else "")
+    return f"u_num {rel(u, 2)}" + (", mostly the spread over the meshes" if defect else "")
 
 
 def ranking(runs, metric, label, estimate_key="p2_error_estimate", lost_key=None):
     """A table (one item of a report's findings): per population (boundary condition) the
     models by median ``metric`` over every run they had (a run without a value counts against
     its model, as infinitely wrong), best first, with the range and 'n of N runs'; a model
-    within the reference's u_num (``uncertainty``) of the first of a group is tied with it
-    (the reference cannot order them)."""
+    within the reference's u_num (``uncertainty``) of the first of a group shares its order,
+    and every model names those within u_num of it (the reference cannot order them)."""
     rows = []
     for bc, rs in populations(runs).items():
         u, defect = uncertainty(rs, metric, estimate_key)
@@ -118,7 +118,7 @@ def ranking(runs, metric, label, estimate_key="p2_error_estimate", lost_key=None
             if lost.get(s.model):
                 note.append(f"{lost[s.model]} unpaired modes (failed, ranked first)")
             if tie:
-                note.append(f"tied with {tie} ({_u_text(u, defect)})")
+                note.append(f"tied with {', '.join(tie)} ({_u_text(u, defect)})")
             if s.failed:
                 note.append(f"{s.failed} failed, counted against it")
             rows.append([bc, rank, s.model, *_stats(s), "; ".join(note)])
@@ -172,7 +172,7 @@ def best_and_worst(runs, metric, what, exact=False, estimate_key="p2_error_estim
                          + ", ".join(unpaired) + ".")
         if exact:
             return line
-        tied = [s.model for _, s, t in st if t == best.model]
+        tied = list(st[0][2])
         if tied:
             line += (f" Tied with {best.model} within the reference's {_u_text(u, defect)}: "
                      f"{', '.join(tied)}.")

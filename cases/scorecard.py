@@ -158,7 +158,7 @@ def cell(standing, tied_with=None):
     else:     # the median over every run, a failed one counted as infinitely wrong
         text = (f"{rel(s.score)} [{rel_range(min(s.values), max(s.values))}] "
                 f"{len(s.values)}/{s.runs}" + (f", {s.failed} failed" if s.failed else ""))
-    return text + (f"; tied with {tied_with}" if tied_with else "")
+    return text + (f"; tied with {', '.join(tied_with)}" if tied_with else "")
 
 
 def unresolved(pops, models, finite=False):
@@ -321,7 +321,7 @@ def case_findings(name, decomposed, runs, patch_tests=(), estimate_key="p2_error
         if ok:
             line += f"closest {ok[0][1].model} ({cell(ok[0][1])}), farthest {ok[-1][1].model} " \
                     f"({cell(ok[-1][1])})"
-            tied = [s.model for _, s, t in ok if t == ok[0][1].model]
+            tied = list(ok[0][2])
             if tied:
                 line += f"; tied with {ok[0][1].model} within u_val {rel(p.u_model_form, 2)}: " \
                         f"{', '.join(tied)}"
@@ -341,15 +341,25 @@ def case_findings(name, decomposed, runs, patch_tests=(), estimate_key="p2_error
                      + (f"; not resolved: the continuum's own u_num, {rel(p.u_continuum, 2)}, "
                         "exceeds a fifth of it" if p.u_continuum > np.median(disc) / 5 else "")
                      + ")")
-            # |total| < |P1's| with a model-form error: its error opposes P1's
-            cancel = [s.model for _, s, _ in ok
+            # |total| < |P1's| with a model-form error: its error opposes P1's; a model that
+            # leaves more continuum modes unpaired than P1 is not closer, whatever its rest
+            lost = p.unpaired_total
+            p1_lost = lost.get(p.quantity.p1, 0)
+            closer = [s.model for _, s, _ in ok
                       if _median(p.errors(s.model, "total")) is not None
                       and np.median(disc) - _median(p.errors(s.model, "total"))
                       > p.u_continuum]
-            level = [s.model for _, s, _ in ok if s.model not in cancel
+            cancel = [m for m in closer if lost.get(m, 0) <= p1_lost]
+            lossy = [m for m in closer if m not in cancel]
+            level = [s.model for _, s, _ in ok if s.model not in closer
+                     and lost.get(s.model, 0) <= p1_lost
                      and _median(p.errors(s.model, "total")) is not None
                      and abs(np.median(disc) - _median(p.errors(s.model, "total")))
                      <= p.u_continuum]
+            if lossy:
+                line += ("; closer to the continuum than P1 on the modes it pairs, yet not "
+                         f"closer: it leaves more continuum modes unpaired than P1 ({p1_lost}): "
+                         + ", ".join(f"{m} ({lost[m]})" for m in lossy))
             if cancel:
                 line += ("; closer to the continuum than P1 only by cancelling its error: "
                          + ", ".join(cancel))

@@ -57,10 +57,10 @@ def test_u_val_combines_in_quadrature():
 
 
 def test_u_num_is_the_larger_of_estimate_and_spread():
-    """A reference whose values over the meshes of one problem spread more than its estimate
-    carries the spread, flagged as a defect; otherwise its estimate."""
-    assert E.u_num(0.01, [1.0, 1.05, 0.98]) == (pytest.approx(0.07), True)
-    assert E.u_num(0.1, [1.0, 1.05, 0.98]) == (0.1, False)
+    """u_num combines the reference's estimate and its spread over the meshes of one problem
+    in quadrature; a spread larger than the estimate is flagged as a defect."""
+    assert E.u_num(0.01, [1.0, 1.05, 0.98]) == (pytest.approx((0.01**2 + 0.07**2) ** 0.5), True)
+    assert E.u_num(0.1, [1.0, 1.05, 0.98]) == (pytest.approx((0.1**2 + 0.07**2) ** 0.5), False)
     assert E.u_num(0.02, [1.0]) == (0.02, False)
 
 
@@ -78,8 +78,16 @@ def test_a_failed_run_scores_against_its_model_only():
 def test_differences_below_u_are_ties():
     """Two models closer than the comparison's uncertainty share a rank and are named tied."""
     rows = E.standings({"a": [0.10], "b": [0.12], "c": [0.3]}, u=0.05)
-    assert [(r, s.model, t) for r, s, t in rows] == [(1, "a", None), (1, "b", "a"),
-                                                     (3, "c", None)]
+    assert [(r, s.model, t) for r, s, t in rows] == [(1, "a", ("b",)), (1, "b", ("a",)),
+                                                     (3, "c", ())]
+
+
+def test_ties_are_pairwise_never_chained_nor_split():
+    """A model within u of the group's first shares its rank; one just beyond starts a group
+    of its own yet is still named tied with its neighbour within u, never with the first."""
+    rows = E.standings({"a": [0.10], "b": [0.14], "c": [0.16]}, u=0.05)
+    assert [(r, s.model, t) for r, s, t in rows] == [(1, "a", ("b",)), (1, "b", ("a", "c")),
+                                                     (3, "c", ("b",))]
 
 
 def test_geometric_mean_floors_and_fails():
@@ -188,6 +196,35 @@ def test_an_order_that_one_mesh_reverses_is_not_resolved(tmp_path):
         ["a", "b", "c"]
     # a: 0.1, 0.1, 0.6; b: 0.3, 0.3, 0.2 -> without five (or six) b's median wins
     assert scorecard.unresolved(pops, models) == {("a", "b"): "five"}
+
+
+def test_single_runs_are_read_against_their_uncertainty():
+    """Errors from one run each are read against u_num: differences below it are named tied
+    (pair by pair along the order, never chained), differences above it resolved."""
+    from cases.answers import _single_runs_u
+    assert _single_runs_u([("a", 0.10), ("b", 0.20)], 0.01, "x") == \
+        "one run each, u_num 0.01 (x): every difference resolved"
+    said = _single_runs_u([("c", 0.3), ("a", 0.10), ("b", 0.104), ("d", 0.108)], 0.005, "x")
+    assert said == "one run each, u_num 0.005 (x): tied: a, b"
+    assert "1e-08" in _single_runs_u([("a", 1e-12), ("b", 2e-12)], 0.0, "x")
+
+
+def test_a_model_with_more_unpaired_modes_is_not_closer_than_p1():
+    """A model whose paired modes are closer to the continuum than P1's but that leaves more
+    continuum modes unpaired is not said closer by cancelling; it is named with its count."""
+    runs = [dict(r, bc="clamped") for r in _torsion_runs({
+        ("five", "fem-linear"): 1.3, ("five", "a"): 1.0, ("five", "b"): 1.35})]
+    for r in runs:
+        r["lost"] = {"a": 3}.get(r["model"], 0)
+
+    class Lossy(E.Scalar):
+        unpaired_total = "lost"
+        count = 1
+    lines, _ = scorecard.case_findings("torsion", Lossy("torque_nm", "torque_fem_nm",
+                                                       "torque"), runs)
+    (line,) = lines
+    assert "only by cancelling" not in line
+    assert line.endswith("it leaves more continuum modes unpaired than P1 (0): a (3).")
 
 
 def test_case_findings_name_cancellation_and_the_twins():

@@ -11,7 +11,7 @@ def test_round_off_is_printed_as_such_and_ties():
     assert rel(3.5e-12) == rel(-2e-9) == f"< {ROUND_OFF:.0e}" == "< 1e-08"
     assert rel(0.0123) == "0.0123" and rel(None) == "n/a"
     (r1, a, _), (r2, b, tie) = standings({"a": [1e-12], "b": [5e-9]}, 0.0)
-    assert r1 == r2 == 1 and tie == "a"
+    assert r1 == r2 == 1 and tie == ("a",)
 
 
 def test_a_blow_up_is_said_by_its_time_to_two_figures():
