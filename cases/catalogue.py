@@ -149,7 +149,7 @@ DESCRIPTORS = frozenset({
     "why", "verdict", "levels", "metric", "dropped", "dyn_reaction_t_s", "homogeneous_failed",
     "finite_failed",
     # the artefact study's factors: the mesh split and size, the model's parts, the load
-    "split", "nodes_per_side", "unmatched_faces", "paper_size", "load", "family", "reading",
+    "split", "nodes_per_side", "unmatched_faces", "load", "family", "reading",
     "constant", "normal", "flutter",
     # how the artefact study's static solve was run: the equal load steps that converged
     "load_steps",
@@ -247,15 +247,17 @@ declare("bulge_profile_mm", "mm", "layer profile",
          "for each y-layer (0, 8, 16, 24, 32 mm) the mean outward lateral displacement of the "
          "side-face nodes.")
 declare("alternation_mm", "mm", "alternation",
-         "the alternating-layer (Nyquist) component of the layer profile beyond the "
-         "reference's: beta of the least-squares fit, over the layers free to move "
-         "laterally, profile_k = alpha profile_FEM,k + q(k) + beta (-1)^k with q a quadratic. "
-         "Zero for the continuum against itself and for any smooth profile of its shape, "
-         "scaled or smoothly deformed; positive puts the ends and the middle layer out, the "
-         "paper's sign; n/a where the free layers leave no residual (the clamped five-layer "
-         "cube's three).", digits=2)
+         "the bulge/neck signature: the period-2 (Nyquist) component of the layer profile "
+         "over the layers free to move laterally, beta of the exact fit profile_k = alpha "
+         "profile_FEM,k + q(k) + beta (-1)^k with q the polynomial of the highest degree that "
+         "leaves (-1)^k apart (on n free layers up to n - 2). Zero to round-off for the "
+         "continuum against itself, scaled, and for smooth barrels; the amplitude of a pure "
+         "(-1)^k pattern; positive puts the layers of even index from the base out (the ends "
+         "and the middle of five: the paper's sign). On five layers it cannot tell a smooth "
+         "bump from an alternation (the paper's own view); n/a where the free layers absorb "
+         "less than a quadratic (the clamped five-layer cube's three).", digits=2)
 declare("alternation_rel", "1", "alternation rel",
-         "the alternation over the reference profile's mean |lateral displacement|; the "
+         "the signature over the reference profile's mean |lateral displacement|; the "
          "pattern is called clear from 0.01.", "signed")
 declare("alternation_max_rel", "1", "largest |alternation|",
          "a model's largest |alternation rel| over its paper-cube runs (extensions study).",

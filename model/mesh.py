@@ -258,7 +258,8 @@ def box(nx, ny, nz, lx, ly, lz, scheme="five", seed=0):
     """A box [0, lx] x [0, ly] x [0, lz] with nx x ny x nz lattice nodes.
 
     Schemes: ``five`` (5 tetrahedra per cell, mirrored in alternating cells so faces conform),
-    ``six`` (Kuhn split), ``bcc`` (body-centred lattice: cell centres added) and
+    ``five-unmirrored`` (every cell split alike: the faces' diagonals cross, not conforming;
+    a control for the mirror, not one of ``SCHEMES``), ``six`` (Kuhn split), ``bcc`` (body-centred lattice: cell centres added) and
     ``unstructured`` (Delaunay of a lattice perturbed within its y-layers, sliver-free).
     """
     pts, cells, ids = _lattice(nx, ny, nz, lx, ly, lz)
@@ -266,6 +267,8 @@ def box(nx, ny, nz, lx, ly, lz, scheme="five", seed=0):
         odd = cells.sum(axis=1) % 2 == 1
         local = np.where(odd[:, None, None], _mirror_x(_FIVE_EVEN)[None], _FIVE_EVEN[None])
         tets = np.take_along_axis(ids[:, None, :], local, axis=2).reshape(-1, 4)
+    elif scheme == "five-unmirrored":
+        tets = ids[:, _FIVE_EVEN].reshape(-1, 4)
     elif scheme == "six":
         tets = ids[:, _SIX].reshape(-1, 4)
     elif scheme == "bcc":

@@ -11,7 +11,7 @@ from model.candidates import NORMAL_FORMS
 from model.compose import label
 from model.errors import ConvergenceError
 from model.mesh import cube
-from model.paper_mesh import paper_size_meshes, unmatched_faces
+from model.paper_mesh import unmatched_faces
 from reference import hyperelastic, linear
 from ... import metrics as M
 from ...framework import FINDINGS
@@ -31,8 +31,6 @@ STATIC_RTOL = 1e-10
 LOAD_SPLITS = (1, 2, 4, 8)
 REF_MESH = ("six", 5)         # the reference's own mesh (refined REF_LEVELS times, P2)
 REF_LEVELS = 1
-# the five family refined: nodes per side (the paper's 5, then the lattice halved twice)
-REFINED = (9, 17)
 # msm with the paper's shear force at the paper's constant: with c = auto the fit sets c = 0
 # on every mesh (the springs alone are stiffer than 2G in the modes the shear adds to)
 MSM_SHEAR = label("msm + shear(reading=variational, c=1)")
@@ -73,39 +71,65 @@ def short(model):
     return "msm +shear (c = 1)" if model == MSM_SHEAR else model
 
 
+# the splits of the paper's lattice: the mirrored five (the paper's), the same five split in
+# every cell (not conforming: its faces' diagonals cross), and two conforming splits without
+# the mirror
+SPLITS = {"five": "mirrored five", "five-unmirrored": "unmirrored five (non-conforming)",
+          "six": "six (Kuhn)", "bcc": "bcc"}
+SIZES = (5, 9, 17)            # nodes per side: the paper's 5 layers, then h halved twice
+DECISIVE = 9                  # from this many layers the signature decides; 5 is the paper's view
+# on the finest meshes: the readings (calibrated and literal), msm with and without the shear
+# term, the control, and one reading with each normal-stress term (the cost of 17^3 nodes)
+FINEST_NORMAL_READING = "variational"
+
+
+def mesh_name(kind, n):
+    return kind if n == P.NODES_PER_SIDE else f"{kind}-{n}"
+
+
 def mesh_specs(quick=False):
-    """{mesh name: (builder kind, nodes per side, seed)}: the paper-size meshes (the lattice's
-    three splits, the Delaunay-374 reconstructions and the conforming five/six mixes) and the
-    mirrored five split refined."""
-    out = {"five": ("five", 5, 0), "six": ("six", 5, 0), "bcc": ("bcc", 5, 0)}
-    out.update({f"delaunay374-{s}": ("delaunay374", 5, s) for s in (7, 15, 25)})
-    out.update({f"mixed374-{s}": ("mixed374", 5, s) for s in (0, 1, 2)})
-    out.update({f"five-{n}": ("five", n, 0) for n in REFINED})
+    """{mesh name: (split, nodes per side, seed)}: each split at each size."""
     if quick:
-        out = {k: out[k] for k in ("five", "six", "delaunay374-7", "mixed374-0", "five-9")}
-    return out
+        return {mesh_name(k, n): (k, n, 0) for k, n in (("five", 5), ("six", 5),
+                                                       ("five-unmirrored", 5), ("five", 9),
+                                                       ("six", 9))}
+    return {mesh_name(k, n): (k, n, 0) for n in SIZES for k in SPLITS}
+
+
+def models_on(spec, models):
+    """The models run on a mesh of ``spec``: all up to once refined; on the finest, the
+    readings (calibrated and literal), msm with and without the shear term, the control and
+    each normal-stress term beside one reading; on the finest bcc (9009 nodes, 49152
+    tetrahedra), the calibrated readings, msm and the control only (the cost)."""
+    kind, n, _ = spec
+    if n < max(SIZES):
+        return list(models)
+    if kind == "bcc":
+        return [m for m, f in models.items() if f["normal"] in ("none", "fem")
+                and f["constant"] in ("calibrated", "none")] + \
+            [m for m, f in models.items() if f["family"] == "msm" and f["reading"] == "none"]
+    return [m for m, f in models.items() if f["normal"] in ("none", "edges", "fem")
+            or f["reading"] == FINEST_NORMAL_READING]
+
+
+def loads_on(spec, loads):
+    """The paper's push on every mesh; the linear regime (a check, and the patch test the
+    consistency hypothesis reads) up to once refined."""
+    return [x for x in loads if x == "paper" or spec[1] < max(SIZES)]
 
 
 @functools.lru_cache(maxsize=16)
 def make_mesh(name, spec):
     """The mesh ``name`` of ``spec`` (built once per process: a worker runs its models one by
     one; callers do not modify it)."""
-    kind, n, seed = spec
-    size = P.SIZE_MM * P.MM
-    if kind in ("five", "six", "bcc"):
-        return cube(n, size, kind)
-    found = paper_size_meshes(size, seeds=(seed,) if kind == "delaunay374" else (),
-                              mixed_seeds=(seed,) if kind == "mixed374" else ())
-    return found[name]
+    kind, n, _ = spec
+    return cube(n, P.SIZE_MM * P.MM, kind)
 
 
 def mesh_factors(name, spec, mesh):
-    kind, n, seed = spec
-    split = {"five": "mirrored five", "six": "six (Kuhn)", "bcc": "bcc",
-             "delaunay374": "Delaunay-374", "mixed374": "five/six mix"}[kind]
-    return {"split": split, "nodes_per_side": n, "tets": mesh.n_tets,
-            "unmatched_faces": unmatched_faces(mesh, P.SIZE_MM * P.MM),
-            "paper_size": mesh.n_nodes == 125 and mesh.n_tets == 374}
+    kind, n, _ = spec
+    return {"split": SPLITS[kind], "nodes_per_side": n, "tets": mesh.n_tets,
+            "unmatched_faces": unmatched_faces(mesh, P.SIZE_MM * P.MM)}
 
 
 @dataclass
@@ -138,11 +162,16 @@ class ArtefactSettings:
                 "reference": {"element": "P2", "mesh": f"{REF_MESH[0]} {REF_MESH[1]}^3",
                               "refinements": REF_LEVELS}}
 
+    def cells(self):
+        """[(mesh, model)]: every unit of work, in the order the cells are reported."""
+        return [(name, m) for name, spec in self.meshes.items()
+                for m in models_on(spec, self.models)]
+
     @property
     def units(self):
         """Work units a pool could share: each model on each mesh (and before them each
         reference)."""
-        return len(self.meshes) * len(self.models)
+        return len(self.cells())
 
     def describe(self):
         return {**self.problem(), "quick": self.quick, "bcs": list(self.bcs),
@@ -205,12 +234,13 @@ def solve_split(pm, dirichlet):
 
 
 def _cells_key(s, name, model):
-    return key(kind="artefact-cells", **s.problem(), mesh=name, bcs=list(s.bcs),
-               loads=list(s.loads), model=model)
+    return key(kind="artefact-cells", **s.problem(), mesh=name, spec=list(s.meshes[name]),
+               bcs=list(s.bcs), loads=loads_on(s.meshes[name], s.loads), model=model)
 
 
 def _model_rows(model, factors, name, spec, mesh, s, u_refs):
     base = {"mesh": name, **mesh_factors(name, spec, mesh), "model": model, **factors}
+    loads = loads_on(spec, s.loads)
     try:
         pm = build(model, mesh, s.material)
     except FINDINGS as exc:
@@ -218,13 +248,13 @@ def _model_rows(model, factors, name, spec, mesh, s, u_refs):
                  "bulge_profile_mm": None, "alternation_mm": None, "alternation_rel": None,
                  "disp_rel_l2": None, "load_steps": None, "growth_rate_1_s": None,
                  "flutter": None}
-                for bc in s.bcs for load in s.loads]
+                for bc in s.bcs for load in loads]
     # the paper's RK4 run on its own lattice (a dense eigenproblem: 5 nodes per side only)
     rate = P.growth_rate(pm, mesh, "clamped") if spec[1] == P.NODES_PER_SIDE else None
     return [{**base, "bc": bc, "load": load, "growth_rate_1_s": rate,
              "flutter": None if rate is None else rate > s.damping / 2,
              **cell(pm, mesh, spec[1], bc, load, u_refs[(bc, load)])}
-            for bc in s.bcs for load in s.loads]
+            for bc in s.bcs for load in loads]
 
 
 def _reference_unit(job):
@@ -250,7 +280,7 @@ def run(s, workers=None, log=True, bench=None, store=OFF):
     references a missing cell or estimate needs (a unit each, on ``workers`` where given),
     then each (mesh, model) not stored (a unit each)."""
     pairs = [(bc, load) for bc in s.bcs for load in s.loads]
-    cells = [(name, model) for name in s.meshes for model in s.models]
+    cells = s.cells()
     found = {c: store.get(_cells_key(s, *c)) for c in cells}
     todo = [c for c in cells if found[c] is None]
     info_keys = {p: key(kind="artefact-reference", **s.problem(), bc=p[0], load=p[1])
