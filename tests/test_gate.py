@@ -392,6 +392,33 @@ def test_a_five_percent_error_in_the_papers_constant_fails_the_quick_gate(tmp_pa
     assert "gold rows of runs not in the metrics set aside" in text
 
 
+def test_an_rk4_weight_error_fails_the_quick_gate(tmp_path, capsys, monkeypatch):
+    """The mutation probe: RK4's end-stage weight 5 % off (dt / 6 x 1.05 for k1 and k4),
+    compiled into the step every dynamic run uses, with the store off, fails the committed
+    quick gold on a particle model's values: the step convergence of the paper cube's push
+    (its order falls from 4). The paper cube's own dynamic metrics move by 1e-4 only (a damped
+    quasi-static push ends at equilibrium whatever the weights), so they cannot be the probe."""
+    from model import integrate, step_cache
+    exact = "h, w1, w2 = 0.5 * dt, dt / 6.0, dt / 3.0"
+    assert exact in step_cache.source((), integrate.rk4_ramp)
+    original = step_cache.source
+    monkeypatch.setattr(step_cache, "source", lambda names, step: original(names, step).replace(
+        exact, "h, w1, w2 = 0.5 * dt, 1.05 * dt / 6.0, dt / 3.0"))
+    monkeypatch.setenv(step_cache.ENV, str(tmp_path / "steps"))
+    step_cache._step_of.cache_clear()
+    try:
+        out = tmp_path / "m" / "convergence"
+        assert main(["run", "convergence", "--quick", "--meshes", "five", "--models",
+                     "pbcm-balanced", "--workers", "1", "--no-cache", "--out", str(out)]) == 0
+    finally:
+        step_cache._step_of.cache_clear()
+    capsys.readouterr()
+    assert main(["check", "--metrics", str(out.parent), "--gold", str(ROOT / "gold"),
+                 "--only-run"]) == 1
+    failed = [line for line in capsys.readouterr().out.splitlines() if "FAIL" in line]
+    assert any("/pbcm-balanced/dt_order" in line for line in failed), failed
+
+
 def test_only_run_gates_a_subset_and_a_plain_check_refuses_it(blessed, tmp_path, capsys):
     """A run of one model of a blessed pair passes with --only-run (the other model's gold
     rows set aside, counted) and is refused by a plain check (its gold was not measured)."""
