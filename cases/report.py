@@ -13,7 +13,7 @@ import numpy as np
 from model.compose import slug
 from model.mesh import write as write_mesh
 from . import costs, figures
-from .document import Document, fmt
+from .document import Document, fmt, rel
 from . import catalogue
 from . import rankings
 from . import scorecard
@@ -183,7 +183,7 @@ def _tables(doc, case, s, runs):
             line = f"{rs[0]['nodes']} nodes, {rs[0]['tets']} tetrahedra"
             if rs[0].get("reaction_fem_p2_n") is not None:
                 line += f"; FEM P2 reaction {fmt(rs[0]['reaction_fem_p2_n'], 4)} N"
-            doc.p(line + f"; P2 reference error estimate {fmt(rs[0]['p2_error_estimate'], 2)}.")
+            doc.p(line + f"; P2 reference error estimate {rel(rs[0]['p2_error_estimate'], 2)}.")
             if rs[0].get("linear_scale") is not None:
                 doc.p(f"Linear regime: the loads times {fmt(rs[0]['linear_scale'], 3)} (largest "
                       "strain of the linear reference 1e-4), each model's answer divided by "
@@ -203,7 +203,7 @@ def _finite_table(doc, case, rs):
         return
     shown = [catalogue.metric(n) for n in catalogue.FINITE]
     line = (f"At the case's load, against the converged neo-Hookean reference (error estimate "
-            f"{fmt(rs[0]['nh_error_estimate'], 2)}")
+            f"{rel(rs[0]['nh_error_estimate'], 2)}")
     if rs[0].get("reaction_fem_nh_n") is not None:
         line += f", reaction {fmt(rs[0]['reaction_fem_nh_n'], 4)} N"
     doc.p(line + "):")

@@ -7,7 +7,7 @@ from pathlib import Path
 import numpy as np
 
 from ... import catalogue, figures
-from ...document import GLOSSARY, Document, fmt
+from ...document import GLOSSARY, Document, fmt, rel
 from ...metrics import ALTERNATION_CLEAR
 from ...report import environment, write_study
 from ...runner import jsonable
@@ -82,7 +82,7 @@ def build(out, study, s, doc):
           f"Bases: {', '.join(s.bcs)}; loads: the paper's push, and {LINEAR_SCALE:g} of it (the "
           "linear regime: a check, and the patch test hypothesis (c) reads) below the finest "
           "size. The reference: " + "; ".join(
-              f"{r['bc']}/{r['load']} error estimate {fmt(r['error_estimate'])}"
+              f"{r['bc']}/{r['load']} error estimate {rel(r['error_estimate'])}"
               for r in doc["references"]) + ".",
           f"The signature: the period-2 component of the layer profile beyond the continuum's "
           "shape and the highest-degree polynomial the free layers allow (0 on the continuum "

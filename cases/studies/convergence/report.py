@@ -4,7 +4,7 @@ sentence is computed from the data it is written with."""
 import numpy as np
 
 from ... import catalogue
-from ...document import Document, fmt
+from ...document import Document, fmt, rel
 from ...report import environment, write_study
 from ...runner import jsonable
 from .plots import directional_young, error_vs_h, pareto
@@ -238,8 +238,8 @@ def build(out, study, s, data):
             f"{r['case']} {r['bc']}: P2 at {', '.join(f'{h:.3g}' for h in r['ladder_mm'])} "
             f"mm, order {fmt(r['order'], 2)}, "
             + ("extrapolated" if r["extrapolated"] else "finest level")
-            + f", estimate {fmt(r['error_estimate'], 2)} (finest P2 alone "
-            f"{fmt(r['p2_error_estimate'], 2)})" for r in refs) + ".",
+            + f", estimate {rel(r['error_estimate'], 2)} (finest P2 alone "
+            f"{rel(r['p2_error_estimate'], 2)})" for r in refs) + ".",
         f"Effective elasticity: a {PATCH_MM:g} mm cube patch of each lattice with {s.patch_n} "
         "nodes per side; surface nodes moved by each unit homogeneous strain, interior relaxed "
         "(the model's Jacobian at rest, condensed); C_eff from the averaged surface forces.",
@@ -281,7 +281,7 @@ def _problem_section(doc, out, s, data, name, bc):
     if ref:
         doc.p(f"Reference: FEM P2, {ref['dofs']} unknowns, {PROBLEMS[name].label} "
               f"{ref['response_fem']:.4g} (SI units), error estimate "
-              f"{fmt(ref['error_estimate'], 2)}.")
+              f"{rel(ref['error_estimate'], 2)}.")
     label = {n: catalogue.metric(n).label for n in ("disp_rel_l2", "order", "e_inf",
                                                     "reaction_ratio", "ratio_inf")}
     header = ["mesh", "model"] + [f"{label['disp_rel_l2']} @ {h:.3g}" for h in hs] + \

@@ -7,7 +7,7 @@ from pathlib import Path
 import numpy as np
 
 from ... import catalogue, figures
-from ...document import Document, fmt
+from ...document import Document, fmt, rel
 from ...error_model import u_val
 from ...report import environment, write_study
 from ...runner import jsonable
@@ -249,7 +249,7 @@ def build(out, study, s, doc):
           f"{s.ref_levels} time(s) (its bead displacement changed by "
           + (", ".join(f"{fmt(r['bead_change_mm'])} mm at {percent(r['strain'])}" for r in ref)
              or "n/a") + " RMS over the last refinement; the global estimate "
-          + (fmt(ref[-1]["error_estimate"]) if ref else "n/a") + ") and linear P2 on the same "
+          + (rel(ref[-1]["error_estimate"]) if ref else "n/a") + ") and linear P2 on the same "
           "mesh, both at the beads by their own basis; the models by P1 interpolation on "
           "their own mesh at the measured rest bead positions.",
           "Each measured state's best rigid in-plane motion (translation in x, y and rotation "
