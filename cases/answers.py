@@ -259,9 +259,10 @@ def _diverging(lim):
 
 
 def _single_runs_u(values, u, what):
-    """'one run each, u_num U (what): ...': the uncertainty single-run errors [(model, error)]
-    are read against (floored at round-off), and whether it resolves every difference between
-    them or which models it ties (the longest runs, in order of error, within u pair by pair)."""
+    """'one run each, so no spread over meshes (n = 1) ...; u_num U (what): ...': single-run
+    errors [(model, error)] carry no spread over meshes, so an order among them holds for that
+    mesh only; against the uncertainty they are read at (floored at round-off), the models it
+    ties (the longest runs, in order of error, within u pair by pair) or none."""
     u = max(u, ROUND_OFF)
     vals = sorted(values, key=lambda kv: kv[1])
     groups, i = [], 0
@@ -273,8 +274,9 @@ def _single_runs_u(values, u, what):
         if j > i:
             groups.append(", ".join(m for m, _ in vals[i:j + 1]))
         i = j + 1 if j > i else i + 1
-    return (f"one run each, u_num {rel(u)} ({what}): "
-            + (f"tied: {'; '.join(groups)}" if groups else "every difference resolved"))
+    return (f"one run each, so no spread over meshes (n = 1): an order among them holds for "
+            f"this mesh only; u_num {rel(u)} ({what}): "
+            + (f"tied: {'; '.join(groups)}" if groups else "no two within it"))
 
 
 def _finest(conv, models, lattices):

@@ -227,8 +227,9 @@ declare("linear_scale", "1", "linear-regime scale",
 # ---------------------------------------------------------------- the case's load
 declare("disp_rel_l2_nh", "1", "disp L2 NH",
         "at the case's load: ||u_model - u_ref|| / ||u_ref|| over the free components, "
-        "against the converged neo-Hookean P2 reference at the particle nodes (fem-linear's is "
-        "its linearisation error).", "max")
+        "against the converged neo-Hookean P2 reference at the particle nodes (fem-linear's "
+        "holds its linearisation error and P1's discretisation error; the first is its "
+        "difference from fem-neohookean's on the same mesh).", "max")
 declare("disp_max_rel_nh", "1", "disp max NH",
         "at the case's load: max_i |u_model,i - u_ref,i| / max_i |u_ref,i| over the free "
         "components, against the neo-Hookean reference.", "max")
@@ -321,6 +322,9 @@ declare("modes_unpaired", "count", "unpaired",
         "FEM modes among the first 10 (of each set compared) that no model mode matches in "
         "shape (MAC >= 0.8 with the mode, or with the space of a cluster of equal "
         "frequencies): left out of the frequency errors.", "max")
+declare("modes_unpaired_held", "count", "unpaired held",
+        "the same among the first 10 modes with the case's constraints alone (the paper "
+        "cube's clamped base).", "max")
 declare("modal_rel_err_p1", "1", "modal err P1",
         "the model-form modal error: the largest relative frequency error of the first 10 "
         "non-rigid modes of FEM P1 on the same tetrahedra (lumped mass, the case's "
@@ -342,7 +346,8 @@ declare("top_settlement_mm", "mm", "settlement",
 declare("top_settlement_cf_mm", "mm", "closed form",
          "the closed-form settlement at this mesh's top nodes (sliding base only).", digits=4)
 declare("top_settlement_cf_rel_err", "1", "err vs closed form",
-         "|model / closed form - 1| of the top settlement.", "max")
+         "|model / closed form - 1| of the top settlement in the linear regime, scaled to "
+         "the case's load (the closed form is linear elasticity).", "max")
 declare("torque_nm", "N m", "torque",
          "the moment about the bar's axis of the forces the supports exert on the turned end "
          "face, sum (y - y_c) R_z - (z - z_c) R_y with rest positions as arms.",

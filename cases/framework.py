@@ -15,7 +15,7 @@ from typing import ClassVar
 import numpy as np
 
 from model import PRESETS, Material, PbcmError, build
-from model.errors import ModelError
+from model.errors import ConvergenceError, ModelError
 from model import static
 from model.compose import parse
 from model.mesh import SCHEMES
@@ -80,6 +80,24 @@ class Settings:
         return {**self.problem(), "meshes": list(self.meshes), "bcs": list(self.bcs),
                 "models": list(self.models), "quick": self.quick,
                 "shear_scale": self.shear_scale}
+
+
+# Newton from rest may stagnate where a split load converges: a solver's limit, not the
+# model's, so a static solve fails only when every split does
+LOAD_SPLITS = (1, 2, 4, 8)
+
+
+def solve_split(pm, dirichlet, f_ext=None, **kw):
+    """``(static result, load steps)``: the model's equilibrium under ``dirichlet`` (and
+    ``f_ext``), in the fewest of LOAD_SPLITS equal steps that converges; the last split's
+    error where none does."""
+    extra = {} if f_ext is None else {"f_ext": f_ext}
+    for steps in LOAD_SPLITS:
+        try:
+            return pm.solve_static(dirichlet, load_steps=steps, **extra, **kw), steps
+        except ConvergenceError:
+            if steps == LOAD_SPLITS[-1]:
+                raise
 
 
 def linear_scale(p2, material):
@@ -371,9 +389,10 @@ class Case(abc.ABC):
         return {}
 
     def solve_static(self, pm, mesh, bc, s, ref):
-        """The model's static solution at the case's load (default one Newton solve with the
-        loads); None for a case without a static problem."""
-        return pm.solve_static(ref.dirichlet, f_ext=ref.f_ext)
+        """The model's static solution at the case's load (default Newton with the loads, in
+        the fewest of LOAD_SPLITS equal steps that converges); None for a case without a
+        static problem."""
+        return solve_split(pm, ref.dirichlet, f_ext=ref.f_ext)[0]
 
     def solve_linear(self, pm, mesh, bc, s, ref):
         """The model's static solution in the linear regime: ``dirichlet_linear`` and the

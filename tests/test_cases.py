@@ -354,3 +354,22 @@ def test_a_wide_table_is_split_and_each_part_keeps_the_row_names():
     assert max(len(b[1]) for b in d2.blocks) <= MAX_COLUMNS
     assert _inline_html("**A** [b](x/report.md) <c>") == (
         "<strong>A</strong> <a href='x/report.html'>b</a> &lt;c&gt;")
+
+
+def test_linearisation_error_is_fem_linear_against_fem_neohookean_per_base():
+    """fem-linear's linearisation error at the case's load is its difference from
+    fem-neohookean's error on the same mesh, one boundary condition at a time, never its
+    total (which holds P1's discretisation error too)."""
+    from cases.rankings import _linearisation
+    runs = [{"mesh": m, "bc": bc, "model": model, "disp_rel_l2_nh": v}
+            for m, bc, model, v in (("five", "clamped", "fem-linear", 0.1565),
+                                    ("five", "clamped", "fem-neohookean", 0.1563),
+                                    ("six", "clamped", "fem-linear", 0.40),
+                                    ("six", "clamped", "fem-neohookean", 0.39),
+                                    ("five", "sliding", "fem-linear", 0.0252),
+                                    ("five", "sliding", "fem-neohookean", 1e-5))]
+    clamped, sliding = _linearisation(runs)
+    assert clamped.startswith("[clamped]") and "0.278 [0.157-0.4]" in clamped
+    assert "linearisation (its error less fem-neohookean's on the same mesh) median 0.0051 " \
+           "[0.0002-0.01]" in clamped
+    assert sliding.startswith("[sliding]") and "0.0252" in sliding

@@ -199,13 +199,15 @@ def test_an_order_that_one_mesh_reverses_is_not_resolved(tmp_path):
 
 
 def test_single_runs_are_read_against_their_uncertainty():
-    """Errors from one run each are read against u_num: differences below it are named tied
-    (pair by pair along the order, never chained), differences above it resolved."""
+    """Errors from one run each say they have no spread over meshes (n = 1), and are read
+    against u_num: differences below it are named tied (pair by pair along the order, never
+    chained)."""
     from cases.answers import _single_runs_u
     assert _single_runs_u([("a", 0.10), ("b", 0.20)], 0.01, "x") == \
-        "one run each, u_num 0.01 (x): every difference resolved"
+        "one run each, so no spread over meshes (n = 1): an order among them holds for this " \
+        "mesh only; u_num 0.01 (x): no two within it"
     said = _single_runs_u([("c", 0.3), ("a", 0.10), ("b", 0.104), ("d", 0.108)], 0.005, "x")
-    assert said == "one run each, u_num 0.005 (x): tied: a, b"
+    assert said.endswith("u_num 0.005 (x): tied: a, b")
     assert "1e-08" in _single_runs_u([("a", 1e-12), ("b", 2e-12)], 0.0, "x")
 
 
@@ -228,8 +230,9 @@ def test_a_model_with_more_unpaired_modes_is_not_closer_than_p1():
 
 
 def test_case_findings_name_cancellation_and_the_twins():
-    """A case report's opening names the FEM twins equal to P1 within u_val, the closest and
-    farthest approximation, and a model closer to the continuum than P1 only because its
+    """A case report's opening names the FEM twins with their distance to P1 and those within
+    the linear regime's nonlinearity (a tolerance set apart from what it checks), the closest
+    and farthest approximation, and a model closer to the continuum than P1 only because its
     error opposes P1's (P1 1.3, the model 1.0 = the continuum: model-form 0.3, total 0)."""
     runs = [dict(r, bc="clamped") for r in _torsion_runs({
         ("five", "fem-linear"): 1.3, ("five", "fem-corotated"): 1.3 + 1e-12,
@@ -237,7 +240,7 @@ def test_case_findings_name_cancellation_and_the_twins():
     lines, tables = scorecard.case_findings("torsion", E.Scalar("torque_nm", "torque_fem_nm",
                                                                 "torque"), runs)
     (line,) = lines
-    assert "equal to FEM P1 within u_val" in line and "fem-corotated" in line
+    assert "equal to it within the linear regime's nonlinearity 0.001: fem-corotated" in line
     assert "closest b (0.05" in line and "farthest a (0.3" in line
     assert "FEM P1 itself is 0.3 [0.3-0.3] from the continuum" in line
     assert line.endswith("closer to the continuum than P1 only by cancelling its error: a.")

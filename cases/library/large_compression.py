@@ -228,7 +228,16 @@ class LargeCompression(Case):
                                       estimate_key=nh),
                 common.best_and_worst(runs, "lateral_rel_err_max", "Lateral expansion",
                                       estimate_key=nh),
-                " ".join(filter(None, (line, self._agreement(runs), common.failures(runs))))]
+                " ".join(filter(None, (line, self._agreement(runs), common.failures(runs),
+                                       self._homogeneous_failures(runs))))]
+
+    @staticmethod
+    def _homogeneous_failures(runs):
+        """The runs whose homogeneous check (the law's own curve on a homogeneous
+        compression) failed, a visible hole; '' where none did."""
+        bad = [f"{r['model']} on {r['mesh']}" for r in runs if r.get("homogeneous_failed")]
+        return ("The homogeneous check failed (no number, counted as a failed run of that "
+                "check) for " + ", ".join(bad) + "." if bad else "")
 
     @staticmethod
     def _agreement(runs):
@@ -253,7 +262,8 @@ class LargeCompression(Case):
                                                      "largest force error", estimate_key=nh),
                 "Lateral expansion": common.ranking(runs, "lateral_rel_err_max",
                                                     "largest lateral error", estimate_key=nh),
-                "Failures": [common.failures(runs)]}
+                "Failures": list(filter(None, [common.failures(runs),
+                                               self._homogeneous_failures(runs)]))}
 
     def sections(self, doc, s, runs, fields, out):
         strain = [100 * p / (SIZE_MM * MM) for p in pushes(s)]

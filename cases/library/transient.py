@@ -93,19 +93,20 @@ def modal_comparison(pm, mesh, static_bc, fem_free, fem_held):
     """``modal_rel_err`` (the first N_MODES FEM modes with the case's constraints, each paired
     with the model mode of the same shape: the largest relative frequency error),
     ``modal_rel_err_free`` (free-free, after the rigid modes), ``modes_unpaired`` (FEM modes of
-    either set without a partner) and ``rigid_modes_free`` (6 for a model that resists every
+    either set without a partner), ``modes_unpaired_held`` (those of the held set alone) and ``rigid_modes_free`` (6 for a model that resists every
     deformation). ``fem_*`` are (frequencies, shapes (k, 3n)); ``fem_held`` None: the case's
     constraints pose no modal problem (their metrics None)."""
     free, free_v, rigid = first_modes(pm, np.ones(3 * mesh.n_nodes, dtype=bool))
     err_free, _, lost = paired_errors(free, free_v, *fem_free, "modal_rel_err_free")
     out = {"modal_rel_err": None, "modal_rel_err_free": err_free,
-           "rigid_modes_free": rigid, "frequencies_hz": None}
+           "rigid_modes_free": rigid, "frequencies_hz": None, "modes_unpaired_held": None}
     if fem_held is not None:
         mask, _ = bc_arrays(static_bc, mesh.n_nodes)
         held, held_v, _ = first_modes(pm, ~mask.ravel(), rigid_expected=0)
         err_held, _, lost_held = paired_errors(held, held_v, *fem_held, "modal_rel_err")
         lost += lost_held
-        out.update(modal_rel_err=err_held, frequencies_hz=held[:N_MODES].tolist())
+        out.update(modal_rel_err=err_held, frequencies_hz=held[:N_MODES].tolist(),
+                   modes_unpaired_held=lost_held)
     return {**out, "modes_unpaired": lost}
 
 
