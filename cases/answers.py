@@ -111,7 +111,7 @@ def table(root, models, pops=()):
     spread = {f: scorecard.spread(pops, models, f) for f in (False, True)}
     header = ["model", "model-form error, linear regime", "model-form error, finite load",
               "consistency limit (largest, +- fit)", "worst isotropy error",
-              "largest |alternation|", "RK4 run", "s per simulated s",
+              "largest |alternation|, 5-layer view", "RK4 run", "s per simulated s",
               "Truth Cube bead RMS [mm]"]
     rows = []
     for m in models:
