@@ -78,7 +78,7 @@ def build(out, study, s, doc):
           f"fitted it is 0 beside the springs) and {YARDSTICK} (the control: constant-strain "
           "FEM on the same tetrahedra). On the finest meshes each normal-stress term beside "
           f"the {FINEST_NORMAL_READING} reading only, and on the finest bcc the calibrated "
-          "readings, msm and the control only (the cost of 9009 nodes).",
+          "readings and the control only (the cost of 9009 nodes).",
           f"Bases: {', '.join(s.bcs)}; loads: the paper's push, and {LINEAR_SCALE:g} of it (the "
           "linear regime: a check, and the patch test hypothesis (c) reads) below the finest "
           "size. The reference: " + "; ".join(

@@ -95,14 +95,14 @@ def models_on(spec, models):
     """The models run on a mesh of ``spec``: all up to once refined; on the finest, the
     readings (calibrated and literal), msm with and without the shear term, the control and
     each normal-stress term beside one reading; on the finest bcc (9009 nodes, 49152
-    tetrahedra), the calibrated readings, msm and the control only (the cost)."""
+    tetrahedra), the calibrated readings and the control only (the cost: msm's Newton there
+    had not converged after 17 minutes)."""
     kind, n, _ = spec
     if n < max(SIZES):
         return list(models)
     if kind == "bcc":
         return [m for m, f in models.items() if f["normal"] in ("none", "fem")
-                and f["constant"] in ("calibrated", "none")] + \
-            [m for m, f in models.items() if f["family"] == "msm" and f["reading"] == "none"]
+                and f["constant"] in ("calibrated", "none")]
     return [m for m, f in models.items() if f["normal"] in ("none", "edges", "fem")
             or f["reading"] == FINEST_NORMAL_READING]
 
