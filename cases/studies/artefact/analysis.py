@@ -94,8 +94,8 @@ def mirror(cells):
     for r in rows:
         fine = at.get((r["model"], MIRRORED, 2 * r["n"] - 1, r["bc"]))
         if r["kind"] in ("mirror", "everywhere") and fine and fine.get("alternation_rel"):
-            orders[(r["model"], r["bc"])] = float(np.log2(abs(r["five"])
-                                                          / abs(fine["alternation_rel"])))
+            orders[f"{r['model']} / {r['bc']}"] = float(np.log2(
+                abs(r["five"]) / abs(fine["alternation_rel"])))
     resolved = count["mirror"] + count["everywhere"] + count["unmirrored"]
     return {"rows": rows, "count": count, "orders": orders,
             "holds": resolved > 0 and count["mirror"] >= REMOVES * resolved,
