@@ -662,20 +662,21 @@ def _cause_numbers(art):
     h = art["answer"]["hypotheses"]
     k, ns, cs = h["mirror"]["count"], h["normal_stress"], h["consistency"]
     rhos = [f"{r['rho']:.2f}" for r in cs["rows"] if r["rho"] is not None]
-    fem = art["answer"]["control"]
-    from .studies.artefact.analysis import DECISIVE, RATIO, RESOLVED
+    from .studies.artefact.analysis import DECISIVE, RATIO
     ratio = h["mirror"].get("ratio_median")
-    return (f"From {DECISIVE} nodes per side, the period-2 signature (resolved from "
-            f"{RESOLVED:g} of the mean "
-            f"lateral displacement) dominates on the mirrored five split only in {k['mirror']}, "
+    fem = h["mirror"].get("control", {})
+    return (f"From {DECISIVE} nodes per side, the period-2 signature (relative to the mean "
+            f"lateral displacement) dominates on the mirrored five split only in {k['mirror']}"
+            f" ({h['mirror'].get('own', 0)} of them {RATIO:g} times FEM P1's there; FEM P1's "
+            f"own reads so in {fem.get('mirror', 0)} of {sum(fem.values())}), "
             f"is resolved on it and an unmirrored conforming split alike in "
             f"{k['everywhere']}, on those only in {k['unmirrored']}, nowhere in {k['none']} of "
             f"{sum(k.values())} (model, base, size) observations"
             + (f" (median ratio mirrored / unmirrored {ratio:.3g})" if ratio else "")
             + f"; a normal-stress term reduces it {RATIO:g}-fold or more in {ns['removed']} of "
             f"{ns['resolved_without']} pairs; its rank correlation with the patch-test error is "
-            f"{', '.join(rhos) or 'not defined'} over the conforming meshes; the FEM control is "
-            f"visible in {fem[0]} of {fem[1]} cells ([artefact study](artefact/report.md)).")
+            f"{', '.join(rhos) or 'not defined'} over the conforming meshes "
+            "([artefact study](artefact/report.md)).")
 
 
 __all__ = ["lines", "table"]
