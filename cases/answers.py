@@ -168,7 +168,10 @@ def lines(root, models, pops=(), quick=False):
                       else f"{v['model']} ") + _decisive(art))
     elif art:
         v = art["verdict"]
-        out.append(f"**Which reading?** {v['model']} ({v['sure']} verdict, "
+        out.append("**Which reading?** "
+                   + ("No reading reproduces all the paper's observables; the closest is "
+                      if v.get("none_reproduces") else "")
+                   + f"{v['model']} ({v['sure']} verdict, "
                    f"[artefact study](artefact/report.md)): in the study's runs it "
                    f"{_decisive(art)}")
     else:
@@ -652,8 +655,7 @@ def _decisive(art):
                       "the paper cube's runs are the scorecard's stability column)"}
     yes = [said[k] for k, v in best["matches"].items() if v]
     no = [said[k] for k, v in best["matches"].items() if not v]
-    return (("no reading reproduces all the paper's observables; " if art["verdict"].get(
-        "none_reproduces") else "") + "has " + ("; ".join(yes) or "none of them")
+    return ("has " + ("; ".join(yes) or "none of them")
             + (f"; lacks {' and '.join(no)}" if no else "") + ".")
 
 
