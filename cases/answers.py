@@ -661,24 +661,25 @@ def _decisive(art):
 
 def _cause_numbers(art):
     """The numbers that decide each hypothesis, from the study's answer."""
+    from .studies.artefact.analysis import RATIO
     h = art["answer"]["hypotheses"]
-    k, ns, cs = h["mirror"]["count"], h["normal_stress"], h["consistency"]
+    m, ns, cs = h["mirror"], h["normal_stress"], h["consistency"]
+    units = "; ".join(
+        f"{u['n']} nodes per side, {u['bc']}: FEM P1 {rel(u['fem_five'], 2)}, own "
+        f"{', '.join(u['classes']['own']) or 'none'}, shared with FEM P1 "
+        f"{len(u['classes']['shared'])}" for u in m["units"])
     rhos = [f"{r['rho']:.2f}" for r in cs["rows"] if r["rho"] is not None]
-    from .studies.artefact.analysis import DECISIVE, RATIO
-    ratio = h["mirror"].get("ratio_median")
-    fem = h["mirror"].get("control", {})
-    return (f"From {DECISIVE} nodes per side, the period-2 signature (relative to the mean "
-            f"lateral displacement) dominates on the mirrored five split only in {k['mirror']}"
-            f" ({h['mirror'].get('own', 0)} of them {RATIO:g} times FEM P1's there; FEM P1's "
-            f"own reads so in {fem.get('mirror', 0)} of {sum(fem.values())}), "
-            f"is resolved on it and an unmirrored conforming split alike in "
-            f"{k['everywhere']}, on those only in {k['unmirrored']}, nowhere in {k['none']} of "
-            f"{sum(k.values())} (model, base, size) observations"
-            + (f" (median ratio mirrored / unmirrored {ratio:.3g})" if ratio else "")
-            + f"; a normal-stress term reduces it {RATIO:g}-fold or more in {ns['removed']} of "
-            f"{ns['resolved_without']} pairs; its rank correlation with the patch-test error is "
-            f"{', '.join(rhos) or 'not defined'} over the conforming meshes "
-            "([artefact study](artefact/report.md)).")
+    return ("The mirrored five split's period-2 signature, resolved and "
+            f"{RATIO:g} times the conforming splits' without the mirror, per (size, base): "
+            f"{units}; the largest anywhere is {rel(art['answer']['largest'])}, "
+            + ("visible" if art["answer"]["visible"] else "below the visible level")
+            + ". A normal-stress term "
+            + (f"reduces a model's own signature {RATIO:g}-fold in {ns['removed']} of "
+               f"{ns['pairs']} pairs" if ns["decided"] else "was not run where a model's own "
+               "signature exists: not decided")
+            + f"; the rank correlation with the patch-test error is {', '.join(rhos) or 'n/a'}"
+            + ("" if cs["holds"] else " (not resolved)")
+            + " ([artefact study](artefact/report.md)).")
 
 
 __all__ = ["lines", "table"]
