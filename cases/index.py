@@ -10,9 +10,6 @@ import numpy as np
 from . import scorecard
 from .document import GLOSSARY, Cell, Document, Link, fmt, rel, rel_range
 from .output import SWEEP_MARK
-from .library.paper_cube import Config as _PaperCube
-
-PAPER_DAMPING = _PaperCube.damping      # the mass damping [1/s] the RK4 runs assume
 
 # headline error bands of the scorecard: within 5 %, within 20 %, beyond
 BANDS = ((0.05, "#c8e6c9", "within 5 %"), (0.20, "#fff59d", "within 20 %"),
@@ -246,9 +243,8 @@ TERMS = {
     "RK4 run": "grows beyond the damping when the linearised growth rate of the clamped "
     "paper cube exceeds half the mass damping (so that the damped RK4 run grows), else stable "
     "under the damping (a positive growth below it, flutter in the paper cube's tables, is "
-    "damped out); the mass damping is ours, "
-    f"{PAPER_DAMPING:g} 1/s "
-    "(the paper states none).",
+    "damped out); the mass damping is ours, stated in the paper cube's report (the paper "
+    "states none).",
     "s per simulated s": "CPU seconds one simulated second costs at the model's own stable "
     "RK4 step (undamped), from `pbcm bench` at about 1e4 tetrahedra; beside it the in-round "
     "ratio to fem-linear's with its range over the bench's rounds.",
