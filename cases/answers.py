@@ -661,8 +661,7 @@ def _decisive(art):
 
 def _cause_numbers(art):
     """The numbers that decide each hypothesis, from the study's answer."""
-    from .studies.artefact.analysis import RATIO
-    h = art["answer"]["hypotheses"]
+    h, RATIO = art["answer"]["hypotheses"], art["answer"]["ratio"]
     m, ns, cs = h["mirror"], h["normal_stress"], h["consistency"]
     units = "; ".join(
         f"{u['n']} nodes per side, {u['bc']}: FEM P1 {rel(u['fem_five'], 2)}, own "

@@ -303,7 +303,7 @@ def answer(cells):
     parts.append(f"So the pattern comes from {cause}.")
     return {"decided": m["holds"], "cause": cause, "text": " ".join(parts),
             "hypotheses": {"mirror": m, "normal_stress": ns, "consistency": cs},
-            "paper_view": view, "visible": visible,
+            "paper_view": view, "visible": visible, "ratio": RATIO, "decisive": DECISIVE,
             "largest": None if top is None else top["alternation_rel"]}
 
 
