@@ -326,9 +326,6 @@ def _cost_of_replacing(pops, models, quick):
                 f"{m} " + (fmt(e[1]) if e[1] is not None else "n/a")
                 + (f" [{fmt(rng[m][0], 2)}-{fmt(rng[m][1], 2)}]" if m in rng else "")
                 + (f" ({e[2]} failed runs)" if e[2] else "")
-                + (" (no equilibrium at the load of " + ", ".join(
-                    f"{c} in {k} of {t} runs" for c, (k, t) in e[5].items()) + ")"
-                   if e[5] else "")
                 + (f" (the same mean rank as {tie})" if tie else "")
                 + "".join(f" (not resolved from {b})" for (a, b) in loose if a == m)
                 for _, m, e, tie in ranked))
@@ -338,8 +335,8 @@ def _cost_of_replacing(pops, models, quick):
             "with the same law on the same tetrahedra, best mean rank over the cases first "
             "(beside it the geometric mean over the cases of the median over the meshes, "
             "[its range when one mesh family is left out]; a failed run counts against its "
-            "model, and a model with a failed run (no number, or at finite load no "
-            "equilibrium at a case's load) ranks after every model without one): "
+            "model, and a model with a failed run (no number: at the load, no "
+            "equilibrium) ranks after every model without one): "
             + "; ".join(said) + " (the scorecard below).")
 
 
@@ -359,25 +356,16 @@ def recommendation(root, models, pops, quick, bench_rows):
     p1_fin = next((p.quantity.p1 for p in pops if p.finite), None)
 
     def best(means, finite):
-        """The first of the ranking and what it is not resolved from (ties and orders that
-        reverse without one mesh family or one case)."""
+        """The first of the ranking and what it is not resolved from, pair by pair: the
+        models tied with it, and those level with it or before it when one mesh family or
+        one case is left out."""
         order = scorecard.ranked(means)
         if not order:
             return None, []
-        loose = scorecard.unresolved(pops, list(means), finite)
-        top, others = order[0][1], []
-        for (_, m, _, tie), (_, nxt, _, _) in zip(order, order[1:]):
-            if m != top and m not in others:
-                break
-            if tie == top or loose.get((m, nxt)) or any(
-                    t == top for _, x, _, t in order if x == nxt):
-                others.append(nxt)
-            else:
-                break
-        # a model that comes first when one mesh family or one case is left out
-        others += [m for m in scorecard.contenders(pops, list(means), finite)
-                   if m not in others]
-        return top, others
+        top = order[0][1]
+        others = [m for _, m, _, tie in order if tie == top]
+        loose = scorecard.not_resolved_from(pops, list(means), top, finite)
+        return top, others + [m for _, m, _, _ in order if m in loose and m not in others]
 
     conv = _load(root, "convergence", "metrics.json")
 
@@ -390,8 +378,8 @@ def recommendation(root, models, pops, quick, bench_rows):
         if limit and limit[0] >= PATCH_TOL:
             said += f", consistency limit {_pm(limit)}"
         if others:
-            said += (f", not resolved from {', '.join(others)} (tied, or first when one mesh "
-                     "family or one case is left out)")
+            said += (f", not resolved from {', '.join(others)} (tied, or level with it or "
+                     "before it when one mesh family or one case is left out)")
         return said
 
     def cost(m):
@@ -415,31 +403,24 @@ def recommendation(root, models, pops, quick, bench_rows):
         linear = (f"; in the linear regime it ranks {order.index(b) + 1} of {len(order)}"
                   + (f" with {lin[b][2]} failed runs" if lin[b][2] else "")
                   if b in order else "")
-        fails = finite_failures(root)
         said = (f"; not decided on {n} case{'s' if n > 1 else ''} between "
-                f"{', '.join([b] + others)} (tied, or first when one mesh family or one case "
-                "is left out)" if others else
+                f"{', '.join([b] + others)} (tied, or level or reversed when one mesh family "
+                "or one case is left out)" if others else
                 f"; the closest other, on {n} case{'s' if n > 1 else ''}, is "
                 f"{named(fin, b, others, True)}{linear}") if b else ""
         cands = [b] + others if b else []
-        failing = [f"{m} in {', '.join(f'{c} {k} of {t}' for c, (k, t) in fails[m].items())}"
-                   for m in cands if fails.get(m)]
+        failing = [f"{m} ({fin[m][2]} failed runs)" for m in cands if fin[m][2]]
         # the models a failed run put after the rest, named with what they would have scored
-        def why(e):
-            if e[5]:
-                return "no equilibrium at the load of " + ", ".join(
-                    f"{c} in {k} of {t} runs" for c, (k, t) in e[5].items())
-            return f"{e[2]} failed runs"
         left = [f"{m} (model-form error "
                 + (rel(e[1]) if e[1] is not None and not e[3] else "failed at the median")
-                + f"; {why(e)})" for m, e in fin.items()
+                + f"; {e[2]} failed runs: no equilibrium at the load)" for m, e in fin.items()
                 if scorecard.failed(e) and m not in cands]
         out.append(f"- Finite strain: {p1_fin} (the reference's law on P1, the identity "
                    "check of this comparison, not a measured accuracy"
                    + _discretisation(pops, True)
                    + ": on these meshes the mesh, not the law, sets the distance to the "
                    f"continuum; refine before choosing){said}"
-                   + ("; no equilibrium at a case's load for " + "; ".join(failing)
+                   + ("; with failed runs (no equilibrium at the load): " + "; ".join(failing)
                       if failing else "")
                    + ("; ranked after them for a failed run: " + "; ".join(left)
                       if left else "") + ".")
@@ -491,22 +472,6 @@ def _discretisation(pops, finite):
     return (f", whose discretisation error, the median over the meshes of each case, runs "
             f"from {rel(lo)} ({a}) to {rel(hi)} ({b}): what every model on those meshes pays "
             "as well")
-
-
-def finite_failures(root):
-    """{model: {case/bc: (runs without an equilibrium at the case's load, runs that tried)}}
-    over every case folder under ``root`` (each boundary condition its own population)."""
-    from .registry import CASES
-    out = {}
-    for case in CASES:
-        d = _load(root, case, "metrics.json")
-        for r in (d or {}).get("runs", []):
-            if "finite_failed" not in r:
-                continue
-            where = f"{case}/{r['bc']}"
-            k, t = out.setdefault(r["model"], {}).get(where, (0, 0))
-            out[r["model"]][where] = (k + bool(r["finite_failed"]), t + 1)
-    return {m: {c: v for c, v in by.items() if v[0]} for m, by in out.items()}
 
 
 def u_vals(truth, strain, floor):

@@ -107,6 +107,7 @@ class Scalar:
     continuum: str
     label: str
     p1: str = P1_LINEAR
+    posed: str = None         # as :class:`Norm`'s
 
     def parts(self, run, p1_run):
         """The run's :class:`Parts`, or None where the run or its P1 twin has no value."""
@@ -131,6 +132,9 @@ class Norm:
     unpaired: str = None      # run key counting the parts that failed (unpaired modes)
     unpaired_total: str = None   # the same against the continuum (the total's failed parts)
     count: int = 1            # the parts a run compares (the modes it pairs)
+    # the run key that is None where the comparison does not exist on a run's mesh (no
+    # reference there): such a run is no run of the population, never a model's failure
+    posed: str = None
 
     def parts(self, run, p1_run):
         mf, tot = run.get(self.model_form), run.get(self.total)
@@ -141,6 +145,12 @@ class Norm:
             mf = 0.0           # P1 against itself, whatever its own run key says
         return Parts(*(float(_array(n, v)) for n, v in (
             ("model-form error", mf), ("discretisation error", disc), ("total error", tot))))
+
+
+# the displacement field at a case's load: the model against FEM P1 with the neo-Hookean law on
+# the same tetrahedra, and against the converged neo-Hookean continuum
+AT_LOAD = Norm("disp_rel_l2_nh_p1", "disp_rel_l2_nh", "displacement at the case's load",
+               p1=P1_FINITE, posed="nh_error_estimate")
 
 
 def decomposed(runs, quantity):

@@ -21,6 +21,7 @@ from model.compose import parse
 from model.mesh import SCHEMES
 from model.loads import body_forces, traction_forces
 from . import catalogue
+from .error_model import AT_LOAD
 
 # what a run may fail with and still be a finding: the suite's own errors and numerical ones
 FINDINGS = (PbcmError, ArithmeticError, np.linalg.LinAlgError)
@@ -212,6 +213,7 @@ class Reference:
     nonlinear: object = None
     nonlinear_reaction: float = None
     nonlinear_failed: str = None
+    nonlinear_p1: object = None       # FEM P1 with the neo-Hookean law on the mesh: the twin
 
 
 class Case(abc.ABC):
@@ -240,6 +242,9 @@ class Case(abc.ABC):
         (against FEM P1 with the same law on the same tetrahedra) and discretisation error
         (FEM P1 against the continuum): a ``Scalar`` quantity or a ``Norm``; None: the case
         has no continuum reference to decompose against.
+    decomposed_at_load : the same at the case's load, against FEM P1 with the reference's
+        neo-Hookean law (default the displacement field, ``error_model.AT_LOAD``, where the
+        case has a neo-Hookean reference; None where ``decomposed`` is already at the load).
     gated : case metrics the CI gate bounds beside the standard ones (catalogue names; the
         catalogue gives their direction).
     columns : case metrics shown in the per-(mesh, bc) table after the standard ones
@@ -271,6 +276,7 @@ class Case(abc.ABC):
     headline_estimate: ClassVar[str] = "p2_error_estimate"
     patch_tests: ClassVar[tuple] = ()
     decomposed: ClassVar[object] = None
+    decomposed_at_load: ClassVar[object] = AT_LOAD
     gated: ClassVar[tuple] = ()
     columns: ClassVar[tuple] = ()
     qoi_errors: ClassVar[tuple] = ()
@@ -295,6 +301,11 @@ class Case(abc.ABC):
                      *([cls.headline_pair] if cls.headline_pair else [])):
             catalogue.metric(name)      # a KeyError naming where to declare it
         catalogue.gated(*cls.gated)     # a gated metric needs a direction, before any run
+
+    @classmethod
+    def decompositions(cls):
+        """The quantities the error model decomposes for this case (linear regime, load)."""
+        return tuple(q for q in (cls.decomposed, cls.decomposed_at_load) if q is not None)
 
     # ------------------------------------------------------------------ settings
     def notes_for(self, s):

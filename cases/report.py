@@ -127,9 +127,9 @@ def build_report(case, s, runs, fields, out):
     doc = Document(f"pbcm report: {case.name}")
     ok = [r for r in runs if not r.get("failed")]
     opening, costs_of_replacing = [], []
-    if case.decomposed is not None:
+    if case.decompositions():
         opening, costs_of_replacing = scorecard.case_findings(
-            case.name, case.decomposed, runs, case.patch_tests, case.headline_estimate)
+            case.name, case.decompositions(), runs, case.patch_tests, case.headline_estimate)
     lines = opening + case.conclusion(s, runs)
     if s.quick:     # a preview on fewer meshes: it decides nothing the full run could reverse
         lines = [f"Quick: not decided (`pbcm run {case.name}` decides, on every mesh); a "

@@ -42,9 +42,7 @@ class Population:
     meshes: dict = field(default_factory=dict)     # {model: [mesh per run]}
     lost: dict = field(default_factory=dict)       # {model: [unpaired modes per run]}
     lost_total: dict = field(default_factory=dict)  # the same against the continuum
-    # {model: [(mesh, no equilibrium at the case's load)]} over the runs with a finite-load
-    # phase and its reference: what the finite-load ranking counts of a linear population
-    load_failed: dict = field(default_factory=dict)
+    where: str = ""        # ' at the load' for a case's second population on one bc
 
     @property
     def unpaired(self):
@@ -63,13 +61,11 @@ class Population:
                        meshes={m: [self.meshes[m][k] for k in ks] for m, ks in keep.items()},
                        lost={m: [self.lost[m][k] for k in keep[m]] for m in self.lost},
                        lost_total={m: [self.lost_total[m][k] for k in keep[m]]
-                                   for m in self.lost_total},
-                       load_failed={m: [x for x in v if x[0] != mesh]
-                                    for m, v in self.load_failed.items()})
+                                   for m in self.lost_total})
 
     @property
     def label(self):
-        return f"{self.case}/{self.bc}"
+        return f"{self.case}/{self.bc}{self.where}"
 
     @property
     def finite(self):
@@ -102,45 +98,49 @@ class Population:
 
 
 def populations(runs_by_case, declared, quick, patch_tests, estimate_keys):
-    """The Populations of every case with a decomposed quantity: ``runs_by_case`` {case: runs},
-    ``declared`` {case: Case}, ``quick`` {case: bool}, ``patch_tests`` {case: bcs},
-    ``estimate_keys`` {case: the run key of its reference's error estimate}."""
+    """The Populations of every case with a decomposed quantity (``Case.decompositions``: the
+    linear regime's, the load's): ``runs_by_case`` {case: runs}, ``declared`` {case: Case},
+    ``quick`` {case: bool}, ``patch_tests`` {case: bcs}, ``estimate_keys`` {case: the run key
+    of its reference's error estimate}."""
     out = []
-    for case, runs in runs_by_case.items():
-        q = declared[case].decomposed
-        if q is None:
-            continue
-        if not any(_key(q) in r for r in runs):
-            continue                     # metrics written before the case declared it
-        for bc in dict.fromkeys(r["bc"] for r in runs):
-            rs = [r for r in runs if r["bc"] == bc]
-            dec = E.decomposed(rs, q)
-            failed_modes = getattr(q, "unpaired", None)
-            parts, meshes, lost, load_failed, lost_total = {}, {}, {}, {}, {}
-            failed_total = getattr(q, "unpaired_total", None)
-            for r in rs:
-                if r.get("nh_error_estimate") is not None and "finite_failed" in r:
-                    load_failed.setdefault(r["model"], []).append(
-                        (r["mesh"], bool(r["finite_failed"])))
-                parts.setdefault(r["model"], []).append(dec[(r["mesh"], r["bc"], r["model"])])
-                meshes.setdefault(r["model"], []).append(r["mesh"])
-                if failed_modes:
-                    lost.setdefault(r["model"], []).append(r.get(failed_modes) or 0)
-                if failed_total:
-                    lost_total.setdefault(r["model"], []).append(r.get(failed_total) or 0)
-            twins = [abs(p.model_form) for m in SAME_LAW.get(q.p1, ()) if m in parts
-                     for p in parts[m] if p is not None]
-            u_mf = max([E.ROUND_OFF] + twins)
-            key = estimate_keys[case]
-            est = [r[key] for r in rs if r.get(key) is not None]
-            cont = {r["mesh"]: r.get(q.continuum) for r in rs} if hasattr(q, "continuum") \
-                else {}
-            cont = [_first(v) for v in cont.values() if v is not None]
-            u_c, defect = E.u_num(max(est) if est else None, cont)
-            out.append(Population(case, bc, q, parts, u_mf, u_c, defect,
-                                  bc in patch_tests[case], quick[case], meshes, lost,
-                                  lost_total=lost_total, load_failed=load_failed))
+    for case, all_runs in runs_by_case.items():
+        quantities = declared[case].decompositions()
+        for q in quantities:
+            # a run is of the population where its comparison is posed (a reference there)
+            runs = [r for r in all_runs if not q.posed or r.get(q.posed) is not None]
+            if not any(_key(q) in r for r in runs):
+                continue                 # metrics written before the case declared it
+            at_load = q.p1 != E.P1_LINEAR and len(quantities) > 1
+            for bc in dict.fromkeys(r["bc"] for r in runs):
+                out.append(_population(case, bc, q, [r for r in runs if r["bc"] == bc],
+                                       quick[case], bc in patch_tests[case],
+                                       # the reference that poses it gives its estimate
+                                       q.posed or estimate_keys[case],
+                                       " at the load" if at_load else ""))
     return out
+
+
+def _population(case, bc, q, rs, quick, patch_test, estimate_key, where):
+    dec = E.decomposed(rs, q)
+    failed_modes = getattr(q, "unpaired", None)
+    failed_total = getattr(q, "unpaired_total", None)
+    parts, meshes, lost, lost_total = {}, {}, {}, {}
+    for r in rs:
+        parts.setdefault(r["model"], []).append(dec[(r["mesh"], r["bc"], r["model"])])
+        meshes.setdefault(r["model"], []).append(r["mesh"])
+        if failed_modes:
+            lost.setdefault(r["model"], []).append(r.get(failed_modes) or 0)
+        if failed_total:
+            lost_total.setdefault(r["model"], []).append(r.get(failed_total) or 0)
+    twins = [abs(p.model_form) for m in SAME_LAW.get(q.p1, ()) if m in parts
+             for p in parts[m] if p is not None]
+    u_mf = max([E.ROUND_OFF] + twins)
+    est = [r[estimate_key] for r in rs if r.get(estimate_key) is not None]
+    cont = {r["mesh"]: r.get(q.continuum) for r in rs} if hasattr(q, "continuum") else {}
+    cont = [_first(v) for v in cont.values() if v is not None]
+    u_c, defect = E.u_num(max(est) if est else None, cont)
+    return Population(case, bc, q, parts, u_mf, u_c, defect, patch_test, quick, meshes, lost,
+                      lost_total=lost_total, where=where)
 
 
 def _key(q):
@@ -173,18 +173,43 @@ def unresolved(pops, models, finite=False):
     population (the mesh, not the run, is the unit of analysis), or one case is left out: the
     first such mesh, else case."""
     order = [m for _, m, _, _ in ranked(overall(pops, models, finite))]
-    cases = sorted({p.case for p in pops if p.finite == finite and not p.patch_test})
-    subsets = [(mesh, [p.without(mesh) for p in pops]) for mesh in _meshes(pops, finite)]
-    if len(cases) > 1:       # the case is a unit too: an order one case decides is not resolved
-        subsets += [(case, [p for p in pops if p.case != case]) for case in cases]
     out = {}
-    for left_out, subset in subsets:
+    for left_out, subset in _subsets(pops, finite):
         alt = overall(subset, models, finite)
         for a, b in zip(order, order[1:]):
             # reversed, or level: an order one subset cannot keep is not resolved
             if (a, b) not in out and a in alt and b in alt and \
                     _order(alt[a], a)[:2] >= _order(alt[b], b)[:2]:
                 out[(a, b)] = left_out
+    return out
+
+
+def not_resolved_from(pops, models, first, finite=False):
+    """{model: what was left out}: the models ranked after ``first`` that come level with it
+    or before it when one mesh family or one case is left out, pair by pair with ``first``
+    (never chained through a neighbour): ``first`` is not resolved from them."""
+    order = [m for _, m, _, _ in ranked(overall(pops, models, finite))]
+    after = order[order.index(first) + 1:] if first in order else []
+    out = {}
+    for left_out, subset in _subsets(pops, finite):
+        alt = overall(subset, models, finite)
+        if first not in alt:
+            continue
+        for m in after:
+            if m in alt and m not in out and \
+                    _order(alt[m], m)[:2] <= _order(alt[first], first)[:2]:
+                out[m] = left_out
+    return out
+
+
+def _subsets(pops, finite):
+    """[(what was left out, the populations without it)]: each mesh family, then each case
+    where the regime has more than one (the case is a unit too: an order one case decides is
+    not resolved)."""
+    cases = sorted({p.case for p in pops if p.finite == finite and not p.patch_test})
+    out = [(mesh, [p.without(mesh) for p in pops]) for mesh in _meshes(pops, finite)]
+    if len(cases) > 1:
+        out += [(case, [p for p in pops if p.case != case]) for case in cases]
     return out
 
 
@@ -207,14 +232,12 @@ def spread(pops, models, finite=False):
 
 def overall(pops, models, finite=False):
     """{model: (mean rank, geometric mean of its finite population scores, failed runs,
-    failed populations, populations, {case/bc: (runs without an equilibrium at the case's
-    load, runs tried)})} over the populations of one regime (``finite``): every population counts
-    for every model, a failed run against its model; each score floored at its population's
-    model-form uncertainty; P1 itself left out (an identity check), and the patch tests (pass
-    or fail, the consistency limit's subject: never pooled with the rest). At finite load,
-    the runs of the linear populations' cases that found no equilibrium at the case's load
-    count too (the last entry); a model with any failed run ranks after every model without
-    one (``_order``)."""
+    failed populations, populations)} over the populations of one regime (``finite``): every
+    population counts for every model, a failed run (no number, or at the load no equilibrium)
+    against its model; each score floored at its population's model-form uncertainty; P1
+    itself left out (an identity check), and the patch tests (pass or fail, the consistency
+    limit's subject: never pooled with the rest); a model with any failed run ranks after
+    every model without one (``_order``)."""
     used = [p for p in pops if p.finite == finite and not p.patch_test]
     out = {}
     for m in models:
@@ -229,14 +252,8 @@ def overall(pops, models, finite=False):
                 scores.append(st.score)
                 floors.append(p.u_model_form)
         failed = sum(sum(v is None for v in p.parts[m]) for p in mine)
-        load = {}
-        if finite:
-            for p in pops:
-                if not p.finite and p.load_failed.get(m):
-                    load[p.label] = (sum(f for _, f in p.load_failed[m]),
-                                     len(p.load_failed[m]))
         out[m] = (E.mean_rank(ranks), E.geometric_mean(scores, floors), failed,
-                  len(mine) - len(scores), len(mine), {c: v for c, v in load.items() if v[0]})
+                  len(mine) - len(scores), len(mine))
     return out
 
 
@@ -250,16 +267,14 @@ def largest(pops, model, finite=False):
 
 
 def _order(entry, model):
-    """The ranking's order of one model: those with a failed run (no number in a population,
-    or no equilibrium at a case's load) after every model without one, then by mean rank,
-    then by geometric mean."""
+    """The ranking's order of one model: those with a failed run (no number in a population)
+    after every model without one, then by mean rank, then by geometric mean."""
     return (failed(entry), entry[0], entry[1] or 0.0, model)
 
 
 def failed(entry):
-    """Whether an ``overall`` entry has a failed run (in its populations or at a case's
-    load)."""
-    return bool(entry[2] or entry[5])
+    """Whether an ``overall`` entry has a failed run."""
+    return bool(entry[2])
 
 
 def ranked(means):
@@ -279,7 +294,7 @@ def ranked(means):
 def describe(entry, rng=None):
     """'mean rank r, geometric mean g [range leaving one mesh family out]' with the failed
     runs and populations of ``overall``."""
-    r, g, n_failed, lost, n, load = entry
+    r, g, n_failed, lost, n = entry
     text = f"mean rank {r:.3g}" + (f", geometric mean {rel(g)}" if g is not None else "")
     if g is not None and rng:
         text += f" [{rel(rng[0])}-{rel(rng[1])} leaving one mesh family out]"
@@ -287,24 +302,23 @@ def describe(entry, rng=None):
         text += f", {n_failed} failed runs"
     if lost:
         text += f" ({lost} of {n} populations failed at the median)"
-    if load:
-        text += "; no equilibrium at a case's load in " + ", ".join(
-            f"{c} {k} of {t} runs" for c, (k, t) in load.items())
     if failed(entry):
         text += " (ranked after every model without a failed run)"
     return text
 
 
-def case_findings(name, decomposed, runs, patch_tests=(), estimate_key="p2_error_estimate"):
-    """(opening lines, tables) of one case's report on the error model: per boundary
-    condition, the closest and farthest model by model-form error with the discretisation
-    error the meshes share, and the models whose total is below P1's only by cancellation;
-    a Table per boundary condition with every model's standing."""
+def case_findings(name, quantities, runs, patch_tests=(), estimate_key="p2_error_estimate"):
+    """(opening lines, tables) of one case's report on the error model, for each of its
+    decomposed ``quantities`` (``Case.decompositions``): per boundary condition, the closest
+    and farthest model by model-form error with the discretisation error the meshes share,
+    and the models whose total is below P1's only by cancellation; a Table per boundary
+    condition with every model's standing."""
     from .document import Table
 
     class Declared:
-        pass
-    Declared.decomposed = decomposed
+        @staticmethod
+        def decompositions():
+            return tuple(quantities)
     pops = populations({name: runs}, {name: Declared}, {name: False},
                        {name: set(patch_tests)}, {name: estimate_key})
     lines, tables = [], []
@@ -312,7 +326,7 @@ def case_findings(name, decomposed, runs, patch_tests=(), estimate_key="p2_error
         st = p.standings()
         if not st:
             continue
-        where = f"[{p.bc}] " if len(pops) > 1 else ""
+        where = f"[{p.bc}{p.where}] " if len(pops) > 1 else ""
         disc = p.discretisation()
         twins = [m for m in sorted(p.identity - {p.quantity.p1}) if m in p.parts]
         # the check's tolerance is set apart from what it checks: the geometric
@@ -349,7 +363,13 @@ def case_findings(name, decomposed, runs, patch_tests=(), estimate_key="p2_error
         failed = [f"{s.model} ({s.failed} of {s.runs} failed)" for _, s, _ in st if s.failed]
         if failed:
             line += "; failed runs, counted against their model: " + ", ".join(failed)
-        if disc:
+        if disc and p.patch_test:
+            # a patch test's continuum is P1's own field: an identity check, not a resolution
+            line += (f". FEM P1 reproduces this patch test's continuum to {rel(max(disc))} "
+                     + ("(exact to round-off: no discretisation error here)"
+                        if max(disc) <= E.ROUND_OFF else
+                        f"(beyond round-off, {rel(E.ROUND_OFF)}: P1 fails its own patch test)"))
+        elif disc:
             line += (f". FEM P1 itself is {rel(np.median(disc))} "
                      f"[{rel_range(min(disc), max(disc))}] from the continuum on these meshes "
                      "(discretisation error"
@@ -413,32 +433,12 @@ def population_contenders(p):
     if not st:
         return {}
     top = st[0][1].model
+    meshes = sorted({x for ms in p.meshes.values() for x in ms})
     out = {}
-    for mesh in sorted({x for ms in p.meshes.values() for x in ms}):
+    for mesh in meshes if len(meshes) > 1 else ():     # one mesh left out leaves none
         for r, s, _ in p.without(mesh).standings():
             if r == 1 and s.model != top and s.model not in out:
                 out[s.model] = mesh
-    return out
-
-
-def contenders(pops, models, finite=False):
-    """{model: what was left out}: the models other than the first of
-    ``ranked(overall(...))`` that come first, or share its place, when one mesh family or
-    one case is left out."""
-    order = ranked(overall(pops, models, finite))
-    if not order:
-        return {}
-    top = order[0][1]
-    cases = sorted({p.case for p in pops if p.finite == finite and not p.patch_test})
-    subsets = [(mesh, [p.without(mesh) for p in pops]) for mesh in _meshes(pops, finite)]
-    if len(cases) > 1:
-        subsets += [(case, [p for p in pops if p.case != case]) for case in cases]
-    out = {}
-    for left_out, subset in subsets:
-        alt = ranked(overall(subset, models, finite))
-        for r, m, _, _ in alt:
-            if r == 1 and m != top and m not in out:
-                out[m] = left_out
     return out
 
 
