@@ -5,12 +5,13 @@ compact table, model by the numbers behind them. Every number is read from the m
 studies, the cases and the bench wrote under the reports folder; an answer whose source is
 missing says which command writes it."""
 import json
+import math
 from pathlib import Path
 
 import numpy as np
 
 from .costs import FILE as BENCH_FILE, FOLDER as BENCH_FOLDER
-from .document import fmt, rel
+from .document import fmt, rel, rel_range
 from .error_model import ROUND_OFF
 from .metrics import PATCH_TOL
 
@@ -194,16 +195,18 @@ def lines(root, models, pops=(), quick=False):
                 "quick"] else "")
                    + "The consistency limit, the sliding cube's error as the mesh is refined "
                    "(a patch test; the largest over the lattices, +- the extrapolation's "
-                   "uncertainty): " + ", ".join(f"{m} {_pm(_worst_limit(lim[m]))}"
-                                                + ("" if m in steady else " (diverges on "
-                                                   + ", ".join(k for k, v in lim[m].items()
-                                                               if v == "diverges") + ")")
-                                                for m in rest if _worst_limit(lim[m]))
+                   "uncertainty; beside it each family where the model has no limit, and "
+                   "what its fit found there): "
+                   + ", ".join(f"{m} {_pm(_worst_limit(lim[m]))}" + _no_limit(lim[m])
+                               for m in rest if _worst_limit(lim[m]))
                    + _limit_ties([(m, _worst_limit(lim[m])) for m in steady
-                                  if _worst_limit(lim[m])])
+                                  if _worst_limit(lim[m])],
+                                 "tied within their +- on the lattices, where both have a "
+                                 "limit")
                    + _limit_ties([(m, _worst_limit(lim[m])) for m in rest
                                   if m not in steady and _worst_limit(lim[m])],
-                                 "tied within their +-, both diverging elsewhere")
+                                 "tied within their +- on the lattices, both diverging "
+                                 "elsewhere")
                    + (f"; below {PATCH_TOL:g}: {', '.join(passed)}" if passed else "")
                    + (f"; no limit on {', '.join(nolimit)}" if nolimit else "")
                    + _diverging(lim)
@@ -253,6 +256,13 @@ def _limit_ties(limits_, said="tied within their +-"):
             groups.append((i, j))
     return (f" ({said}: " + "; ".join(
         ", ".join(m for m, _ in limits_[i:j + 1]) for i, j in groups) + ")" if groups else "")
+
+
+def _no_limit(values):
+    """' (diverges on x; not asymptotic on y)': the families without a limit, with the fit's
+    verdict there ('' where every family has one)."""
+    other = [f"{v} on {k}" for k, v in values.items() if not isinstance(v, tuple)]
+    return f" ({'; '.join(other)})" if other else ""
 
 
 def _diverging(lim):
@@ -446,7 +456,9 @@ def recommendation(root, models, pops, quick, bench_rows):
                 f"case of the linear regime, the median over its meshes): {cheap}"
                 + (" (FEM P1 itself: no approximation is within it on every case)"
                    if cheap == p1_lin else f" (at most {fmt(worst_of[cheap])})")
-                + f", {fmt(bench_rows[cheap]['cpu_s_per_simulated_s'])} s per simulated s")
+                + f", {fmt(bench_rows[cheap]['cpu_s_per_simulated_s'])} s per simulated s on "
+                "the bench's machine (its median round; a time moves with the machine, the "
+                "ratios to fem-linear are the comparison)")
         if cheapest and bench_rows[cheapest]["cpu_s_per_simulated_s"] < \
                 bench_rows[cheap]["cpu_s_per_simulated_s"]:
             line += (f"; {cheapest} is cheaper ("
@@ -459,27 +471,33 @@ def recommendation(root, models, pops, quick, bench_rows):
 
 def _discretisation(pops, finite):
     """', whose discretisation error ...': FEM P1's discretisation error per population (the
-    median over its meshes), the smallest and largest population named, never pooled."""
-    meds = [(float(np.median(p.discretisation())), p.label
-             + (", not resolved there: the continuum's u_num exceeds a fifth of it"
-                if p.u_continuum > np.median(p.discretisation()) / 5 else ""))
-            for p in pops if p.finite == finite and not p.patch_test and p.discretisation()]
+    median over its meshes [their range]), the smallest and largest population named, never
+    pooled."""
+    meds = []
+    for p in pops:
+        d = p.discretisation()
+        if p.finite != finite or p.patch_test or not d:
+            continue
+        meds.append((float(np.median(d)), f"[{rel_range(min(d), max(d))} over the meshes]",
+                     p.label + (", not resolved there: the continuum's u_num exceeds a "
+                                "fifth of it" if p.u_continuum > np.median(d) / 5 else "")))
     if not meds:
         return ""
-    (lo, a), (hi, b) = min(meds), max(meds)
+    (lo, lo_range, a), (hi, hi_range, b) = min(meds), max(meds)
     if len(meds) == 1:
-        return f", whose discretisation error there is {rel(lo)} (median over the meshes)"
+        return (f", whose discretisation error there is {rel(lo)} {lo_range} (median over "
+                f"the meshes, {a})")
     return (f", whose discretisation error, the median over the meshes of each case, runs "
-            f"from {rel(lo)} ({a}) to {rel(hi)} ({b}): what every model on those meshes pays "
-            "as well")
-
+            f"from {rel(lo)} {lo_range} ({a}) to {rel(hi)} {hi_range} ({b}): what every "
+            "model on those meshes pays as well")
 
 def u_vals(truth, strain, floor):
     """The Truth Cube's u_val (ASME V&V 20) of each model at ``strain`` (and of the neo-Hookean
     continuum, read as the models are), with its parts: u_D the beads' noise ``floor``, u_input
-    half the range of the model's own bead RMS over the study's variants of the inputs nobody
-    measured (plate friction, travel, nu; on the mesh they ran on; the continuum's over its
-    references' variants), u_num the neo-Hookean reference's change over its last refinement.
+    the model's own bead RMS over the study's variants of the inputs nobody measured (plate
+    friction, travel, nu; on the mesh they ran on; the continuum's over its references'
+    variants), each input's half range combined in quadrature (``input_spread``), u_num the
+    neo-Hookean reference's change over its last refinement.
     Returns ({model: u_val}, u_num, {model: u_input}, the variants' mesh)."""
     from .error_model import u_val
     nh = truth["headline"].get("continuum")
@@ -490,19 +508,34 @@ def u_vals(truth, strain, floor):
                 default=0.0)
     rows = [r for r in truth.get("rows", []) if abs(r.get("strain", -1) - strain) < 1e-9
             and r.get("bead_rms_mm") is not None]
-    variants = set(truth["parameters"].get("variants", {}))
+    variants = truth["parameters"].get("variants", {})
     mesh = next((r["mesh"] for r in rows if r["variant"] != "bonded"), None)
     u_input, u = {}, {}
     for m in truth["parameters"]["models"]:
-        vals = [r["bead_rms_mm"] for r in rows if r["model"] == m and r["mesh"] == mesh
-                and r["variant"] in variants]
-        u_input[m] = (max(vals) - min(vals)) / 2 if len(vals) > 1 else 0.0
-    cont = [r["bead_rms_mm"] for r in at if r.get("bead_rms_mm") is not None]
+        u_input[m] = input_spread({r["variant"]: r["bead_rms_mm"] for r in rows
+                                   if r["model"] == m and r["mesh"] == mesh}, variants)
+    cont = {r["variant"]: r["bead_rms_mm"] for r in at if r.get("bead_rms_mm") is not None}
     if nh and cont:
-        u_input[nh] = (max(cont) - min(cont)) / 2
+        u_input[nh] = input_spread(cont, variants)
     for m, ui in u_input.items():
         u[m] = u_val(u_num, ui, floor)
     return u, u_num, u_input, mesh
+
+
+def input_spread(values, variants, base="bonded"):
+    """u_input of one output: ``values`` {variant: output}, ``variants`` {variant: its inputs
+    (a tuple)}, each variant other than ``base`` changing inputs of the base's; per input
+    changed (the variants that change the same inputs), half the range of the output over
+    them and the base, combined in quadrature (independent inputs, V&V 20)."""
+    if base not in values or base not in variants:
+        vals = list(values.values())
+        return (max(vals) - min(vals)) / 2 if len(vals) > 1 else 0.0
+    groups = {}
+    for name, inputs in variants.items():
+        if name != base and name in values:
+            changed = tuple(k for k, (a, b) in enumerate(zip(inputs, variants[base])) if a != b)
+            groups.setdefault(changed, [values[base]]).append(values[name])
+    return math.sqrt(sum(((max(v) - min(v)) / 2) ** 2 for v in groups.values()))
 
 
 def validation(truth):

@@ -196,8 +196,10 @@ TERMS = {
     "over the load steps), with FEM P1 the same law on the same tetrahedra under the same "
     "constraints and load (linear P1 in the linear regime, neo-Hookean P1 at finite load), "
     "Q_c the converged continuum's; for the modes, the largest relative frequency error "
-    "against P1's modes paired by shape, an unpaired mode a failed mode. What the scorecard "
-    "ranks (cases/error_model.py).",
+    "against P1's modes paired by shape, an unpaired mode a failed mode; at a case's load "
+    "(every case with a neo-Hookean reference, its population 'at the load'), "
+    "||u_model - u_P1|| / ||u_P1|| against neo-Hookean P1, a run without an equilibrium a "
+    "failed run. What the scorecard ranks (cases/error_model.py).",
     "discretisation error": "(Q_P1 - Q_c) / |Q_c|: how far FEM P1 on a mesh is from the "
     "converged continuum; the same for every model on that mesh.",
     "total error": "(Q_model - Q_c) / |Q_c| = model-form error + discretisation error (for a "
@@ -216,13 +218,13 @@ TERMS = {
     "population, each population ranking its models first by the parts they lost (unpaired "
     "modes), then by the median over the meshes with a failed run counted as infinitely "
     "wrong (so a failure never removes a population from anyone's comparison); models within "
-    "u_val of the first of a group share its rank. At finite load a model that found no "
-    "equilibrium at a case's load (a linear case's finite-load phase) ranks after every model "
-    "that found one. Beside it the geometric mean of the population medians, each floored at "
+    "u_val of the first of a group share its rank; a model with a failed run ranks after "
+    "every model without one. Beside it the geometric mean of the population medians, each floored at "
     "its population's u_val, with its range over the rankings that leave one mesh family out.",
-    "not resolved": "an order of two neighbouring models that reverses when one mesh family "
+    "not resolved": "an order of two models that reverses, or levels, when one mesh family "
     "(every population's runs on it) or one case is left out: the data cannot order them, "
-    "whatever their mean ranks say.",
+    "whatever their mean ranks say; judged pair by pair (neighbours in a ranking, the first "
+    "against each other in a pick), never chained through a third.",
     "failed run": "a run that gave no number (no equilibrium, a metric undefined, a run that "
     "could not start): it counts against its model, as infinitely wrong, in every ranking, "
     "case table and answer; the population stays in every other model's comparison.",

@@ -313,7 +313,8 @@ def test_what_to_pick_is_computed_and_names_what_is_not_decided(tmp_path):
     assert lines[0] == "**What to pick?**"
     assert lines[1].startswith("- Linear regime: FEM P1 (fem-linear: 0 model-form error by "
                                "construction, an identity check), whose discretisation error "
-                               "there is 0.2 (median over the meshes)")
+                               "there is 0.2 [0.2-0.2 over the meshes] (median over the "
+                               "meshes, torsion/clamped)")
     assert "the closest approximation is a, model-form error 0.1" in lines[1]
     # at finite load a's model-form errors are 0.1, 0.2 and b's 0.1, 0.2 (six reversed)
     assert "not decided on 1 case between" in lines[2]
@@ -427,3 +428,15 @@ def test_a_total_with_unpaired_continuum_modes_ranks_after_one_without():
     assert "9 unpaired modes (failed, ranked first)" in table.rows[-1][-1]
     line = rankings.best_and_worst(runs, "tot", "Error", lost_key="lost_c")
     assert "to a (" in line and "Unpaired modes" in line and "a (9)" in line
+
+
+def test_truth_cube_u_input_adds_each_unmeasured_inputs_half_range_in_quadrature():
+    """u_input combines the inputs apart: plate 1.6 vs 1.8 (half range 0.1), travel 1.6 vs
+    1.6 (0) and nu 1.3 to 2.0 (0.35) give sqrt(0.1^2 + 0.35^2), not the half range 0.35 of
+    every variant pooled."""
+    from cases.answers import input_spread
+    variants = {"bonded": ("bonded", "nominal", 0.499), "frictionless": ("free", "nominal", 0.499),
+                "fitted": ("bonded", "fitted", 0.499), "nu-": ("bonded", "nominal", 0.49),
+                "nu+": ("bonded", "nominal", 0.4999)}
+    values = {"bonded": 1.6, "frictionless": 1.8, "fitted": 1.6, "nu-": 1.3, "nu+": 2.0}
+    assert input_spread(values, variants) == pytest.approx(math.hypot(0.1, 0.35))
