@@ -324,8 +324,10 @@ class Verdict:
     aside: int = 0        # gold rows of runs not in the metrics (``only_run``)
 
 
-def check(gold, measurements, only_run=False):
-    """Every measured metric against its gold value (``Verdict``).
+def check(gold, measurements, only_run=False, models=None):
+    """Every measured metric against its gold value (``Verdict``); ``models``, when given,
+    the models gated (the gold's and the measurements' other models are left out, never
+    deleted).
 
     Status 0: every value holds; 1: a metric left its band, or was null in the gold and is a
     number now (or the reverse); NEW (3): every value holds but some (case, mode, model) has
@@ -335,8 +337,13 @@ def check(gold, measurements, only_run=False):
     counted), a metric or row the gold lacks for a model it has, or a value that is not
     finite raise CheckError (exit 2): a missing reference never passes."""
     values, policy = measurements.values, gold.policy
+    if models:
+        measurements, gold_rows = _only_models(measurements, gold, models)
+        values = measurements.values
+    else:
+        gold_rows = gold.rows
     ran = {k[:2] for k in values} | {k[:2] for k in (measurements.rows or ())}
-    rows = {k: v for k, v in gold.rows.items() if k[:2] in ran}
+    rows = {k: v for k, v in gold_rows.items() if k[:2] in ran}
     if not rows:
         raise CheckError(f"no gold for the measured {', '.join('/'.join(r) for r in sorted(ran))}"
                          "; run in a mode the gold covers, or bless this one")
@@ -375,7 +382,8 @@ def check(gold, measurements, only_run=False):
         if key5 not in measured_rows:
             raise CheckError(f"{'/'.join(key5[2:])} of {key5[0]} ({key5[1]} mode) has gold "
                              "values but was not measured: run the case in that mode, or "
-                             "bless without it (--prune)")
+                             "gate what was run (--only-run, or --models for a subset of "
+                             "models)")
         for metric, g in sorted(metrics.items()):
             v = values.get((*key5, metric))
             if v is not None and not _finite(v):
@@ -399,6 +407,24 @@ def check(gold, measurements, only_run=False):
         status = NEW
     return Verdict(out, flips, [(*k, n) for k, n in sorted(new.items())], status,
                    aside if only_run else 0)
+
+
+def _only_models(measurements, gold, models):
+    """(the measurements, the gold's rows) of ``models`` only; a model named that neither
+    has is refused (a typo gates nothing)."""
+    from dataclasses import replace
+    known = {k[4] for k in gold.rows} | {k[4] for k in measurements.values}
+    unknown = [m for m in models if m not in known]
+    if unknown:
+        raise CheckError(f"--models {', '.join(unknown)}: no gold and no measurement of "
+                         f"{'it' if len(unknown) == 1 else 'them'}; known: "
+                         f"{', '.join(sorted(known))}")
+    keep = set(models)
+    return (replace(measurements,
+                    values={k: v for k, v in measurements.values.items() if k[4] in keep},
+                    rows=None if measurements.rows is None else
+                    type(measurements.rows)(k for k in measurements.rows if k[4] in keep)),
+            {k: v for k, v in gold.rows.items() if k[4] in keep})
 
 
 def flip_message(key, gold, now):

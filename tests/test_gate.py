@@ -20,7 +20,7 @@ def test_committed_bounds_hold_for_the_quick_run(quick, capsys):
                    str(ROOT / "gold"), "--allow-new"])
     out = capsys.readouterr().out
     assert status == 0, out
-    assert re.search(r"^\d+ passed, 0 failed$", out, re.M)
+    assert re.search(r"^\d+ passed, 0 failed( \(--verbose prints every value\))?$", out, re.M)
 
 
 @pytest.fixture(scope="module")
@@ -246,7 +246,7 @@ def test_a_model_without_bounds_is_new_not_gated_yet(blessed, tmp_path, capsys):
     assert check(tmp_path / "m", blessed / "g") == 3
     out = capsys.readouterr().out
     assert f"NEW  paper-cube (quick) {extra}: new, not gated yet" in out
-    assert re.search(r"^\d+ passed, 0 failed$", out, re.M)
+    assert re.search(r"^\d+ passed, 0 failed( \(--verbose prints every value\))?$", out, re.M)
     assert main(["check", "--metrics", str(tmp_path / "m"), "--gold",
                  str(blessed / "g"), "--allow-new"]) == 0
     # a failing bound still fails (1), new models or not
@@ -430,3 +430,53 @@ def test_only_run_gates_a_subset_and_a_plain_check_refuses_it(blessed, tmp_path,
     assert main(["check", "--metrics", str(sub.parent), "--gold", str(blessed / "g"),
                  "--only-run"]) == 0
     assert "set aside" in capsys.readouterr().out
+
+
+def test_models_gates_a_subset_of_a_blessed_pair_and_refuses_an_unknown_model(blessed,
+                                                                               capsys):
+    """--models gates the models named (a two-model gold checked for one of them passes on
+    that model's values alone, and prints no other model's); a model that neither the gold
+    nor the metrics know is refused, naming the known ones (a typo gates nothing)."""
+    assert main(["check", "--metrics", str(blessed / "good"), "--gold", str(blessed / "g"),
+                 "--models", "msm", "--verbose"]) == 0
+    out = capsys.readouterr().out
+    assert "/msm/" in out and "/pbcm-variational/" not in out
+    assert main(["check", "--metrics", str(blessed / "good"), "--gold", str(blessed / "g"),
+                 "--models", "mms"]) == 2
+    err = capsys.readouterr().err
+    assert "--models mms" in err and "known: msm, pbcm-variational" in err
+
+
+def test_check_prints_failures_and_totals_by_default_and_writes_junit(blessed, tmp_path,
+                                                                      capsys):
+    """By default the check prints the failures, the legend that defines margin and band,
+    and the totals, every compared value only with --verbose; --junit writes one test case
+    per gated value, a failure for each value out of its band."""
+    edit_gold(blessed / "g", tmp_path / "g", "msm", "disp_rel_l2_p2", lambda v: v * 1.5)
+    junit = tmp_path / "ci" / "gate.xml"
+    assert main(["check", "--metrics", str(blessed / "good"), "--gold", str(tmp_path / "g"),
+                 "--junit", str(junit)]) == 1
+    out = capsys.readouterr().out
+    assert " PASS" not in out and "FAIL" in out
+    assert "margin: how far inside its band" in out and "band: the gold value +-" in out
+    assert re.search(r"^\d+ passed, 1 failed \(--verbose prints every value\)$", out, re.M)
+    import xml.etree.ElementTree as ET
+    suite = ET.parse(junit).getroot()
+    cases = suite.findall("testcase")
+    assert int(suite.get("tests")) == len(cases) > 1 and suite.get("failures") == "1"
+    (bad,) = [c for c in cases if c.find("failure") is not None]
+    assert bad.get("name") == "disp_rel_l2_p2" and bad.get("classname").endswith("/msm")
+    assert main(["check", "--metrics", str(blessed / "good"), "--gold", str(tmp_path / "g"),
+                 "--verbose"]) == 1
+    assert " PASS" in capsys.readouterr().out
+
+
+def test_bless_without_metrics_refuses_to_start_a_run_unless_asked(tmp_path, capsys):
+    """A bare `pbcm bless` computes nothing and says what to give (--metrics, or --run);
+    --run with --metrics is refused too; the gold folder is left untouched."""
+    assert main(["bless", "--gold", str(tmp_path / "g")]) == 2
+    err = capsys.readouterr().err
+    assert "--metrics DIR" in err and "--run" in err and "30 minutes" in err
+    assert main(["bless", "--run", "--metrics", str(tmp_path), "--gold",
+                 str(tmp_path / "g")]) == 2
+    assert not (tmp_path / "g").exists()

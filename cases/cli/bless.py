@@ -14,8 +14,9 @@ def add(sub):
                     "files gold/CASE.quick.jsonl (6 significant digits; a value that agrees "
                     "to that precision is kept as it is), full mode by installing the case "
                     "folder as the committed reports/CASE. Without --metrics it first runs "
-                    "every case and study: in full mode (about 30 minutes on 2 cores from "
-                    "an empty run store) unless --quick is given. It keeps the gold rows of "
+                    "every case and study, and only when --run asks for it: in full mode "
+                    "(about 30 minutes on 2 cores from an empty run store) unless --quick is "
+                    "given. It keeps the gold rows of "
                     "runs it did not see (other modes, meshes, models) unless --prune is "
                     "given; --margin sets the policy's rtol. It prints every value it adds, "
                     "changes or removes.")
@@ -29,6 +30,9 @@ def add(sub):
                    help="the gold folder to rewrite (default gold)")
     b.add_argument("--metrics", help="bless the metrics.json files under this folder instead "
                                      "of a fresh run")
+    b.add_argument("--run", action="store_true",
+                   help="without --metrics: run every case and study first (minutes in "
+                        "quick mode, about 30 minutes in full mode), then bless")
     add_selection(b)
     b.set_defaults(func=run)
 
@@ -41,6 +45,16 @@ def run(args):
     import tempfile
     from ..gate import COMPACT_MODES, POLICY, CheckError, Gold, Policy, bless, load, measured
     folder = Path(args.gold)
+    if not args.metrics and not args.run:
+        print("pbcm bless: error: nothing to bless: give --metrics DIR (metrics already "
+              "measured, e.g. by `pbcm report --quick --out DIR`), or --run to run every case "
+              "and study first" + (" (quick mode)" if args.quick else " (full mode: about 30 "
+                                   "minutes)"), file=sys.stderr)
+        return 2
+    if args.metrics and args.run:
+        print("pbcm bless: error: --run and --metrics exclude each other: bless what was "
+              "measured, or run first", file=sys.stderr)
+        return 2
     try:   # every check before the run: the old gold must load and the folder be writable
         writable_folder(folder, flag="--gold")
         old = load(folder) if (folder / POLICY).is_file() and any(
