@@ -20,6 +20,7 @@ from . import stop
 
 # a folder the suite may replace: empty, or written by it before (it always holds this file)
 OWNED_MARK = "metrics.json"
+ROOT_MARK = "index.md"          # the reports root: what `pbcm report` and `pbcm index` write
 # a sweep's folder (``pbcm sweep``): its runs/<key>/metrics.json are rows of a table, not
 # case metrics, so the gate does not read them
 SWEEP_MARK = "sweep.json"
@@ -90,6 +91,18 @@ def writable_folder(path, flag="--out"):
     return path
 
 
+def writer(path, mark=OWNED_MARK):
+    """The case or study whose output ``path`` holds (its ``mark``'s 'case' entry), or None
+    where it holds none or the mark does not say."""
+    import json
+    try:
+        data = json.loads((Path(path) / mark).read_text())
+    except (OSError, ValueError):
+        return None
+    return data.get("case") if isinstance(data, dict) and isinstance(data.get("case"), str) \
+        else None
+
+
 def owned(path, mark=OWNED_MARK):
     """True when the suite may replace ``path``: missing, empty, or a folder pbcm wrote (it
     holds ``mark``: a case's metrics.json, the benchmark's bench.json)."""
@@ -108,14 +121,27 @@ class StagedFolder:
     removes the staging folder and leaves ``target`` as it was.
     """
 
-    def __init__(self, target, flag="--out", mark=OWNED_MARK):
+    def __init__(self, target, flag="--out", mark=OWNED_MARK, owner=None):
         self.target = Path(target)
         if self.target.exists() and not self.target.is_dir():
             raise OutputError(f"{flag} {self.target} is a file, not a folder; give a folder")
+        if (self.target / ROOT_MARK).is_file() and not (self.target / mark).is_file():
+            raise OutputError(f"{flag} {self.target} is the root of pbcm's reports (it holds "
+                              f"{ROOT_MARK}): each case and study writes its own folder in it; "
+                              f"give {self.target / (owner or 'NAME')}")
         if not owned(self.target, mark):
             raise OutputError(f"{flag} {self.target} holds files that pbcm did not write (no "
                               f"{mark}); pbcm replaces the whole folder it writes, so "
                               "give a new or empty folder")
+        wrote = writer(self.target, mark)
+        if owner and wrote and wrote != owner:
+            raise OutputError(f"{flag} {self.target} holds the output of {wrote}, not of "
+                              f"{owner}; writing {owner} there would replace it: give "
+                              f"another folder (e.g. {self.target.parent / owner})")
+        if os.path.ismount(self.target):
+            raise OutputError(f"{flag} {self.target} is a mount point: pbcm swaps in the "
+                              "folder it writes by a rename, which a mount point cannot take; "
+                              f"give a folder inside it (e.g. {self.target / (owner or 'out')})")
         parent = writable_folder(self.target.parent, flag=f"{flag} {self.target}: the folder")
         for left in stale_staging(self.target):    # a killed run's: never its own output
             shutil.rmtree(left, ignore_errors=True)

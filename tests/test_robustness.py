@@ -145,6 +145,42 @@ def test_staged_folder_keeps_the_earlier_set_until_commit(tmp_path):
         StagedFolder(tmp_path / "foreign")
 
 
+def test_out_refuses_another_cases_folder_and_the_reports_root_before_computing(tmp_path,
+                                                                                capsys):
+    """--out naming a folder another case wrote is refused, naming that case, and the folder
+    is left as it was; the reports root (its index.md) is recognised as pbcm's and the case's
+    own folder in it named; both before any computing (no staging folder appears)."""
+    other = tmp_path / "paper-cube"
+    other.mkdir()
+    (other / "metrics.json").write_text(json.dumps({"case": "paper-cube", "runs": []}))
+    (other / "report.md").write_text("the paper cube's")
+    assert main(["run", "cantilever", "--quick", "--out", str(other)]) == 2
+    err = capsys.readouterr().err
+    assert "holds the output of paper-cube, not of cantilever" in err
+    assert (other / "report.md").read_text() == "the paper cube's"
+    (tmp_path / "index.md").write_text("# pbcm reports")
+    assert main(["run", "cantilever", "--quick", "--out", str(tmp_path)]) == 2
+    err = capsys.readouterr().err
+    assert "is the root of pbcm's reports" in err and str(tmp_path / "cantilever") in err
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["index.md", "paper-cube"]
+    with StagedFolder(other, owner="paper-cube") as s:     # its own case is welcome
+        s.discard()
+
+
+def test_out_on_a_mount_point_is_refused_before_computing(tmp_path, monkeypatch):
+    """A mount point cannot be swapped by a rename: --out on one is refused at once, naming a
+    folder inside it, rather than failing after the computing."""
+    import os.path
+    target = tmp_path / "volume"
+    target.mkdir()
+    real = os.path.ismount
+    monkeypatch.setattr(os.path, "ismount", lambda p: Path(p) == target or real(p))
+    with pytest.raises(OutputError, match="is a mount point") as exc:
+        StagedFolder(target, owner="paper-cube")
+    assert str(target / "paper-cube") in str(exc.value)
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["volume"]
+
+
 def test_a_narrower_rerun_leaves_no_stale_files(quick, tmp_path):
     out = tmp_path / "paper-cube"
     shutil.copytree(quick, out)

@@ -19,7 +19,8 @@ def run(args):
     cfgs = configs(args)
     root = writable_folder(args.out or "reports")
     with ExitStack() as stack:   # every case folder checked and staged before any computing
-        staged = {name: stack.enter_context(StagedFolder(root / name)) for name in cfgs}
+        staged = {name: stack.enter_context(StagedFolder(root / name, owner=name))
+                  for name in cfgs}
 
         def done(name, runs):
             what = "" if runs is None else f"{len(runs)} runs "

@@ -35,14 +35,16 @@ def run(args):
                 raise UsageError(f"--{option} does not apply to the {study.name} study: "
                                  f"{takes} {option}; leave --{option} out")
         cfg = study_config(study, args)
-        with StagedFolder(Path(args.out) if args.out else Path("reports") / args.case) as out, \
+        with StagedFolder(Path(args.out) if args.out else Path("reports") / args.case,
+                          owner=args.case) as out, \
                 worker_pool(args, {args.case: cfg}) as workers:
             run_study_into(study, cfg, out.path, workers, run_store(args))
             path = out.commit()
         print(f"{args.case}: written to {path}")
         return 0
     cfgs = case_configs([args.case], args)
-    with StagedFolder(Path(args.out) if args.out else Path("reports") / args.case) as out, \
+    with StagedFolder(Path(args.out) if args.out else Path("reports") / args.case,
+                          owner=args.case) as out, \
             worker_pool(args, cfgs) as workers:
         runs = run_case_into(args.case, cfgs[args.case], out.path, workers, run_store(args))
         path = out.commit()
@@ -70,7 +72,7 @@ def _rewrite_study(study, folder):
     if cfg.problem() != metrics.get("problem"):
         raise UsageError(f"the {study.name} study's problem parameters have changed since "
                          f"{path} was written; rerun the study")
-    with StagedFolder(folder) as out:
+    with StagedFolder(folder, owner=study.name) as out:
         study.write(out.path, cfg, data)
         written = out.commit()
     print(f"{study.name}: rewritten from its recorded runs in {written}")
