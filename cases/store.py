@@ -11,7 +11,12 @@ change to any of these files therefore misses every entry: nothing stale is ever
 The entries live in a diskcache (SQLite and files) in ``$PBCM_CACHE``, by default the user's
 cache directory; an entry is committed in one transaction after its value is written, so a run
 killed while writing leaves no entry that a later run would trust. ``--no-cache`` (or
-``PBCM_NO_CACHE=1``) bypasses the store. ``PBCM_CACHE_KINDS`` (a comma-separated list of
+``PBCM_NO_CACHE=1``) bypasses the store. Each entry is tagged with the source fingerprint it
+was computed under (a different one makes it stale: no key of today's source finds it) and
+expires ``KEEP_DAYS`` days after it was last stored or found, so stale entries leave on their
+own; the store is capped at ``PBCM_CACHE_SIZE_GB`` (default ``SIZE_GB``), the least recently
+used entries evicted beyond it (diskcache's eviction). ``pbcm cache info`` shows it and
+``pbcm cache clear [--stale]`` empties it. ``PBCM_CACHE_KINDS`` (a comma-separated list of
 kinds, e.g. the FEM references: ``reference,convergence-reference``) keeps and finds only
 entries of those kinds: every model run is computed, the references solved once (the test
 suite runs so).
@@ -24,9 +29,14 @@ import sys
 from functools import lru_cache
 from pathlib import Path
 
+from model.errors import PbcmError
+
 ENV = "PBCM_CACHE"
 ENV_OFF = "PBCM_NO_CACHE"
 ENV_KINDS = "PBCM_CACHE_KINDS"
+ENV_SIZE = "PBCM_CACHE_SIZE_GB"
+SIZE_GB = 4.0          # the default cap in GiB: a day's work of the full library with room to spare
+KEEP_DAYS = 14         # an entry neither stored nor found for this long expires
 # the kinds that hold FEM references only: what no model, and no patch of a model, changes
 REFERENCE_KINDS = ("reference", "convergence-reference", "convergence-reference-at",
                    "artefact-reference", "truthcube-reference", "truthcube-fit",
@@ -158,14 +168,11 @@ class RunStore:
             if db.is_file() and db.stat().st_size == 0 and len(list(self.folder.iterdir())) > 1:
                 self._set_aside("its index cache.db is empty")
             try:
-                # no size limit: results are evicted by a change of source, not by age
-                self._cache = diskcache.Cache(str(self.folder), size_limit=2 ** 62,
-                                              eviction_policy="none")
+                self._cache = diskcache.Cache(str(self.folder), **settings())
                 len(self._cache)          # reads the index: a corrupt one raises here
             except sqlite3.DatabaseError as exc:
                 self._set_aside(f"its index is corrupt ({exc})")
-                self._cache = diskcache.Cache(str(self.folder), size_limit=2 ** 62,
-                                              eviction_policy="none")
+                self._cache = diskcache.Cache(str(self.folder), **settings())
         return self._cache
 
     def _set_aside(self, why):
@@ -193,7 +200,10 @@ class RunStore:
         if not self._keeps(k):
             return None
         try:
-            value = self._open().get(k)
+            cache = self._open()
+            value = cache.get(k)
+            if value is not None:
+                cache.touch(k, expire=KEEP_DAYS * 86400)    # found: kept another while
         except (OSError, sqlite3.Error) as exc:
             self._failed("be read", exc)
             return None
@@ -206,17 +216,69 @@ class RunStore:
         keep it warns once and is off for the rest of the process."""
         if self._keeps(k):
             try:
-                self._open().set(k, value)
+                self._open().set(k, value, expire=KEEP_DAYS * 86400, tag=fingerprint())
             except (OSError, sqlite3.Error) as exc:
                 self._failed("keep a result", exc)
                 return value
             self.kept += 1
         return value
 
+    def _tags(self):
+        """{key: the source fingerprint its entry was computed under (None: untagged)}."""
+        cache, out = self._open(), {}
+        for k in list(cache.iterkeys()):
+            got = cache.get(k, read=True, tag=True)
+            if got is None or got[0] is None:
+                continue                     # gone meanwhile (expired, evicted)
+            if hasattr(got[0], "close"):
+                got[0].close()
+            out[k] = got[1]
+        return out
+
+    def info(self):
+        """{'folder', 'bytes', 'entries': {kind: n}, 'stale': n, 'cap_bytes'}: what the store
+        holds, a stale entry being one computed under another source than this process's."""
+        cache, now = self._open(), fingerprint()
+        cache.expire()
+        tags = self._tags()
+        kinds = {}
+        for k in tags:
+            kinds[kind_of(k)] = kinds.get(kind_of(k), 0) + 1
+        return {"folder": self.folder, "bytes": cache.volume(), "entries": kinds,
+                "stale": sum(t != now for t in tags.values()),
+                "cap_bytes": settings()["size_limit"]}
+
+    def clear(self, stale_only=False):
+        """Remove every entry, or only those computed under another source; the number
+        removed."""
+        cache = self._open()
+        if not stale_only:
+            return cache.clear()
+        now = fingerprint()
+        return sum(bool(cache.delete(k)) for k, t in self._tags().items() if t != now)
+
     def close(self):
         if self._cache is not None:
             self._cache.close()
             self._cache = None
+
+
+def settings():
+    """The diskcache settings of the store: capped at ``$PBCM_CACHE_SIZE_GB`` (default
+    SIZE_GB), the least recently used entries evicted beyond it."""
+    raw = os.environ.get(ENV_SIZE)
+    try:
+        gb = float(raw) if raw else SIZE_GB
+        if not gb > 0:
+            raise ValueError
+    except ValueError:
+        raise StoreError(f"{ENV_SIZE}={raw!r}: the run store's cap in GB is a number > 0; "
+                         "set it to one, or unset it for the default") from None
+    return {"size_limit": int(gb * 2 ** 30), "eviction_policy": "least-recently-used"}
+
+
+class StoreError(PbcmError, ValueError):
+    """A setting of the run store that cannot be used."""
 
 
 OFF = RunStore(enabled=False)

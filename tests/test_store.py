@@ -3,6 +3,8 @@ the same files; a change to any source file of the package misses every entry; a
 while writing leaves no entry a later run trusts; a static-only study run takes the rows of
 the cases' full runs."""
 import filecmp
+import re
+import time
 import os
 import shutil
 import subprocess
@@ -315,3 +317,50 @@ def test_an_output_fault_is_one_line_with_exit_2(tmp_path, capsys, monkeypatch):
     err = capsys.readouterr().err
     assert status == 2 and err.startswith("pbcm: error:") and "Traceback" not in err
     assert "No space left on device" in err and "choose another --out" in err
+
+
+def test_cache_info_counts_kinds_and_stale_entries_and_clear_stale_keeps_the_current(
+        tmp_path, monkeypatch, capsys):
+    """`pbcm cache info` prints the store's size, cap and entries by kind, counting as stale
+    the entries computed under another source; `clear --stale` removes those only, `clear`
+    every entry; each entry expires KEEP_DAYS after it was stored or last found."""
+    from cases import store as S
+    from cases.cli import main
+    monkeypatch.setenv(S.ENV, str(tmp_path / "store"))
+    monkeypatch.delenv(S.ENV_KINDS, raising=False)       # every kind kept
+    st = S.RunStore()
+    st.put("reference:a", 1)
+    st.put("run:b", 2)
+    st._open().set("run:old", 3, tag="another source")       # as an older checkout left it
+    st._open().set("run:untagged", 4)
+    expires = st._open().get("run:b", expire_time=True)[1]
+    assert expires == pytest.approx(time.time() + S.KEEP_DAYS * 86400, abs=60)
+    st.close()
+    assert main(["cache", "info"]) == 0
+    out = capsys.readouterr().out
+    assert "4 entries, 2 stale" in out and "GiB cap" in out
+    assert re.search(r"^  reference\s+1$", out, re.M) and re.search(r"^  run\s+3$", out, re.M)
+    assert main(["cache", "clear", "--stale"]) == 0
+    assert "removed 2 stale entries" in capsys.readouterr().out
+    st = S.RunStore()
+    assert st.get("reference:a") == 1 and st.get("run:b") == 2 and st.get("run:old") is None
+    st.close()
+    assert main(["cache", "clear"]) == 0
+    assert "removed 2 entries" in capsys.readouterr().out
+
+
+def test_the_store_cap_is_diskcaches_lru_eviction_and_a_bad_cap_is_refused(tmp_path,
+                                                                          monkeypatch):
+    """The store is capped by diskcache's own least-recently-used eviction at
+    $PBCM_CACHE_SIZE_GB (default SIZE_GB); a cap that is not a number > 0 is refused with a
+    message naming the variable, before anything runs."""
+    from cases import store as S
+    from cases.cli import main
+    assert S.settings() == {"size_limit": int(S.SIZE_GB * 2 ** 30),
+                            "eviction_policy": "least-recently-used"}
+    monkeypatch.setenv(S.ENV_SIZE, "0.5")
+    assert S.settings()["size_limit"] == 2 ** 29
+    monkeypatch.setenv(S.ENV, str(tmp_path / "store"))
+    monkeypatch.setenv(S.ENV_SIZE, "-1")
+    assert main(["run", "paper-cube", "--quick", "--out", str(tmp_path / "o")]) == 2
+    assert not (tmp_path / "o").exists()

@@ -155,8 +155,11 @@ def check_executor(args):
 
 def run_store(args):
     """The run store a command reads and fills (``--no-cache``: none)."""
-    from ..store import RunStore
-    return RunStore(enabled=not getattr(args, "no_cache", False))
+    from ..store import RunStore, settings
+    store = RunStore(enabled=not getattr(args, "no_cache", False))
+    if store.enabled:
+        settings()          # its cap, checked before anything runs
+    return store
 
 
 def add_store(p):
