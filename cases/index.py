@@ -131,9 +131,10 @@ def conclusion(pops, models, quick):
     return out
 
 
-def index_documents(root, cases, studies=()):
+def index_documents(root, cases, studies=(), missing=()):
     """The Markdown and HTML of reports/index: the answers (``cases.answers``) and their
-    table first, then the studies, the scorecard and its conclusion."""
+    table first, then the studies, the scorecard and its conclusion; ``missing``, the
+    library's cases without a folder, named first (every answer is over the cases found)."""
     from . import answers
     from .registry import studies as declared
     root = Path(root)
@@ -143,6 +144,9 @@ def index_documents(root, cases, studies=()):
         models += [m for m in data[case]["parameters"]["models"] if m not in models]
     quick = any(d["parameters"]["quick"] for d in data.values())
     doc = Document("pbcm reports")
+    if missing:
+        doc.p(f"Not run here (no folder): {', '.join(missing)}; every answer below is over "
+              f"the cases found: {', '.join(cases)}.")
     for line in answers.lines(root, models, pops, quick):
         doc.p(line)
     header, rows = answers.table(root, models, pops)
@@ -279,11 +283,12 @@ def glossary_documents():
     return doc.markdown() + "\n", doc.html(".") + "\n"
 
 
-def write_index(root, cases, studies):
-    """index.md/.html and glossary.md/.html under ``root``, each written atomically."""
+def write_index(root, cases, studies, missing=()):
+    """index.md/.html and glossary.md/.html under ``root``, each written atomically;
+    ``missing``: the library's cases with no folder there (named in the index)."""
     from .output import write_atomic
     root = Path(root)
-    md, html = index_documents(root, cases, studies)
+    md, html = index_documents(root, cases, studies, missing)
     write_atomic(root / "index.md", md)
     write_atomic(root / "index.html", html)
     md, html = glossary_documents()

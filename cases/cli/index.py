@@ -18,11 +18,15 @@ def run(args):
     from ..registry import CASES, STUDY_MODULES
     from ..index import write_index
     root = Path(args.out)
-    missing = [name for name in CASES if not (root / name / "metrics.json").is_file()]
+    present = [name for name in CASES if (root / name / "metrics.json").is_file()]
+    if not present:
+        raise UsageError(f"{root} holds no case folder (a CASE/metrics.json): run `pbcm "
+                         "report` (or `pbcm run CASE`) first, or give the reports folder")
+    missing = [name for name in CASES if name not in present]
+    path = write_index(root, present, list(STUDY_MODULES), missing)
     if missing:
-        raise UsageError(f"{root} lacks the metrics.json of {', '.join(missing)}: run "
-                         "`pbcm report` (or `pbcm run CASE` for each) first")
-    path = write_index(root, list(CASES), list(STUDY_MODULES))
+        print(f"note: no folder of {', '.join(missing)} under {root}: the index answers over "
+              "the cases it found, and says so")
     print(f"index written to {path}, with index.html and the glossary")
     return 0
 
