@@ -160,11 +160,12 @@ def lines(root, models, pops=(), quick=False):
     out = []
     if art and art["parameters"]["quick"]:
         out.append("**Which reading?** Quick: not decided (`pbcm run artefact` decides).")
-    elif art and art["verdict"]["sure"] == "undecided":
+    elif art and art["verdict"]["sure"] in ("undecided", "tied"):
         v = art["verdict"]
-        out.append(f"**Which reading?** Undecided between {', '.join(v['tied'])} "
+        out.append(f"**Which reading?** Tied between {', '.join(v['tied'])} "
                    f"([artefact study](artefact/report.md)): in the study's runs "
-                   + ("each " if len({json.dumps(r["matches"], sort_keys=True)
+                   + ("each " if len({json.dumps({k: x is True for k, x in r["matches"].items()},
+                                                 sort_keys=True)
                                       for r in art["readings"] if r["model"] in v["tied"]}) == 1
                       else f"{v['model']} ") + _decisive(art))
     elif art:
@@ -645,38 +646,30 @@ def _largest(limit):
 
 
 def _decisive(art):
+    """What the best reading has and lacks of the paper's observables (an observable it was
+    not measured on, such as an untimed step, said so), and the verdict without damping."""
     best = next(r for r in art["readings"] if r["model"] == art["verdict"]["model"])
     said = {"pattern": "the paper's pattern on its own 5-layer mirrored five cube",
             "cost": "the paper's cost ratio (a step over 10x msm's: a property of this "
                     "implementation as much as of the reading)",
             "stable": "no flutter at the damping the study assumes (the paper states none; "
                       "the paper cube's runs are the scorecard's stability column)"}
-    yes = [said[k] for k, v in best["matches"].items() if v]
-    no = [said[k] for k, v in best["matches"].items() if not v]
+    yes = [said[k] for k, v in best["matches"].items() if v is True]
+    no = [said[k] for k, v in best["matches"].items() if v is False]
+    unmeasured = [said[k] for k, v in best["matches"].items() if v is None]
+    undamped = art["verdict"].get("undamped_text")
     return ("has " + ("; ".join(yes) or "none of them")
-            + (f"; lacks {' and '.join(no)}" if no else "") + ".")
+            + (f"; lacks {' and '.join(no)}" if no else "")
+            + (f"; not measured: {' and '.join(unmeasured)}" if unmeasured else "")
+            + (f"; {undamped}" if undamped else "") + ".")
 
 
 def _cause_numbers(art):
-    """The numbers that decide each hypothesis, from the study's answer."""
-    h, RATIO = art["answer"]["hypotheses"], art["answer"]["ratio"]
-    m, ns, cs = h["mirror"], h["normal_stress"], h["consistency"]
-    units = "; ".join(
-        f"{u['n']} nodes per side, {u['bc']}: FEM P1 {rel(u['fem_five'], 2)}, own "
-        f"{', '.join(u['classes']['own']) or 'none'}, shared with FEM P1 "
-        f"{len(u['classes']['shared'])}" for u in m["units"])
-    rhos = [f"{r['rho']:.2f}" for r in cs["rows"] if r["rho"] is not None]
-    return ("The mirrored five split's period-2 signature, resolved and "
-            f"{RATIO:g} times the conforming splits' without the mirror, per (size, base): "
-            f"{units}; the largest anywhere is {rel(art['answer']['largest'])}, "
-            + ("visible" if art["answer"]["visible"] else "below the visible level")
-            + ". A normal-stress term "
-            + (f"reduces a model's own signature {RATIO:g}-fold in {ns['removed']} of "
-               f"{ns['pairs']} pairs" if ns["decided"] else "was not run where a model's own "
-               "signature exists: not decided")
-            + f"; the rank correlation with the patch-test error is {', '.join(rhos) or 'n/a'}"
-            + ("" if cs["holds"] else " (not resolved)")
-            + " ([artefact study](artefact/report.md)).")
+    """The numbers that decide the cause, as the study's answer states them."""
+    a = art["answer"]
+    if a.get("numbers"):
+        return a["numbers"] + " ([artefact study](artefact/report.md))."
+    return "([artefact study](artefact/report.md))."
 
 
 __all__ = ["lines", "table"]

@@ -10,6 +10,12 @@ from rich.progress import BarColumn, Progress as Bar, TextColumn, TimeElapsedCol
     TimeRemainingColumn
 
 LOG_STEPS = 10     # lines a log gets over the whole work
+NUMBERS = 40       # the columns the bar's numbers (percentage, elapsed, time left) need
+
+
+def fit(text, width):
+    """``text`` cut to ``width`` characters, an ellipsis marking the cut."""
+    return text if len(text) <= width else text[:width - 1] + "\u2026"
 
 
 class Progress:
@@ -20,7 +26,10 @@ class Progress:
         self.done, self._said = 0.0, 0
         self.console = Console(stderr=True)
         self.tty = log and sys.stderr.isatty()
-        self._bar = Bar(TextColumn(f"{{task.description:<{width}}}"), BarColumn(),
+        # the numbers keep their room on a narrow terminal: the description gives way
+        self.width = max(12, min(width, self.console.width - NUMBERS))
+        self._bar = Bar(TextColumn(f"{{task.description:<{self.width}}}"),
+                        BarColumn(bar_width=None if self.console.width > 100 else 10),
                         TextColumn("{task.percentage:>3.0f}%"), TimeElapsedColumn(),
                         TextColumn("left"), TimeRemainingColumn(), console=self.console,
                         disable=not self.tty)
@@ -38,7 +47,7 @@ class Progress:
         """``work`` more done; ``text`` what is being done now."""
         self.done += work
         self._bar.update(self._task, completed=self.done,
-                         description=text if text is not None else self.title)
+                         description=fit(text if text is not None else self.title, self.width))
         step = int(LOG_STEPS * self.done / self.total)
         if self.log and not self.tty and work and step > self._said:
             self._said = step

@@ -440,3 +440,17 @@ def test_after_a_stop_a_finaliser_cut_off_half_way_is_not_reported(monkeypatch, 
     elsewhere = type("U", (), {"object": print, "exc_value": ValueError("x")})()
     sys.unraisablehook(elsewhere)
     assert seen == [elsewhere]
+
+
+def test_the_progress_bar_keeps_its_numbers_at_80_columns(monkeypatch):
+    """At 80 columns the description gives way (cut with an ellipsis) so that the bar, the
+    percentage, the time spent and the time left keep their room."""
+    import io
+    from rich.console import Console
+    from cases import progress
+    monkeypatch.setattr(progress, "Console", lambda stderr: Console(
+        file=io.StringIO(), width=80, force_terminal=True))
+    p = progress.Progress("paper-cube", 10, width=56)
+    assert p.width == 80 - progress.NUMBERS
+    assert progress.fit("x" * 60, p.width) == "x" * (p.width - 1) + "\u2026"
+    assert progress.fit("short", p.width) == "short"

@@ -297,10 +297,10 @@ def units(cells, models=None):
                     for x in ctrls}
         floor = max([ROUND_OFF_FLOOR] + [abs(v) for v in fem_ctrl.values() if v is not None])
         identity = all(v is not None and abs(v) < ROUND_OFF_FLOOR for v in fem_ctrl.values())
-        law = _law_change(at, n, bc)
+        law, law_from = _law_change(at, n, bc), n
         if law is None:     # the linear load is not run on the finest meshes: the base's largest
-            law = max((x for x in (_law_change(at, k, bc) for k in range(n)) if x is not None),
-                      default=None)
+            got = [(x, k) for k in range(n) for x in [_law_change(at, k, bc)] if x is not None]
+            law, law_from = max(got, default=(None, None))
         fem_vs = None if fem_five is None else against(abs(fem_five) / floor, RATIO)
         rows, seen = [], []
         for m in mirrored:
@@ -365,7 +365,7 @@ def units(cells, models=None):
                     "controls": ctrls, "missing_controls": missing, "fem_five": fem_five,
                     "fem_controls": fem_ctrl, "floor": floor, "identity": identity,
                     "fem_ratio": None if fem_five is None else abs(fem_five) / floor,
-                    "fem_vs": fem_vs, "law": law, "rows": rows,
+                    "fem_vs": fem_vs, "law": law, "law_from": law_from, "rows": rows,
                     "distinct": len(distinct), "run": len(rows)})
     return out
 
@@ -548,9 +548,11 @@ def linear_check(cells):
                  and p["split"] == MIRRORED]
         pairs = [(p, q) for p, q in pairs if q is not None]
         fem, seen, rows = [], [], []
+        pairs = [(p, q) for p, q in pairs if p.get("alternation_rel") is not None
+                 and q.get("alternation_rel") is not None]
         for p, q in pairs:
-            a, b = p.get("alternation_rel"), q.get("alternation_rel")
-            if a is None or b is None or abs(a) <= 1e3 * ROUND_OFF_FLOOR:
+            a, b = p["alternation_rel"], q["alternation_rel"]
+            if abs(a) <= 1e3 * ROUND_OFF_FLOOR:
                 continue
             if p["family"] == CONTROL:
                 fem.append((p["nodes_per_side"], b / a))
@@ -655,8 +657,10 @@ def _mesh_text(dec):
 
 
 def times(x):
-    """A ratio for a sentence: two significant figures, whole from 100."""
-    return "n/a" if x is None else f"{x:.0f}" if x >= 100 else fmt(x, 2)
+    """A ratio for a sentence: two significant figures, whole from 100, powers of ten from
+    1e4."""
+    return ("n/a" if x is None else f"{x:.1e}" if x >= 1e4 else f"{x:.0f}" if x >= 100
+            else fmt(x, 2))
 
 
 def _five_text(us):
@@ -832,11 +836,10 @@ def _rank(table, key):
 
 
 def _lead_text(best, below, margin, tied, sure, key, total):
-    lead = (f", {margin} more than the rest ({below['model']} and below)"
-            if below is not None and margin else "")
+    lead = f", {margin} more than the other readings" if below is not None and margin else ""
     if sure == "tied":
-        return f"tied: {', '.join(tied)} each match {best[key]} of {total}{lead}"
-    return f"{best['model']} matches {best[key]} of {total}{lead}: a {sure} verdict"
+        return f"{', '.join(tied)} tie at {best[key]} of {total}{lead}"
+    return f"{best['model']} leads with {best[key]} of {total}{lead} (a {sure} verdict)"
 
 
 def reading_verdict(table, damping):
@@ -855,10 +858,10 @@ def reading_verdict(table, damping):
              for r in readings}
     none_all = all(r["score"] < total for r in readings)
     both = [r["name"] for r in extra if r["score"] == total and r["score_undamped"] == total]
-    undamped_text = "undamped: " + _lead_text(ub, us_, um, ut, usure, "score_undamped", total)
+    undamped_text = "undamped, " + _lead_text(ub, us_, um, ut, usure, "score_undamped", total)
     text = (("No reading reproduces all the paper's observables. " if none_all else "")
             + f"With the mass damping we assume ({damping:g} 1/s: a mode grows only where its "
-            f"undamped rate exceeds {damping / 2:g} 1/s) "
+            f"undamped rate exceeds {damping / 2:g} 1/s), "
             + _lead_text(best, second, margin, tied, sure, "score", total)
             + f"; {undamped_text} (a mode grows where its rate is above round-off; the paper "
             "states no damping). No reading's step is over "
