@@ -1,7 +1,9 @@
 """The one progress display of every command that computes: a rich bar with the time left on
-a terminal; on a log (CI, a file) a line at every tenth of the work; nothing when told not to
-log. The work is counted in whatever the caller advances by (runs, or an expected cost), and
-the time left assumes the rest goes at the pace so far."""
+a terminal (the description cut so that the numbers fit 80 columns); on a log (CI, a file) a
+line at every tenth of the work; nothing when told not to log. The work is counted in
+whatever the caller advances by (model runs and reference solves, reported from inside the
+units a worker runs; or an expected cost), and the time left assumes the rest goes at the
+pace so far."""
 import sys
 import time
 

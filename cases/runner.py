@@ -17,7 +17,7 @@ from .catalogue import FINITE, STATIC, err_name, ref_name
 from .framework import FINDINGS, Reference, linear_scale
 from .progress import Progress
 from .store import OFF, key
-from .workers import one_blas_thread
+from .workers import one_blas_thread, tick
 
 # a reference field that varies by less than this fraction of its size is uniform: its
 # variation is the iterative solver's (relative residual 1e-10 gives about 1e-9 here), and a
@@ -388,7 +388,8 @@ def _mesh_in_worker(job):
     case, s, mesh_name, store, reuse_full = job
     mesh_of = _built_once(case, s)
     with one_blas_thread():
-        return mesh_name, [unit(case, s, mesh_name, bc, mesh_of, store=store,
+        return mesh_name, [unit(case, s, mesh_name, bc, mesh_of,
+                                lambda text, done: tick(mesh_name, text, done), store=store,
                                 reuse_full=reuse_full) for bc in s.bcs]
 
 
@@ -429,11 +430,19 @@ def run(case, s, log=True, workers=None, store=OFF, reuse_full=False):
             mesh_of = _built_once(case, s)
             order = sorted(s.meshes, key=lambda name: -mesh_of(name).n_tets)
             jobs = [(case, s, mesh_name, store, reuse_full) for mesh_name in order]
-            for mesh_name, done in workers.unordered(_mesh_in_worker, jobs):
+            ticked, finished = {}, set()
+
+            def running(mesh_name, text, done):   # a model run finished inside a unit
+                if mesh_name not in finished:      # a late report is counted at the end
+                    ticked[mesh_name] = ticked.get(mesh_name, 0) + done
+                    bar.advance(done, text)
+            for mesh_name, done in workers.unordered(_mesh_in_worker, jobs, running):
                 stop.checkpoint()
+                finished.add(mesh_name)
                 for bc, result in zip(s.bcs, done):
                     results[units.index((mesh_name, bc))] = result
-                bar.advance(per_unit * len(s.bcs), f"{case.name} {mesh_name}: done")
+                bar.advance(per_unit * len(s.bcs) - ticked.get(mesh_name, 0),
+                            f"{case.name} {mesh_name}: done")
         bar.advance(0, f"{case.name}: done")
     runs, fields = [], {}
     for r, f in results:

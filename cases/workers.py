@@ -59,6 +59,23 @@ def _ignore_interrupt():
     signal.signal(signal.SIGINT, signal.SIG_IGN)
 
 
+_TICKS = None      # in a local worker: the queue its progress goes to (None elsewhere)
+
+
+def _init_worker(ticks):
+    global _TICKS
+    _ignore_interrupt()
+    _TICKS = ticks
+
+
+def tick(*news):
+    """Report progress within a unit from the process running it: ``news`` reaches the
+    ``on_tick`` of the ``outcomes`` call that gave the unit out (a local pool's; nothing on
+    a Dask cluster, where a unit's progress shows when it ends)."""
+    if _TICKS is not None:
+        _TICKS.put(news)
+
+
 def _indexed(item):
     fn, i, job = item
     with one_blas_thread():
@@ -98,9 +115,10 @@ class _Executor:
     n = 1
     dashboard = None
 
-    def unordered(self, fn, items):
-        """``fn(item)`` for every item, as the workers finish them; the first error raised."""
-        for _, error, result in self.outcomes(fn, items):
+    def unordered(self, fn, items, on_tick=None):
+        """``fn(item)`` for every item, as the workers finish them; the first error raised;
+        ``on_tick(*news)`` for what the units report while they run (``tick``)."""
+        for _, error, result in self.outcomes(fn, items, on_tick):
             if error is not None:
                 raise error
             yield result
@@ -114,11 +132,13 @@ class Workers(_Executor):
         if not (isinstance(n, int) and n >= 1):
             raise ValueError(f"the number of workers must be an integer >= 1, got {n!r}")
         self.n = n
-        self._pool = None
+        self._pool = self._ticks = None
 
     def _start(self):
-        self._pool = ProcessPoolExecutor(self.n, mp_context=multiprocessing.get_context("spawn"),
-                                         initializer=_ignore_interrupt)
+        context = multiprocessing.get_context("spawn")
+        self._ticks = context.SimpleQueue()
+        self._pool = ProcessPoolExecutor(self.n, mp_context=context, initializer=_init_worker,
+                                         initargs=(self._ticks,))
 
     def __enter__(self):
         self._start()
@@ -136,9 +156,14 @@ class Workers(_Executor):
     def __exit__(self, kind, value, tb):
         self._stop(now=kind is not None)
 
-    def outcomes(self, fn, items):
+    def _drain(self, on_tick):
+        while on_tick is not None and self._ticks is not None and not self._ticks.empty():
+            on_tick(*self._ticks.get())
+
+    def outcomes(self, fn, items, on_tick=None):
         """``(index, error, result)`` of ``fn(items[index])`` as each finishes; a unit whose
-        worker died is given out again on a new pool, at most RETRIES times."""
+        worker died is given out again on a new pool, at most RETRIES times; ``on_tick(*news)``
+        for each report of a running unit (``tick``), in this process."""
         items = list(items)
         tries = [0] * len(items)
         left = set(range(len(items)))
@@ -147,7 +172,9 @@ class Workers(_Executor):
             broken = False
             pending = set(futures)
             while pending:
-                done, pending = wait(pending, return_when=FIRST_COMPLETED)
+                done, pending = wait(pending, timeout=0.25 if on_tick else None,
+                                     return_when=FIRST_COMPLETED)
+                self._drain(on_tick)
                 for fut in done:
                     i = futures[fut]
                     try:
@@ -204,9 +231,10 @@ class Cluster(_Executor):
         if self.cluster is not None:
             self.cluster.close()
 
-    def outcomes(self, fn, items):
+    def outcomes(self, fn, items, on_tick=None):
         """``(index, error, result)`` as each task finishes; a task whose worker died is
-        given to another by the scheduler (allowed-failures), and only then is an error."""
+        given to another by the scheduler (allowed-failures), and only then is an error
+        (``on_tick`` is not called: a unit's progress shows when it ends)."""
         from distributed import as_completed
         futures = {self.client.submit(_call, fn, item, pure=False): i
                    for i, item in enumerate(items)}
@@ -234,5 +262,5 @@ def executor(scheduler=None, workers=None, units=None):
     return Workers(n) if n > 1 else None
 
 
-__all__ = ["Workers", "Cluster", "executor", "available_cores", "one_blas_thread",
+__all__ = ["Workers", "Cluster", "executor", "available_cores", "one_blas_thread", "tick",
            "WorkerLost", "SchedulerError", "RETRIES"]

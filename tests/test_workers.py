@@ -146,3 +146,21 @@ def test_a_stopped_run_leaves_no_worker_behind(sig, status, tmp_path):
         with pytest.raises(ProcessLookupError):
             os.kill(pid, 0)
     assert not (tmp_path / "pc").exists()
+
+
+def _reports_twice(x):
+    from cases.workers import tick
+    tick(x, "half")
+    tick(x, "all")
+    return x
+
+
+def test_a_local_pool_passes_a_units_progress_to_the_parent_as_it_runs():
+    """What a unit reports while it runs (``tick``) reaches ``on_tick`` in the parent, every
+    report of every unit, before its result is handed out."""
+    from cases.workers import Workers
+    seen = []
+    with Workers(2) as w:
+        for x in w.unordered(_reports_twice, [1, 2, 3], lambda *news: seen.append(news)):
+            assert (x, "all") in seen
+    assert sorted(seen) == sorted((x, w) for x in (1, 2, 3) for w in ("half", "all"))

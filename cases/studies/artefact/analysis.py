@@ -150,7 +150,7 @@ def metric_check(cells):
         if row is None:
             out[(n, bc)] = {"n": n, "bc": bc, "free": int(_free_layers(bc, n).sum()),
                             "decides": False, "why": f"{int(_free_layers(bc, n).sum())} free "
-                            "layers: no signature (they absorb less than a quadratic)"}
+                            "layers, no signature (they absorb less than a quadratic)"}
             continue
         why = (None if row["versus_clear"] == "below" and n >= DECISIVE else
                f"fewer than {DECISIVE} layers" if n < DECISIVE else
@@ -748,7 +748,9 @@ def how_sure(ans, verdict):
     """The report's 'how sure' line: what the answers rest on and what is at a threshold."""
     us = ans["hypotheses"]["mirror"]["units"]
     dec = [u for u in us if u["decides"]]
-    at = [f"{r['name']} ({u['n']} {u['bc']})" for u in dec for r in u["rows"]
+    at = [f"{r['name']} ({u['n']} {u['bc']}: "
+          + ("the clear level" if r["clear"] == "at" else r["kind"][len("at the threshold ("):-1])
+          + ")" for u in dec for r in u["rows"]
           if r["same_as"] is None and (r["kind"].startswith("at the") or r["clear"] == "at")]
     distinct = sum(u["distinct"] for u in dec)
     failed = [f"{r['name']} ({u['n']} {u['bc']})" for u in us for r in u["rows"]
