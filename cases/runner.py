@@ -4,6 +4,7 @@ metrics. A failure (a mesh that cannot be built, a reference that does not conve
 without equilibrium) is recorded in the runs it touches and the case goes on.
 """
 import dataclasses
+import sys
 from dataclasses import dataclass
 
 import numpy as np
@@ -401,6 +402,8 @@ def _built_once(case, s):
     def mesh_of(name):
         if name not in meshes:
             meshes[name] = case.mesh(name, s)
+            for line in meshes[name].warnings():     # said before it is computed on
+                print(f"pbcm: warning: {case.name} mesh {name}: {line}", file=sys.stderr)
         return meshes[name]
     return mesh_of
 

@@ -18,6 +18,9 @@ DEGENERATE_VOLUME_TOL = 1e-10
 # below this radius ratio (1 regular, 0 flat) a tetrahedron is a sliver: its stiffness
 # dominates a calibration and its stable step
 SLIVER_RADIUS_RATIO = 0.05
+# dihedral angles outside this range make a tetrahedron flat or needle-like even where its
+# radius ratio passes (a cap or a wedge): they cut the explicit stable step too
+DIHEDRAL_RANGE_DEG = (3.0, 175.0)
 
 
 def _first(ids, k=10):
@@ -159,6 +162,36 @@ class TetMesh:
     def slivers(self):
         """The tetrahedra whose radius ratio is below ``SLIVER_RADIUS_RATIO``, sorted."""
         return np.flatnonzero(radius_ratio(self.points, self.tets) < SLIVER_RADIUS_RATIO)
+
+    def warnings(self, k=5):
+        """What a run on this mesh should be told before computing: slivers (radius ratio below
+        SLIVER_RADIUS_RATIO) and tetrahedra with a dihedral angle outside DIHEDRAL_RANGE_DEG,
+        each with its worst ``k`` ids and values, and the tetrahedra read inverted (re-oriented);
+        [] for a sound mesh."""
+        out = []
+        rr = radius_ratio(self.points, self.tets)
+        thin = np.flatnonzero(rr < SLIVER_RADIUS_RATIO)
+        if thin.size:
+            worst = thin[np.argsort(rr[thin])][:k]
+            out.append(f"{thin.size} sliver(s) (radius ratio below {SLIVER_RADIUS_RATIO:g}), "
+                       "the worst: " + ", ".join(f"tetrahedron {i} ({rr[i]:.3g})"
+                                                for i in worst)
+                       + "; a calibrated model (c = auto) refuses them and they cut the "
+                       "explicit stable step: re-mesh them")
+        dih = dihedral_angles(self.points, self.tets)
+        lo, hi = DIHEDRAL_RANGE_DEG
+        off = np.maximum(lo - dih.min(axis=1), dih.max(axis=1) - hi)
+        bad = np.flatnonzero(off > 0)
+        if bad.size:
+            worst = bad[np.argsort(-off[bad])][:k]
+            out.append(f"{bad.size} tetrahedra with a dihedral angle outside {lo:g}-{hi:g} "
+                       "deg, the worst: " + ", ".join(
+                           f"tetrahedron {i} ({dih[i].min():.3g}-{dih[i].max():.3g} deg)"
+                           for i in worst))
+        if self.reoriented:
+            out.append(f"{self.reoriented} tetrahedra were read with a negative orientation and "
+                       "re-oriented: check the exporter's node order")
+        return out
 
     def quality(self):
         """Quality summary: volume, radius ratio (1 regular, 0 sliver), dihedral angles."""

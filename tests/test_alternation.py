@@ -112,3 +112,24 @@ def test_too_few_free_layers_and_bad_input():
         M.alternation(msm, np.zeros(5))
     with pytest.raises(M.MetricError, match="same"):
         M.alternation(msm, msm[:4])
+
+
+@pytest.mark.parametrize("n, symmetric, skewed", [(9, 3, 4), (17, 13, 13)])
+def test_the_degree_absorbed_depends_on_the_reference(n, symmetric, skewed):
+    """The polynomial degree the signature absorbs on m free layers depends on the reference:
+    n - 2 on n layers beside a uniform reference (the sliding cube's); on 7 free layers m - 4
+    beside a symmetric barrel and m - 3 beside an asymmetric one (the clamped cube's reference,
+    pushed from the top, is not symmetric); on 15 free layers a half-sine barrel is a
+    polynomial of degree m - 2 to the rank tolerance, so m - 2. The report prints the degree
+    each unit uses rather than one rule."""
+    from cases.studies.artefact.analysis import absorbed_degree
+    y = np.linspace(0.0, 1.0, n)
+    free = np.r_[False, [True] * (n - 2), False]
+    k = np.flatnonzero(free)
+    m = len(k)
+    uniform = M.nyquist_weights(np.full(n, 0.38), np.arange(n))
+    assert absorbed_degree(uniform, n) == n - 2
+    barrel = 0.45 * np.sin(np.pi * y)
+    assert absorbed_degree(M.nyquist_weights(barrel[free], k), m) == symmetric
+    skew = barrel * (1 + 0.01 * (y - 0.5))
+    assert absorbed_degree(M.nyquist_weights(skew[free], k), m) == skewed

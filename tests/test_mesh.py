@@ -200,3 +200,25 @@ def test_a_sliver_is_named_and_refused_for_calibration():
     with pytest.raises(ModelError, match="tetrahedra 1 of the mesh are slivers"):
         build("pbcm-variational", m, Material(10e3, 0.45))
     build("shear(reading=variational, c=1) + volume", m, Material(10e3, 0.45))
+
+
+def test_mesh_warnings_name_the_worst_slivers_and_dihedral_angles_before_computing(
+        tmp_path, capsys):
+    """A sliver (radius ratio below the threshold) and a flat tetrahedron (a dihedral angle
+    outside the range) are named with their ids and values, the worst first, by the mesh and
+    by `pbcm mesh`; a regular tetrahedron gives no warning."""
+    from cases.cli import main
+    pts = np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0], [0, 0, 1],
+                    [2, 0, 0], [3, 0, 0], [2, 1, 0], [3, 1, 0.02]], float)
+    regular = TetMesh(pts[:4], np.array([[0, 1, 2, 3]]))
+    assert regular.warnings() == []
+    mesh = TetMesh(pts, np.array([[0, 1, 2, 3], [4, 5, 6, 7]]))
+    sliver, flat = mesh.warnings()
+    assert sliver.startswith("1 sliver(s) (radius ratio below 0.05), the worst: tetrahedron 1 (")
+    assert flat.startswith("1 tetrahedra with a dihedral angle outside 3-175 deg, the worst: "
+                           "tetrahedron 1 (")
+    path = tmp_path / "m.vtu"
+    write(path, mesh)
+    assert main(["mesh", str(path)]) == 0
+    out = capsys.readouterr().out
+    assert "warning: 1 sliver(s)" in out and "warning: 1 tetrahedra with a dihedral" in out

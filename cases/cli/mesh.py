@@ -1,7 +1,7 @@
 """`pbcm mesh`: node and tetrahedron counts and quality of a mesh file or a cube."""
 from pathlib import Path
 
-from model.mesh import SCHEMES, SLIVER_RADIUS_RATIO, _first, box, read
+from model.mesh import SCHEMES, box, read
 from .common import UsageError, number
 
 def add(sub):
@@ -41,12 +41,7 @@ def run(args):
           "  (1 = regular, 0 = sliver)")
     print(f"  dihedral angles     min {q['dihedral_min_deg']:.1f} deg  "
           f"max {q['dihedral_max_deg']:.1f} deg")
-    if mesh.reoriented:
-        print(f"  re-oriented         {mesh.reoriented} negatively ordered tetrahedra")
-    thin = mesh.slivers()
-    if thin.size:
-        print(f"  warning: {thin.size} sliver(s) (radius ratio below {SLIVER_RADIUS_RATIO:g}): "
-              f"tetrahedra {_first(thin)}; a calibrated model (c = auto) refuses them and "
-              "they cut the explicit stable step: re-mesh them")
+    for line in mesh.warnings():
+        print(f"  warning: {line}")
     return 0
 

@@ -464,7 +464,8 @@ def normal_stress(cells, us):
         ratio = abs(with_) / abs(without)
         pairs.append({"n": n, "bc": bc, "term": normal, "model": name,
                       "base": short(base["model"]), "without": without, "with": with_,
-                      "ratio": ratio, "reduced": against(1.0 / ratio, RATIO)})
+                      "ratio": ratio, "reduced": against(
+                          abs(without) / max(abs(with_), ROUND_OFF_FLOOR), RATIO)})
     removed = sum(p["reduced"] == "above" for p in pairs)
     at_ = sum(p["reduced"] == "at" for p in pairs)
     return {"pairs": pairs, "untested": untested, "tested": len(pairs), "removed": removed,
