@@ -164,8 +164,7 @@ def lines(root, models, pops=(), quick=False):
         v = art["verdict"]
         out.append(f"**Which reading?** Tied between {', '.join(v['tied'])} "
                    f"([artefact study](artefact/report.md)): in the study's runs "
-                   + ("each " if len({json.dumps({k: x is True for k, x in r["matches"].items()},
-                                                 sort_keys=True)
+                   + ("each " if len({json.dumps(r["matches"], sort_keys=True)
                                       for r in art["readings"] if r["model"] in v["tied"]}) == 1
                       else f"{v['model']} ") + _decisive(art))
     elif art:

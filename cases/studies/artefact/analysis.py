@@ -759,8 +759,9 @@ def how_sure(ans, verdict):
     return ("**How sure.** " + (
         f"The cause rests on {len(dec)} of {len(us)} (size, base) units (those whose smooth "
         f"test fields leak below {CLEAR:g}), {distinct} distinct model signatures there, one "
-        "mesh per split and size (no spread over meshes of one continuum problem), orders "
-        "from two sizes only; "
+        "mesh per split and size (no spread over meshes of one continuum problem)"
+        + (", orders from two sizes only; " if any(
+            o["orders"] for o in ans["hypotheses"]["mirror"]["orders"].values()) else "; ")
         + (f"within {NEAR:.0%} of a threshold, not decided: {', '.join(at)}; " if at
            else f"none within {NEAR:.0%} of a threshold; ")
         + (f"failed: {', '.join(failed)}; " if failed else "")
@@ -861,20 +862,20 @@ def reading_verdict(table, damping):
              for r in readings}
     none_all = all(r["score"] < total for r in readings)
     both = [r["name"] for r in extra if r["score"] == total and r["score_undamped"] == total]
-    undamped_text = "undamped, " + _lead_text(ub, us_, um, ut, usure, "score_undamped", total)
+    undamped_text = ("without damping (a mode grows where its rate is above round-off), "
+                     + _lead_text(ub, us_, um, ut, usure, "score_undamped", total))
     text = (("No reading reproduces all the paper's observables. " if none_all else "")
             + f"With the mass damping we assume ({damping:g} 1/s: a mode grows only where its "
             f"undamped rate exceeds {damping / 2:g} 1/s), "
             + _lead_text(best, second, margin, tied, sure, "score", total)
-            + f"; {undamped_text} (a mode grows where its rate is above round-off; the paper "
-            "states no damping). No reading's step is over "
+            + f"; {undamped_text}; the paper states no damping. No reading's step is over "
             f"{PAPER_COST:g} times msm's ("
             + (f"{fmt(min(costs), 3)}-{fmt(max(costs), 3)}" if costs else "none timed")
-            + (f"; not timed: {', '.join(untimed)}, assumed equal to the calibrated "
-               "reading's" if untimed else "") + ")"
+            + (f"; not timed: {', '.join(untimed)}, whose stored ratio is the calibrated "
+               "reading's, not a measurement" if untimed else "") + ")"
             + (f". With a normal-stress term the paper's equations lack, {', '.join(both)} "
-               "match both observables with and without damping (a cost of this "
-               "implementation)" if both else "") + ".")
+               "match both observables with and without damping (their step cost is this "
+               "implementation's)" if both else "") + ".")
     return {"model": best["model"], "sure": sure, "margin": margin, "tied": tied,
             "none_reproduces": none_all, "fails": fails, "text": text,
             "undamped": {"model": ub["model"], "sure": usure, "margin": um, "tied": ut},

@@ -137,9 +137,13 @@ def _what_was_run(d, s, doc):
         "The signature (glossary: alternation): beta of the exact fit profile_k = alpha "
         "reference_k + q(k) + beta (-1)^k over the free layers (every layer sliding, all but "
         "the two held ones clamped), q the polynomial of the highest degree that leaves "
-        "(-1)^k apart: n - 2 on n free layers beside the sliding base's uniform reference, "
-        "n - 3 beside the clamped base's barrel, which is not exactly symmetric (the degree "
-        "each unit uses is in the metric's check). Positive: the layers of even index from "
+        "(-1)^k apart, which depends on the reference: n - 2 on n free layers beside the "
+        "sliding base's uniform reference, n - 3 beside the clamped base's barrel, which is "
+        "not exactly symmetric (here: " + ", ".join(
+            f"{_unit(u)} degree {u['check']['degree']} on {u['check']['free']}"
+            for u in doc["answer"]["hypotheses"]["mirror"]["units"]
+            if u["check"].get("degree") is not None) + " free layers). Positive: the "
+        "layers of even index from "
         "the base out bulge (the paper's sign). Relative to the reference's mean |lateral "
         "displacement| over all layers (alternation rel, stored and gated: the classes are "
         "ratios of signatures on the same layers and do not depend on it), and relative to "
