@@ -56,8 +56,8 @@ def test_a_value_within_a_fifth_of_a_threshold_is_at_it():
 def test_the_pattern_is_read_over_the_models_own_lateral_displacement():
     """The clear level applies to the signature over the model's own mean lateral displacement:
     a body with a third of the continuum's lateral displacement and a signature of 0.005 of the
-    reference's mean is clear (about 0.015 of its own); + is the paper's sign; within 20 % of the level is 'at'; undefined or
-    failed is None."""
+    reference's mean is clear (about 0.015 of its own); + is the paper's sign; within 20 % of
+    the level is 'at'; undefined or failed is None."""
     soft = cell("five", FIVE, "m", 0.005, scale=1 / 3)
     # its own mean over 5 layers: 1/3 of the continuum's plus 1/5 of the alternation
     assert analysis.signature_own(soft) == pytest.approx(0.005 / (1 / 3 + 0.001), rel=1e-9)

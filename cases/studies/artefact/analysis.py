@@ -152,11 +152,12 @@ def metric_check(cells):
                             "decides": False, "why": f"{int(_free_layers(bc, n).sum())} free "
                             "layers, no signature (they absorb less than a quadratic)"}
             continue
-        why = (None if row["versus_clear"] == "below" and n >= DECISIVE else
-               f"fewer than {DECISIVE} layers" if n < DECISIVE else
-               f"smooth fields leak {fmt(row['worst'], 2)} of their height "
-               + ("at" if row["versus_clear"] == "at" else "above") + f" the clear level "
-               f"{CLEAR:g}")
+        reasons = ([f"fewer than {DECISIVE} layers"] if n < DECISIVE else []) + (
+            [] if row["versus_clear"] == "below" else
+            [f"smooth fields leak {fmt(row['worst'], 2)} of their height "
+             + ("at" if row["versus_clear"] == "at" else "above") + f" the clear level "
+             f"{CLEAR:g}"])
+        why = "; ".join(reasons) or None
         out[(n, bc)] = {"n": n, "bc": bc, **row, "decides": why is None, "why": why}
     return out
 

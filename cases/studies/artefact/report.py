@@ -126,7 +126,7 @@ def _what_was_run(d, s, doc):
         "only appear on the sliding base. Loads: the paper's push "
         f"({doc['problem']['push_mm']:g} mm) and {LINEAR_SCALE:g} of it (the linear regime; "
         "on the sliding base a patch test), the latter below the finest size.",
-        "The reference: P2 on the six split of 5^3 nodes refined "
+        "The reference: P2 on the six split (one of the controls' splits) of 5^3 nodes refined "
         f"{doc['problem']['reference']['refinements']} time(s), neo-Hookean at the push, "
         "linear at the linear load; its error estimate (the relative L2 difference of the "
         "displacement from the unrefined solution: one difference, unitless): " + "; ".join(
@@ -215,10 +215,11 @@ def _mirror(d, doc):
         n = sum(len(v) for v in k.values())
         rows.append([_unit(u), "yes" if u["decides"] else "no",
                      ", ".join(x.split(" ")[0] for x in u["controls"]) + "".join(
-                         f"; {x.split(' ')[0]} not run for {len(v)}"
+                         f"; {x.split(' ')[0]} not run for {len(v)} of {u['run']}"
                          for x, v in u["missing_controls"].items() if v),
                      _sig(u["fem_five"]),
-                     ("identity check (exact)" if u["identity"] else _sig(u["floor"])),
+                     ("n/a" if u["fem_five"] is None else "identity check (exact)"
+                      if u["identity"] else _sig(u["floor"])),
                      times(u["fem_ratio"]) if not u["identity"] else "n/a",
                      "n/a (P1 exact)" if u["identity"] else
                      fmt(u["law"], 2) + ("" if u["law_from"] in (None, u["n"])
@@ -251,6 +252,12 @@ def _mirror(d, doc):
                          times(r.get("mirror_ratio")), _sig(r["unmirrored"]), r["kind"]])
     d.table(["model", "unit", "signature", "over own mean", "lateral stiffness error",
              "part (model - FEM P1)", "u", "mirror ratio", "unmirrored five", "class"], rows)
+    failed = [(u, r) for u in us for r in u["rows"] if r["kind"].startswith("failed")]
+    if failed:
+        d.p("Failed observations (a hole, counted against the model): " + "; ".join(
+            f"{r['name']} at {_unit(u)}: {r['kind']}" for u, r in failed) + ". The study's "
+            "static solve splits the load into up to 8 steps before it reports a failure; no "
+            "finer stepping was run, so these cells have no number.")
     tags = a.get("by_reading") or {}
     if tags:
         dec = [u for u in us if u["decides"]]
