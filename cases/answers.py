@@ -408,15 +408,15 @@ def recommendation(root, models, pops, quick, bench_rows):
                    + ".")
     if fin and p1_fin:
         b, others = best(fin, True)
-        n = len([p for p in pops if p.finite])
+        n = len([p for p in pops if p.finite and not p.patch_test])
         order = [m for _, m, _, _ in scorecard.ranked(lin)] if lin else []
         linear = (f"; in the linear regime it ranks {order.index(b) + 1} of {len(order)}"
                   + (f" with {lin[b][2]} failed runs" if lin[b][2] else "")
                   if b in order else "")
-        said = (f"; not decided on {n} case{'s' if n > 1 else ''} between "
+        said = (f"; not decided on {n} case/bc population{'s' if n > 1 else ''} between "
                 f"{', '.join([b] + others)} (tied, or level or reversed when one mesh family "
                 "or one case is left out)" if others else
-                f"; the closest other, on {n} case{'s' if n > 1 else ''}, is "
+                f"; the closest other, on {n} case/bc population{'s' if n > 1 else ''}, is "
                 f"{named(fin, b, others, True)}{linear}") if b else ""
         cands = [b] + others if b else []
         failing = [f"{m} ({fin[m][2]} failed runs)" for m in cands if fin[m][2]]

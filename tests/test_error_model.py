@@ -317,7 +317,7 @@ def test_what_to_pick_is_computed_and_names_what_is_not_decided(tmp_path):
                                "meshes, torsion/clamped)")
     assert "the closest approximation is a, model-form error 0.1" in lines[1]
     # at finite load a's model-form errors are 0.1, 0.2 and b's 0.1, 0.2 (six reversed)
-    assert "not decided on 1 case between" in lines[2]
+    assert "not decided on 1 case/bc population between" in lines[2]
     assert "with failed runs (no equilibrium at the load): b (1 failed runs)" in lines[2]
     assert recommendation(tmp_path, ["a"], pops, True, {}) == [
         "**What to pick?** Quick: not decided (`pbcm report` decides)."]
