@@ -134,6 +134,11 @@ def _population(case, bc, q, rs, quick, patch_test, estimate_key, where):
             lost_total.setdefault(r["model"], []).append(r.get(failed_total) or 0)
     twins = [abs(p.model_form) for m in SAME_LAW.get(q.p1, ()) if m in parts
              for p in parts[m] if p is not None]
+    # P1's own model run against the twin a Norm is measured on (the reference's P1): how
+    # closely two solvers of one discrete problem agree, below which nothing is resolved
+    if isinstance(q, E.Norm):
+        twins += [abs(r[q.model_form]) for r in rs
+                  if r["model"] == q.p1 and r.get(q.model_form) is not None]
     u_mf = max([E.ROUND_OFF] + twins)
     est = [r[estimate_key] for r in rs if r.get(estimate_key) is not None]
     cont = {r["mesh"]: r.get(q.continuum) for r in rs} if hasattr(q, "continuum") else {}

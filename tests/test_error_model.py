@@ -457,3 +457,24 @@ def test_at_the_load_fem_neohookean_is_its_own_twin_and_the_others_are_measured(
     assert linear and min(linear) > 100 * max(twins)
     assert "at the load] What replacing FEM P1 costs (displacement at the case's load" in \
         (quick / "report.md").read_text()
+
+
+def test_a_norms_uncertainty_includes_p1s_own_distance_to_its_twin():
+    """The model-form u_val of a field comparison includes how far FEM P1's own run lies
+    from the P1 twin the others are measured on (two solvers of one discrete problem): a
+    model closer to the first than that is tied with it."""
+    q = E.Norm("mf", "tot", "displacement", p1="fem-neohookean")
+    run = {"mesh": "five", "bc": "clamped"}
+    runs = [dict(run, model="fem-neohookean", mf=3e-6, tot=0.1),
+            dict(run, model="a", mf=0.02, tot=0.11), dict(run, model="b", mf=0.020002,
+                                                            tot=0.12)]
+
+    class Declared:
+        @staticmethod
+        def decompositions():
+            return (q,)
+    (p,) = scorecard.populations({"torsion": runs}, {"torsion": Declared},
+                                 {"torsion": False}, {"torsion": set()}, {"torsion": "est"})
+    assert p.u_model_form == 3e-6
+    (_, a, tied_a), (_, b, _) = p.standings()
+    assert (a.model, b.model) == ("a", "b") and tied_a == ("b",)
