@@ -216,7 +216,10 @@ def lines(root, models, pops=(), quick=False):
                    + " ([convergence](convergence/report.md)).")
     truth = _load(root, MEASURED, "metrics.json")
     if truth and truth.get("headline"):
-        out.append(_measured_line(truth, models))
+        out.append(_measured_line(truth, models) if not truth["parameters"]["quick"] else
+                   "**How far from a measured body?** Quick: not decided (`pbcm run "
+                   "truth-cube` decides: a quick run has no variants of the inputs nobody "
+                   "measured, so no u_input to read the beads against).")
     rows = {m: _bench_row(bench, m) for m in models}
     if all(rows.get(k) for k in ("fem-linear", "msm")):
         fl = rows["fem-linear"]
