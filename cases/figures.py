@@ -19,10 +19,11 @@ def boundary_faces(tets):
     return f[once], np.repeat(np.arange(len(tets)), 4)[once]
 
 
-def stress_panels(path, panels, title, magnify):
+def stress_panels(path, panels, title, magnify, up="y"):
     """The analogue of the paper's Figure 1: each panel (label, mesh, u, max_tau) drawn
-    deformed (displacement x ``magnify``), boundary faces coloured by max |tau| on one shared
-    scale: blue at or below 0.01 of it, red at or above 0.9."""
+    deformed (displacement x ``magnify``), standing on the axis ``up``, boundary faces
+    coloured by max |tau| on one shared scale: blue at or below 0.01 of it, red at or above
+    0.9."""
     scale = max(float(np.max(p[3])) for p in panels)
     # the paper's normalisation: max |tau| / scale, blue at or below 0.01, red from 0.9
     norm = matplotlib.colors.Normalize(vmin=0.01, vmax=0.9, clip=True)
@@ -40,7 +41,7 @@ def stress_panels(path, panels, title, magnify):
         pad = 0.06 * (hi - lo).max()
         ax.set_xlim(lo[0] - pad, hi[0] + pad), ax.set_ylim(lo[1] - pad, hi[1] + pad)
         ax.set_zlim(lo[2] - pad, hi[2] + pad)
-        ax.view_init(elev=20, azim=-60, vertical_axis="y")
+        ax.view_init(elev=20, azim=-60, vertical_axis=up)
         ax.set_box_aspect(tuple(hi - lo + 2 * pad))
         ax.set_title(label, fontsize=9)
         ax.set_axis_off()

@@ -260,6 +260,9 @@ class Case(abc.ABC):
     static : whether the case has a static displacement problem (what ``pbcm fit`` fits).
     resolution, load : the Settings fields a sweep's ``resolution`` and ``load`` axes turn
         (a Knob each), or None where the case has none.
+    up : the vertical axis ("x", "y" or "z") the report's figures stand on.
+    material_from : where the report says the material comes from (the options that change
+        it).
     """
 
     name: ClassVar[str]
@@ -288,6 +291,8 @@ class Case(abc.ABC):
     static: ClassVar[bool] = True          # False: no static displacement (modes)
     resolution: ClassVar[Knob] = None      # what a sweep's resolution axis turns
     load: ClassVar[Knob] = None            # what a sweep's load axis turns
+    up: ClassVar[str] = "y"                # the vertical axis of the figures
+    material_from: ClassVar[str] = "override with --E, --nu, --rho"
 
     def __init_subclass__(cls, **kw):
         """A declaration error shows when the case is imported, not in its report."""
@@ -419,6 +424,10 @@ class Case(abc.ABC):
         return {}
 
     # ------------------------------------------------------------------ report
+    def command(self):
+        """The command that runs this case, as a report tells its reader."""
+        return f"pbcm run {self.name}"
+
     def what_was_run(self, s, runs):
         """Report lines saying what the case ran (geometry, loads, references)."""
         return []

@@ -283,15 +283,24 @@ def measured(metrics_dir):
         problems[(case, mode)] = problem
         sources[(case, mode)] = f
         # the file says which metrics are gated; the catalogue says which way
-        try:
-            directions.update({m: catalogue.metric(m).direction for m in gated})
-        except KeyError as exc:
-            raise CheckError(f"{f} gates {exc.args[0]}") from None
+        directions.update({m: _direction(m, data["gated"], f) for m in gated})
         for r in runs:
             rows.add((case, mode, r["mesh"], r["bc"], r["model"]))
             for metric in gated:
                 values[(case, mode, r["mesh"], r["bc"], r["model"], metric)] = r.get(metric)
     return Measurements(values, problems, directions, rows, sources)
+
+
+def _direction(metric, recorded, path):
+    """The gate's direction of ``metric``: the catalogue's; for a metric it does not know (a
+    quantity a user's problem declares, ``pbcm run --problem``), the one the file recorded."""
+    if catalogue.known(metric):
+        return catalogue.metric(metric).direction
+    given = recorded.get(metric) if isinstance(recorded, dict) else None
+    if given not in ("max", "min", "signed"):
+        raise CheckError(f"{path} gates {metric!r}, which is not a metric of the catalogue "
+                         "and whose direction the file does not record; rerun the case")
+    return given
 
 
 def _same_problem(case, mode, recorded, ran):
@@ -343,7 +352,19 @@ def check(gold, measurements, only_run=False, models=None):
     else:
         gold_rows = gold.rows
     ran = {k[:2] for k in values} | {k[:2] for k in (measurements.rows or ())}
+    # a case or problem the gold has never seen is new, as a model without gold is
+    unseen = {c for c in ran if c not in gold.problems and not any(k[:2] == c
+                                                                    for k in gold_rows)}
+    ran -= unseen
     rows = {k: v for k, v in gold_rows.items() if k[:2] in ran}
+    if not rows and unseen:
+        bad = [k for k, v in values.items() if v is not None and not _finite(v)]
+        if bad:
+            raise CheckError(f"metric {bad[0][5]} of {'/'.join(bad[0][:5])} is "
+                             f"{values[bad[0]]!r}, not a finite number")
+        return Verdict([], [], [(c, m, "every model", sum(
+            1 for k, v in values.items() if k[:2] == (c, m) and v is not None))
+            for c, m in sorted(unseen)], NEW, 0)
     if not rows:
         raise CheckError(f"no gold for the measured {', '.join('/'.join(r) for r in sorted(ran))}"
                          "; run in a mode the gold covers, or bless this one")
@@ -357,6 +378,11 @@ def check(gold, measurements, only_run=False, models=None):
     measured_rows = set(measurements.rows or {k[:5] for k in values})
     new = {}
     for k, v in values.items():
+        if k[:2] in unseen:
+            if v is not None and not _finite(v):
+                raise CheckError(f"metric {k[5]} of {'/'.join(k[:5])} is {v!r}, not a "
+                                 "finite number")
+            continue
         if not (k[:2] + (k[4],) in gated_models):
             if v is not None and not _finite(v):
                 raise CheckError(f"metric {k[5]} of {'/'.join(k[:5])} is {v!r}, not a "
@@ -403,6 +429,9 @@ def check(gold, measurements, only_run=False, models=None):
     if not out and not flips:
         raise CheckError("no value was compared with its gold (every gated value is n/a in "
                          "both): a check that reads nothing passes nothing")
+    for c, m in sorted(unseen):
+        new[(c, m, "every model")] = sum(1 for k, v in values.items()
+                                         if k[:2] == (c, m) and v is not None)
     if new and status == 0:
         status = NEW
     return Verdict(out, flips, [(*k, n) for k, n in sorted(new.items())], status,

@@ -431,36 +431,18 @@ def read(path, file_format=None):
     Raises MeshError naming the file and the formats tried for every unreadable input
     (missing, empty, garbage, truncated, unknown extension, no tetrahedra), never SystemExit.
     """
-    import contextlib
-    import io
+    return read_with_sets(path, file_format)[0]
+
+
+def read_with_sets(path, file_format=None):
+    """``(mesh, sets)``: the TetMesh of :func:`read` and the file's named node sets,
+    {name: sorted node indices of that mesh}: its point sets, its cell sets and (Gmsh) its
+    physical groups, each as the nodes of its cells that belong to a tetrahedron (a surface
+    group gives the nodes of its triangles). The first of these that names a set wins."""
     from pathlib import Path
 
-    import meshio
-
     path = Path(path)
-    if not path.is_file():
-        raise MeshError(f"mesh file {path} does not exist" if not path.exists()
-                        else f"mesh file {path} is not a file")
-    if path.stat().st_size == 0:
-        raise MeshError(f"mesh file {path} is empty")
-    if file_format is None:
-        tried = meshio.extension_to_filetypes.get(path.suffix.lower())
-        if not tried:
-            raise MeshError(f"cannot read mesh file {path}: the extension {path.suffix!r} is not "
-                            "a mesh format meshio knows (e.g. .msh, .vtu, .vtk, .mesh, .inp); "
-                            "rename it or pass file_format")
-    else:
-        tried = [file_format]
-    said = io.StringIO()   # meshio prints to stdout and may call sys.exit on a bad file
-    try:
-        with contextlib.redirect_stdout(said), contextlib.redirect_stderr(said):
-            m = meshio.read(path, file_format=file_format)
-    except (Exception, SystemExit) as exc:
-        reason = " ".join((str(exc) if not isinstance(exc, SystemExit) else "").split()) \
-            or " ".join(said.getvalue().split()) or type(exc).__name__
-        raise MeshError(f"cannot read mesh file {path} as {' or '.join(tried)} (formats tried "
-                        f"for {path.suffix or 'it'}): {reason[:300]}; is the file complete and "
-                        "in that format?") from None
+    m = _meshio_read(path, file_format)
     blocks = [c.data for c in m.cells if c.type == "tetra"]
     if not blocks:
         kinds = sorted({c.type for c in m.cells}) or ["none"]
@@ -478,9 +460,64 @@ def read(path, file_format=None):
     remap = np.full(len(pts), -1)
     remap[used] = np.arange(len(used))
     try:
-        return TetMesh(pts[used], remap[tets])
+        mesh = TetMesh(pts[used], remap[tets])
     except MeshError as exc:
         raise MeshError(f"{path}: {exc}") from None
+    sets = {}
+    for name, nodes in _named_sets(m).items():
+        kept = remap[np.unique(np.asarray(nodes, dtype=np.int64))]
+        sets.setdefault(name, np.sort(kept[kept >= 0]))
+    return mesh, sets
+
+
+def _named_sets(m):
+    """{name: file node indices} of a meshio Mesh: point sets, cell sets, Gmsh physical
+    groups (the names of ``field_data``, matched on the tag and dimension of each block)."""
+    out = {name: np.asarray(ids).ravel() for name, ids in (m.point_sets or {}).items()}
+    for name, per_block in (m.cell_sets or {}).items():
+        nodes = [m.cells[k].data[np.asarray(ids, dtype=np.int64)].ravel()
+                 for k, ids in enumerate(per_block) if ids is not None and len(ids)]
+        out.setdefault(name, np.concatenate(nodes) if nodes else np.zeros(0, np.int64))
+    tags = (m.cell_data or {}).get("gmsh:physical")
+    dims = {"vertex": 0, "line": 1, "triangle": 2, "quad": 2, "tetra": 3, "hexahedron": 3}
+    for name, (tag, dim) in ((n, v[:2]) for n, v in (m.field_data or {}).items()
+                             if tags is not None and len(v) >= 2):
+        nodes = [c.data[np.asarray(t) == tag].ravel() for c, t in zip(m.cells, tags)
+                 if dims.get(c.type) == dim]
+        out.setdefault(name, np.concatenate(nodes) if nodes else np.zeros(0, np.int64))
+    return out
+
+
+def _meshio_read(path, file_format):
+    """The meshio Mesh of ``path``, or a MeshError naming the file and the formats tried."""
+    import contextlib
+    import io
+
+    import meshio
+
+    if not path.is_file():
+        raise MeshError(f"mesh file {path} does not exist" if not path.exists()
+                        else f"mesh file {path} is not a file")
+    if path.stat().st_size == 0:
+        raise MeshError(f"mesh file {path} is empty")
+    if file_format is None:
+        tried = meshio.extension_to_filetypes.get(path.suffix.lower())
+        if not tried:
+            raise MeshError(f"cannot read mesh file {path}: the extension {path.suffix!r} is not "
+                            "a mesh format meshio knows (e.g. .msh, .vtu, .vtk, .mesh, .inp); "
+                            "rename it or pass file_format")
+    else:
+        tried = [file_format]
+    said = io.StringIO()   # meshio prints to stdout and may call sys.exit on a bad file
+    try:
+        with contextlib.redirect_stdout(said), contextlib.redirect_stderr(said):
+            return meshio.read(path, file_format=file_format)
+    except (Exception, SystemExit) as exc:
+        reason = " ".join((str(exc) if not isinstance(exc, SystemExit) else "").split()) \
+            or " ".join(said.getvalue().split()) or type(exc).__name__
+        raise MeshError(f"cannot read mesh file {path} as {' or '.join(tried)} (formats tried "
+                        f"for {path.suffix or 'it'}): {reason[:300]}; is the file complete and "
+                        "in that format?") from None
 
 
 def write(path, mesh, point_data=None, cell_data=None):

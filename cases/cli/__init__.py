@@ -14,13 +14,14 @@ import model
 import model.terms
 from model.errors import PbcmError
 from .. import stop
-from . import bench, bless, cache, check, fit, index, listing, mesh, report, run, sweep
+from . import (bench, bless, cache, check, fit, index, listing, mesh, problem, report, run,
+               sweep)
 from .common import Parser, UsageError
 
 DESCRIPTION = """\
 pbcm measures how far the particle soft-body model of Nakagawa et al. is from the continuum:
 it runs cases against FEM references, writes reports, and gates CI on gold values."""
-COMMANDS = (mesh, listing, run, report, bench, fit, index, check, sweep, bless, cache)
+COMMANDS = (mesh, listing, run, problem, report, bench, fit, index, check, sweep, bless, cache)
 
 
 def parser():

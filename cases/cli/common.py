@@ -116,10 +116,14 @@ def case_config(case, args):
 def run_case_into(name, cfg, folder, workers=None, store=None):
     """Run case ``name`` with ``cfg`` (on ``workers``, a started Workers, when given; from
     and into ``store``, a RunStore) and write its files into the existing ``folder``."""
+    return case_into(case_named(name), cfg, folder, workers, store)
+
+
+def case_into(case, cfg, folder, workers=None, store=None):
+    """Run ``case`` (a Case, of the library or a user's problem) as ``run_case_into``."""
     from ..report import write_case
     from ..runner import run
     from ..store import OFF
-    case = case_named(name)
     runs, fields = run(case, cfg, workers=workers, store=store or OFF)
     write_case(folder, case, cfg, runs, fields)
     return runs

@@ -1,15 +1,27 @@
-"""`pbcm run CASE`: one case or study, written to its folder."""
+"""`pbcm run CASE`: one case or study, written to its folder; `pbcm run --problem FILE`: a
+user's problem, declared in a TOML file, run as a case."""
 from pathlib import Path
 
+import model
 from ..output import StagedFolder
-from .common import (UsageError, add_selection, case_configs, run_case_into, run_store,
-                     run_study_into, study_config, worker_pool)
+from .common import (UsageError, add_selection, case_configs, case_into, check_executor,
+                     chosen_models, run_case_into, run_store, run_study_into, study_config,
+                     worker_pool)
 
 def add(sub):
     """The command's parser."""
-    r = sub.add_parser("run", help="run one case and write its report folder")
-    r.add_argument("case", help="a case or study name (see pbcm list)")
-    r.add_argument("--out", help="output folder (default reports/CASE)")
+    r = sub.add_parser("run", help="run one case, study or problem and write its report folder",
+                       description="Run a case or study of the library (`pbcm list` names "
+                                   "them), or a problem of your own: --problem FILE.toml "
+                                   "declares its mesh, material, boundary conditions and "
+                                   "measures (`pbcm problem new NAME` writes a commented "
+                                   "template).")
+    r.add_argument("case", nargs="?", help="a case or study name (see pbcm list)")
+    r.add_argument("--problem", metavar="FILE",
+                   help="run the problem this TOML file declares instead of a library case "
+                        "(output: reports/problems/NAME, NAME its name)")
+    r.add_argument("--out", help="output folder (default reports/CASE, or "
+                                 "reports/problems/NAME for --problem)")
     r.add_argument("--rewrite", action="store_true",
                    help="a study only: draw its report again from the runs recorded in the "
                         "metrics.json of --out, without computing (after a change of the "
@@ -20,6 +32,8 @@ def add(sub):
 
 def run(args):
     from ..registry import STUDY_MODULES, studies
+    if args.problem or not args.case:
+        return _run_problem(args)
     if args.case in STUDY_MODULES and args.rewrite:
         return _rewrite_study(studies()[args.case], Path(args.out) if args.out
                               else Path("reports") / args.case)
@@ -49,6 +63,40 @@ def run(args):
         runs = run_case_into(args.case, cfgs[args.case], out.path, workers, run_store(args))
         path = out.commit()
     print(f"{args.case}: {len(runs)} runs written to {path}")
+    return 0
+
+
+# what a problem's TOML declares, so the command line does not: the option and the key
+FROM_THE_TOML = {"meshes": "[mesh] file", "bcs": "the [[displacement]] entries",
+                 "E": "[material] E", "nu": "[material] nu", "rho": "[material] rho",
+                 "rewrite": None}
+
+
+def _run_problem(args):
+    """`pbcm run --problem FILE`: the problem checked whole, then run as a case into its
+    folder, with a verbatim copy of the TOML."""
+    from ..library.problem import problem_case
+    if not args.problem:
+        raise UsageError("give a case or study name (see `pbcm list`), or --problem FILE.toml")
+    if args.case:
+        raise UsageError(f"give either the case {args.case} or --problem {args.problem}, not "
+                         "both")
+    for option, key in FROM_THE_TOML.items():
+        if getattr(args, option, None):
+            where = f"set {key} in the TOML" if key else "rerun the problem"
+            raise UsageError(f"--{option} does not apply to --problem: {where}")
+    check_executor(args)
+    path = Path(args.problem)
+    case = problem_case(path)        # every error of the TOML, before any computing
+    cfg = case.settings(quick=args.quick, models=chosen_models(args.models,
+                                                                list(model.PRESETS)))
+    with StagedFolder(Path(args.out) if args.out else Path("reports") / "problems" / case.name,
+                      owner=case.name) as out, \
+            worker_pool(args, {case.name: cfg}) as workers:
+        runs = case_into(case, cfg, out.path, workers, run_store(args))
+        (out.path / path.name).write_bytes(case.spec.source)
+        written = out.commit()
+    print(f"{case.name}: {len(runs)} runs written to {written}")
     return 0
 
 
