@@ -19,12 +19,18 @@ def boundary_faces(tets):
     return f[once], np.repeat(np.arange(len(tets)), 4)[once]
 
 
+SCALE_PERCENTILE = 99.0     # a stress panel's scale: robust to a few extreme tetrahedra
+
+
 def stress_panels(path, panels, title, magnify, up="y"):
     """The analogue of the paper's Figure 1: each panel (label, mesh, u, max_tau) drawn
     deformed (displacement x ``magnify``), standing on the axis ``up``, boundary faces
     coloured by max |tau| on one shared scale: blue at or below 0.01 of it, red at or above
-    0.9."""
-    scale = max(float(np.max(p[3])) for p in panels)
+    0.9. The scale is the largest panel's SCALE_PERCENTILE-th percentile over its
+    tetrahedra, not its maximum: one sliver's spike would turn every other face blue."""
+    scale = max(float(np.percentile(p[3], SCALE_PERCENTILE)) for p in panels)
+    if not scale > 0:
+        scale = max(float(np.max(p[3])) for p in panels) or 1.0
     # the paper's normalisation: max |tau| / scale, blue at or below 0.01, red from 0.9
     norm = matplotlib.colors.Normalize(vmin=0.01, vmax=0.9, clip=True)
     cmap = plt.get_cmap("jet")
@@ -47,7 +53,8 @@ def stress_panels(path, panels, title, magnify, up="y"):
         ax.set_axis_off()
     sm = matplotlib.cm.ScalarMappable(norm=norm, cmap=cmap)
     fig.colorbar(sm, ax=fig.axes, shrink=0.6, extend="both", ticks=[0.01, 0.25, 0.5, 0.75, 0.9],
-                 label=f"max |tau| / {scale:.4g} Pa (blue <= 0.01, red >= 0.9)")
+                 label=f"max |tau| / {scale:.4g} Pa, the {SCALE_PERCENTILE:g}th percentile "
+                       "(blue <= 0.01, red >= 0.9)")
     fig.suptitle(f"{title} (displacement x{magnify:g})", fontsize=10)
     fig.savefig(path, dpi=90)
     plt.close(fig)

@@ -9,6 +9,7 @@ import time
 from pathlib import Path
 
 import meshio
+import numpy as np
 import pytest
 
 from cases import runner
@@ -454,3 +455,20 @@ def test_the_progress_bar_keeps_its_numbers_at_80_columns(monkeypatch):
     assert p.width == 80 - progress.NUMBERS
     assert progress.fit("x" * 60, p.width) == "x" * (p.width - 1) + "\u2026"
     assert progress.fit("short", p.width) == "short"
+
+
+def test_a_stress_panels_scale_is_robust_to_one_slivers_spike(tmp_path, monkeypatch):
+    """The stress figure's colour scale is the 99th percentile of max |tau|, not its maximum:
+    one tetrahedron with a spike 1000 times the rest leaves the scale near the rest's, and
+    the colour bar says which percentile."""
+    from cases import figures
+    mesh = cube(4, 0.032, "five")
+    tau = np.full(mesh.n_tets, 1e3)
+    tau[0] = 1e6
+    labels = []
+    real = figures.plt.Figure.colorbar
+    monkeypatch.setattr(figures.plt.Figure, "colorbar",
+                        lambda self, *a, **k: labels.append(k["label"]) or real(self, *a, **k))
+    figures.stress_panels(tmp_path / "s.png", [("a", mesh, np.zeros((mesh.n_nodes, 3)), tau)],
+                          "max |tau|", 1.0)
+    assert labels[0].startswith("max |tau| / 1000 Pa, the 99th percentile")
