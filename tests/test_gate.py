@@ -296,7 +296,7 @@ def test_a_case_folder_behind_a_link_is_checked(quick, tmp_path, capsys):
     (tmp_path / "m").mkdir()
     (tmp_path / "m" / "paper-cube").symlink_to(quick, target_is_directory=True)
     assert main(["check", "--metrics", str(tmp_path / "m"), "--gold", str(ROOT / "gold"),
-                 "--allow-new"]) == 0
+                 "--allow-new", "--verbose"]) == 0
     assert "paper-cube/five/clamped/" in capsys.readouterr().out
 
 
