@@ -12,7 +12,7 @@ import numpy as np
 
 from .costs import FILE as BENCH_FILE, FOLDER as BENCH_FOLDER
 from .document import fmt, rel, rel_range
-from .error_model import ROUND_OFF
+from .error_model import ROUND_OFF, input_spread
 from .metrics import PATCH_TOL
 
 COST_TETS = 1e4          # the mesh size of the cost column (tetrahedra)
@@ -112,8 +112,8 @@ def table(root, models, pops=()):
     spread = {f: scorecard.spread(pops, models, f) for f in (False, True)}
     header = ["model", "model-form error, linear regime", "model-form error, finite load",
               "consistency limit (largest, +- fit)", "worst isotropy error",
-              "largest |alternation|, 5-layer view", "RK4 run", "s per simulated s",
-              "Truth Cube bead RMS [mm]"]
+              "largest |alternation|, 5-layer view (decides nothing)", "RK4 run",
+              "s per simulated s", "Truth Cube bead RMS [mm]"]
     rows = []
     for m in models:
         el = [e["moduli_rel_err"] for e in (conv or {}).get("elasticity", [])
@@ -184,10 +184,7 @@ def lines(root, models, pops=(), quick=False):
         passed = [m for m, v in lim.items() if v and all(
             x[0] + x[1] < PATCH_TOL if isinstance(x, tuple) else x in LIMITED
             for x in v.values())]
-        # a model diverging on a lattice has no consistency limit there: never tied with one
-        # that has a limit everywhere it converges
         rest = sorted((m for m in models if m not in passed), key=lambda m: _largest(lim[m]))
-        steady = [m for m in rest if "diverges" not in lim[m].values()]
         nolimit = sorted({k for m in rest for k, v in lim[m].items()
                           if not isinstance(v, tuple)})
         out.append("**How far from the continuum?** " + (
@@ -199,14 +196,10 @@ def lines(root, models, pops=(), quick=False):
                    "what its fit found there): "
                    + ", ".join(f"{m} {_pm(_worst_limit(lim[m]))}" + _no_limit(lim[m])
                                for m in rest if _worst_limit(lim[m]))
-                   + _limit_ties([(m, _worst_limit(lim[m])) for m in steady
-                                  if _worst_limit(lim[m])],
-                                 "tied within their +- on the lattices, where both have a "
-                                 "limit")
-                   + _limit_ties([(m, _worst_limit(lim[m])) for m in rest
-                                  if m not in steady and _worst_limit(lim[m])],
-                                 "tied within their +- on the lattices, both diverging "
-                                 "elsewhere")
+                   + _limit_ties(sorted(((m, _worst_limit(lim[m])) for m in rest
+                                         if _worst_limit(lim[m])), key=lambda x: x[1][0]),
+                                 "tied within their +- on the lattices, whatever each does on "
+                                 "the families where it has no limit")
                    + (f"; below {PATCH_TOL:g}: {', '.join(passed)}" if passed else "")
                    + (f"; no limit on {', '.join(nolimit)}" if nolimit else "")
                    + _diverging(lim)
@@ -232,7 +225,9 @@ def lines(root, models, pops=(), quick=False):
                    + " ([bench](bench/bench.md)).")
     if art and not art["parameters"]["quick"] and art["answer"].get("decided"):
         out.append(f"**What causes the bulge/neck?** {art['answer']['cause'][0].upper()}"
-                   f"{art['answer']['cause'][1:]}. {_cause_numbers(art)}")
+                   f"{art['answer']['cause'][1:]} (a model's own part: resolved above its "
+                   "uncertainty, which is not the clear level below). "
+                   f"{_cause_numbers(art)}")
     elif art and art["parameters"]["quick"]:
         out.append("**What causes the bulge/neck?** Quick: not decided (`pbcm run artefact` "
                    "decides).")
@@ -333,11 +328,16 @@ def _cost_of_replacing(pops, models, quick):
         loose = scorecard.unresolved(pops, models, finite)
         rng = scorecard.spread(pops, models, finite)
         if ranked:
-            n = len([p for p in pops if p.finite == finite and not p.patch_test])
-            said.append(f"{regime} (over {n} case/bc population{'s' if n > 1 else ''}"
-                        + (", so one case decides it" if n == 1 else "") + "): " + ", ".join(
-                f"{m} " + (fmt(e[1]) if e[1] is not None else "n/a")
-                + (f" [{fmt(rng[m][0], 2)}-{fmt(rng[m][1], 2)}]" if m in rng else "")
+            used = [p for p in pops if p.finite == finite and not p.patch_test]
+            n, c = len(used), len({p.case for p in used})
+            said.append(f"{regime} (over {c} case{'s' if c > 1 else ''}, {n} case/bc "
+                        f"population{'s' if n > 1 else ''}"
+                        + (", so one case decides it" if c == 1 else "") + "): " + ", ".join(
+                f"{m} " + (f"failed ({e[3]} of {e[4]} populations failed at the median"
+                           + (f"; {fmt(e[1])} over the others" if e[1] is not None else "")
+                           + ")" if e[3] else fmt(e[1]) if e[1] is not None else "n/a")
+                + (f" [{fmt(rng[m][0], 2)}-{fmt(rng[m][1], 2)}]" if m in rng and not e[3]
+                   else "")
                 + (f" ({e[2]} failed runs)" if e[2] else "")
                 + (f" (the same mean rank as {tie})" if tie else "")
                 + "".join(f" (not resolved from {b})" for (a, b) in loose if a == m)
@@ -345,11 +345,12 @@ def _cost_of_replacing(pops, models, quick):
     if not said:
         return "**What does replacing FEM cost?** No case has a decomposed quantity."
     return ("**What does replacing FEM cost?** The model-form error, each model against FEM P1 "
-            "with the same law on the same tetrahedra, best mean rank over the cases first "
-            "(beside it the geometric mean over the cases of the median over the meshes, "
-            "[its range when one mesh family is left out]; a failed run counts against its "
-            "model, and a model with a failed run (no number: at the load, no "
-            "equilibrium) ranks after every model without one): "
+            "with the same law on the same tetrahedra, in order of mean rank over the cases "
+            "(each case weighing one, its boundary conditions averaged; the mean rank decides "
+            "the order), beside it the geometric mean over the cases of the median over the "
+            "meshes [its range when one mesh family is left out]; a failed run counts against "
+            "its model, and a model with a failed run (no number; at the load, no converged "
+            "solve) ranks after every model without one: "
             + "; ".join(said) + " (the scorecard below).")
 
 
@@ -426,14 +427,15 @@ def recommendation(root, models, pops, quick, bench_rows):
         # the models a failed run put after the rest, named with what they would have scored
         left = [f"{m} (model-form error "
                 + (rel(e[1]) if e[1] is not None and not e[3] else "failed at the median")
-                + f"; {e[2]} failed runs: no equilibrium at the load)" for m, e in fin.items()
+                + f"; {e[2]} failed runs: no converged solve at the load)"
+                for m, e in fin.items()
                 if scorecard.failed(e) and m not in cands]
         out.append(f"- Finite strain: {p1_fin} (the reference's law on P1, the identity "
                    "check of this comparison, not a measured accuracy"
                    + _discretisation(pops, True)
                    + ": on these meshes the mesh, not the law, sets the distance to the "
                    f"continuum; refine before choosing){said}"
-                   + ("; with failed runs (no equilibrium at the load): " + "; ".join(failing)
+                   + ("; with failed runs (no converged solve at the load): " + "; ".join(failing)
                       if failing else "")
                    + ("; ranked after them for a failed run: " + "; ".join(left)
                       if left else "") + ".")
@@ -465,7 +467,8 @@ def recommendation(root, models, pops, quick, bench_rows):
         if cheapest and bench_rows[cheapest]["cpu_s_per_simulated_s"] < \
                 bench_rows[cheap]["cpu_s_per_simulated_s"]:
             line += (f"; {cheapest} is cheaper ("
-                     f"{fmt(bench_rows[cheapest]['cpu_s_per_simulated_s'])}, "
+                     f"{fmt(bench_rows[cheapest]['cpu_s_per_simulated_s'])} s per simulated "
+                     "s, "
                      f"{ratio_text(bench_rows[cheapest], bench_rows[p1_lin])} x {p1_lin}'s) "
                      f"at model-form error up to {fmt(worst_of[cheapest])} on a case")
         out.append(line + ".")
@@ -523,22 +526,6 @@ def u_vals(truth, strain, floor):
     for m, ui in u_input.items():
         u[m] = u_val(u_num, ui, floor)
     return u, u_num, u_input, mesh
-
-
-def input_spread(values, variants, base="bonded"):
-    """u_input of one output: ``values`` {variant: output}, ``variants`` {variant: its inputs
-    (a tuple)}, each variant other than ``base`` changing inputs of the base's; per input
-    changed (the variants that change the same inputs), half the range of the output over
-    them and the base, combined in quadrature (independent inputs, V&V 20)."""
-    if base not in values or base not in variants:
-        vals = list(values.values())
-        return (max(vals) - min(vals)) / 2 if len(vals) > 1 else 0.0
-    groups = {}
-    for name, inputs in variants.items():
-        if name != base and name in values:
-            changed = tuple(k for k, (a, b) in enumerate(zip(inputs, variants[base])) if a != b)
-            groups.setdefault(changed, [values[base]]).append(values[name])
-    return math.sqrt(sum(((max(v) - min(v)) / 2) ** 2 for v in groups.values()))
 
 
 def validation(truth):
@@ -623,21 +610,23 @@ def _irregular(conv, models):
     """'; on irregular patches ...': each model's worst patch-test error over the families
     whose patch is irregular (perturbed lattices, unstructured), where the study ran it, read
     against FEM P1's error on the same patches (the exact answer's numerical floor)."""
-    worst_of, floor = {}, 0.0
+    worst_of, floor, where = {}, 0.0, {}
     for r in conv.get("patch", []):
         if r["mesh"] in REGULAR or r.get("patch_error") is None:
             continue
         if r["model"] == "FEM P1":
             floor = max(floor, r["patch_error"])
-        if r["model"] in models:
-            worst_of[r["model"]] = max(worst_of.get(r["model"], 0.0), r["patch_error"])
+        if r["model"] in models and r["patch_error"] >= worst_of.get(r["model"], 0.0):
+            worst_of[r["model"]], where[r["model"]] = r["patch_error"], r["mesh"]
     if not worst_of:
         return ""
     ordered = sorted(worst_of.items(), key=lambda kv: kv[1])
     return ("; the patch test with every boundary node prescribed, on irregular patches "
-            "(worst, against the exact linear field; "
-            + _single_runs_u(ordered, floor, "FEM P1's own error there") + "): "
-            + ", ".join(f"{m} {rel(v)}" for m, v in ordered))
+            f"({', '.join(sorted(set(where.values())))}; each model's worst, on the patch "
+            "named, against the exact linear field; "
+            + _single_runs_u(ordered, floor, "FEM P1's own error there").replace(
+                "this mesh only", "these patches only") + "): "
+            + ", ".join(f"{m} {rel(v)} ({where[m]})" for m, v in ordered))
 
 
 def _largest(limit):
@@ -669,9 +658,10 @@ def _decisive(art):
 def _cause_numbers(art):
     """The numbers that decide the cause, as the study's answer states them."""
     a = art["answer"]
-    if a.get("numbers"):
-        return a["numbers"] + " ([artefact study](artefact/report.md))."
-    return "([artefact study](artefact/report.md))."
+    # the study's own statement of how sure it is travels with its answer, never left behind
+    sure = art.get("how_sure", "").replace("**How sure.** ", "How sure: ")
+    said = " ".join(x for x in (a.get("numbers"), sure) if x)
+    return (said + " " if said else "") + "([artefact study](artefact/report.md))."
 
 
 __all__ = ["lines", "table"]

@@ -96,6 +96,22 @@ def u_num(estimate, continuum_values):
     return float(np.hypot(est, spread)), spread > est
 
 
+def input_spread(values, variants, base="bonded"):
+    """u_input of one output: ``values`` {variant: output}, ``variants`` {variant: its inputs
+    (a tuple)}, each variant other than ``base`` changing inputs of the base's; per input
+    changed (the variants that change the same inputs), half the range of the output over
+    them and the base, combined in quadrature (independent inputs, V&V 20)."""
+    if base not in values or base not in variants:
+        vals = list(values.values())
+        return (max(vals) - min(vals)) / 2 if len(vals) > 1 else 0.0
+    groups = {}
+    for name, inputs in variants.items():
+        if name != base and name in values:
+            changed = tuple(k for k, (a, b) in enumerate(zip(inputs, variants[base])) if a != b)
+            groups.setdefault(changed, [values[base]]).append(values[name])
+    return math.sqrt(sum(((max(v) - min(v)) / 2) ** 2 for v in groups.values()))
+
+
 @dataclass(frozen=True)
 class Scalar:
     """A case's decomposed quantity: ``key`` the run key of the model's value (a number or a

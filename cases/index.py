@@ -207,10 +207,12 @@ TERMS = {
     "failed run. What the scorecard ranks (cases/error_model.py).",
     "discretisation error": "(Q_P1 - Q_c) / |Q_c|: how far FEM P1 on a mesh is from the "
     "converged continuum; the same for every model on that mesh.",
-    "total error": "(Q_model - Q_c) / |Q_c| = model-form error + discretisation error (for a "
-    "quantity over load steps or a set of modes each is its largest component, and the two "
-    "parts bound the total). A small total with a large model-form error is two errors "
-    "cancelling.",
+    "total error": "(Q_model - Q_c) / |Q_c| = model-form error + discretisation error for a "
+    "scalar (over load steps each is its largest component, and the two parts bound the "
+    "total); for a field (the displacement at the load) the parts are norms that bound the "
+    "total by the triangle inequality; for the modes, paired by shape separately against P1 "
+    "and against the continuum, they need not bound it. A small total with a large "
+    "model-form error is two errors cancelling.",
     "u_val": "the validation uncertainty sqrt(u_num^2 + u_input^2 + u_D^2) (ASME V&V 20) a "
     "comparison is read against: u_num the reference's estimate and its spread over the meshes "
     "of one continuum problem, in quadrature (for a model-form error, the distance "
@@ -239,12 +241,14 @@ TERMS = {
     "the sliding cube (a homogeneous compression, a patch test) in the linear regime, per "
     "lattice, +- its extrapolation's uncertainty; FEM's is zero to rounding. The index's "
     "'how far from the continuum' reads these limits only. Two limits are tied when they "
-    "differ by less than their +- combined, pair by pair (ties are not transitive); a model "
-    "that diverges on a lattice is never tied with one that converges everywhere.",
+    "differ by less than their +- combined, pair by pair (ties are not transitive), on the "
+    "lattices; each model's families without a limit (diverging, or not asymptotic) are "
+    "named beside it.",
     "worst isotropy error": "the largest relative error of the six Kelvin moduli of the "
     "model's effective elasticity tensor (a relaxed lattice patch) against the isotropic "
     "target's, over the lattices.",
-    "largest |alternation|, 5-layer view": "the largest |alternation rel| of the paper cube's "
+    "largest |alternation|, 5-layer view (decides nothing)": "the largest |alternation rel| "
+    "of the paper cube's "
     "runs, on its five layers: the paper's own view, which cannot tell a smooth barrel from "
     "an alternation and decides nothing (the artefact study reads the cause on 9 and 17 "
     "layers).",

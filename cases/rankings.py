@@ -96,8 +96,12 @@ def _standings(runs, metric, u, lost_key=None):
     return standings(by, u, lost)
 
 
-def _u_text(u, defect):
-    return f"u_num {rel(u, 2)}" + (", mostly the spread over the meshes" if defect else "")
+def _u_text(u, defect, field=False):
+    """'u_num U' and what it holds: the reference's estimate and its spread over the meshes
+    in quadrature, or the estimate alone for a field (no one value to spread)."""
+    return f"u_num {rel(u, 2)}" + (
+        " (the reference's estimate: a field has no one value to spread over the meshes)"
+        if field else ", mostly the spread over the meshes" if defect else "")
 
 
 def ranking(runs, metric, label, estimate_key="p2_error_estimate", lost_key=None):
@@ -118,7 +122,8 @@ def ranking(runs, metric, label, estimate_key="p2_error_estimate", lost_key=None
             if lost.get(s.model):
                 note.append(f"{lost[s.model]} unpaired modes (failed, ranked first)")
             if tie:
-                note.append(f"tied with {', '.join(tie)} ({_u_text(u, defect)})")
+                note.append(f"tied with {', '.join(tie)} "
+                            f"({_u_text(u, defect, _continuum_key(rs, metric) is None)})")
             if s.failed:
                 note.append(f"{s.failed} failed, counted against it")
             rows.append([bc, rank, s.model, *_stats(s), "; ".join(note)])
@@ -174,7 +179,8 @@ def best_and_worst(runs, metric, what, exact=False, estimate_key="p2_error_estim
             return line
         tied = list(st[0][2])
         if tied:
-            line += (f" Tied with {best.model} within the reference's {_u_text(u, defect)}: "
+            line += (f" Tied with {best.model} within the reference's "
+                     f"{_u_text(u, defect, _continuum_key(rs, metric) is None)}: "
                      f"{', '.join(tied)}.")
         smallest = min(min(s.values) for _, s, _ in st if s.values)
         if u > smallest / 5:
@@ -207,8 +213,8 @@ def failures(runs, key=None, where="in the linear regime"):
     exists, and the runs that could not start); or that none failed."""
     if key is not None:
         bad = [f"{r['model']} on {r['mesh']}/{r['bc']}" for r in runs if r.get(key)]
-        return (f"No static equilibrium {where} for " + ", ".join(bad) + "." if bad
-                else f"Every model found its static equilibrium {where} on every mesh run.")
+        return (f"No converged static solve {where} for " + ", ".join(bad) + "." if bad
+                else f"Every model's static solve converged {where} on every mesh run.")
     phases = (("static_failed", "in the linear regime", runs),
               ("finite_failed", "at the case's load",
                [r for r in runs if r.get("nh_error_estimate") is not None]),
@@ -218,39 +224,34 @@ def failures(runs, key=None, where="in the linear regime"):
         bad = [f"{r['model']} on {r['mesh']}/{r['bc']}" for r in rs if r.get(k)]
         if bad:
             said.append(("Could not start: " if k == "failed" else
-                         f"No static equilibrium {label} for ") + ", ".join(bad))
+                         f"No converged static solve {label} for ") + ", ".join(bad))
         elif rs and any(k in r for r in rs) and k != "failed":
             checked.append(label)
     if not said:
-        return ("Every model found its static equilibrium " + " and ".join(checked)
+        return ("Every model's static solve converged " + " and ".join(checked)
                 + " on every mesh run.")
-    return "; ".join(said) + (f". Every model found its static equilibrium "
+    return "; ".join(said) + (f". Every model's static solve converged "
                               f"{' and '.join(checked)} on every mesh run" if checked
                               else "") + "."
 
 
 def _linearisation(runs):
-    """Per boundary condition, fem-linear's linearisation error: its displacement against
-    fem-neohookean's on the same mesh at the case's load (both P1, the same tetrahedra: the
-    reference's discretisation error, which both carry, cancels), as the difference of their
-    errors against the neo-Hookean reference bounds it from below, and their total."""
+    """Per boundary condition, fem-linear's linearisation error at the case's load: its
+    displacement against neo-Hookean P1 on the same mesh (both P1 on the same tetrahedra, so
+    the discretisation error both carry cancels: ``disp_rel_l2_nh_p1``, its model-form error
+    at the load), beside its total against the neo-Hookean reference."""
     said = []
     for bc, rs in populations(runs).items():
-        at = {(r["mesh"], r["model"]): r for r in rs}
-        gaps, totals = [], []
-        for (mesh, model), r in at.items():
-            twin = at.get((mesh, "fem-neohookean"))
-            if model != "fem-linear" or twin is None:
-                continue
-            a, b = r.get("disp_rel_l2_nh"), twin.get("disp_rel_l2_nh")
-            if a is not None and b is not None:
-                gaps.append(abs(a - b))
-                totals.append(a)
-        if gaps:
-            said.append(f"[{bc}] fem-linear at the case's load: its total error against the "
-                        f"neo-Hookean reference {cell(totals, len(totals))}, of which its "
-                        f"linearisation (its error less fem-neohookean's on the same mesh) "
-                        f"{cell(gaps, len(gaps))}; the rest is P1's discretisation error.")
+        mine = [r for r in rs if r["model"] == "fem-linear"]
+        lin = [r["disp_rel_l2_nh_p1"] for r in mine if r.get("disp_rel_l2_nh_p1") is not None]
+        tot = [r["disp_rel_l2_nh"] for r in mine if r.get("disp_rel_l2_nh") is not None]
+        if lin and tot:
+            said.append(f"[{bc}] fem-linear at the case's load: its linearisation error (its "
+                        f"displacement against neo-Hookean P1 on the same mesh) "
+                        f"{cell(lin, len(mine))}; its total against the neo-Hookean "
+                        f"reference {cell(tot, len(mine))}, which holds P1's discretisation "
+                        "error too (the two are norms: they bound the total, they do not "
+                        "add).")
     return said
 
 

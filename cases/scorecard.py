@@ -238,27 +238,32 @@ def spread(pops, models, finite=False):
 def overall(pops, models, finite=False):
     """{model: (mean rank, geometric mean of its finite population scores, failed runs,
     failed populations, populations)} over the populations of one regime (``finite``): every
-    population counts for every model, a failed run (no number, or at the load no equilibrium)
-    against its model; each score floored at its population's model-form uncertainty; P1
-    itself left out (an identity check), and the patch tests (pass or fail, the consistency
-    limit's subject: never pooled with the rest); a model with any failed run ranks after
-    every model without one (``_order``)."""
+    population counts for every model, a failed run (no number, or at the load no converged
+    solve) against its model; each case weighs one (its boundary conditions are averaged
+    first: two bcs of one case are not two independent observations); each score floored at
+    its population's model-form uncertainty; P1 itself left out (an identity check), and the
+    patch tests (pass or fail, the consistency limit's subject: never pooled with the rest);
+    a model with any failed run ranks after every model without one (``_order``)."""
     used = [p for p in pops if p.finite == finite and not p.patch_test]
     out = {}
     for m in models:
         mine = [p for p in used if m in p.parts and m not in p.identity]
         if not mine:
             continue
-        ranks, scores, floors = [], [], []
+        by_case = {}
         for p in mine:
             rank, st = next((r, s) for r, s, _ in p.standings() if s.model == m)
-            ranks.append(rank)
-            if math.isfinite(st.score):
-                scores.append(st.score)
-                floors.append(p.u_model_form)
+            by_case.setdefault(p.case, []).append((rank, st.score, p.u_model_form))
+        ranks = [float(np.mean([r for r, _, _ in c])) for c in by_case.values()]
+        scores = [E.geometric_mean([s for _, s, _ in c if math.isfinite(s)],
+                                   [f for _, s, f in c if math.isfinite(s)])
+                  for c in by_case.values()]
+        scores = [s for s in scores if s is not None]
         failed = sum(sum(v is None for v in p.parts[m]) for p in mine)
-        out[m] = (E.mean_rank(ranks), E.geometric_mean(scores, floors), failed,
-                  len(mine) - len(scores), len(mine))
+        lost = sum(1 for p in mine for r, s, _ in p.standings()
+                   if s.model == m and not math.isfinite(s.score))
+        out[m] = (E.mean_rank(ranks), E.geometric_mean(scores, [0.0] * len(scores)), failed,
+                  lost, len(mine))
     return out
 
 
@@ -300,13 +305,16 @@ def describe(entry, rng=None):
     """'mean rank r, geometric mean g [range leaving one mesh family out]' with the failed
     runs and populations of ``overall``."""
     r, g, n_failed, lost, n = entry
-    text = f"mean rank {r:.3g}" + (f", geometric mean {rel(g)}" if g is not None else "")
-    if g is not None and rng:
-        text += f" [{rel(rng[0])}-{rel(rng[1])} leaving one mesh family out]"
+    text = f"mean rank {r:.3g}"
+    if lost:    # a failed population scores infinitely wrong: no finite mean exists
+        text += (f", geometric mean failed ({lost} of {n} populations failed at the median"
+                 + (f"; {rel(g)} over the other {n - lost}" if g is not None else "") + ")")
+    elif g is not None:
+        text += f", geometric mean {rel(g)}"
+        if rng:
+            text += f" [{rel(rng[0])}-{rel(rng[1])} leaving one mesh family out]"
     if n_failed:
         text += f", {n_failed} failed runs"
-    if lost:
-        text += f" ({lost} of {n} populations failed at the median)"
     if failed(entry):
         text += " (ranked after every model without a failed run)"
     return text

@@ -200,9 +200,10 @@ def test_index_opens_with_the_answers_and_lists_the_study(study, tmp_path, capsy
     assert "**How far from the continuum?** Quick: not decided (`pbcm run convergence` " \
         "decides); The consistency limit" in md
     # the patch test's irregular patches: msm (springs) misses the strain by over 10 %
-    irregular = md.split("on irregular patches (worst, against the exact linear field; one "
+    irregular = md.split("on the patch named, against the exact linear field; one "
                          "run each, ")[1].split(" ([convergence]")[0].rsplit("): ", 1)[1]
-    worst = dict(item.split(" ", 1) for item in irregular.split(", "))
+    worst = {m: v.split(" (")[0] for m, v in (item.split(" ", 1)
+                                              for item in irregular.split("), "))}
     assert float(worst["msm"]) > 0.1 and worst["fem-linear"] == "< 1e-08"   # round-off
     assert md.index("**How far") < md.index("| model | model-form error, linear regime") \
         < md.index("## Studies") < md.index("## Scorecard")

@@ -133,9 +133,8 @@ def test_scorecard_decomposes_counts_failures_and_names_identity(tmp_path):
     assert "fem-corotated" not in ranks and "fem-corotated" not in lines[0]   # identity
     assert "1. a (mean rank 1, geometric " \
         "mean 0.13 [0.12-0.14 leaving one mesh family out])" in lines[0]
-    assert "2. b (mean rank 2, 1 failed runs (1 of 1 populations failed at the median) (ranked " \
-        "after every model without a failed run))" \
-        in lines[0]
+    assert "2. b (mean rank 2, geometric mean failed (1 of 1 populations failed at the " \
+        "median), 1 failed runs (ranked after every model without a failed run))" in lines[0]
     assert "b in torsion/clamped (1 of 2)" in lines[-1]
     md, _ = index_documents(tmp_path, ["torsion"])
     assert "FEM P1 itself (0 by construction)" in md
@@ -318,7 +317,7 @@ def test_what_to_pick_is_computed_and_names_what_is_not_decided(tmp_path):
     assert "the closest approximation is a, model-form error 0.1" in lines[1]
     # at finite load a's model-form errors are 0.1, 0.2 and b's 0.1, 0.2 (six reversed)
     assert "not decided on 1 case/bc population between" in lines[2]
-    assert "with failed runs (no equilibrium at the load): b (1 failed runs)" in lines[2]
+    assert "with failed runs (no converged solve at the load): b (1 failed runs)" in lines[2]
     assert recommendation(tmp_path, ["a"], pops, True, {}) == [
         "**What to pick?** Quick: not decided (`pbcm report` decides)."]
 
@@ -352,9 +351,9 @@ def test_no_equilibrium_at_a_linear_cases_load_is_a_failed_run_of_its_load_popul
     means = scorecard.overall(pops, ["fem-linear", "a", "b"], finite=True)
     assert means["a"][2] == 2 and means["b"][2] == 0
     assert [m for _, m, _, _ in scorecard.ranked(means)] == ["fem-linear", "b", "a"]
-    assert scorecard.describe(means["a"]).endswith(
-        "2 failed runs (1 of 1 populations failed at the median) (ranked after every model "
-        "without a failed run)")
+    assert scorecard.describe(means["a"]) == (
+        "mean rank 3, geometric mean failed (1 of 1 populations failed at the median), 2 "
+        "failed runs (ranked after every model without a failed run)")
 
 
 def test_the_first_is_unresolved_only_from_models_that_reach_it_themselves(tmp_path):
@@ -373,6 +372,28 @@ def test_the_first_is_unresolved_only_from_models_that_reach_it_themselves(tmp_p
     assert scorecard.unresolved(pops, models) == {("b", "c"): "five"}
     assert scorecard.not_resolved_from(pops, models, "a") == {}
     assert scorecard.not_resolved_from(pops, models, "b") == {"c": "five"}
+
+
+def test_each_case_weighs_one_in_the_overall_ranking(tmp_path):
+    """Two boundary conditions of one case are averaged before the cases are: a model first
+    on both bcs of one case and last on one other case has the mean rank (1 + 2) / 2, not
+    (1 + 1 + 2) / 3, and its geometric mean is over the cases' geometric means."""
+    from cases.index import populations
+    runs = []
+    for bc in ("clamped", "sliding"):
+        runs += [dict(r, bc=bc) for r in _torsion_runs({("five", "fem-linear"): 1.0,
+                                                        ("five", "a"): 1.1,
+                                                        ("five", "b"): 1.2})]
+    _case_folder(tmp_path, "torsion", runs)
+    other = [dict(r, torque_nm=None, torque_fem_nm=None, tip_deflection_mm=q,
+                  tip_deflection_fem_mm=1.0)
+             for r, q in zip(_torsion_runs({("five", m): 1.0 for m in ("fem-linear", "a", "b")}),
+                             (1.0, 1.4, 1.2))]
+    _case_folder(tmp_path, "cantilever", other)
+    pops, _ = populations(tmp_path, ["torsion", "cantilever"])
+    a = scorecard.overall(pops, ["fem-linear", "a", "b"])["a"]
+    assert a[0] == pytest.approx(1.5) and a[4] == 3
+    assert a[1] == pytest.approx((0.1 * 0.4) ** 0.5)
 
 
 def test_geometric_mean_range_leaves_one_mesh_family_out(tmp_path):
@@ -434,7 +455,7 @@ def test_truth_cube_u_input_adds_each_unmeasured_inputs_half_range_in_quadrature
     """u_input combines the inputs apart: plate 1.6 vs 1.8 (half range 0.1), travel 1.6 vs
     1.6 (0) and nu 1.3 to 2.0 (0.35) give sqrt(0.1^2 + 0.35^2), not the half range 0.35 of
     every variant pooled."""
-    from cases.answers import input_spread
+    from cases.error_model import input_spread
     variants = {"bonded": ("bonded", "nominal", 0.499), "frictionless": ("free", "nominal", 0.499),
                 "fitted": ("bonded", "fitted", 0.499), "nu-": ("bonded", "nominal", 0.49),
                 "nu+": ("bonded", "nominal", 0.4999)}

@@ -71,4 +71,4 @@ def test_a_non_finite_metric_fails_its_run_and_says_so(tmp_path, monkeypatch):
     md = (out / "report.md").read_text()
     # NaN only inside the stated cause, never as a number in a table or a sentence
     assert md.lower().count("nan") == md.count("not finite (nan)") > 0
-    assert "No static equilibrium in the linear regime for msm" in md
+    assert "No converged static solve in the linear regime for msm" in md

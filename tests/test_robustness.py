@@ -66,7 +66,7 @@ def test_a_failed_static_solve_is_recorded_and_the_case_goes_on(tmp_path, monkey
     assert runs["msm"]["growth_rate_1_s"] is not None     # the other phases still ran
     assert runs["pbcm-variational"]["static_failed"] is None
     md = (out / "report.md").read_text()
-    assert "No static equilibrium for msm on five/clamped" in md and "n/a" in md
+    assert "No converged static solve for msm on five/clamped" in md and "n/a" in md
 
 
 # ------------------------------------------------------------ paths checked before computing

@@ -8,7 +8,7 @@ import numpy as np
 
 from ... import catalogue, figures
 from ...document import Document, fmt, rel
-from ...error_model import u_val
+from ...error_model import input_spread, u_val
 from ...report import environment, write_study
 from ...runner import jsonable
 from .beads import WITHIN, excess, within
@@ -194,9 +194,8 @@ def conclusion(doc):
             )
     by = doc["continuum_by_assumption_mm"]
     if nh:
-        # the continuum read as the models are: its u_input the half-range over the
-        # unmeasured plate friction, travel and nu
-        u_in = (max(by.values()) - min(by.values())) / 2 if len(by) > 1 else 0.0
+        # the continuum read as the models are (error_model.input_spread)
+        u_in = input_spread(by, doc["parameters"].get("variants", {}))
         u_nh = u_val(val["u_num"], u_in, val["u_d"])
         line += (f"; the neo-Hookean continuum is {fmt(nh)} mm RMS off at {percent(last)}, "
                  f"{'within' if nh <= u_nh else 'beyond'} its u_val {fmt(u_nh, 2)} mm")
