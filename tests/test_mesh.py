@@ -222,3 +222,17 @@ def test_mesh_warnings_name_the_worst_slivers_and_dihedral_angles_before_computi
     assert main(["mesh", str(path)]) == 0
     out = capsys.readouterr().out
     assert "warning: 1 sliver(s)" in out and "warning: 1 tetrahedra with a dihedral" in out
+
+
+def test_unstructured_states_its_limit_and_keeps_within_it():
+    """The unstructured generator builds every box whose spacings are within its stated
+    factor of 4 (2-4 nodes per side, several seeds) and, beyond its limit (spacings 16 apart),
+    refuses with MeshError naming what failed rather than returning slivers."""
+    for n in ((2, 3, 2), (4, 2, 3), (3, 4, 4)):
+        for lengths in ((1.0, 1.0, 1.0), (1.0, 0.5, 1.0), (1.0, 1.0, 0.25)):
+            spacing = [length / (k - 1) for length, k in zip(lengths, n)]
+            if max(spacing) / min(spacing) <= 4:
+                for seed in range(3):
+                    box(*n, *lengths, scheme="unstructured", seed=seed)
+    with pytest.raises(MeshError, match="no sliver-free perturbed Delaunay mesh"):
+        box(2, 3, 2, 1.0, 0.125, 1.0, scheme="unstructured", seed=0)

@@ -1,6 +1,6 @@
 """Property-based tests (hypothesis): any valid mesh, in any node and vertex order, gives finite
 forces that conserve momentum for every conservative preset; any corrupted mesh raises
-MeshError and nothing else (issue 8)."""
+MeshError and nothing else."""
 import numpy as np
 import pytest
 from hypothesis import assume, given, strategies as st
@@ -22,6 +22,9 @@ def valid_meshes(draw):
     lengths = [draw(st.floats(1e-3, 1.0)) for _ in range(3)]
     assume(max(lengths) / min(lengths) <= 8)
     scheme = draw(st.sampled_from(SCHEMES))
+    spacing = [length / (k - 1) for length, k in zip(lengths, n)]
+    # the generator's stated limit (model.mesh.box): draw only what it can build
+    assume(scheme != "unstructured" or max(spacing) / min(spacing) <= 4)
     seed = draw(st.integers(0, 2**32 - 1))
     rng = np.random.default_rng(seed)
     base = box(*n, *lengths, scheme=scheme, seed=seed % 7)
