@@ -1,4 +1,4 @@
-"""`pbcm bench` (issue 11): what it measures and how its ratios are taken. No test here asserts
+"""`pbcm bench`: what it measures and how its ratios are taken. No test here asserts
 a wall-clock time: timings are the benchmark's output, not a pass condition."""
 import json
 

@@ -1,4 +1,4 @@
-"""The paper-cube case, its metrics and its report (issue 4)."""
+"""The paper-cube case, its metrics and its report."""
 import json
 from html.parser import HTMLParser
 

@@ -1,4 +1,4 @@
-"""The metric catalogue (issue 24): every metric the suite writes is declared once, with a
+"""The metric catalogue: every metric the suite writes is declared once, with a
 unit, a gate direction, a label and a definition; what the reports and the gate say about a
 metric comes from there."""
 import json

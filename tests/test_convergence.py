@@ -1,4 +1,4 @@
-"""The convergence study (issue 12): the fit recovers e_inf and p of synthetic sequences and
+"""The convergence study: the fit recovers e_inf and p of synthetic sequences and
 says the right verdict; the Pareto front; the reference evaluated off its nodes; and the quick
 study end to end: its metrics, its ties to the effective tensors, its gate and its progress."""
 import json

@@ -1,4 +1,4 @@
-"""The dynamic FEM reference (reference/dynamic.py) against closed forms (issue 9)."""
+"""The dynamic FEM reference (reference/dynamic.py) against closed forms."""
 import numpy as np
 import pytest
 

@@ -1,4 +1,4 @@
-"""The converged neo-Hookean reference (issue 25): the homogeneous closed form, the small-load
+"""The converged neo-Hookean reference: the homogeneous closed form, the small-load
 limit equal to linear P2, a tangent and a residual consistent with finite differences of the
 energy, convergence under refinement with an estimate, the mixed form up to nu = 0.499, and an
 independent code (FElupe) on a bonded block compressed 20 %."""

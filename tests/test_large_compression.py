@@ -1,4 +1,4 @@
-"""The large-compression case (issue 25): bonded plates make a barrel judged against the
+"""The large-compression case: bonded plates make a barrel judged against the
 converged mixed neo-Hookean reference with its estimate; the homogeneous (sliding) compression
 is a constitutive check whose law is the closed form and whose energy curve is dW/d(push)."""
 import numpy as np

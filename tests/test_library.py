@@ -1,4 +1,4 @@
-"""The case library on the declarative framework (issue 10): every registered case is
+"""The case library on the declarative framework: every registered case is
 discovered and run in quick mode, the paper cube's metrics did not move when it moved onto the
 framework, the loads reach the particle model as consistent nodal forces, and a failing run
 is recorded while the case goes on."""
@@ -79,25 +79,25 @@ def test_quick_library_passes_the_committed_bounds(library, capsys):
 # baseline was stored (consistent mass integrated exactly, transient exact in time)
 FEM_DYNAMICS_CHANGED = {"reaction_time_rel_l2", "disp_end_push_rel_l2", "modal_rel_err",
                         "modal_rel_err_free", "rest_time_fem_s"}
-# issue 25 moved the standard static metrics and the model's quantities to the linear regime
+# the linear regime moved the standard static metrics and the model's quantities to the linear regime
 # (loads scaled to strains of 1e-4, the answer scaled back) and dropped the sliding base's
 # modes and rest time (ill-posed): changed on purpose, gated by the gold values
 REGIMES_CHANGED = set(catalogue.STATIC) | {"bulge_profile_mm", "paper_pattern",
                                            "apparent_poisson"}
-# issue 26 replaced the zig-zag (not zero for a smooth profile) by the alternation, and
+# the alternation replaced the zig-zag (not zero for a smooth profile) by the alternation, and
 # calibrates every reading alike: corner and balanced are other models now (c fitted, not 1)
 ZIGZAG_RETIRED = {"zigzag", "zigzag_fem"}
 RECALIBRATED = {"pbcm-corner", "pbcm-balanced"}
 SLIDING_DROPPED = {"frequencies_hz", "rest_time_s"}
-# issue 29: quick mode repeats at dt/4 only the runs that blew up at dt (not known elsewhere)
+# quick mode repeats at dt/4 only the runs that blew up at dt (not known elsewhere)
 DT4_REPEATED = {"dyn_failed_dt4", "verdict_changes_dt4"}
 
 
 def test_paper_cube_on_the_framework_matches_the_landed_case(quick):
     """Every non-timing metric of the quick paper cube equals the one the pre-framework code
-    wrote (stored in tests/data). The framework move was bit for bit (commit b783075). Issue 11
-    rewrote the force kernels and compiled the RK4 step (sums in another order) and takes the
-    calibration from strain measures instead of whole energies (c moves by 1e-9), so values
+    wrote (stored in tests/data), within round-off: the force kernels were rewritten since
+    and the RK4 step compiled (sums in another order), and the calibration reads strain
+    measures instead of whole energies (c moves by 1e-9), so values
     now agree to 1e-7 relative with a floor of 1e-7 (an error that is a difference of two
     numbers moves by the Newton tolerance), series to 1e-7 of their largest value with the
     same floor (a profile of 0.005 mm moves by 1e-8 mm with chord Newton steps), and the

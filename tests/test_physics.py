@@ -1,5 +1,5 @@
 """Physics pinned by values worked out here, sharing no code with the implementation
-(issue 9): a wrong factor, sign or weight in the model must turn one of these red."""
+a wrong factor, sign or weight in the model must turn one of these red."""
 import itertools
 
 import numpy as np

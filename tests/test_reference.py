@@ -297,7 +297,7 @@ def test_new_points_are_prescribed_only_on_fully_prescribed_facets():
 
 
 def test_one_cell_slab_with_declared_surfaces_matches_a_thick_mesh():
-    """Issue 8: a slab one cell thick between a clamped bottom and a pushed top. From nodal
+    """A slab one cell thick between a clamped bottom and a pushed top. From nodal
     data alone every facet of it has three prescribed vertices, so its sides are held (the
     answer to that problem, 1.94 N, at every level); declaring the prescribed surfaces with
     dirichlet_fn (NaN elsewhere) frees the sides, and the top force comes within 5 % of the

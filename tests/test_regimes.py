@@ -1,4 +1,4 @@
-"""Two regimes kept apart (issue 25): every case with a load is answered in the linear regime
+"""Two regimes kept apart: every case with a load is answered in the linear regime
 (loads scaled to strains of 1e-4, against linear FEM) and at its own load (against the
 converged neo-Hookean reference). The sliding paper cube is homogeneous, so both references
 are closed forms there: the tests work them out by hand."""

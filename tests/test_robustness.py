@@ -1,4 +1,4 @@
-"""Every input a user can give ends in a result or a clear error, and nothing is lost (issue 8)."""
+"""Every input a user can give ends in a result or a clear error, and nothing is lost."""
 import json
 import os
 import shutil
@@ -25,10 +25,9 @@ ROOT = Path(__file__).resolve().parents[1]
 
 @pytest.mark.parametrize("nu", [0.3, 0.0])
 def test_blow_ups_are_findings_and_the_report_is_complete(nu, tmp_path, capsys):
-    """The issue's reproducer (balanced on six/clamped at nu = 0.3 blows up) and more: exit 0,
-    every file written, the failures recorded per run. The reproducer is the literal reading
-    (c = 1; the calibrated presets since issue 26 are softer and do not blow up here). (Step
-    times left the case for `pbcm bench` with issue 11.)"""
+    """A run that blows up (the balanced reading on six/clamped at nu = 0.3) is a finding:
+    exit 0, every file written, the failures recorded per run. The blow-up needs the literal
+    reading (c = 1: the calibrated presets are softer and do not blow up here)."""
     out = tmp_path / "paper-cube"
     assert main(["run", "paper-cube", "--quick", "--nu", str(nu), "--models",
                  "pbcm-balanced-literal", "pbcm-corner-literal", "msm", "--out", str(out)]) == 0

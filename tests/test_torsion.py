@@ -1,4 +1,4 @@
-"""Torsion's linear regime (issue 25): the end face gets the linearised rotation u = theta x r,
+"""Torsion's linear regime: the end face gets the linearised rotation u = theta x r,
 and then the converged linear torque is at or above Saint-Venant's beta G a^4 theta / L: the
 clamped root restrains the warping Saint-Venant leaves free, and P2's energy (twice the work of
 the prescribed rotation) bounds the exact one from above."""

@@ -1,4 +1,4 @@
-"""User terms and composed models (issue 13): a term file outside the package, the entry-point
+"""User terms and composed models: a term file outside the package, the entry-point
 group, the composition grammar, and the worked example of docs/example_term.py."""
 import json
 import os

@@ -1,5 +1,5 @@
 """The paper cube's dynamics against FEM: the RK4 run against the FEM transient on the same
-boundary motion, and the model's modes (linearised at rest) against FEM modes (issue 9).
+boundary motion, and the model's modes (linearised at rest) against FEM modes.
 
 Plain functions of arrays; the case module decides when to call them.
 """
