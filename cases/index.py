@@ -222,13 +222,17 @@ TERMS = {
     "load are given, not measured; the Truth Cube's plate friction, travel and nu), u_D the "
     "measurement's noise (0 where nothing is measured). Two errors closer than u_val are "
     "tied.",
-    "mean rank": "a model's overall standing in one regime: the mean of its rank in every "
-    "population, each population ranking its models first by the parts they lost (unpaired "
+    "mean rank": "a model's overall standing in one regime: the mean over the cases of its "
+    "rank in each case (the mean over that case's populations, one per boundary condition: "
+    "each case weighs one), each population ranking its models first by the parts they "
+    "lost (unpaired "
     "modes), then by the median over the meshes with a failed run counted as infinitely "
     "wrong (so a failure never removes a population from anyone's comparison); models within "
     "u_val of the first of a group share its rank; a model with a failed run ranks after "
-    "every model without one. Beside it the geometric mean of the population medians, each floored at "
-    "its population's u_val, with its range over the rankings that leave one mesh family out.",
+    "every model without one. Beside it the geometric mean over the cases of the population "
+    "medians, each floored at its population's u_val, with its range over the rankings that "
+    "leave one mesh family out; 'failed' where a population failed at the median (no finite "
+    "mean exists), with the mean over the others beside it.",
     "not resolved": "an order of two models that reverses, or levels, when one mesh family "
     "(every population's runs on it) or one case is left out: the data cannot order them, "
     "whatever their mean ranks say; judged pair by pair (neighbours in a ranking, the first "
