@@ -1,4 +1,4 @@
-"""The package's dependency rules, checked on its import graph (README, "Architecture").
+"""The package's dependency rules, checked on its import graph (docs/architecture.md).
 
 Every import counts, also one inside a function: an import circle that loads only because one
 of its imports is deferred is still a circle.
