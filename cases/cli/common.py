@@ -77,11 +77,21 @@ class UsageError(Exception):
     pass
 
 
-def case_named(name):
-    from ..registry import CASES, STUDY_MODULES
-    if name not in CASES:
-        raise UsageError(f"unknown case {name}; valid: {', '.join([*CASES, *STUDY_MODULES])}")
-    return CASES[name]
+def case_named(name, files=()):
+    """The library's case ``name``, else a case from outside the package (``--case FILE``
+    files, the ``pbcm.cases`` entry points)."""
+    from ..registry import CASES, STUDY_MODULES, UserCaseError, user_cases
+    if name in CASES:
+        return CASES[name]
+    try:
+        users = user_cases(files)
+    except UserCaseError as exc:
+        raise UsageError(str(exc)) from None
+    if name not in users:
+        raise UsageError(f"unknown case {name}; valid: "
+                         f"{', '.join([*CASES, *STUDY_MODULES, *users])} (a case of your own: "
+                         "--case FILE.py, or the pbcm.cases entry-point group)")
+    return users[name]
 
 
 def study_config(study, args):
@@ -175,7 +185,8 @@ def add_store(p):
 def case_configs(names, args):
     """Every case's configuration, built (and so checked) before anything runs."""
     check_executor(args)
-    return {name: case_config(case_named(name), args) for name in names}
+    return {name: case_config(case_named(name, getattr(args, "case_file", ())), args)
+            for name in names}
 
 
 def add_selection(p):

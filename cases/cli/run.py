@@ -4,8 +4,8 @@ from pathlib import Path
 
 import model
 from ..output import StagedFolder
-from .common import (UsageError, add_selection, case_configs, case_into, check_executor,
-                     chosen_models, run_case_into, run_store, run_study_into, study_config,
+from .common import (UsageError, add_selection, case_configs, case_into, case_named,
+                     check_executor, chosen_models, run_store, run_study_into, study_config,
                      worker_pool)
 
 def add(sub):
@@ -17,6 +17,9 @@ def add(sub):
                                    "measures (`pbcm problem new NAME` writes a commented "
                                    "template).")
     r.add_argument("case", nargs="?", help="a case or study name (see pbcm list)")
+    r.add_argument("--case", dest="case_file", action="append", default=[], metavar="FILE",
+                   help="a Python file that declares a case of your own (CASE = YourCase(), "
+                        "a cases.framework.Case); then run it by its name (repeatable)")
     r.add_argument("--problem", metavar="FILE",
                    help="run the problem this TOML file declares instead of a library case "
                         "(output: reports/problems/NAME, NAME its name)")
@@ -57,10 +60,11 @@ def run(args):
         print(f"{args.case}: written to {path}")
         return 0
     cfgs = case_configs([args.case], args)
+    case = case_named(args.case, args.case_file)
     with StagedFolder(Path(args.out) if args.out else Path("reports") / args.case,
                           owner=args.case) as out, \
             worker_pool(args, cfgs) as workers:
-        runs = run_case_into(args.case, cfgs[args.case], out.path, workers, run_store(args))
+        runs = case_into(case, cfgs[args.case], out.path, workers, run_store(args))
         path = out.commit()
     print(f"{args.case}: {len(runs)} runs written to {path}")
     return 0
