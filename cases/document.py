@@ -108,12 +108,13 @@ class Document:
     def ul(self, items):
         self.blocks.append(("ul", list(items)))
 
-    def opening(self, lines):
+    def opening(self, lines, glossary=f"../{GLOSSARY}"):
         """The first CONCLUSION_LINES of ``lines`` as the report's opening paragraphs, a link
-        to the glossary, and the rest under a heading of their own."""
+        to the glossary (``glossary``: its path from the report), and the rest under a
+        heading of their own."""
         for line in lines[:CONCLUSION_LINES]:
             self.p(line)
-        self.p(f"Definitions: [glossary](../{GLOSSARY}).")
+        self.p(f"Definitions: [glossary]({glossary}).")
         if lines[CONCLUSION_LINES:]:
             self.h(2, "More findings")
             self.ul(lines[CONCLUSION_LINES:])

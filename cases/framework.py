@@ -292,6 +292,7 @@ class Case(abc.ABC):
     resolution: ClassVar[Knob] = None      # what a sweep's resolution axis turns
     load: ClassVar[Knob] = None            # what a sweep's load axis turns
     up: ClassVar[str] = "y"                # the vertical axis of the figures
+    glossary: ClassVar[str] = "../glossary.md"   # the glossary's path from the case's report
     material_from: ClassVar[str] = "override with --E, --nu, --rho"
 
     def __init_subclass__(cls, **kw):

@@ -106,6 +106,9 @@ def test_the_run_writes_what_a_case_writes_with_its_toml_verbatim(example_run):
     assert list((out / "vtu").glob("*.vtu"))
     report = (out / "report.md").read_text()
     assert "pbcm run --problem" in report and "end_force" in report
+    # the glossary it links travels with it: a problem's folder lives anywhere
+    assert "Definitions: [glossary](glossary.md)." in report
+    assert "end_force" in (out / "glossary.md").read_text()      # its own measures defined
 
 
 def test_a_problem_is_blessed_and_checked_like_a_case(example_run, tmp_path):

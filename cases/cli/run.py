@@ -99,9 +99,19 @@ def _run_problem(args):
             worker_pool(args, {case.name: cfg}) as workers:
         runs = case_into(case, cfg, out.path, workers, run_store(args))
         (out.path / path.name).write_bytes(case.spec.source)
+        _write_glossary(out.path)
         written = out.commit()
     print(f"{case.name}: {len(runs)} runs written to {written}")
     return 0
+
+
+def _write_glossary(folder):
+    """The glossary beside a problem's report (its folder may live outside a reports root)."""
+    from ..index import glossary_documents
+    from ..output import write_atomic
+    md, html = glossary_documents()
+    write_atomic(folder / "glossary.md", md)
+    write_atomic(folder / "glossary.html", html)
 
 
 def _rewrite_study(study, folder):

@@ -123,6 +123,7 @@ class ProblemCase(Case):
     bcs = (BC,)
     quick = {"p2_levels": 1}
     material_from = "the problem's [material]"
+    glossary = "glossary.md"      # written into the problem's own folder: it lives anywhere
 
     def __reduce__(self):
         """Pickled as the TOML it was read from (a worker process reads it again)."""
