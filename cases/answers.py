@@ -164,7 +164,7 @@ def lines(root, models, pops=(), quick=False):
         out.append(f"**Which reading?** {_decisive(art)}")
     else:
         out.append("**Which reading?** Not computed: run `pbcm run artefact`.")
-    out.append(_cost_of_replacing(pops, models, quick))
+    out.append(_cost_of_replacing(pops, models, quick) + _imbalance(root, models))
     if conv:
         lim = {m: limits(conv, m) for m in models}
         # below the patch tolerance on every lattice, and converging on the irregular ones
@@ -334,6 +334,32 @@ def _cost_of_replacing(pops, models, quick):
             "its model, and a model with a failed run (no number; at the load, no converged "
             "solve) ranks after every model without one: "
             + "; ".join(said) + " (the scorecard below).")
+
+
+# a model's internal forces balance where their net sum is round-off against their sizes
+BALANCE_TOL = 1e-8
+
+
+def _imbalance(root, models):
+    """' Internal forces that do not balance ...': the models whose net internal force
+    (net_force_rel, at the continuum's deformed state) exceeds BALANCE_TOL in some run of a
+    case folder under ``root``, with the largest and where: such a model creates momentum,
+    whatever its errors."""
+    from .registry import CASES
+    worst = {}
+    for case in CASES:
+        for r in (_load(root, case, "metrics.json") or {}).get("runs", []):
+            v = r.get("net_force_rel")
+            if r["model"] in models and v is not None and v > BALANCE_TOL and \
+                    v > worst.get(r["model"], (0.0, ""))[0]:
+                worst[r["model"]] = (v, f"{case}/{r['mesh']}/{r['bc']}")
+    if not worst:
+        return ""
+    return (f" Internal forces that do not balance (net force above {BALANCE_TOL:g} of their "
+            "sum, at the continuum's deformed state: the model creates momentum, whatever its "
+            "errors): " + ", ".join(f"{m} up to {rel(v)} ({w})"
+                                    for m, (v, w) in sorted(worst.items())) + "; every other "
+            f"model balances to {BALANCE_TOL:g}.")
 
 
 ACCURACY = 0.05     # the stated accuracy of the cost recommendation (model-form, linear)

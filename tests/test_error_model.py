@@ -499,3 +499,16 @@ def test_a_norms_uncertainty_includes_p1s_own_distance_to_its_twin():
     assert p.u_model_form == 3e-6
     (_, a, tied_a), (_, b, _) = p.standings()
     assert (a.model, b.model) == ("a", "b") and tied_a == ("b",)
+
+
+def test_the_index_names_a_model_whose_forces_do_not_balance(tmp_path):
+    """A model whose net internal force exceeds round-off in some run is named with its
+    largest value and where; models that balance to round-off are not."""
+    from cases.answers import _imbalance
+    runs = [{"mesh": "five", "bc": "clamped", "model": "a", "net_force_rel": 0.2},
+            {"mesh": "six", "bc": "clamped", "model": "a", "net_force_rel": 0.05},
+            {"mesh": "five", "bc": "clamped", "model": "b", "net_force_rel": 3e-16}]
+    _case_folder(tmp_path, "torsion", runs)
+    said = _imbalance(tmp_path, ["a", "b"])
+    assert "a up to 0.2 (torsion/five/clamped)" in said and " b up to" not in said
+    assert _imbalance(tmp_path, ["b"]) == ""
