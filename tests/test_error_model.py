@@ -182,17 +182,23 @@ def _torsion_runs(values):
             for (mesh, model), q in values.items()]
 
 
-def test_an_order_that_one_mesh_reverses_is_not_resolved(tmp_path):
-    """The mesh is the unit of analysis: a ranking that reverses when one mesh family is left
-    out names that mesh, one that holds on every subset does not."""
+def _three_models(tmp_path, torques):
+    """The populations of a synthetic torsion case: fem-linear at 1 and models a, b, c at
+    ``torques`` {mesh: (a, b, c)} against a continuum of 1; and the models."""
     from cases.index import populations
     v = {}
-    for mesh, (a, b, c) in {"five": (1.1, 1.3, 2.0), "six": (1.1, 1.3, 2.0),
-                            "bcc": (1.6, 1.2, 2.0)}.items():
+    for mesh, (a, b, c) in torques.items():
         v.update({(mesh, "fem-linear"): 1.0, (mesh, "a"): a, (mesh, "b"): b, (mesh, "c"): c})
     _case_folder(tmp_path, "torsion", _torsion_runs(v))
     pops, _ = populations(tmp_path, ["torsion"])
-    models = ["fem-linear", "a", "b", "c"]
+    return pops, ["fem-linear", "a", "b", "c"]
+
+
+def test_an_order_that_one_mesh_reverses_is_not_resolved(tmp_path):
+    """The mesh is the unit of analysis: a ranking that reverses when one mesh family is left
+    out names that mesh, one that holds on every subset does not."""
+    pops, models = _three_models(tmp_path, {"five": (1.1, 1.3, 2.0), "six": (1.1, 1.3, 2.0),
+                                            "bcc": (1.6, 1.2, 2.0)})
     assert [m for _, m, _, _ in scorecard.ranked(scorecard.overall(pops, models))] == \
         ["a", "b", "c"]
     # a: 0.1, 0.1, 0.6; b: 0.3, 0.3, 0.2 -> without five (or six) b's median wins
@@ -359,14 +365,9 @@ def test_no_equilibrium_at_a_linear_cases_load_is_a_failed_run_of_its_load_popul
 def test_the_first_is_unresolved_only_from_models_that_reach_it_themselves(tmp_path):
     """'Not resolved from' is pair by pair with the first: a model that overtakes the second
     when one mesh is left out, but never the first, is not named against the first."""
-    v = {}
-    for mesh, (a, b, c) in {"five": (1.01, 1.10, 1.12), "six": (1.01, 1.10, 1.12),
-                            "bcc": (1.01, 1.15, 1.11)}.items():
-        v.update({(mesh, "fem-linear"): 1.0, (mesh, "a"): a, (mesh, "b"): b, (mesh, "c"): c})
-    _case_folder(tmp_path, "torsion", _torsion_runs(v))
-    from cases.index import populations
-    pops, _ = populations(tmp_path, ["torsion"])
-    models = ["fem-linear", "a", "b", "c"]
+    pops, models = _three_models(tmp_path, {"five": (1.01, 1.10, 1.12),
+                                            "six": (1.01, 1.10, 1.12),
+                                            "bcc": (1.01, 1.15, 1.11)})
     assert [m for _, m, _, _ in scorecard.ranked(scorecard.overall(pops, models))] == \
         ["a", "b", "c"]
     assert scorecard.unresolved(pops, models) == {("b", "c"): "five"}
