@@ -356,15 +356,16 @@ def check(gold, measurements, only_run=False, models=None):
     unseen = {c for c in ran if c not in gold.problems and not any(k[:2] == c
                                                                     for k in gold_rows)}
     ran -= unseen
+    for k, v in values.items():       # a new case is not gated, but never a NaN either
+        if k[:2] in unseen and v is not None and not _finite(v):
+            raise CheckError(f"metric {k[5]} of {'/'.join(k[:5])} is {v!r}, not a finite "
+                             "number")
+    new = {(c, m, "every model"): sum(1 for k, v in values.items()
+                                      if k[:2] == (c, m) and v is not None)
+           for c, m in unseen}
     rows = {k: v for k, v in gold_rows.items() if k[:2] in ran}
     if not rows and unseen:
-        bad = [k for k, v in values.items() if v is not None and not _finite(v)]
-        if bad:
-            raise CheckError(f"metric {bad[0][5]} of {'/'.join(bad[0][:5])} is "
-                             f"{values[bad[0]]!r}, not a finite number")
-        return Verdict([], [], [(c, m, "every model", sum(
-            1 for k, v in values.items() if k[:2] == (c, m) and v is not None))
-            for c, m in sorted(unseen)], NEW, 0)
+        return Verdict([], [], [(*k, n) for k, n in sorted(new.items())], NEW, 0)
     if not rows:
         raise CheckError(f"no gold for the measured {', '.join('/'.join(r) for r in sorted(ran))}"
                          "; run in a mode the gold covers, or bless this one")
@@ -376,12 +377,8 @@ def check(gold, measurements, only_run=False, models=None):
                       measurements.problems[(case, mode)])
     gated_models = {k[:2] + (k[4],) for k in rows}
     measured_rows = set(measurements.rows or {k[:5] for k in values})
-    new = {}
     for k, v in values.items():
         if k[:2] in unseen:
-            if v is not None and not _finite(v):
-                raise CheckError(f"metric {k[5]} of {'/'.join(k[:5])} is {v!r}, not a "
-                                 "finite number")
             continue
         if not (k[:2] + (k[4],) in gated_models):
             if v is not None and not _finite(v):
@@ -429,9 +426,6 @@ def check(gold, measurements, only_run=False, models=None):
     if not out and not flips:
         raise CheckError("no value was compared with its gold (every gated value is n/a in "
                          "both): a check that reads nothing passes nothing")
-    for c, m in sorted(unseen):
-        new[(c, m, "every model")] = sum(1 for k, v in values.items()
-                                         if k[:2] == (c, m) and v is not None)
     if new and status == 0:
         status = NEW
     return Verdict(out, flips, [(*k, n) for k, n in sorted(new.items())], status,

@@ -260,8 +260,7 @@ def overall(pops, models, finite=False):
                   for c in by_case.values()]
         scores = [s for s in scores if s is not None]
         failed = sum(sum(v is None for v in p.parts[m]) for p in mine)
-        lost = sum(1 for p in mine for r, s, _ in p.standings()
-                   if s.model == m and not math.isfinite(s.score))
+        lost = sum(not math.isfinite(s) for c in by_case.values() for _, s, _ in c)
         out[m] = (E.mean_rank(ranks), E.geometric_mean(scores, [0.0] * len(scores)), failed,
                   lost, len(mine))
     return out

@@ -35,7 +35,7 @@ ENV = "PBCM_CACHE"
 ENV_OFF = "PBCM_NO_CACHE"
 ENV_KINDS = "PBCM_CACHE_KINDS"
 ENV_SIZE = "PBCM_CACHE_SIZE_GB"
-SIZE_GB = 4.0          # the default cap in GiB: a day's work of the full library with room to spare
+SIZE_GB = 4.0          # the default cap in GiB: a day's work of the library, with room
 KEEP_DAYS = 14         # an entry neither stored nor found for this long expires
 # the kinds that hold FEM references only: what no model, and no patch of a model, changes
 REFERENCE_KINDS = ("reference", "convergence-reference", "convergence-reference-at",

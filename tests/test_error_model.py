@@ -503,13 +503,16 @@ def test_a_norms_uncertainty_includes_p1s_own_distance_to_its_twin():
 
 
 def test_the_index_names_a_model_whose_forces_do_not_balance(tmp_path):
-    """A model whose net internal force exceeds round-off in some run is named with its
-    largest value and where; models that balance to round-off are not."""
+    """A model whose net internal force exceeds round-off (1e-8 of its forces' sum) in some
+    run is named with its largest value and where, even a small 1e-6; models that balance
+    to round-off are not."""
     from cases.answers import _imbalance
     runs = [{"mesh": "five", "bc": "clamped", "model": "a", "net_force_rel": 0.2},
             {"mesh": "six", "bc": "clamped", "model": "a", "net_force_rel": 0.05},
+            {"mesh": "five", "bc": "clamped", "model": "c", "net_force_rel": 1e-6},
             {"mesh": "five", "bc": "clamped", "model": "b", "net_force_rel": 3e-16}]
     _case_folder(tmp_path, "torsion", runs)
-    said = _imbalance(tmp_path, ["a", "b"])
+    said = _imbalance(tmp_path, ["a", "b", "c"])
     assert "a up to 0.2 (torsion/five/clamped)" in said and " b up to" not in said
+    assert "c up to 1e-06 (torsion/five/clamped)" in said
     assert _imbalance(tmp_path, ["b"]) == ""
