@@ -389,22 +389,23 @@ def _mesh_in_worker(job):
     matrices (reference.fem keeps the last ones assembled), which a (mesh, bc) per worker
     would assemble twice."""
     case, s, mesh_name, store, reuse_full = job
-    mesh_of = _built_once(case, s)
+    mesh_of = _built_once(case, s, warn=False)      # the parent said them
     with one_blas_thread():
         return mesh_name, [unit(case, s, mesh_name, bc, mesh_of,
                                 lambda text, done: tick(mesh_name, text, done), store=store,
                                 reuse_full=reuse_full) for bc in s.bcs]
 
 
-def _built_once(case, s):
+def _built_once(case, s, warn=True):
     """``mesh_of(name)``: the case's mesh ``name``, built on first use and then recalled, so
-    that its bcs share one mesh."""
+    that its bcs share one mesh; ``warn``: print its quality warnings (once, in the process
+    that gives the units out, before any is computed)."""
     meshes = {}
 
     def mesh_of(name):
         if name not in meshes:
             meshes[name] = case.mesh(name, s)
-            for line in meshes[name].warnings():     # said before it is computed on
+            for line in meshes[name].warnings() if warn else ():
                 print(f"pbcm: warning: {case.name} mesh {name}: {line}", file=sys.stderr)
         return meshes[name]
     return mesh_of
