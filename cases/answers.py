@@ -478,7 +478,10 @@ def recommendation(root, models, pops, quick, bench_rows):
                      f"{fmt(bench_rows[cheapest]['cpu_s_per_simulated_s'])} s per simulated "
                      "s, "
                      f"{ratio_text(bench_rows[cheapest], bench_rows[p1_lin])} x {p1_lin}'s) "
-                     f"at model-form error up to {fmt(worst_of[cheapest])} on a case")
+                     + (f"at model-form error up to {fmt(worst_of[cheapest])} on a case"
+                        if math.isfinite(worst_of[cheapest]) else
+                        "but failed at the median on a case (a run with no number, or an "
+                        "unpaired mode)"))
         out.append(line + ".")
     return out[:5] if len(out) > 1 else []
 
@@ -567,11 +570,14 @@ def _measured_line(truth, models):
     mine = sorted((m for m in models if m in v), key=lambda m: v[m]["bead_rms_mm"])
     said = (f"**How far from a measured body?** On the Truth Cube's 343 beads at "
             f"{fmt(100 * h['strain'], 4)} % compression (bonded plates, {h['mesh']} mesh), each "
-            f"model read against its u_val {_span(val['u_val'].values())} mm (the beads' noise "
-            f"{fmt(val['u_d'], 2)}; the model's own spread over the unmeasured plate friction, "
-            f"travel and nu, on the {val['mesh']} mesh, {_span(val['u_input'].values())}; the "
-            f"neo-Hookean reference's change over its last refinement "
-            f"{fmt(val['u_num'], 2)}): ")
+            f"model read against its u_val = sqrt(u_D^2 + u_input^2 + u_num^2), "
+            f"{_span(val['u_val'].values())} mm (u_D the beads' noise "
+            f"{fmt(val['u_d'], 2)}; u_input the model's own bead RMS over the unmeasured plate "
+            f"friction, plate travel and nu, each input's half range, in quadrature, on the "
+            f"{val['mesh']} mesh, {_span(val['u_input'].values())}, which holds each model's "
+            f"own response to nu there, locking included; u_num the neo-Hookean reference's "
+            f"change over its last refinement, {fmt(val['u_num'], 2)}, the same for every "
+            f"model): ")
     if NH in v:
         u_nh = val.get("continuum_u_val")
         said += (f"the neo-Hookean continuum is {fmt(v[NH]['bead_rms_mm'])} mm RMS off"

@@ -21,7 +21,7 @@ from dataclasses import dataclass
 
 from .document import fmt, rel
 
-UNIT_SUFFIXES = ("_mm", "_n", "_nm", "_hz", "_s", "_pa")
+from .names import UNIT_SUFFIXES, err_name, load_name, ref_name  # noqa: F401 (the names' home)
 
 
 @dataclass(frozen=True)
@@ -78,27 +78,18 @@ def declare(name, unit, label, definition, direction=None, shown=None, digits=3)
     CATALOGUE[name] = m
 
 
-def ref_name(name):
-    """The run key of the FEM value of quantity ``name``: '_fem' before a unit suffix
-    (bulge_profile_mm -> bulge_profile_fem_mm, paper_pattern -> paper_pattern_fem)."""
-    for unit in UNIT_SUFFIXES:
-        if name.endswith(unit):
-            return name[:-len(unit)] + "_fem" + unit
-    return name + "_fem"
-
-
-def err_name(name):
-    """The run key of the relative error of quantity ``name`` (tip_deflection_mm ->
-    tip_deflection_rel_err)."""
-    for unit in UNIT_SUFFIXES:
-        if name.endswith(unit):
-            return name[:-len(unit)] + "_rel_err"
-    return name + "_rel_err"
-
-
 def _derived(name):
-    """The Metric of a FEM twin or a relative error of a declared quantity, or None."""
+    """The Metric of a FEM twin, a relative error or the value at the load of a declared
+    quantity, or None."""
     for q, m in CATALOGUE.items():
+        if load_name(q) == name != q:
+            return Metric(name, m.unit, f"{m.label} at the load",
+                          f"the {m.label} at the case's load (the finite-strain solve).", None,
+                          m.shown, m.digits)
+        if ref_name(load_name(q)) == name:
+            return Metric(name, m.unit, f"NH {m.label} at the load",
+                          f"the {m.label} of the converged neo-Hookean reference at the case's "
+                          "load.", None, m.shown, m.digits)
         if ref_name(q) == name != q:
             return Metric(name, m.unit, f"FEM {m.label}",
                           f"the {m.label} of the FEM reference's solution.", None, m.shown,

@@ -20,6 +20,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from model.static import RTOL
+from .names import load_name, ref_name
 
 # a relative value within ten times the solvers' tolerance is round-off (a solve stops there,
 # and where it stops differs from one processor to the next): printed as such, and never the
@@ -138,7 +139,8 @@ class Norm:
     """A case's decomposed error that is a norm (a field, a set of paired frequencies):
     ``model_form`` the run key of the model's error against P1 on the same mesh, ``total`` that
     against the continuum; the discretisation error is P1's own ``total``; ``unpaired`` the run
-    key of how many of its parts failed (a run with one is a failed run). The parts are
+    key of how many of its parts failed against P1 (a run with one is a failed run: its
+    largest error is undefined). The parts are
     magnitudes and bound the total (triangle inequality)."""
 
     model_form: str
@@ -153,9 +155,14 @@ class Norm:
     posed: str = None
 
     def parts(self, run, p1_run):
+        """The run's :class:`Parts`, or None where it or its P1 twin has no value, or where a
+        part failed against P1 (an unpaired mode: the largest error over the parts is then
+        undefined, so the run is a failed run)."""
         mf, tot = run.get(self.model_form), run.get(self.total)
         disc = (p1_run or {}).get(self.total)
         if any(v is None for v in (mf, tot, disc)):
+            return None
+        if self.unpaired and run["model"] != self.p1 and run.get(self.unpaired):
             return None
         if run["model"] == self.p1:
             mf = 0.0           # P1 against itself, whatever its own run key says
@@ -163,10 +170,17 @@ class Norm:
             ("model-form error", mf), ("discretisation error", disc), ("total error", tot))))
 
 
-# the displacement field at a case's load: the model against FEM P1 with the neo-Hookean law on
-# the same tetrahedra, and against the converged neo-Hookean continuum
-AT_LOAD = Norm("disp_rel_l2_nh_p1", "disp_rel_l2_nh", "displacement at the case's load",
-               p1=P1_FINITE, posed="nh_error_estimate")
+def at_load(q):
+    """The quantity ``q`` of the linear regime at the case's load: the same :class:`Scalar`
+    (the same quantity of interest, so that both regimes rank one quantity) measured on the
+    finite-strain solve, against FEM P1 with the reference's neo-Hookean law on the same
+    tetrahedra and the converged neo-Hookean continuum; None for a quantity that is not a
+    linear-regime :class:`Scalar` (a set of frequencies, a quantity already at the load)."""
+    if not isinstance(q, Scalar) or q.p1 != P1_LINEAR:
+        return None
+    key = load_name(q.key)
+    return Scalar(key, ref_name(key), f"{q.label} at the load", p1=P1_FINITE,
+                  posed="nh_error_estimate")
 
 
 def decomposed(runs, quantity):
@@ -198,13 +212,27 @@ class Standing:
             return math.inf
         return float(np.median(list(self.values) + [math.inf] * self.failed))
 
+    @property
+    def spread(self):
+        """How much the median moves with the meshes (each run is one mesh, the unit of
+        analysis): half the range of the medians with one run left out (a jackknife), those
+        that stay finite; 0 with fewer than three runs (nothing left to take a median of)."""
+        every = list(self.values) + [math.inf] * self.failed
+        if len(every) < 3 or math.isinf(self.score):
+            return 0.0
+        meds = [float(np.median(every[:k] + every[k + 1:])) for k in range(len(every))]
+        meds = [m for m in meds if math.isfinite(m)]
+        return (max(meds) - min(meds)) / 2 if meds else 0.0
+
 
 def standings(by_model, u, lost=None):
     """Rank a population: ``by_model`` {model: [error magnitude or None per run]}, ``u`` the
     validation uncertainty of a difference, ``lost`` {model: failed parts of runs that gave a
     number (unpaired modes)}, ranked on before the error. Returns [(rank, Standing, tied)],
-    best first: a model whose score is within ``u`` of the first of a group (and that lost as
-    many parts) shares that group's rank; ``tied`` names every other model within ``u`` of it
+    best first: a model whose score is within the uncertainty of a difference (``u`` and the
+    two medians' ``Standing.spread`` over the meshes, in quadrature) of the first of a group
+    (and that lost as many parts) shares that group's rank; ``tied`` names every other model within that
+    uncertainty of it
     (pair by pair, never chained, so two neighbours across a rank boundary are still said
     tied); failed runs count against their model, and models that all failed their median
     share the last rank."""
@@ -213,9 +241,10 @@ def standings(by_model, u, lost=None):
     st = sorted((Standing(m, tuple(abs(v) for v in vs if v is not None), len(vs))
                  for m, vs in by_model.items()),
                 key=lambda s: (lost.get(s.model, 0), s.score, s.model))
-    def tie(a, b):
+    def tie(a, b):      # within the comparison's u_val and both medians' spread over meshes
         return lost.get(a.model, 0) == lost.get(b.model, 0) and (
-            a.score == b.score or abs(a.score - b.score) < u)
+            a.score == b.score or abs(a.score - b.score) < math.sqrt(
+                u ** 2 + a.spread ** 2 + b.spread ** 2))
 
     out, head, rank = [], None, 0
     for k, s in enumerate(st):

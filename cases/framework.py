@@ -21,7 +21,10 @@ from model.compose import parse
 from model.mesh import SCHEMES
 from model.loads import body_forces, traction_forces
 from . import catalogue
-from .error_model import AT_LOAD
+from .error_model import at_load
+
+# ``Case.decomposed_at_load``'s default: the case's ``decomposed`` quantity at its load
+AT_LOAD = "the decomposed quantity at the load"
 
 # what a run may fail with and still be a finding: the suite's own errors and numerical ones
 FINDINGS = (PbcmError, ArithmeticError, np.linalg.LinAlgError)
@@ -213,6 +216,7 @@ class Reference:
     nonlinear: object = None
     nonlinear_reaction: float = None
     nonlinear_failed: str = None
+    quantities_at_load: dict = None   # the quantities of interest of ``nonlinear`` at the load
     nonlinear_p1: object = None       # FEM P1 with the neo-Hookean law on the mesh: the twin
 
 
@@ -238,13 +242,18 @@ class Case(abc.ABC):
         floor of its entries in the index's geometric mean).
     patch_tests : the boundary conditions whose problem is a patch test (a field every
         consistent discretisation reproduces exactly): reported pass or fail, never pooled.
+    per_mesh_continuum : the boundary conditions where each mesh poses its own continuum
+        problem (a closed form read at the mesh's nodes, a load on the mesh's own nodes): the
+        continuum values' spread over the meshes is then no numerical uncertainty, and u_num
+        is the reference's estimate alone.
     decomposed : what the error model (``cases.error_model``) splits into model-form error
         (against FEM P1 with the same law on the same tetrahedra) and discretisation error
         (FEM P1 against the continuum): a ``Scalar`` quantity or a ``Norm``; None: the case
         has no continuum reference to decompose against.
     decomposed_at_load : the same at the case's load, against FEM P1 with the reference's
-        neo-Hookean law (default the displacement field, ``error_model.AT_LOAD``, where the
-        case has a neo-Hookean reference; None where ``decomposed`` is already at the load).
+        neo-Hookean law (default ``AT_LOAD``: the quantity ``decomposed`` itself, measured on
+        the finite-strain solve, ``error_model.at_load``, so that both regimes rank one
+        quantity; None where ``decomposed`` is already at the load or the case has none).
     gated : case metrics the CI gate bounds beside the standard ones (catalogue names; the
         catalogue gives their direction).
     columns : case metrics shown in the per-(mesh, bc) table after the standard ones
@@ -278,6 +287,7 @@ class Case(abc.ABC):
     headline_pair: ClassVar[str] = None
     headline_estimate: ClassVar[str] = "p2_error_estimate"
     patch_tests: ClassVar[tuple] = ()
+    per_mesh_continuum: ClassVar[tuple] = ()
     decomposed: ClassVar[object] = None
     decomposed_at_load: ClassVar[object] = AT_LOAD
     gated: ClassVar[tuple] = ()
@@ -311,7 +321,10 @@ class Case(abc.ABC):
     @classmethod
     def decompositions(cls):
         """The quantities the error model decomposes for this case (linear regime, load)."""
-        return tuple(q for q in (cls.decomposed, cls.decomposed_at_load) if q is not None)
+        at = cls.decomposed_at_load
+        if at == AT_LOAD:
+            at = at_load(cls.decomposed)
+        return tuple(q for q in (cls.decomposed, at) if q is not None)
 
     # ------------------------------------------------------------------ settings
     def notes_for(self, s):

@@ -75,7 +75,8 @@ def scorecard_rows(pops, data, models):
         shared = (f"{rel(np.median(disc))} [{rel_range(min(disc), max(disc))}]" if disc
                   else "no P1 run")
         u_c = rel(p.u_continuum) + (" (spread over meshes exceeds the estimate)"
-                                   if p.spread_defect else "")
+                                   if p.spread_defect else "") + (
+            " (the estimate alone: each mesh its own continuum problem)" if p.per_mesh else "")
         rows.append([Link(label, f"{p.case}/report.md", f"{p.case}/report.html"),
                      f"{p.quantity.label}: model-form vs FEM P1 ({law})",
                      shared, f"{rel(p.u_model_form, 2)}"]
@@ -169,10 +170,11 @@ def index_documents(root, cases, studies=(), missing=()):
           "against (model-form: the distance between FEM laws that coincide in the linear "
           "regime, FEM P1's own run against the twin a field is measured on, or the solver's "
           "tolerance; total: the reference's estimate and its spread "
-          "over the meshes in quadrature). Each cell is the median over the meshes "
+          "over the meshes in quadrature, or the estimate alone where each mesh poses its "
+          "own continuum problem). Each cell is the median over the meshes "
           "[smallest-largest], n of N runs; a failed run counts against its model; models "
-          "within u_val of the first of a group share its rank, and a cell names every model "
-          "within u_val of it (tied). Colours in the HTML: "
+          "within u_val and the two medians' spread over the meshes of the first of a group "
+          "share its rank, and a cell names every model within that of it (tied). Colours in the HTML: "
           + ", ".join(f"{label}" for _, _, label in BANDS) + ", red also for a failed run. "
           "Quick-mode cases are marked. The last rows are measured against reality (the "
           "Truth Cube's beads).")
@@ -200,17 +202,17 @@ TERMS = {
     "for a case's quantity Q (tip deflection, torque, reaction, punch force, settlement, force "
     "over the load steps), with FEM P1 the same law on the same tetrahedra under the same "
     "constraints and load (linear P1 in the linear regime, neo-Hookean P1 at finite load), "
-    "Q_c the converged continuum's; for the modes, the largest relative frequency error "
-    "against P1's modes paired by shape, an unpaired mode a failed mode; at a case's load "
-    "(every case with a neo-Hookean reference, its population 'at the load'), "
-    "||u_model - u_P1|| / ||u_P1|| against neo-Hookean P1, a run without an equilibrium a "
-    "failed run. What the scorecard ranks (cases/error_model.py).",
+    "Q_c the converged continuum's; the same quantity in both regimes: at a case's load "
+    "(every case with a neo-Hookean reference, its population 'at the load') Q is measured "
+    "on the finite-strain solve against neo-Hookean P1 and the neo-Hookean continuum, a run "
+    "without an equilibrium a failed run; for the modes, the largest relative frequency "
+    "error against P1's modes paired by shape, a run with an unpaired mode a failed run (its "
+    "largest error is undefined). What the scorecard ranks (cases/error_model.py).",
     "discretisation error": "(Q_P1 - Q_c) / |Q_c|: how far FEM P1 on a mesh is from the "
     "converged continuum; the same for every model on that mesh.",
     "total error": "(Q_model - Q_c) / |Q_c| = model-form error + discretisation error for a "
     "scalar (over load steps each is its largest component, and the two parts bound the "
-    "total); for a field (the displacement at the load) the parts are norms that bound the "
-    "total by the triangle inequality; for the modes, paired by shape separately against P1 "
+    "total); for a norm the parts bound the total by the triangle inequality; for the modes, paired by shape separately against P1 "
     "and against the continuum, they need not bound it. A small total with a large "
     "model-form error is two errors cancelling.",
     "u_val": "the validation uncertainty sqrt(u_num^2 + u_input^2 + u_D^2) (ASME V&V 20) a "
@@ -221,14 +223,17 @@ TERMS = {
     "the sensitivity to inputs nobody measured (0 for the library's cases, whose material and "
     "load are given, not measured; the Truth Cube's plate friction, travel and nu), u_D the "
     "measurement's noise (0 where nothing is measured). Two errors closer than u_val are "
-    "tied.",
+    "tied; two medians over the meshes are tied within u_val and both medians' spread over "
+    "the meshes (half the range of the medians with one mesh left out), in quadrature. On "
+    "the Truth Cube, u_input is each unmeasured input's half range of the model's bead RMS "
+    "(plate friction, plate travel, nu), in quadrature, and u_D the beads' noise.",
     "mean rank": "a model's overall standing in one regime: the mean over the cases of its "
     "rank in each case (the mean over that case's populations, one per boundary condition: "
     "each case weighs one), each population ranking its models first by the parts they "
     "lost (unpaired "
     "modes), then by the median over the meshes with a failed run counted as infinitely "
     "wrong (so a failure never removes a population from anyone's comparison); models within "
-    "u_val of the first of a group share its rank; a model with a failed run ranks after "
+    "u_val and the medians' spread over the meshes of the first of a group share its rank; a model with a failed run ranks after "
     "every model without one. Beside it the geometric mean over the cases of the population "
     "medians, each floored at its population's u_val, with its range over the rankings that "
     "leave one mesh family out; 'failed' where a population failed at the median (no finite "
@@ -270,6 +275,24 @@ TERMS = {
     "discretisation reproduces it on any mesh; a model that does not has a consistency error.",
     "population": "the runs of one case under one boundary condition: what a median, a range "
     "or a criterion is taken over (never pooled across populations).",
+    "identity check": "a comparison whose answer is known to be zero by construction (FEM P1 "
+    "against itself; the FEM laws in the linear regime, where they coincide with P1's; FEM "
+    "P1 on a patch test it reproduces exactly): it tests the pipeline, never ranks a model.",
+    "unit": "the unit of analysis of a study: one (mesh size, base) configuration of the "
+    "artefact study, over which its signatures are compared; in the scorecard, the mesh "
+    "family (leaving one out tests whether an order holds).",
+    "leak": "how much of a smooth test field (a barrel, a Gaussian bulge) the period-2 "
+    "signature reads as alternation on a given number of layers; a signature below the leak "
+    "of smooth fields is not resolved.",
+    "model names": "pbcm-corner, pbcm-balanced, pbcm-variational: the paper's shear term "
+    "under three readings of its garbled equations, with the volume term, their constant c "
+    "fitted so that the deviatoric moduli are closest to 2G; -literal: c = 1, the paper's "
+    "constant; pbcm-variational+normal: pbcm-variational plus the deviatoric normal-stress "
+    "term on the edge strains at each corner (registered as normal, also named normal_edge), "
+    "its constant fitted the same way; msm: springs on the mesh edges with van Gelder's "
+    "stiffness E sum V0 / L^2, a fixed rule, not fitted (its Poisson ratio is 1/4 whatever "
+    "nu is asked for); msm+volume: those springs plus the paper's volume term; fem-linear, "
+    "fem-corotated, fem-neohookean: explicit FEM P1 with lumped mass and the named law.",
 }
 
 

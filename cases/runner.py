@@ -14,7 +14,8 @@ from model.terms.shear import Shear
 from reference import hyperelastic, linear
 from . import metrics as M
 from . import stop
-from .catalogue import FINITE, STATIC, err_name, ref_name
+from .catalogue import FINITE, STATIC, err_name, load_name, ref_name
+from .error_model import at_load
 from .framework import FINDINGS, Reference, linear_scale
 from .progress import Progress
 from .store import OFF, key
@@ -74,6 +75,8 @@ def reference(case, mesh, bc, s, probe, extra=True, nonlinear=None):
             # comparison at the load where it has no equilibrium, as where the continuum has none)
             ref.nonlinear_p1 = hyperelastic.solve(mesh, mat.E, mat.nu, dirichlet, element="P1",
                                                   load_steps=case.finite_steps(s), **kw)
+            nh = ref.nonlinear.result
+            ref.quantities_at_load = at_load_quantities(case, mesh, bc, s, nh.u, nh.reaction)
         except FINDINGS as exc:     # recorded: the linear regime still stands
             ref.nonlinear, ref.nonlinear_reaction = None, None
             ref.nonlinear_failed = str(exc)
@@ -171,7 +174,23 @@ def finite_metrics(case, st, mesh, bc, s, ref):
         out["reaction_rel_err_nh"] = M.finite(
             "reaction_rel_err_nh", abs(reaction / _nonzero("reaction", ref.nonlinear_reaction)
                                        - 1))
+    out.update(at_load_quantities(case, mesh, bc, s, st.u, st.reaction))
     return out
+
+
+def at_load_quantities(case, mesh, bc, s, u, reaction):
+    """{run key: value} of the case's decomposed quantity at its load (``error_model.
+    at_load``) from a solution (u, reaction) there: the reaction on the driven nodes or one
+    of the case's quantities of interest; {} where the case decomposes none at the load."""
+    q = case.decomposed
+    if at_load(q) is None or at_load(q) not in case.decompositions():
+        return {}
+    if q.key == "reaction_n":
+        driven = case.driven(mesh, bc, s)
+        value = None if driven is None else float(reaction_along(reaction, driven))
+    else:
+        value = case.quantities(mesh, u, reaction, s, bc)[q.key]
+    return {load_name(q.key): value}
 
 
 def _nonzero(name, value):
@@ -197,6 +216,7 @@ def model_run(case, mesh_name, mesh, bc, model_name, s, ref):
         r["nh_error_estimate"] = ref.nonlinear.error_estimate
         if ref.nonlinear_reaction is not None:
             r["reaction_fem_nh_n"] = ref.nonlinear_reaction
+        r.update({ref_name(k): v for k, v in (ref.quantities_at_load or {}).items()})
     if not s.static_only:
         r.update(case.reference_entries(ref))
     pm = case.build_model(model_name, mesh, s)
@@ -225,6 +245,7 @@ def model_run(case, mesh_name, mesh, bc, model_name, s, ref):
     except FINDINGS as exc:   # no equilibrium found, or a metric undefined: a finding
         r.update(blank, static_failed=str(exc))
     r.update(dict.fromkeys(FINITE))
+    r.update(dict.fromkeys(ref.quantities_at_load or ()))
     if (ref.nonlinear is not None or ref.nonlinear_failed) and not s.static_only:
         r["finite_failed"] = finite_failed or ref.nonlinear_failed
         if st is not None and ref.nonlinear is not None:

@@ -43,6 +43,9 @@ class Population:
     lost: dict = field(default_factory=dict)       # {model: [unpaired modes per run]}
     lost_total: dict = field(default_factory=dict)  # the same against the continuum
     where: str = ""        # ' at the load' for a case's second population on one bc
+    # each mesh poses its own continuum problem (the case's ``per_mesh_continuum``): the
+    # values' spread over the meshes is no uncertainty, u_num is the estimate alone
+    per_mesh: bool = False
 
     @property
     def unpaired(self):
@@ -116,11 +119,13 @@ def populations(runs_by_case, declared, quick, patch_tests, estimate_keys):
                                        quick[case], bc in patch_tests[case],
                                        # the reference that poses it gives its estimate
                                        q.posed or estimate_keys[case],
-                                       " at the load" if at_load else ""))
+                                       " at the load" if at_load else "",
+                                       bc in getattr(declared[case], "per_mesh_continuum",
+                                                     ())))
     return out
 
 
-def _population(case, bc, q, rs, quick, patch_test, estimate_key, where):
+def _population(case, bc, q, rs, quick, patch_test, estimate_key, where, per_mesh=False):
     dec = E.decomposed(rs, q)
     failed_modes = getattr(q, "unpaired", None)
     failed_total = getattr(q, "unpaired_total", None)
@@ -142,10 +147,10 @@ def _population(case, bc, q, rs, quick, patch_test, estimate_key, where):
     u_mf = max([E.ROUND_OFF] + twins)
     est = [r[estimate_key] for r in rs if r.get(estimate_key) is not None]
     cont = {r["mesh"]: r.get(q.continuum) for r in rs} if hasattr(q, "continuum") else {}
-    cont = [_first(v) for v in cont.values() if v is not None]
+    cont = [] if per_mesh else [_first(v) for v in cont.values() if v is not None]
     u_c, defect = E.u_num(max(est) if est else None, cont)
     return Population(case, bc, q, parts, u_mf, u_c, defect, patch_test, quick, meshes, lost,
-                      lost_total=lost_total, where=where)
+                      lost_total=lost_total, where=where, per_mesh=per_mesh)
 
 
 def _key(q):
@@ -431,7 +436,9 @@ def case_findings(name, quantities, runs, patch_tests=(), estimate_key="p2_error
                             f"(u_val: model-form {rel(p.u_model_form, 2)}, total "
                             f"{rel(p.u_continuum, 2)}"
                             + (", the reference's spread over the meshes exceeding its "
-                               "estimate" if p.spread_defect else "") + "):",
+                               "estimate" if p.spread_defect else "")
+                            + (", the reference's estimate alone: each mesh poses its own "
+                               "continuum problem" if p.per_mesh else "") + "):",
                             ["bc", "rank", "model", "model-form", "total"]
                             + (["unpaired P1 modes (failed, ranked first)"] if p.lost else []),
                             rows))

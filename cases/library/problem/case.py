@@ -19,8 +19,8 @@ from .. import common
 from ... import catalogue, figures
 from ... import metrics as M
 from ...catalogue import err_name, ref_name
-from ...error_model import AT_LOAD, Scalar
-from ...framework import MM, Case, Loads, Settings
+from ...error_model import Scalar
+from ...framework import AT_LOAD, MM, Case, Loads, Settings
 from ...runner import reaction_along, reference
 from .spec import AXES, ProblemError, load, nodes_said
 

@@ -1,0 +1,33 @@
+"""The run keys derived from a quantity's name: its FEM value, its relative error, its value at
+the case's load. Kept apart from the catalogue so that the error model can name keys without
+importing the reports' formatting."""
+
+UNIT_SUFFIXES = ("_mm", "_n", "_nm", "_hz", "_s", "_pa")
+
+
+def ref_name(name):
+    """The run key of the FEM value of quantity ``name``: '_fem' before a unit suffix
+    (bulge_profile_mm -> bulge_profile_fem_mm, paper_pattern -> paper_pattern_fem)."""
+    for unit in UNIT_SUFFIXES:
+        if name.endswith(unit):
+            return name[:-len(unit)] + "_fem" + unit
+    return name + "_fem"
+
+
+def load_name(name):
+    """The run key of quantity ``name`` at the case's load (the finite-strain solve):
+    '_at_load' before a unit suffix (tip_deflection_mm -> tip_deflection_at_load_mm); its
+    continuum value is ``ref_name`` of it."""
+    for unit in UNIT_SUFFIXES:
+        if name.endswith(unit):
+            return name[:-len(unit)] + "_at_load" + unit
+    return name + "_at_load"
+
+
+def err_name(name):
+    """The run key of the relative error of quantity ``name`` (tip_deflection_mm ->
+    tip_deflection_rel_err)."""
+    for unit in UNIT_SUFFIXES:
+        if name.endswith(unit):
+            return name[:-len(unit)] + "_rel_err"
+    return name + "_rel_err"
