@@ -154,9 +154,10 @@ def test_quick_scorecard_decides_nothing(tmp_path):
 
 
 def test_an_unpaired_mode_is_failed_and_ranked_first():
-    """A modal run's unpaired P1 modes are failed modes: counted per model and ranked on
-    before the error of the paired ones (a model pairing every mode ranks above one that
-    pairs fewer, whatever their errors)."""
+    """A modal run's unpaired P1 modes are failed modes: the run's largest error is then
+    undefined, so it is a failed run (no number, in every median, mean and pick); counted per
+    model and ranked on before the error of the paired ones (a model pairing every mode
+    ranks above one that pairs fewer, whatever their errors)."""
     q = E.Norm("mf", "tot", "modes", unpaired="lost")
     run = {"mesh": "five", "bc": "free"}
     runs = [dict(run, model="fem-linear", mf=0.0, tot=0.05, lost=0),
@@ -171,7 +172,64 @@ def test_an_unpaired_mode_is_failed_and_ranked_first():
                                  {"modes": set()}, {"modes": "est"})
     assert p.unpaired == {"fem-linear": 0, "a": 3, "b": 0}
     assert p.parts["fem-linear"][0].discretisation == 0.05
+    assert p.parts["a"] == [None] and p.parts["b"][0].model_form == 0.3
     assert [(r, s.model) for r, s, _ in p.standings()] == [(1, "b"), (2, "a")]
+    assert math.isinf(next(s for _, s, _ in p.standings() if s.model == "a").score)
+
+
+def test_a_medians_spread_is_half_the_range_of_its_leave_one_mesh_out_medians():
+    """Over runs 1..5 the medians with one run left out are 3.5, 3.5, 3, 2.5, 2.5: the spread
+    is 0.5; fewer than three runs, or a median that failed, have none."""
+    st = E.Standing("a", (1.0, 2.0, 3.0, 4.0, 5.0), 5)
+    assert st.spread == pytest.approx(0.5)
+    assert E.Standing("a", (1.0, 9.0), 2).spread == 0.0
+    assert E.Standing("a", (1.0,), 3).spread == 0.0          # two of three failed
+
+
+def test_medians_within_their_spread_over_the_meshes_are_tied():
+    """Two medians 0.01 apart are tied when the meshes move them more than that (a
+    difference the unit of analysis does not resolve), and ranked when every mesh agrees."""
+    noisy = E.standings({"a": [0.10, 0.20, 0.30], "b": [0.11, 0.21, 0.31]}, u=0.0)
+    assert [(r, s.model, t) for r, s, t in noisy] == [(1, "a", ("b",)), (1, "b", ("a",))]
+    steady = E.standings({"a": [0.20, 0.20, 0.20], "b": [0.21, 0.21, 0.21]}, u=0.0)
+    assert [(r, s.model, t) for r, s, t in steady] == [(1, "a", ()), (2, "b", ())]
+
+
+def test_the_quantity_at_the_load_is_the_linear_regimes_on_the_finite_solve():
+    """A linear-regime Scalar has its twin at the load: the same quantity under the load's
+    run key, against neo-Hookean P1 and the neo-Hookean continuum, posed where that reference
+    exists; a quantity already at the load, or a set of modes, has none; the catalogue
+    declares both derived keys."""
+    from cases import catalogue
+    q = E.at_load(E.Scalar("torque_nm", "torque_fem_nm", "torque"))
+    assert (q.key, q.continuum, q.p1, q.posed) == (
+        "torque_at_load_nm", "torque_at_load_fem_nm", E.P1_FINITE, "nh_error_estimate")
+    assert E.at_load(E.Scalar("f_n", "f_fem_n", "f", p1=E.P1_FINITE)) is None
+    assert E.at_load(E.Norm("mf", "tot", "modes")) is None
+    assert catalogue.metric("torque_at_load_nm").unit == "N m"
+    assert catalogue.metric("torque_at_load_fem_nm").label.startswith("NH torque")
+
+
+def test_a_continuum_posed_per_mesh_has_no_spread_in_its_u_num():
+    """Where each mesh poses its own continuum problem (a closed form read at its nodes), the
+    continuum values' spread over the meshes is not u_num: the estimate alone is."""
+    runs = _torsion_runs({("five", "fem-linear"): 1.0, ("six", "fem-linear"): 1.0})
+    runs[1]["torque_fem_nm"] = 1.2
+
+    class Declared:
+        per_mesh_continuum = ()
+
+        @staticmethod
+        def decompositions():
+            return (E.Scalar("torque_nm", "torque_fem_nm", "torque"),)
+
+    def u(per_mesh):
+        Declared.per_mesh_continuum = ("clamped",) if per_mesh else ()
+        (p,) = scorecard.populations({"t": runs}, {"t": Declared}, {"t": False},
+                                     {"t": set()}, {"t": "p2_error_estimate"})
+        return p.u_continuum, p.per_mesh
+    assert u(True) == (pytest.approx(0.001), True)
+    assert u(False)[0] > 0.1
 
 
 def _torsion_runs(values):
