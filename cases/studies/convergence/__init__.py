@@ -11,7 +11,7 @@ from ...framework import Study
 from ...store import OFF
 from . import report
 from .problems import PROBLEMS
-from .study import ConvergenceSettings, run
+from .study import ConvergenceSettings, fits, run
 
 # what metrics.json records of a run, all the report is drawn from
 RECORDED = ("runs", "fits", "references", "elasticity", "cost", "manufactured", "patch",
@@ -49,7 +49,11 @@ class Convergence(Study):
             meshes=tuple(p["meshes"]), models=tuple(p["models"]), h_mm=tuple(p["h_mm"]),
             load_scale=p["load_scale"], patch_n=p["patch_n"], quick=p["quick"],
             ref_finest_mm=_finest(p["ref_ladders_mm"]))
-        return s, {k: metrics[k] for k in RECORDED}
+        data = {k: metrics[k] for k in RECORDED}
+        # the fits are derived from the recorded runs and references: drawn again by the
+        # current rule, never recomputing a run
+        data["fits"] = fits(data["runs"], data["references"])
+        return s, data
 
 
 def _finest(ladders):

@@ -7,7 +7,23 @@ grid convergence index (GCI, Roache 1994, J. Fluids Eng. 116: 405-413): the extr
 correction times a safety factor, 1.25 with three or more levels, 3 with two. With two levels
 no order can be observed: the extrapolation then assumes first order, the lowest a consistent
 model shows, which gives the smallest floor the two errors allow. With four or more levels a
-least-squares fit of all of them is reported as well, and the larger uncertainty kept.
+least-squares fit of all of them is reported as well, and the larger uncertainty kept. Every
+uncertainty includes the values' own (``u``: the reference's error estimate, each error being
+known to within it), combined in quadrature as u_val (docs/VERDICTS.md rule 10).
+
+A floor is an error that has stopped falling within its uncertainty and stays above zero beyond
+it; a sequence that is still falling is never one because its fit is poor:
+
+- stopped: with three levels or more, the two finest changes are not both falls larger than
+  ``u``, or the finest levels fall at an order below ORDER_MIN (log(e_-3 / e_-1) /
+  log(h_-3 / h_-1)): a floor at the finest error, +- 1.25 x the larger of the two finest
+  changes (and ``u``), where that is above zero;
+- still falling with an observed order (e = e_inf + C h^p): a floor at the extrapolated e_inf
+  where e_inf - u_val > 0 (a constant plus a decaying part), else converges;
+- still falling without an observed order (the finest changes do not shrink as a power of h):
+  converges, its limit not extrapolated (at most the finest error);
+- two levels observe no order: first order assumed (a floor where e_inf - u_val > 0), which
+  decides nothing the finer levels cannot overturn (the report says "not decided").
 """
 from dataclasses import dataclass
 import math
@@ -22,6 +38,8 @@ GROWTH = 1.1                   # error at the finest level above this x the coar
 # E h^2) and the nonlinearity left at the study's scaled load (strains about 5e-5)
 EXACT = 1e-4
 ORDER_RANGE = (0.05, 8.0)      # orders the three-level equation is solved over
+# the finest levels falling at a lower order have stopped: halving h removes under 4 % of it
+ORDER_MIN = ORDER_RANGE[0]
 
 
 @dataclass(frozen=True)
@@ -110,10 +128,25 @@ def extrapolate(h, v):
     return v[-1] - corr, FS_TWO * abs(corr), None
 
 
-def fit(h, e, nested=True):
+def still_falling(h, e, u=0.0):
+    """(falling, order): whether errors ``e`` at mesh sizes ``h`` (h descending, two levels or
+    more) are still falling at the finest levels beyond the values' uncertainty ``u``, and the
+    order they fall at there (log(e_-3 / e_-1) / log(h_-3 / h_-1) over the three finest, the
+    two finest with two levels; None where an error is not positive). Falling: each of the
+    (up to two) finest changes is a fall larger than ``u``, at an order of ORDER_MIN or more."""
+    k = min(len(h), 3)
+    hs, es = h[-k:], e[-k:]
+    falls = all(a - b > u for a, b in zip(es, es[1:]))
+    q = (math.log(es[0] / es[-1]) / math.log(hs[0] / hs[-1])
+         if es[0] > 0 and es[-1] > 0 else None)
+    return falls and q is not None and q >= ORDER_MIN, q
+
+
+def fit(h, e, nested=True, u=0.0):
     """The Fit of errors ``e`` at mesh sizes ``h`` (any order; NaN-free, at least two);
     ``nested`` False for a family whose meshes are not self-similar (unstructured), which is
-    never extrapolated."""
+    never extrapolated; ``u`` the values' own uncertainty (the reference's error estimate),
+    part of every +- (u_val) and of what counts as a fall (the rule: the module's doc)."""
     order = np.argsort(h)[::-1]
     h = [float(h[i]) for i in order]
     e = [float(e[i]) for i in order]
@@ -133,7 +166,24 @@ def fit(h, e, nested=True):
         return Fit(None, None, None, "not asymptotic",
                    "the meshes are not self-similar (no asymptotic expansion in h holds), so "
                    f"no limit is extrapolated; the finest error is {e[-1]:.3g}", n)
+    falling, q = still_falling(h, e, u)
+    if n >= 3 and not falling:
+        # stopped within its uncertainty: the level it stopped at, +- its last changes
+        e_inf = e[-1]
+        err = math.hypot(FS_THREE * max(abs(e[-1] - e[-2]), abs(e[-2] - e[-3])), u)
+        p_obs = None       # an order read off a sequence that stopped is its noise's
+        changes = ", ".join(f"{b - a:+.2g}" for a, b in zip(e[-3:], e[-2:]))
+        stopped = (f"stopped falling (finest changes {changes}"
+                   + (f", the values' uncertainty {u:.2g}" if u else "")
+                   + (f", order {q:.2g} there" if q is not None else "") + ")")
+        if e_inf - err > 0:
+            return Fit(p_obs, e_inf, err, "floor",
+                       f"{stopped}: the error stays at {e_inf:.3g} +- {err:.2g}, which no "
+                       "refinement removes", n)
+        return Fit(p_obs, e_inf, err, "converges",
+                   f"{stopped} at {e_inf:.2g} +- {err:.2g}, not distinguishable from zero", n)
     e_inf, err, p = extrapolate(h, e)
+    err = math.hypot(err, u)
     r = h[-2] / h[-1]
     p_obs = p if p is not None else (
         math.log(e[-2] / e[-1]) / math.log(r) if n == 2 and e[-1] > 0 and e[-2] > e[-1]
@@ -143,12 +193,18 @@ def fit(h, e, nested=True):
                    f"the extrapolated limit {e_inf:.3g} +- {err:.2g} is below zero: the levels "
                    "are not in the asymptotic range", n)
     e_inf = max(e_inf, 0.0)
-    if e_inf - err > 0 and e_inf > 0.2 * e[-1]:
+    if n >= 3 and p is None:
+        # still falling, but its changes do not shrink as a power of h: no limit, no floor
+        return Fit(None, e_inf, err, "converges",
+                   f"still falling (order {q:.2g} over the finest levels), not yet in the "
+                   f"asymptotic range: no limit extrapolated, at most the finest error "
+                   f"{e[-1]:.2g}", n)
+    if e_inf - err > 0:
         return Fit(p_obs, e_inf, err, "floor",
-                   f"the error tends to {e_inf:.3g} +- {err:.2g}, which no refinement removes",
-                   n)
+                   f"the error tends to {e_inf:.3g} +- {err:.2g}, which no refinement removes"
+                   + (" (two levels, first order assumed)" if n == 2 else ""), n)
     why = (f"observed order {p_obs:.2g}" if p_obs is not None else
-           "no asymptotic order observed, but no floor distinguishable from zero")
+           "no order observed, but no floor distinguishable from zero")
     return Fit(p_obs, e_inf, err, "converges", why + f"; limit {e_inf:.2g} +- {err:.2g}", n)
 
 
@@ -178,5 +234,5 @@ def cancellation(e, ratios=None):
     return None
 
 
-__all__ = ["Fit", "fit", "extrapolate", "observed_order", "ratio_limit", "cancellation",
-           "EXACT"]
+__all__ = ["Fit", "fit", "extrapolate", "observed_order", "still_falling", "ratio_limit",
+           "cancellation", "EXACT", "ORDER_MIN"]

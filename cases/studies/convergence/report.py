@@ -10,7 +10,7 @@ from ...runner import jsonable
 from .plots import directional_young, error_vs_h, pareto
 from .elasticity import ANGLES_DEG, PATCH_MM
 from .problems import PROBLEMS
-from .fit import EXACT
+from .fit import EXACT, ORDER_MIN
 from .study import FEM_P1, MAX_NODES
 from .verification_report import (gate_rows as verification_gate_rows, manufactured_section,
                                   patch_section, steps_section)
@@ -21,7 +21,9 @@ GATED = catalogue.gated("disp_rel_l2", "reaction_rel_err", "e_inf", "moduli_rel_
                         "anisotropy_AU", "mms_order", "mms_rel_l2", "patch_error", "dt_error",
                         "dt_order")
 BUDGETS = (0.1, 0.02)   # error targets of the cost table: the cheapest run reaching each
-REF_MARGIN = 3.0        # a reference this many times below the smallest error is well below
+# a reference whose estimate is more than a fifth of an error cannot judge it (VERDICTS.md rule
+# 1): the errors below this many times its estimate are "not resolved"
+REF_MARGIN = 5.0
 ISOTROPIC_TOL = 0.01    # every C_eff modulus within this of the target's: the lattice is it
 
 
@@ -62,13 +64,24 @@ def definitions():
         "factor 3); with four levels or more the least-squares fit of all, with the larger "
         "uncertainty.",
         f"verdict: 'exact' when every error is below {EXACT:g} (the reference's own level: "
-        "the static solver's tolerance and the nonlinearity left at the scaled load); 'floor' when e_inf - err > 0 and e_inf > 0.2 x the finest error (a "
-        "consistency error no refinement removes); 'diverges' when the finest error exceeds "
-        "the coarsest by 10 %; 'not asymptotic' on a family whose meshes are not "
-        "self-similar (unstructured: never extrapolated) or where the extrapolated limit lies "
-        "below zero beyond its uncertainty (a limit is never below 0; a stiffness ratio's "
-        "limit never at or below 0); otherwise 'converges' (with the order when one is "
-        "observed). 'cancellation' marks a series whose error is not monotone in h or whose "
+        "the static solver's tolerance and the nonlinearity left at the scaled load); "
+        "'diverges' when the finest error exceeds the coarsest by 10 %; 'not asymptotic' on a "
+        "family whose meshes are not self-similar (unstructured: never extrapolated) or where "
+        "the extrapolated limit lies below zero beyond its uncertainty (a limit is never below "
+        "0; a stiffness ratio's limit never at or below 0); 'floor' (a consistency error no "
+        "refinement removes) when the error has stopped falling within its uncertainty and "
+        "stays above zero beyond it: either the finest levels have stopped (their two changes "
+        "not both falls larger than the values' uncertainty u, the reference's estimate, or "
+        f"a fall at an order below {ORDER_MIN:g} over them; the floor is the finest error +- "
+        "1.25 x the larger change, with u) or, still falling at an observed order, the "
+        "extrapolated e_inf exceeds its +- (a constant plus a decaying part); a sequence still "
+        "falling without an observed order is never a floor; otherwise 'converges' (with the "
+        "order when one is observed). Every +- includes u in quadrature (u_val). With two "
+        "levels no order is observed: first order is assumed and the verdict is 'not decided' "
+        "in the report (`pbcm run convergence` decides, on four levels). 'not resolved' marks "
+        f"a fit whose finest error is below {REF_MARGIN:g} x its reference's estimate: that "
+        "reference cannot judge it (docs/VERDICTS.md rule 1). 'cancellation' marks a series "
+        "whose error is not monotone in h or whose "
         "stiffness ratio crosses 1: an error falling through zero is small at one level by "
         "accident, so such a run is never on a cost front.",
         "C_eff: 6 x 6 in Voigt order (xx, yy, zz, yz, xz, xy), engineering shear; E_i = "
@@ -83,18 +96,51 @@ def definitions():
 
 
 # ---------------------------------------------------------------------- sentences
-def _by_model(fits, models):
-    return {m: [f for f in fits if f["model"] == m and f.get("verdict") in
-                ("exact", "converges", "floor", "diverges")] for m in models}
+VERDICTS = ("exact", "converges", "floor", "diverges")   # a limit or a trend
+TWO_LEVELS = ("two levels observe no order: a floor, a slow convergence and a rise before the "
+              "asymptotic range look alike there")
+
+
+def decided(f):
+    """Whether a fit's verdict is decided: 'exact' on any levels; 'converges', 'floor' and
+    'diverges' on three levels or more (VERDICTS.md rule 14: two levels observe no order, and
+    the finer levels overturn their verdicts)."""
+    return f.get("verdict") == "exact" or (f.get("verdict") in VERDICTS
+                                           and (f.get("levels") or 0) >= 3)
+
+
+def unresolved(data):
+    """The (case, bc, mesh, model) of every fit, 'exact' aside, whose finest error is below
+    what its reference can judge (``unresolved_below``): 'not resolved'."""
+    refs = {(r["case"], r["bc"]): unresolved_below(r) for r in data["references"]}
+    finest = {}
+    for r in data["runs"]:
+        k = (r["case"], r["bc"], r["mesh"], r["model"])
+        if r.get("disp_rel_l2") is not None and (k not in finest or r["h_mm"] < finest[k][0]):
+            finest[k] = (r["h_mm"], r["disp_rel_l2"])
+    return {(f["case"], f["bc"], f["mesh"], f["model"]) for f in data["fits"]
+            if f.get("verdict") != "exact" and (f["case"], f["bc"], f["mesh"], f["model"])
+            in finest and finest[(f["case"], f["bc"], f["mesh"], f["model"])][1]
+            < refs.get((f["case"], f["bc"]), 0.0)}
+
+
+def _by_model(fits, models, skip=()):
+    return {m: [f for f in fits if f["model"] == m and decided(f) and (
+        f["case"], f["bc"], f["mesh"], f["model"]) not in skip] for m in models}
 
 
 def conclusion(s, data):
     """The study's headline: which models converge to the continuum, which stop at a floor
-    (and how high), what the lattices' effective tensors say, and who is on the cost front."""
+    (and how high), what the lattices' effective tensors say, and who is on the cost front;
+    a verdict that two levels cannot decide is said to be not decided."""
     models = [FEM_P1] + list(s.models)
-    by = _by_model(data["fits"], models)
-    conv = [m for m in models if by[m] and all(f["verdict"] in ("converges", "exact")
-                                                for f in by[m])]
+    loose = unresolved(data)
+    by = _by_model(data["fits"], models, loose)
+    pending = {m: [f for f in data["fits"] if f["model"] == m and f.get("verdict") in VERDICTS
+                   and not decided(f)] for m in models}
+    undecided = sum(len(v) for v in pending.values())
+    conv = [m for m in models if by[m] and not pending[m] and all(
+        f["verdict"] in ("converges", "exact") for f in by[m])]
     floors = {m: [f for f in by[m] if f["verdict"] == "floor"] for m in models}
     floored = [m for m in models if floors[m]]
     out = []
@@ -102,25 +148,35 @@ def conclusion(s, data):
     total = len({(f["case"], f["bc"], f["mesh"]) for f in data["fits"]})
     preview = ("Quick: not decided (`pbcm run convergence` decides, on finer levels and "
                "references); a preview. " if s.quick else "")
-    out.append(
-        preview +
-        f"Convergence (h = {', '.join(f'{h:.3g}' for h in s.h_mm)} mm, {total} problem x mesh "
-        f"family combinations): converging everywhere: {', '.join(conv) or 'none'}; stopping "
-        "at a floor that no refinement removes: " + ("; ".join(
-            f"{m} in {len(floors[m])} of {total} ({len(by[m])} with a limit or a trend; "
-            "median floor "
-            f"{np.median([f['e_inf'] for f in floors[m]]):.2g})" for m in floored) or "none")
-        + f" (loads scaled by {s.load_scale:g}: the linear regime, so that a floor is the "
-        "model's consistency error, not geometric nonlinearity).")
+    head = (preview + f"Convergence (h = {', '.join(f'{h:.3g}' for h in s.h_mm)} mm, {total} "
+            "problem x mesh family combinations): ")
+    if any(f["verdict"] != "exact" for m in models for f in by[m]):
+        head += (
+            f"converging on every fit its reference resolves: {', '.join(conv) or 'none'}; "
+            "stopping at a floor that no refinement removes: " + ("; ".join(
+                f"{m} in {len(floors[m])} of {total} ({len(by[m])} with a limit or a trend; "
+                "median floor "
+                f"{np.median([f['e_inf'] for f in floors[m]]):.2g})" for m in floored)
+                or "none"))
+        if loose:
+            head += (f"; not resolved (VERDICTS.md rule 1: the reference's estimate more than a "
+                     f"fifth of the finest error, left out of these counts): {len(loose)} fits, "
+                     "on " + ", ".join(sorted({f"{k[0]} {k[1]}" for k in loose})))
+    if undecided:
+        head += ("; " if head.endswith(")") or head.endswith("none") else "") + (
+            f"not decided: {undecided} fits ({TWO_LEVELS}; `pbcm run convergence` decides, on "
+            "four levels)")
+    out.append(head + f" (loads scaled by {s.load_scale:g}: the linear regime, so that a floor "
+               "is the model's consistency error, not geometric nonlinearity).")
     odd = [f for f in data["fits"] if f.get("verdict") == "not asymptotic"]
     if odd:
         out.append(f"Not asymptotic ({len(odd)} fits, not extrapolated or with a limit below "
                    "zero): " + ", ".join(sorted({f"{f['model']} on {f['mesh']}" for f in odd}))
                    + ".")
-    div = sorted({f["model"] for f in data["fits"] if f.get("verdict") == "diverges"})
+    div = sorted({f["model"] for f in data["fits"] if f.get("verdict") == "diverges"
+                  and decided(f)})
     if div:
-        out.append(("Quick, not decided: " if s.quick else "")
-                   + "Diverging somewhere (error growing as h falls): " + ", ".join(div) + ".")
+        out.append("Diverging somewhere (error growing as h falls): " + ", ".join(div) + ".")
     eff = [e for e in data["elasticity"] if not e.get("failed")]
     exact = [m for m in s.models if all(e["moduli_rel_err"] < ISOTROPIC_TOL for e in eff
                                          if e["model"] == m)]
@@ -143,26 +199,42 @@ def conclusion(s, data):
 
 
 def _tensor_vs_verdicts(s, data, eff):
-    """How the effective tensors and the verdicts agree, counted over (model, lattice)."""
-    off, on = [], []
+    """How the effective tensors and the verdicts agree, counted over (model, lattice) pairs
+    whose every verdict is decided."""
+    off, on, pending = [], [], 0
     for e in eff:
-        verdicts = {f["verdict"] for f in data["fits"]
-                    if f["model"] == e["model"] and f["mesh"] == e["mesh"]}
+        mine = [f for f in data["fits"] if f["model"] == e["model"] and f["mesh"] == e["mesh"]]
+        if any(f.get("verdict") in VERDICTS and not decided(f) for f in mine):
+            pending += 1
+            continue
+        verdicts = {f["verdict"] for f in mine}
         if not verdicts:
             continue
         bad = bool(verdicts & {"floor", "diverges"})
         (off if e["moduli_rel_err"] >= ISOTROPIC_TOL else on).append((e, bad))
+    if not off and not any(b for _, b in on) and pending:
+        return (f"Not decided whether the lattices off the target are those that stop at a floor "
+                f"or diverge: {pending} (model, lattice) pairs have a verdict that two levels "
+                "cannot decide (`pbcm run convergence` decides, on four levels).")
     return (f"Of the {len(off)} (model, lattice) pairs whose tensor is more than "
             f"{ISOTROPIC_TOL:.0%} from the target, {sum(b for _, b in off)} stop at a floor or "
             f"diverge in some problem on that lattice; of the {len(on)} pairs on target, "
             f"{sum(b for _, b in on)} do" + (" (" + ", ".join(
                 f"{e['model']} on {e['mesh']}" for e, b in on if b) + ")" if any(
-                b for _, b in on) else "") + ".")
+                b for _, b in on) else "")
+            + (f"; {pending} pairs not decided (two levels)" if pending else "") + ".")
+
+
+def unresolved_below(ref):
+    """The error below which the reference ``ref`` (its summary) cannot judge a run: REF_MARGIN
+    times its own estimate (VERDICTS.md rule 1: an estimate more than a fifth of an error)."""
+    return REF_MARGIN * (ref.get("error_estimate") or 0.0)
 
 
 def _reference_margin(data):
     """How far below the errors it judges each reference is: the smallest error of a run
-    that is not exact, over the reference's own estimate, per problem."""
+    that is not exact, over the reference's own estimate, per problem; where that is under
+    REF_MARGIN the runs it cannot judge are 'not resolved' (VERDICTS.md rule 1)."""
     exact = {(f["case"], f["bc"], f["mesh"], f["model"]) for f in data["fits"]
              if f.get("verdict") == "exact"}
     parts = []
@@ -172,9 +244,13 @@ def _reference_margin(data):
                 and (r["case"], r["bc"], r["mesh"], r["model"]) not in exact]
         if errs:
             margin = min(errs) / max(ref["error_estimate"], 1e-300)
+            below = unresolved_below(ref)
             parts.append(f"{ref['case']} {ref['bc']}: smallest error {min(errs):.2g}, "
                          f"{margin:.3g}x the reference's estimate"
-                         + (" (not well below: read its finest levels with care)"
+                         + (f" (not resolved: its estimate {ref['error_estimate']:.2g} is more "
+                            "than a fifth of the smallest error, so it cannot judge the "
+                            f"{sum(e < below for e in errs)} of {len(errs)} runs with an error "
+                            f"below {below:.2g}, nor a fit whose finest error is)"
                             if margin < REF_MARGIN else ""))
     return ("The references against the errors they judge (runs exact at every h left out): "
             + "; ".join(parts) + ".")
@@ -278,6 +354,7 @@ def _problem_section(doc, out, s, data, name, bc):
     hs = sorted({r["h_mm"] for r in runs}, reverse=True)
     doc.h(3, f"{name}, {bc}")
     ref = next((r for r in data["references"] if r["case"] == name and r["bc"] == bc), None)
+    below = unresolved_below(ref) if ref else 0.0
     if ref:
         doc.p(f"Reference: FEM P2, {ref['dofs']} unknowns, {PROBLEMS[name].label} "
               f"{ref['response_fem']:.4g} (SI units), error estimate "
@@ -306,8 +383,7 @@ def _problem_section(doc, out, s, data, name, bc):
                         + [fmt(f.get("order"), 2),
                            "n/a" if f.get("e_inf") is None
                            else f"{f['e_inf']:.2g} +- {f['e_inf_err']:.1g}",
-                           f.get("verdict", "n/a")
-                           + (", cancellation" if f.get("cancellation") else ""),
+                           verdict_cell(f, rs[min(rs)].get("disp_rel_l2"), below),
                            fmt(finest.get("reaction_ratio")),
                            fmt(f.get("ratio_inf")) if f.get("ratio_inf") is not None
                            else f"n/a ({f.get('ratio_why') or 'no ratio'})"])
@@ -316,6 +392,18 @@ def _problem_section(doc, out, s, data, name, bc):
     error_vs_h(out / png, f"{name}, {bc}: displacement error against h",
                      list(s.meshes), list(s.models), series, FEM_P1)
     doc.img(png, f"{name}, {bc}: error against h, per mesh family (FEM P1 in black)")
+
+
+def verdict_cell(f, finest, below):
+    """A fit's verdict as its table prints it: 'not decided (two levels)' where two levels
+    cannot decide it, ', not resolved' where its finest error ``finest`` is below what the
+    reference can judge (``below``), ', cancellation' where the series may cancel."""
+    v = f.get("verdict", "n/a")
+    if v in VERDICTS and not decided(f):
+        v = "not decided (two levels)"
+    elif v != "exact" and finest is not None and finest < below:
+        v += ", not resolved"
+    return v + (", cancellation" if f.get("cancellation") else "")
 
 
 def _elasticity_section(doc, out, s, data):

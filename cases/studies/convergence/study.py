@@ -339,11 +339,13 @@ def _weights(name, s):
 
 
 # ---------------------------------------------------------------------- the study
-def fits(runs):
+def fits(runs, references=()):
     """A fit per (case, mesh, bc, model) of the displacement error over h, with the limit of
     the stiffness ratio extrapolated alike (never on a family that is not self-similar, never
     a limit at or below zero) and the series flagged where it may cancel rather than
-    converge."""
+    converge. ``references`` (their summaries) give each error's own uncertainty: its
+    problem's reference error estimate."""
+    u_ref = {(r["case"], r["bc"]): r.get("error_estimate") or 0.0 for r in references}
     out = []
     keys = dict.fromkeys((r["case"], r["mesh"], r["bc"], r["model"]) for r in runs)
     for case, mesh, bc, model in keys:
@@ -358,7 +360,8 @@ def fits(runs):
             continue
         h = [r["h_mm"] for r in rs]
         nested = mesh in SELF_SIMILAR
-        f = fit(h, [r["disp_rel_l2"] for r in rs], nested=nested)
+        f = fit(h, [r["disp_rel_l2"] for r in rs], nested=nested,
+                u=u_ref.get((case, bc), 0.0))
         row.update(order=f.order, e_inf=f.e_inf, e_inf_err=f.e_inf_err, verdict=f.verdict,
                    why=f.why, label=f.label())
         ratios = [r["reaction_ratio"] for r in rs]
@@ -417,10 +420,11 @@ def run(s, workers=None, log=True, bench=None, store=OFF):
         verification = {name: [r for (n, _), r in zip(work, checked) if n == name]
                         for name in tables}
     runs = [r for rs in rows for r in rs]
-    fitted = fits(runs)
+    summaries = [ref.summary() for ref in refs]
+    fitted = fits(runs, summaries)
     cancelling = {(f["case"], f["mesh"], f["bc"], f["model"]) for f in fitted
                   if f.get("cancellation")}
-    data = {"runs": runs, "fits": fitted, "references": [ref.summary() for ref in refs],
+    data = {"runs": runs, "fits": fitted, "references": summaries,
             "elasticity": eff, "cost": accuracy_per_cost(runs, bench, EXACT, cancelling),
             **verification}
     return jsonable(data)
