@@ -651,22 +651,37 @@ def _largest(limit):
 
 
 def _decisive(art):
-    """The artefact study's reading verdict as its report states it: decided or not (and
-    why), whether no reading, or no timed one, reproduces all the paper's observables, which
-    observable each reading misses or leaves undecided, and the readings with a normal-stress
-    term (their cost not decided)."""
+    """The artefact study's reading verdict as its report states it, from its own table: decided
+    or not (and why), whether no reading, or no timed one, reproduces all the paper's
+    observables, and per reading each observable's call with the numbers that make it (the
+    cost's ratio with its range over the bench's rounds and sizes; the growth rate on each
+    mesh it was measured on: a reading stable on one mesh and growing on another is not
+    stable); the readings with a normal-stress term apart (their cost not decided)."""
     v = art["verdict"]
     names = {r["model"]: r["name"] for r in art["readings"]}
-    said = {"cost": "the cost (the paper's Figure 2: a step over 10x msm's; one timing per "
-                    "model of this implementation)",
-            "stable": "stability (the linearised growth rate at rest, with and without the "
-                      "damping the paper does not state)"}
+    words = {True: "matched", False: "missed", None: "not decided"}
+    said = {"cost": "the cost (the paper's Figure 2: a step over 10x msm's; the bench's "
+                    "in-round ratio on the paper's cube, read on its range over the bench's "
+                    "rounds and sizes)",
+            "stable": "stability (the linearised growth rate at rest on each conforming split "
+                      "of the paper's lattice, with and without the damping the paper does "
+                      "not state; stable only where stable on every mesh)"}
+
+    def cost(r):
+        span = r.get("step_range")
+        if not r.get("timed"):
+            return "not timed"
+        return (fmt(r["step_vs_msm"], 3) + (f" [{fmt(span[0], 2)}-{fmt(span[1], 2)}]" if span
+                                             else ", no range"))
+
+    def stable(r):
+        by = r.get("growth_by_mesh") or {}
+        return r.get("stable_why") or (", ".join(f"{m} {fmt(x, 3)} 1/s" for m, x in by.items())
+                                       or "no growth rate")
     rows = [r for r in art["readings"] if r["in_paper"]]
     per = "; ".join(
-        f"{r['name']}: " + ", ".join(f"{k} " + {True: "matched", False: "missed",
-                                                None: "not decided"}[x]
-                                     for k, x in r["matches"].items())
-        for r in rows)
+        f"{r['name']}: cost {words[r['matches']['cost']]} ({cost(r)}), stable "
+        f"{words[r['matches']['stable']]} ({stable(r)})" for r in rows)
     head = (f"{names.get(v['model'], v['model'])} ({v['why']})" if v.get("decided") else
             f"Not decided ({v['why']})")
     return (head + " ([artefact study](artefact/report.md)). "
@@ -676,9 +691,11 @@ def _decisive(art):
                + ", ".join(v.get("cost_miss", [])) + " each miss the cost; the literal "
                "readings were not timed). " if v.get("none_reproduces_timed") else "")
             + f"Observables: {said['cost']} and {said['stable']}; per reading: {per}."
-            + (f" Stable with and without damping: {', '.join(v['stable'])}; not decided "
-               f"(grows only without the assumed damping): "
-               f"{', '.join(v['stability_depends']) or 'none'}." if v.get("stable") else "")
+            + (f" Stable on every mesh with and without damping: "
+               f"{', '.join(v['stable']) or 'none'}; not decided (on the mesh or the damping): "
+               f"{', '.join(v['stability_depends']) or 'none'}"
+               + (f"; growing on every mesh: {', '.join(v['unstable'])}"
+                  if v.get("unstable") else "") + "." if "stable" in v else "")
             + (" With a normal-stress term the paper's equations lack, the cost is not "
                "decided (this implementation's added term): no such variant is evidence "
                "for a reading." if v.get("with_normal_term") else ""))
@@ -686,8 +703,13 @@ def _decisive(art):
 
 def _cause_numbers(art):
     """The artefact study's answer to what causes the bulge/neck pattern, as its report
-    opens (what is resolved, then what is not), with its own statement of how sure."""
+    opens (what is resolved, then what is not), with its own statement of how sure; 'quick:
+    not decided' where the run lacks the meshes that decide (9 and 17 nodes per side)."""
     a = art["answer"]
+    decisive = a.get("decisive", 9)
+    if not any(c["nodes_per_side"] >= decisive for c in art.get("cells", [])):
+        return (f"Quick: not decided (this run lacks the meshes of {decisive} and more nodes "
+                "per side; `pbcm run artefact` decides) ([artefact study](artefact/report.md)).")
     # the study's own statement of how sure it is travels with its answer, never left behind
     sure = art.get("how_sure", "").replace("**How sure.** ", "How sure: ")
     said = " ".join(x for x in (a.get("text"), sure) if x)

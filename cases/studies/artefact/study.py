@@ -289,7 +289,34 @@ def run(s, workers=None, log=True, bench=None, store=OFF):
     found.update(zip(todo, made))
     return jsonable({"cells": [r for c in cells for r in found[c]],
                      "references": [infos[p] for p in pairs],
-                     "step_vs_msm": step_costs(bench, list(s.models))})
+                     **bench_costs(bench, list(s.models))})
+
+
+def bench_costs(bench, models):
+    """What the study takes from the bench document ``bench``: each model's step over msm's
+    on the paper's cube (``step_costs``) and its spread over the bench's rounds and sizes
+    (``step_ranges``), with the sizes and rounds that spread covers."""
+    return {"step_vs_msm": step_costs(bench, models),
+            "step_vs_msm_range": step_ranges(bench, models),
+            "bench_spread": None if not bench else {
+                "tets": sorted({r["tets"] for r in bench.get("rows", [])}),
+                "rounds": max([r.get("rounds") or 0 for r in bench.get("rows", [])],
+                              default=0)}}
+
+
+def step_ranges(bench, models):
+    """{model: [smallest, largest]} of its RK4 step over msm's over every round and every size
+    the bench timed (each size's in-round ratios [smallest-largest]); a literal reading's is
+    its calibrated reading's (the same kernel); None where the bench lacks the model."""
+    out = {}
+    rows = (bench or {}).get("rows", [])
+    for m in models:
+        timed = m.replace("-literal", "")
+        spans = [r.get("step_vs_msm_range") or [r["step_vs_msm"]] * 2 for r in rows
+                 if r["model"] == timed and r.get("step_vs_msm") is not None]
+        out[m] = ([float(min(lo for lo, _ in spans)), float(max(hi for _, hi in spans))]
+                  if spans else None)
+    return out
 
 
 def step_costs(bench, models):
