@@ -196,8 +196,7 @@ def paper_pattern(profile):
     return bool(d2[0] > tol and d2[1] < -tol and d2[2] > tol)
 
 
-MAC_MIN = 0.8          # a model mode pairs with a reference mode whose shape it matches this well
-CLUSTER_TOL = 0.01     # reference frequencies this close (relative) span one degenerate space
+MAC_MIN = 0.8          # a model mode pairs with reference modes whose span holds this much of it
 
 
 def mac(a, B):
@@ -210,34 +209,63 @@ def mac(a, B):
     return float(np.linalg.norm(Q.conj().T @ a) ** 2 / np.vdot(a, a).real)
 
 
-def pair_modes(f_model, v_model, f_ref, v_ref, mac_min=MAC_MIN, cluster_tol=CLUSTER_TOL,
-               count=None):
+def spanned(a, B, mac_min=MAC_MIN):
+    """The fewest columns of ``B`` (best single MAC first) whose span holds ``mac_min`` of the
+    shape ``a``; None when all of them together do not (a shape the reference lacks)."""
+    a = np.asarray(a, dtype=complex) / np.linalg.norm(a)
+    single = np.abs(a.conj() @ B) ** 2 / np.linalg.norm(B, axis=0) ** 2
+    order = np.argsort(-single, kind="stable")
+    Q, _ = np.linalg.qr(B[:, order])     # its first k columns span the best k
+    held = np.cumsum(np.abs(Q.conj().T @ a) ** 2)
+    return list(order[:np.argmax(held >= mac_min) + 1]) if held[-1] >= mac_min else None
+
+
+def pair_modes(f_model, v_model, f_ref, v_ref, mac_min=MAC_MIN, count=None, mass=None):
     """Pair reference modes with model modes by shape: [(i_ref, j_model)] and the unpaired
     reference indices among the first ``count`` (default all). ``f_*`` ascending frequencies,
-    ``v_*`` (k, 3n) shapes; reference modes past ``count`` only complete the space of a
-    cluster that ``count`` would cut (a degenerate pair or triple cut in two has no defined
-    shape). The reference
-    modes are grouped into clusters of (near-)equal frequency, whose shapes are only defined
-    as a space (the cube's symmetry makes pairs and triples); each cluster takes the unused
-    model modes whose subspace MAC with it is at least ``mac_min``, the best matching first,
-    paired in frequency order. A spurious model mode thus stays unpaired instead of shifting
-    every later frequency."""
-    f_ref = np.asarray(f_ref, float)
-    clusters, start = [], 0
-    for i in range(1, len(f_ref) + 1):
-        if i == len(f_ref) or f_ref[i] > f_ref[start] * (1 + cluster_tol):
-            clusters.append(list(range(start, i)))
-            start = i
-    used, pairs, unpaired = set(), [], []
-    for c in clusters:
-        B = np.asarray(v_ref)[c].T
-        score = {j: mac(v_model[j], B) for j in range(len(f_model)) if j not in used}
-        fit = sorted((j for j, s in score.items() if s >= mac_min), key=lambda j: -score[j])
-        chosen = sorted(fit[:len(c)], key=lambda j: f_model[j])
-        used.update(chosen)
+    ``v_*`` (k, 3n) shapes, node by node; ``mass`` (n,) nodal masses weight the comparison
+    (the modes' own inner product: unweighted, the few light corner and surface nodes would
+    count as much as the heavy inner ones). Reference modes past ``count`` only complete a
+    group that ``count`` would cut.
+
+    Individual reference shapes are only defined up to mixing with those of near frequency:
+    the cube's symmetry makes pairs and triples, which an irregular mesh splits by a few %,
+    and a model's own error mixes modes further apart (FEM P1 on the 5-node cube: up to 20 %
+    apart). So each model mode is explained by the fewest reference modes whose span holds
+    ``mac_min`` of its shape (``spanned``), and each reference mode by the fewest model modes
+    (both ways: a degenerate model space may come as any, even non-orthogonal, basis);
+    the modes one mode needs jointly form one group with it (transitively), and a group
+    pairs its reference modes with the model modes it explains, the best matching first, in
+    frequency order. A model mode no set of reference modes explains (a spurious shape)
+    pairs with none, instead of shifting every later frequency; a reference mode its group
+    finds no model mode for is unpaired."""
+    w = 1.0 if mass is None else np.sqrt(np.repeat(np.asarray(mass, float), 3))
+    vm, B = np.asarray(v_model, complex) * w, (np.asarray(v_ref, complex) * w).T
+    nr = len(f_ref)
+    root = list(range(nr + len(f_model)))   # union-find: reference modes, then model modes
+
+    def find(i):
+        while root[i] != i:
+            i = root[i]
+        return i
+
+    def join(a, others):
+        for b in others:
+            root[find(b)] = find(a)
+    spans = {j: s for j in range(len(f_model)) if (s := spanned(vm[j], B, mac_min))}
+    for j, s in spans.items():
+        join(nr + j, s)
+    for i in range(nr):
+        join(i, [nr + j for j in spanned(B[:, i], vm.T, mac_min) or []])
+    pairs, unpaired = [], []
+    for g in sorted({find(i) for i in range(nr)}):
+        c = [i for i in range(nr) if find(i) == g]
+        fit = sorted((j for j in spans if find(nr + j) == g), key=lambda j: -mac(vm[j], B[:, c]))
+        chosen = sorted(fit[:len(c)], key=lambda j: (f_model[j], j))
         pairs += list(zip(c, chosen))
         unpaired += c[len(chosen):]
+    pairs.sort()
     if count is not None:
         pairs = [(i, j) for i, j in pairs if i < count]
         unpaired = [i for i in unpaired if i < count]
-    return pairs, unpaired
+    return pairs, sorted(unpaired)

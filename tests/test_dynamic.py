@@ -252,6 +252,73 @@ def test_pairing_by_shape_skips_a_spurious_mode_and_spans_degenerate_pairs():
     assert pairs == [(0, 0), (1, 1)] and unpaired == [2, 3]
 
 
+def _orthonormal(n, k, seed=0):
+    return np.linalg.qr(np.random.default_rng(seed).standard_normal((n, k)))[0].T
+
+
+def test_a_model_equal_to_the_reference_pairs_every_mode_with_itself():
+    from cases.metrics import pair_modes
+    f, v = [1.0, 1.0, 1.3, 2.0, 2.0, 2.0, 2.5], _orthonormal(30, 7)
+    mass = np.random.default_rng(1).uniform(0.5, 2.0, 10)
+    pairs, unpaired = pair_modes(f, v, f, v, mass=mass)
+    assert pairs == [(i, i) for i in range(7)] and unpaired == []
+    # the same model, its degenerate pair in a non-orthogonal basis (np.linalg.eig's of a
+    # non-symmetric M^-1 K): both shapes lie 0.81 along the first reference one
+    skew = v.copy()
+    skew[1] = 0.9 * v[0] + np.sqrt(0.19) * v[1]
+    pairs, unpaired = pair_modes(f, skew, f, v)
+    assert pairs == [(i, i) for i in range(7)] and unpaired == []
+
+
+def test_a_spurious_mode_stays_unpaired_and_does_not_shift_the_later_pairs():
+    from cases.metrics import pair_modes
+    e = _orthonormal(30, 7)
+    f_ref, v_ref = [1.0, 1.2, 1.5, 2.0, 2.4, 3.0], e[:6]
+    f_model = [1.0, 1.2, 1.3, 1.5, 2.0, 2.4, 3.0]           # 1.3: a shape no reference has
+    v_model = np.vstack([e[:2], e[6], e[2:6]])
+    pairs, unpaired = pair_modes(f_model, v_model, f_ref, v_ref, count=5)
+    assert pairs == [(0, 0), (1, 1), (2, 3), (3, 4), (4, 5)] and unpaired == []
+
+
+def test_two_mixed_modes_pair_as_one_space_though_their_frequencies_differ():
+    """A model's error mixes reference modes a few % apart (FEM P1 those 15 % apart): each
+    model mode then matches neither alone (MAC 0.5) but the two together."""
+    from cases.metrics import pair_modes
+    e = _orthonormal(30, 4)
+    f_ref, v_ref = [1.0, 1.05, 1.5, 2.0], e
+    mixed = np.array([e[0] + e[1], e[0] - e[1]]) / np.sqrt(2)
+    f_model = [1.1, 1.2, 1.55, 2.1]
+    pairs, unpaired = pair_modes(f_model, np.vstack([mixed, e[2:]]), f_ref, v_ref)
+    assert pairs == [(0, 0), (1, 1), (2, 2), (3, 3)] and unpaired == []
+    # one of the two alone pairs the lower reference mode of the space; the other is lost
+    pairs, unpaired = pair_modes(f_model[1:], np.vstack([mixed[1:], e[2:]]), f_ref, v_ref)
+    assert pairs == [(0, 0), (2, 1), (3, 2)] and unpaired == [1]
+
+
+@pytest.mark.parametrize("bc", ["free", "clamped"])
+@pytest.mark.parametrize("family", ["five", "six", "bcc", "unstructured"])
+def test_fem_p1_pairs_all_its_modes_with_fem_p2_and_with_itself(family, bc):
+    """The modes case's cube: FEM P1 (lumped mass) differs from FEM P2 only by
+    discretisation, so every one of its first 10 modes must pair (mesh P2: the old pairing
+    left 1 to 3 unpaired on six and bcc clamped and on unstructured)."""
+    from cases.error_model import P1_LINEAR
+    from cases.library import transient
+    from cases.library.modes import CASE, ModesSettings
+    from cases.metrics import pair_modes
+    s = ModesSettings(fem_refine=0)
+    mesh = CASE.mesh(family, s)
+    ref = CASE.solve_reference(mesh, bc, s, None)
+    mass = CASE.build_model(P1_LINEAR, mesh, s).mass
+    f2, v2 = ref.extra["frequencies_hz"], ref.extra["shapes"]
+    f1, v1 = ref.extra["p1_frequencies_hz"], ref.extra["p1_shapes"]
+    pairs, unpaired = pair_modes(f1, v1, f2, v2, count=transient.N_MODES, mass=mass)
+    assert unpaired == [] and len(pairs) == transient.N_MODES
+    err = max(abs(f1[j] / f2[i] - 1) for i, j in pairs)
+    assert err < 0.5        # P1 on the 5-node cube: up to 42 % (unstructured, clamped)
+    pairs, unpaired = pair_modes(f1, v1, f1, v1, count=transient.N_MODES, mass=mass)
+    assert pairs == [(i, i) for i in range(transient.N_MODES)] and unpaired == []
+
+
 def test_fem_frequency_estimates_fall_under_refinement_as_rayleigh_ritz_bounds_do():
     """Nested conforming P2 spaces with consistent mass bound each frequency from above, so
     the refined frequencies lie below the coarse ones and each estimate, relative to the refined reference, is f_0 / f_1 - 1 >= 0

@@ -40,11 +40,13 @@ class Modes(Case):
     columns = ("frequencies_hz", "frequencies_fem_hz", "modal_rel_err", "modal_rel_err_median",
                "modes_unpaired", "modal_rel_err_p1", "modes_unpaired_p1", "rigid_modes")
     notes = ("The table shows the first of the frequencies (f1) of the model and of FEM P2.",
-             "Modes are paired by shape, not by rank: each FEM mode (a cluster of FEM modes "
-             "within 1 % in frequency, which the cube's symmetry makes pairs and triples, as "
-             "one space) takes the model modes whose MAC with it is at least 0.8; a FEM mode "
-             "without one is unpaired and left out of the errors, so a spurious model mode "
-             "does not shift every later frequency.")
+             "Modes are paired by shape, not by rank (mass-weighted MAC): each model mode is "
+             "explained by the fewest FEM modes whose span holds 0.8 of its shape; FEM modes "
+             "a model mode needs jointly (the cube's degenerate pairs and triples, and modes "
+             "a model's error mixes) form one group, paired with the model modes it explains "
+             "in frequency order. A FEM mode without one is unpaired and left out of the "
+             "errors; a spurious model mode, explained by none, does not shift every later "
+             "frequency.")
 
     def mesh(self, family, s):
         return cube(NODES, SIZE_MM * MM, family)
@@ -88,10 +90,11 @@ class Modes(Case):
     def run_extra(self, pm, mesh, bc, s, ref, st):
         freq, shapes, rigid = transient.first_modes(pm, self._free(mesh, ref.dirichlet))
         worst, median, lost = transient.paired_errors(
-            freq, shapes, ref.extra["frequencies_hz"], ref.extra["shapes"], "modal_rel_err")
+            freq, shapes, ref.extra["frequencies_hz"], ref.extra["shapes"], "modal_rel_err",
+            mass=pm.mass)
         worst_p1, _, lost_p1 = transient.paired_errors(
             freq, shapes, ref.extra["p1_frequencies_hz"], ref.extra["p1_shapes"],
-            "modal_rel_err_p1")
+            "modal_rel_err_p1", mass=pm.mass)
         return {"frequencies_hz": freq[:N_MODES].tolist(), "rigid_modes": rigid,
                 "modes_unpaired": lost, "modal_rel_err": worst,
                 "modal_rel_err_median": median, "modal_rel_err_p1": worst_p1,
