@@ -136,6 +136,10 @@ class Term:
         forces at positions ``x`` (n, 3) into ``out`` (n, 3) and returns -1, or the index of
         the first element it found flattened or inverted (``degenerate_tets`` turns that index
         into tetrahedra). The compiled integrator calls it directly, with no Python between;
+    ``reference_kernel()``
+        optional: ``(fn, args)`` of a plainer kernel with the same contract whose forces the
+        kernel's equal to round-off (a built-in term's former, tetrahedron-by-tetrahedron
+        kernel, kept for the tests); None, the default, where there is none;
     ``threaded_kernel()``
         optional: the same contract run on several threads with a result equal bit for bit
         to ``kernel()`` (model.terms._threads); None, the default, runs the serial kernel;
@@ -196,6 +200,9 @@ class Term:
         raise NotImplementedError(f"term {self.name!r} provides no kernel")
 
     def threaded_kernel(self):
+        return None
+
+    def reference_kernel(self):
         return None
 
     def degenerate_tets(self, bad):

@@ -5,8 +5,13 @@ arrays that numba cannot keep in registers (it cannot prove they do not alias ``
 ``out``), and the variational kernel cost 210 ns per tetrahedron; written out, every quantity
 is a named scalar and it costs 60 (``pbcm bench``). This file holds the maths once, per
 combination, and the generated file is what runs. After editing this file or the helpers in
-``_kernels.py`` run ``python model/terms/_shear_codegen.py``; tests/test_terms.py fails while
-the generated file is stale (and its changed text makes numba recompile the cached kernels).
+``_kernels.py`` or ``_blocks.py`` run ``python model/terms/_shear_codegen.py``;
+tests/test_terms.py fails while the generated file is stale (and its changed text makes numba
+recompile the cached kernels).
+
+The force kernels run over blocks of tetrahedra (``_blocks.py``): ``blocked`` writes each
+reading's block function, its serial driver and its two-thread twin; ``reference`` writes the
+same maths tetrahedron by tetrahedron as ``*_reference``, the kernels the tests hold them to.
 
 Notation of the generated code, for the tetrahedron's corners 0..3:
 
@@ -18,6 +23,7 @@ Notation of the generated code, for the tetrahedron's corners 0..3:
   ``gamma = D / L_am * h_j - gamma0`` (the paper's eq. 4, as in shear.py).
 """
 import hashlib
+import re
 import importlib.util
 import pathlib
 
@@ -40,18 +46,31 @@ def e(p, q):
 
 def frame(check):
     """Per tetrahedron: corners, edges, squared and reciprocal lengths, face vectors, 6V,
-    reciprocal heights; ``check`` is the flattening test (a string of code, or None)."""
+    reciprocal heights; ``check`` is the flattening test (a string of code, or None).
+    ``INVERSES`` marks where the reciprocals are taken (see ``SERIAL`` and ``BLOCK``)."""
     lines = ["n0, n1, n2, n3 = tets[t, 0], tets[t, 1], tets[t, 2], tets[t, 3]",
              "x0, x1, x2, x3 = vec(x, n0), vec(x, n1), vec(x, n2), vec(x, n3)"]
     for p, q in PAIRS:
         lines += [f"d{p}{q} = sub(x{q}, x{p})", f"l{p}{q} = dot(d{p}{q}, d{p}{q})",
-                  f"iL{p}{q} = 1.0 / np.sqrt(l{p}{q})"]
+                  f"{INVERSE_LENGTH}{p}{q}"]
     for j in range(4):
         a, m, l = FACE[j]
         lines += [f"c{j} = cross(d{e(a, m)}, d{e(a, l)})", f"cn{j} = np.sqrt(dot(c{j}, c{j}))"]
-    lines += ["V6 = dot(d01, c1)", f"if {check}:", FLATTENED_ACTION, "iV6 = 1.0 / V6"]
+    lines += ["V6 = dot(d01, c1)", f"if {check}:", FLATTENED_ACTION, INVERSES]
     lines += [f"h{j} = cn{j} * iV6" for j in range(4)]
     return lines
+
+
+def inverses():
+    """1 / V6 and the six 1 / L_pq from one division (the divider is what a lane waits on):
+    with the running products a_k of L01, L02, ..., L23, r = 1 / (a_6 V6), then each
+    reciprocal is r times the product of the others, peeled off from the last."""
+    names = [f"L{p}{q}" for p, q in PAIRS]
+    lines = [f"a1 = {names[0]}"] + [f"a{k + 1} = a{k} * {names[k]}" for k in range(1, 6)]
+    lines += ["r = 1.0 / (a6 * V6)", "iV6 = r * a6", "r = r * V6"]
+    for k in range(5, 0, -1):
+        lines += [f"i{names[k]} = r * a{k}", f"r = r * {names[k]}"]
+    return lines + [f"i{names[0]} = r"]
 
 
 def strain(s, a, j, m):
@@ -81,11 +100,25 @@ def edge_forces(coef):
 
 FLATTENED = "V6 <= FLAT * 6.0 * vol0[t]"
 # what the serial and the per-tetrahedron (threaded) variants do at these two places
-FLATTENED_ACTION, SCATTER = "@flattened@", "@scatter@"
+FLATTENED_ACTION, SCATTER, INVERSES = "@flattened@", "@scatter@", "@inverses@"
+INVERSE_LENGTH = "@inverse_length@"
 SERIAL = {FLATTENED_ACTION: ["    return t"],
-          SCATTER: [f"add_to(out, n{i}, f{i})" for i in range(4)]}
-PER_TET = {FLATTENED_ACTION: ["    flat[t] = 1", "    n_flat += 1", "    continue"],
-           SCATTER: [f"put(ft, t, {i}, f{i})" for i in range(4)]}
+          SCATTER: [f"add_to(out, n{i}, f{i})" for i in range(4)],
+          INVERSES: ["iV6 = 1.0 / V6"],
+          **{f"{INVERSE_LENGTH}{p}{q}": [f"iL{p}{q} = 1.0 / np.sqrt(l{p}{q})"] for p, q in PAIRS}}
+# in a block (model/terms/_blocks.py): the corners from the scratch array, the flattening
+# margin kept and counted (the lane goes on: its forces are never added), the forces stored
+BLOCK = {"n0, n1, n2, n3 = tets[t, 0], tets[t, 1], tets[t, 2], tets[t, 3]": [],
+         "x0, x1, x2, x3 = vec(x, n0), vec(x, n1), vec(x, n2), vec(x, n3)":
+         [f"x{c} = (s[{3 * c} * B + i], s[{3 * c + 1} * B + i], s[{3 * c + 2} * B + i])"
+          for c in range(4)],
+         f"if {FLATTENED}:": ["margin = V6 - FLAT * 6.0 * vol0[t]", "s[FLAG + i] = margin",
+                              "n_flat += margin <= 0.0"],
+         FLATTENED_ACTION: [],
+         SCATTER: [f"s[OUT + {3 * c + k} * B + i] = f{c}[{k}]"
+                   for c in range(4) for k in range(3)],
+         INVERSES: inverses(),
+         **{f"{INVERSE_LENGTH}{p}{q}": [f"L{p}{q} = np.sqrt(l{p}{q})"] for p, q in PAIRS}}
 
 
 def corner():
@@ -164,53 +197,103 @@ def variational():
             [], frame(FLATTENED) + init + body + faces + forces + [SCATTER])
 
 
-READERS = (strains, corner, balanced, variational)
-
-
 def expand(lines, variant):
     return [new for line in lines for new in
             ([line[:len(line) - len(line.lstrip())] + n for n in variant[line.strip()]]
              if line.strip() in variant else [line])]
 
 
-def function(name, args, doc, before, per_tet):
-    """The serial kernel, and for a force kernel (``out`` last) its per-tetrahedron twin
-    ``name_tets`` for the two-thread mode: the same lines over a range of tetrahedra (the
-    threads take ranges, model.terms._threads), each tetrahedron's four forces stored in
-    ft (m, 4, 3) for a fixed-order sum, flattened ones flagged in ``flat``; it returns their
-    count."""
+def reference(name, args, doc, before, per_tet):
+    """The tetrahedron-by-tetrahedron kernel ``name_reference``: each tetrahedron's forces
+    added into ``out`` as they are computed. What the blocked kernels are tested against."""
     pad = " " * 8
-    text = "\n".join(
+    return "\n".join(
+        ["", "", "", "@njit(cache=True, fastmath=FAST)", f"def {name}_reference({args}):",
+         f'    """{doc} Tetrahedron by tetrahedron (the reference of ``{name}``)."""']
+        + [f"    {line}" for line in before]
+        + ["    for t in range(tets.shape[0]):"] + [pad + x for x in expand(per_tet, SERIAL)]
+        + ["    return -1"])
+
+
+def in_block(line):
+    """A line of the per-tetrahedron maths as it reads lane i of block blk (_blocks.py)."""
+    line = re.sub(r"gamma0\[t, (\d+)\]", r"g0[\1 * B + i]", line)
+    return line.replace("vol0[t]", "v0[i]")
+
+
+def blocked(name, args, doc, before, per_tet):
+    """The kernel ``name`` over blocks of tetrahedra (model/terms/_blocks.py): ``name_block``
+    computes one block's lanes (what the compiler vectorises), ``name`` gathers, computes and
+    adds into ``out`` block by block, and ``name_tets`` is its twin for the two-thread mode
+    (the blocks holding the tetrahedra [first, stop) into ft (m, 4, 3), flattened ones flagged
+    in ``flat``; it returns their count). Per-tetrahedron data are in the blocked layout."""
+    pad = " " * 8
+    data = args[len("x, tets, "):-len(", out")]
+    lane = [in_block(x) for x in expand(per_tet, BLOCK)]
+    compute = "\n".join(
+        ["", "", "", "@njit(**OPTIONS)", f"def {name}_block(s, blk, {data}):",
+         f'    """{name} on the lanes of block blk: positions from s, forces and flattening '
+         'margins into s; returns the count of flattened lanes."""']
+        + [f"    {line}" for line in before]
+        # the block's own slices: an index the compiler sees is never negative (so no
+        # wraparound select, and SIMD loads rather than gathers)
+        + ["    g0 = gamma0[blk * 24 * B:(blk + 1) * 24 * B]", "    v0 = vol0[blk * B:(blk + 1) * B]",
+           "    n_flat = 0", "    for i in range(B):"]
+        + [pad + x for x in lane] + ["    return n_flat"])
+    serial = "\n".join(
+        ["", "", "", "@njit(**OPTIONS)", f"def {name}(x, tb, m, {data}, out):",
+         f'    """{doc}"""',
+         "    s = np.empty(SCRATCH)",
+         "    for blk in range((m + B - 1) // B):",
+         "        gather(x, tb, blk, s)",
+         f"        if {name}_block(s, blk, {data}) > 0:",
+         "            return first_flat(s, blk, m)",
+         "        scatter(out, tb, blk, m, s)",
+         "    return -1"])
+    twin = "\n".join(
+        ["", "", "", "@njit(**OPTIONS)",
+         f"def {name}_tets(x, tb, m, {data}, ft, flat, first, stop):",
+         f'    """{name} for the tetrahedra [first, stop) into ft (m, 4, 3); flattened ones '
+         'flagged in flat."""',
+         "    s = np.empty(SCRATCH)",
+         "    n_flat = 0",
+         "    for blk in range(first // B, (stop + B - 1) // B):",
+         "        gather(x, tb, blk, s)",
+         f"        {name}_block(s, blk, {data})",
+         "        n_flat += put(ft, flat, blk, first, stop, s)",
+         "    return n_flat"])
+    return compute + serial + twin
+
+
+def strains_function(name, args, doc, before, per_tet):
+    """The strains, tetrahedron by tetrahedron (calibration and stresses, not the forces)."""
+    pad = " " * 8
+    return "\n".join(
         ["", "", "", "@njit(cache=True, fastmath=FAST)", f"def {name}({args}):",
          f'    """{doc}"""']
         + [f"    {line}" for line in before]
         + ["    for t in range(tets.shape[0]):"] + [pad + x for x in expand(per_tet, SERIAL)]
         + ["    return -1"])
-    if not args.endswith(", out"):
-        return text
-    return text + "\n".join(
-        ["", "", "", "@njit(cache=True, fastmath=FAST)",
-         f"def {name}_tets({args[:-len(', out')]}, ft, flat, first, stop):",
-         f'    """{name} per tetrahedron for t in [first, stop) into ft (m, 4, 3); flattened '
-         'ones flagged in flat."""']
-        + [f"    {line}" for line in before] + ["    n_flat = 0"]
-        + ["    for t in range(first, stop):"] + [pad + x for x in expand(per_tet, PER_TET)]
-        + ["    return n_flat"])
 
 
 def source():
     """The text of ``_shear_kernels.py``."""
     helpers = hashlib.sha256((HERE / "_kernels.py").read_bytes()).hexdigest()[:16]
+    blocks = hashlib.sha256((HERE / "_blocks.py").read_bytes()).hexdigest()[:16]
     head = ['"""GENERATED by model/terms/_shear_codegen.py: do not edit (see its docstring).',
             "", "Each reading's derivation is in the docstring of its writer there.", "",
-            f"_kernels.py sha256 {helpers}", '"""',
+            f"_kernels.py sha256 {helpers}", f"_blocks.py sha256 {blocks}", '"""',
             "import numpy as np", "from numba import njit", "",
-            "from ._kernels import add_to, axpy, cross, dot, lin, put, sub, vec",
+            "from ._blocks import (B, FLAG, OPTIONS, OUT, SCRATCH, first_flat, gather, put,",
+            "                      scatter)",
+            "from ._kernels import add_to, axpy, cross, dot, lin, sub, vec",
             "from .volume import FLAT", "",
             "# fast maths without reassociation: the serial and the per-tetrahedron twins then",
             "# round the same way (the two-thread mode's bit-for-bit promise)",
             'FAST = {"nnan", "ninf", "nsz", "arcp", "contract", "afn"}']
-    return "\n".join(head) + "".join(function(*r()) for r in READERS) + "\n"
+    forces = (corner(), balanced(), variational())
+    return "\n".join(head) + strains_function(*strains()) \
+        + "".join(blocked(*f) for f in forces) + "".join(reference(*f) for f in forces) + "\n"
 
 
 if __name__ == "__main__":

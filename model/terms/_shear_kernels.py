@@ -3,11 +3,14 @@
 Each reading's derivation is in the docstring of its writer there.
 
 _kernels.py sha256 1ec64e200bb30940
+_blocks.py sha256 01aaaefbaa14feb9
 """
 import numpy as np
 from numba import njit
 
-from ._kernels import add_to, axpy, cross, dot, lin, put, sub, vec
+from ._blocks import (B, FLAG, OPTIONS, OUT, SCRATCH, first_flat, gather, put,
+                      scatter)
+from ._kernels import add_to, axpy, cross, dot, lin, sub, vec
 from .volume import FLAT
 
 # fast maths without reassociation: the serial and the per-tetrahedron twins then
@@ -154,204 +157,265 @@ def shear_strains(x, tets, gamma0, gamma_out):
     return -1
 
 
-@njit(cache=True, fastmath=FAST)
-def shear_corner(x, tets, vol0, gamma0, G, out):
+@njit(**OPTIONS)
+def shear_corner_block(s, blk, vol0, gamma0, G):
+    """shear_corner on the lanes of block blk: positions from s, forces and flattening margins into s; returns the count of flattened lanes."""
+    G8 = 0.125 * G
+    g0 = gamma0[blk * 24 * B:(blk + 1) * 24 * B]
+    v0 = vol0[blk * B:(blk + 1) * B]
+    n_flat = 0
+    for i in range(B):
+        x0 = (s[0 * B + i], s[1 * B + i], s[2 * B + i])
+        x1 = (s[3 * B + i], s[4 * B + i], s[5 * B + i])
+        x2 = (s[6 * B + i], s[7 * B + i], s[8 * B + i])
+        x3 = (s[9 * B + i], s[10 * B + i], s[11 * B + i])
+        d01 = sub(x1, x0)
+        l01 = dot(d01, d01)
+        L01 = np.sqrt(l01)
+        d02 = sub(x2, x0)
+        l02 = dot(d02, d02)
+        L02 = np.sqrt(l02)
+        d03 = sub(x3, x0)
+        l03 = dot(d03, d03)
+        L03 = np.sqrt(l03)
+        d12 = sub(x2, x1)
+        l12 = dot(d12, d12)
+        L12 = np.sqrt(l12)
+        d13 = sub(x3, x1)
+        l13 = dot(d13, d13)
+        L13 = np.sqrt(l13)
+        d23 = sub(x3, x2)
+        l23 = dot(d23, d23)
+        L23 = np.sqrt(l23)
+        c0 = cross(d13, d12)
+        cn0 = np.sqrt(dot(c0, c0))
+        c1 = cross(d02, d03)
+        cn1 = np.sqrt(dot(c1, c1))
+        c2 = cross(d03, d01)
+        cn2 = np.sqrt(dot(c2, c2))
+        c3 = cross(d01, d02)
+        cn3 = np.sqrt(dot(c3, c3))
+        V6 = dot(d01, c1)
+        margin = V6 - FLAT * 6.0 * v0[i]
+        s[FLAG + i] = margin
+        n_flat += margin <= 0.0
+        a1 = L01
+        a2 = a1 * L02
+        a3 = a2 * L03
+        a4 = a3 * L12
+        a5 = a4 * L13
+        a6 = a5 * L23
+        r = 1.0 / (a6 * V6)
+        iV6 = r * a6
+        r = r * V6
+        iL23 = r * a5
+        r = r * L23
+        iL13 = r * a4
+        r = r * L13
+        iL12 = r * a3
+        r = r * L12
+        iL03 = r * a2
+        r = r * L03
+        iL02 = r * a1
+        r = r * L02
+        iL01 = r
+        h0 = cn0 * iV6
+        h1 = cn1 * iV6
+        h2 = cn2 * iV6
+        h3 = cn3 * iV6
+        K01 = 0.0
+        K02 = 0.0
+        K03 = 0.0
+        K10 = 0.0
+        K12 = 0.0
+        K13 = 0.0
+        K20 = 0.0
+        K21 = 0.0
+        K23 = 0.0
+        K30 = 0.0
+        K31 = 0.0
+        K32 = 0.0
+        # combination 0: corner 0, tip 1, edge 0 -> 2
+        D = 0.5 * (l01 + l02 - l12)
+        gamma = D * iL02 * h1 - g0[0 * B + i]
+        K02 += G8 * gamma * cn1 * iL02
+        # combination 1: corner 0, tip 1, edge 0 -> 3
+        D = 0.5 * (l01 + l03 - l13)
+        gamma = D * iL03 * h1 - g0[1 * B + i]
+        K03 += G8 * gamma * cn1 * iL03
+        # combination 2: corner 0, tip 2, edge 0 -> 1
+        D = 0.5 * (l02 + l01 - l12)
+        gamma = D * iL01 * h2 - g0[2 * B + i]
+        K01 += G8 * gamma * cn2 * iL01
+        # combination 3: corner 0, tip 2, edge 0 -> 3
+        D = 0.5 * (l02 + l03 - l23)
+        gamma = D * iL03 * h2 - g0[3 * B + i]
+        K03 += G8 * gamma * cn2 * iL03
+        # combination 4: corner 0, tip 3, edge 0 -> 1
+        D = 0.5 * (l03 + l01 - l13)
+        gamma = D * iL01 * h3 - g0[4 * B + i]
+        K01 += G8 * gamma * cn3 * iL01
+        # combination 5: corner 0, tip 3, edge 0 -> 2
+        D = 0.5 * (l03 + l02 - l23)
+        gamma = D * iL02 * h3 - g0[5 * B + i]
+        K02 += G8 * gamma * cn3 * iL02
+        # combination 6: corner 1, tip 0, edge 1 -> 2
+        D = 0.5 * (l01 + l12 - l02)
+        gamma = D * iL12 * h0 - g0[6 * B + i]
+        K12 += G8 * gamma * cn0 * iL12
+        # combination 7: corner 1, tip 0, edge 1 -> 3
+        D = 0.5 * (l01 + l13 - l03)
+        gamma = D * iL13 * h0 - g0[7 * B + i]
+        K13 += G8 * gamma * cn0 * iL13
+        # combination 8: corner 1, tip 2, edge 1 -> 0
+        D = 0.5 * (l12 + l01 - l02)
+        gamma = D * iL01 * h2 - g0[8 * B + i]
+        K10 += G8 * gamma * cn2 * iL01
+        # combination 9: corner 1, tip 2, edge 1 -> 3
+        D = 0.5 * (l12 + l13 - l23)
+        gamma = D * iL13 * h2 - g0[9 * B + i]
+        K13 += G8 * gamma * cn2 * iL13
+        # combination 10: corner 1, tip 3, edge 1 -> 0
+        D = 0.5 * (l13 + l01 - l03)
+        gamma = D * iL01 * h3 - g0[10 * B + i]
+        K10 += G8 * gamma * cn3 * iL01
+        # combination 11: corner 1, tip 3, edge 1 -> 2
+        D = 0.5 * (l13 + l12 - l23)
+        gamma = D * iL12 * h3 - g0[11 * B + i]
+        K12 += G8 * gamma * cn3 * iL12
+        # combination 12: corner 2, tip 0, edge 2 -> 1
+        D = 0.5 * (l02 + l12 - l01)
+        gamma = D * iL12 * h0 - g0[12 * B + i]
+        K21 += G8 * gamma * cn0 * iL12
+        # combination 13: corner 2, tip 0, edge 2 -> 3
+        D = 0.5 * (l02 + l23 - l03)
+        gamma = D * iL23 * h0 - g0[13 * B + i]
+        K23 += G8 * gamma * cn0 * iL23
+        # combination 14: corner 2, tip 1, edge 2 -> 0
+        D = 0.5 * (l12 + l02 - l01)
+        gamma = D * iL02 * h1 - g0[14 * B + i]
+        K20 += G8 * gamma * cn1 * iL02
+        # combination 15: corner 2, tip 1, edge 2 -> 3
+        D = 0.5 * (l12 + l23 - l13)
+        gamma = D * iL23 * h1 - g0[15 * B + i]
+        K23 += G8 * gamma * cn1 * iL23
+        # combination 16: corner 2, tip 3, edge 2 -> 0
+        D = 0.5 * (l23 + l02 - l03)
+        gamma = D * iL02 * h3 - g0[16 * B + i]
+        K20 += G8 * gamma * cn3 * iL02
+        # combination 17: corner 2, tip 3, edge 2 -> 1
+        D = 0.5 * (l23 + l12 - l13)
+        gamma = D * iL12 * h3 - g0[17 * B + i]
+        K21 += G8 * gamma * cn3 * iL12
+        # combination 18: corner 3, tip 0, edge 3 -> 1
+        D = 0.5 * (l03 + l13 - l01)
+        gamma = D * iL13 * h0 - g0[18 * B + i]
+        K31 += G8 * gamma * cn0 * iL13
+        # combination 19: corner 3, tip 0, edge 3 -> 2
+        D = 0.5 * (l03 + l23 - l02)
+        gamma = D * iL23 * h0 - g0[19 * B + i]
+        K32 += G8 * gamma * cn0 * iL23
+        # combination 20: corner 3, tip 1, edge 3 -> 0
+        D = 0.5 * (l13 + l03 - l01)
+        gamma = D * iL03 * h1 - g0[20 * B + i]
+        K30 += G8 * gamma * cn1 * iL03
+        # combination 21: corner 3, tip 1, edge 3 -> 2
+        D = 0.5 * (l13 + l23 - l12)
+        gamma = D * iL23 * h1 - g0[21 * B + i]
+        K32 += G8 * gamma * cn1 * iL23
+        # combination 22: corner 3, tip 2, edge 3 -> 0
+        D = 0.5 * (l23 + l03 - l02)
+        gamma = D * iL03 * h2 - g0[22 * B + i]
+        K30 += G8 * gamma * cn2 * iL03
+        # combination 23: corner 3, tip 2, edge 3 -> 1
+        D = 0.5 * (l23 + l13 - l12)
+        gamma = D * iL13 * h2 - g0[23 * B + i]
+        K31 += G8 * gamma * cn2 * iL13
+        f0 = (0.0, 0.0, 0.0)
+        f1 = (0.0, 0.0, 0.0)
+        f2 = (0.0, 0.0, 0.0)
+        f3 = (0.0, 0.0, 0.0)
+        f0 = axpy(K01, d01, f0)
+        f1 = axpy(-(K10), d01, f1)
+        f0 = axpy(K02, d02, f0)
+        f2 = axpy(-(K20), d02, f2)
+        f0 = axpy(K03, d03, f0)
+        f3 = axpy(-(K30), d03, f3)
+        f1 = axpy(K12, d12, f1)
+        f2 = axpy(-(K21), d12, f2)
+        f1 = axpy(K13, d13, f1)
+        f3 = axpy(-(K31), d13, f3)
+        f2 = axpy(K23, d23, f2)
+        f3 = axpy(-(K32), d23, f3)
+        s[OUT + 0 * B + i] = f0[0]
+        s[OUT + 1 * B + i] = f0[1]
+        s[OUT + 2 * B + i] = f0[2]
+        s[OUT + 3 * B + i] = f1[0]
+        s[OUT + 4 * B + i] = f1[1]
+        s[OUT + 5 * B + i] = f1[2]
+        s[OUT + 6 * B + i] = f2[0]
+        s[OUT + 7 * B + i] = f2[1]
+        s[OUT + 8 * B + i] = f2[2]
+        s[OUT + 9 * B + i] = f3[0]
+        s[OUT + 10 * B + i] = f3[1]
+        s[OUT + 11 * B + i] = f3[2]
+    return n_flat
+
+
+@njit(**OPTIONS)
+def shear_corner(x, tb, m, vol0, gamma0, G, out):
     """Literal eq. 5: f_a += (1/4) tau S_F e, tau = G gamma, S_F = cn_j / 2, e = d_am / L_am; returns the first flattened tetrahedron, or -1."""
-    G8 = 0.125 * G
-    for t in range(tets.shape[0]):
-        n0, n1, n2, n3 = tets[t, 0], tets[t, 1], tets[t, 2], tets[t, 3]
-        x0, x1, x2, x3 = vec(x, n0), vec(x, n1), vec(x, n2), vec(x, n3)
-        d01 = sub(x1, x0)
-        l01 = dot(d01, d01)
-        iL01 = 1.0 / np.sqrt(l01)
-        d02 = sub(x2, x0)
-        l02 = dot(d02, d02)
-        iL02 = 1.0 / np.sqrt(l02)
-        d03 = sub(x3, x0)
-        l03 = dot(d03, d03)
-        iL03 = 1.0 / np.sqrt(l03)
-        d12 = sub(x2, x1)
-        l12 = dot(d12, d12)
-        iL12 = 1.0 / np.sqrt(l12)
-        d13 = sub(x3, x1)
-        l13 = dot(d13, d13)
-        iL13 = 1.0 / np.sqrt(l13)
-        d23 = sub(x3, x2)
-        l23 = dot(d23, d23)
-        iL23 = 1.0 / np.sqrt(l23)
-        c0 = cross(d13, d12)
-        cn0 = np.sqrt(dot(c0, c0))
-        c1 = cross(d02, d03)
-        cn1 = np.sqrt(dot(c1, c1))
-        c2 = cross(d03, d01)
-        cn2 = np.sqrt(dot(c2, c2))
-        c3 = cross(d01, d02)
-        cn3 = np.sqrt(dot(c3, c3))
-        V6 = dot(d01, c1)
-        if V6 <= FLAT * 6.0 * vol0[t]:
-            return t
-        iV6 = 1.0 / V6
-        h0 = cn0 * iV6
-        h1 = cn1 * iV6
-        h2 = cn2 * iV6
-        h3 = cn3 * iV6
-        K01 = 0.0
-        K02 = 0.0
-        K03 = 0.0
-        K10 = 0.0
-        K12 = 0.0
-        K13 = 0.0
-        K20 = 0.0
-        K21 = 0.0
-        K23 = 0.0
-        K30 = 0.0
-        K31 = 0.0
-        K32 = 0.0
-        # combination 0: corner 0, tip 1, edge 0 -> 2
-        D = 0.5 * (l01 + l02 - l12)
-        gamma = D * iL02 * h1 - gamma0[t, 0]
-        K02 += G8 * gamma * cn1 * iL02
-        # combination 1: corner 0, tip 1, edge 0 -> 3
-        D = 0.5 * (l01 + l03 - l13)
-        gamma = D * iL03 * h1 - gamma0[t, 1]
-        K03 += G8 * gamma * cn1 * iL03
-        # combination 2: corner 0, tip 2, edge 0 -> 1
-        D = 0.5 * (l02 + l01 - l12)
-        gamma = D * iL01 * h2 - gamma0[t, 2]
-        K01 += G8 * gamma * cn2 * iL01
-        # combination 3: corner 0, tip 2, edge 0 -> 3
-        D = 0.5 * (l02 + l03 - l23)
-        gamma = D * iL03 * h2 - gamma0[t, 3]
-        K03 += G8 * gamma * cn2 * iL03
-        # combination 4: corner 0, tip 3, edge 0 -> 1
-        D = 0.5 * (l03 + l01 - l13)
-        gamma = D * iL01 * h3 - gamma0[t, 4]
-        K01 += G8 * gamma * cn3 * iL01
-        # combination 5: corner 0, tip 3, edge 0 -> 2
-        D = 0.5 * (l03 + l02 - l23)
-        gamma = D * iL02 * h3 - gamma0[t, 5]
-        K02 += G8 * gamma * cn3 * iL02
-        # combination 6: corner 1, tip 0, edge 1 -> 2
-        D = 0.5 * (l01 + l12 - l02)
-        gamma = D * iL12 * h0 - gamma0[t, 6]
-        K12 += G8 * gamma * cn0 * iL12
-        # combination 7: corner 1, tip 0, edge 1 -> 3
-        D = 0.5 * (l01 + l13 - l03)
-        gamma = D * iL13 * h0 - gamma0[t, 7]
-        K13 += G8 * gamma * cn0 * iL13
-        # combination 8: corner 1, tip 2, edge 1 -> 0
-        D = 0.5 * (l12 + l01 - l02)
-        gamma = D * iL01 * h2 - gamma0[t, 8]
-        K10 += G8 * gamma * cn2 * iL01
-        # combination 9: corner 1, tip 2, edge 1 -> 3
-        D = 0.5 * (l12 + l13 - l23)
-        gamma = D * iL13 * h2 - gamma0[t, 9]
-        K13 += G8 * gamma * cn2 * iL13
-        # combination 10: corner 1, tip 3, edge 1 -> 0
-        D = 0.5 * (l13 + l01 - l03)
-        gamma = D * iL01 * h3 - gamma0[t, 10]
-        K10 += G8 * gamma * cn3 * iL01
-        # combination 11: corner 1, tip 3, edge 1 -> 2
-        D = 0.5 * (l13 + l12 - l23)
-        gamma = D * iL12 * h3 - gamma0[t, 11]
-        K12 += G8 * gamma * cn3 * iL12
-        # combination 12: corner 2, tip 0, edge 2 -> 1
-        D = 0.5 * (l02 + l12 - l01)
-        gamma = D * iL12 * h0 - gamma0[t, 12]
-        K21 += G8 * gamma * cn0 * iL12
-        # combination 13: corner 2, tip 0, edge 2 -> 3
-        D = 0.5 * (l02 + l23 - l03)
-        gamma = D * iL23 * h0 - gamma0[t, 13]
-        K23 += G8 * gamma * cn0 * iL23
-        # combination 14: corner 2, tip 1, edge 2 -> 0
-        D = 0.5 * (l12 + l02 - l01)
-        gamma = D * iL02 * h1 - gamma0[t, 14]
-        K20 += G8 * gamma * cn1 * iL02
-        # combination 15: corner 2, tip 1, edge 2 -> 3
-        D = 0.5 * (l12 + l23 - l13)
-        gamma = D * iL23 * h1 - gamma0[t, 15]
-        K23 += G8 * gamma * cn1 * iL23
-        # combination 16: corner 2, tip 3, edge 2 -> 0
-        D = 0.5 * (l23 + l02 - l03)
-        gamma = D * iL02 * h3 - gamma0[t, 16]
-        K20 += G8 * gamma * cn3 * iL02
-        # combination 17: corner 2, tip 3, edge 2 -> 1
-        D = 0.5 * (l23 + l12 - l13)
-        gamma = D * iL12 * h3 - gamma0[t, 17]
-        K21 += G8 * gamma * cn3 * iL12
-        # combination 18: corner 3, tip 0, edge 3 -> 1
-        D = 0.5 * (l03 + l13 - l01)
-        gamma = D * iL13 * h0 - gamma0[t, 18]
-        K31 += G8 * gamma * cn0 * iL13
-        # combination 19: corner 3, tip 0, edge 3 -> 2
-        D = 0.5 * (l03 + l23 - l02)
-        gamma = D * iL23 * h0 - gamma0[t, 19]
-        K32 += G8 * gamma * cn0 * iL23
-        # combination 20: corner 3, tip 1, edge 3 -> 0
-        D = 0.5 * (l13 + l03 - l01)
-        gamma = D * iL03 * h1 - gamma0[t, 20]
-        K30 += G8 * gamma * cn1 * iL03
-        # combination 21: corner 3, tip 1, edge 3 -> 2
-        D = 0.5 * (l13 + l23 - l12)
-        gamma = D * iL23 * h1 - gamma0[t, 21]
-        K32 += G8 * gamma * cn1 * iL23
-        # combination 22: corner 3, tip 2, edge 3 -> 0
-        D = 0.5 * (l23 + l03 - l02)
-        gamma = D * iL03 * h2 - gamma0[t, 22]
-        K30 += G8 * gamma * cn2 * iL03
-        # combination 23: corner 3, tip 2, edge 3 -> 1
-        D = 0.5 * (l23 + l13 - l12)
-        gamma = D * iL13 * h2 - gamma0[t, 23]
-        K31 += G8 * gamma * cn2 * iL13
-        f0 = (0.0, 0.0, 0.0)
-        f1 = (0.0, 0.0, 0.0)
-        f2 = (0.0, 0.0, 0.0)
-        f3 = (0.0, 0.0, 0.0)
-        f0 = axpy(K01, d01, f0)
-        f1 = axpy(-(K10), d01, f1)
-        f0 = axpy(K02, d02, f0)
-        f2 = axpy(-(K20), d02, f2)
-        f0 = axpy(K03, d03, f0)
-        f3 = axpy(-(K30), d03, f3)
-        f1 = axpy(K12, d12, f1)
-        f2 = axpy(-(K21), d12, f2)
-        f1 = axpy(K13, d13, f1)
-        f3 = axpy(-(K31), d13, f3)
-        f2 = axpy(K23, d23, f2)
-        f3 = axpy(-(K32), d23, f3)
-        add_to(out, n0, f0)
-        add_to(out, n1, f1)
-        add_to(out, n2, f2)
-        add_to(out, n3, f3)
+    s = np.empty(SCRATCH)
+    for blk in range((m + B - 1) // B):
+        gather(x, tb, blk, s)
+        if shear_corner_block(s, blk, vol0, gamma0, G) > 0:
+            return first_flat(s, blk, m)
+        scatter(out, tb, blk, m, s)
     return -1
 
 
-@njit(cache=True, fastmath=FAST)
-def shear_corner_tets(x, tets, vol0, gamma0, G, ft, flat, first, stop):
-    """shear_corner per tetrahedron for t in [first, stop) into ft (m, 4, 3); flattened ones flagged in flat."""
-    G8 = 0.125 * G
+@njit(**OPTIONS)
+def shear_corner_tets(x, tb, m, vol0, gamma0, G, ft, flat, first, stop):
+    """shear_corner for the tetrahedra [first, stop) into ft (m, 4, 3); flattened ones flagged in flat."""
+    s = np.empty(SCRATCH)
     n_flat = 0
-    for t in range(first, stop):
-        n0, n1, n2, n3 = tets[t, 0], tets[t, 1], tets[t, 2], tets[t, 3]
-        x0, x1, x2, x3 = vec(x, n0), vec(x, n1), vec(x, n2), vec(x, n3)
+    for blk in range(first // B, (stop + B - 1) // B):
+        gather(x, tb, blk, s)
+        shear_corner_block(s, blk, vol0, gamma0, G)
+        n_flat += put(ft, flat, blk, first, stop, s)
+    return n_flat
+
+
+@njit(**OPTIONS)
+def shear_balanced_block(s, blk, vol0, gamma0, G):
+    """shear_balanced on the lanes of block blk: positions from s, forces and flattening margins into s; returns the count of flattened lanes."""
+    G2 = 0.5 * G
+    g0 = gamma0[blk * 24 * B:(blk + 1) * 24 * B]
+    v0 = vol0[blk * B:(blk + 1) * B]
+    n_flat = 0
+    for i in range(B):
+        x0 = (s[0 * B + i], s[1 * B + i], s[2 * B + i])
+        x1 = (s[3 * B + i], s[4 * B + i], s[5 * B + i])
+        x2 = (s[6 * B + i], s[7 * B + i], s[8 * B + i])
+        x3 = (s[9 * B + i], s[10 * B + i], s[11 * B + i])
         d01 = sub(x1, x0)
         l01 = dot(d01, d01)
-        iL01 = 1.0 / np.sqrt(l01)
+        L01 = np.sqrt(l01)
         d02 = sub(x2, x0)
         l02 = dot(d02, d02)
-        iL02 = 1.0 / np.sqrt(l02)
+        L02 = np.sqrt(l02)
         d03 = sub(x3, x0)
         l03 = dot(d03, d03)
-        iL03 = 1.0 / np.sqrt(l03)
+        L03 = np.sqrt(l03)
         d12 = sub(x2, x1)
         l12 = dot(d12, d12)
-        iL12 = 1.0 / np.sqrt(l12)
+        L12 = np.sqrt(l12)
         d13 = sub(x3, x1)
         l13 = dot(d13, d13)
-        iL13 = 1.0 / np.sqrt(l13)
+        L13 = np.sqrt(l13)
         d23 = sub(x3, x2)
         l23 = dot(d23, d23)
-        iL23 = 1.0 / np.sqrt(l23)
+        L23 = np.sqrt(l23)
         c0 = cross(d13, d12)
         cn0 = np.sqrt(dot(c0, c0))
         c1 = cross(d02, d03)
@@ -361,337 +425,218 @@ def shear_corner_tets(x, tets, vol0, gamma0, G, ft, flat, first, stop):
         c3 = cross(d01, d02)
         cn3 = np.sqrt(dot(c3, c3))
         V6 = dot(d01, c1)
-        if V6 <= FLAT * 6.0 * vol0[t]:
-            flat[t] = 1
-            n_flat += 1
-            continue
-        iV6 = 1.0 / V6
+        margin = V6 - FLAT * 6.0 * v0[i]
+        s[FLAG + i] = margin
+        n_flat += margin <= 0.0
+        a1 = L01
+        a2 = a1 * L02
+        a3 = a2 * L03
+        a4 = a3 * L12
+        a5 = a4 * L13
+        a6 = a5 * L23
+        r = 1.0 / (a6 * V6)
+        iV6 = r * a6
+        r = r * V6
+        iL23 = r * a5
+        r = r * L23
+        iL13 = r * a4
+        r = r * L13
+        iL12 = r * a3
+        r = r * L12
+        iL03 = r * a2
+        r = r * L03
+        iL02 = r * a1
+        r = r * L02
+        iL01 = r
         h0 = cn0 * iV6
         h1 = cn1 * iV6
         h2 = cn2 * iV6
         h3 = cn3 * iV6
-        K01 = 0.0
-        K02 = 0.0
-        K03 = 0.0
-        K10 = 0.0
-        K12 = 0.0
-        K13 = 0.0
-        K20 = 0.0
-        K21 = 0.0
-        K23 = 0.0
-        K30 = 0.0
-        K31 = 0.0
-        K32 = 0.0
+        B0_12 = 0.0
+        B0_13 = 0.0
+        B0_23 = 0.0
+        B1_02 = 0.0
+        B1_03 = 0.0
+        B1_23 = 0.0
+        B2_01 = 0.0
+        B2_03 = 0.0
+        B2_13 = 0.0
+        B3_01 = 0.0
+        B3_02 = 0.0
+        B3_12 = 0.0
         # combination 0: corner 0, tip 1, edge 0 -> 2
         D = 0.5 * (l01 + l02 - l12)
-        gamma = D * iL02 * h1 - gamma0[t, 0]
-        K02 += G8 * gamma * cn1 * iL02
+        gamma = D * iL02 * h1 - g0[0 * B + i]
+        B1_02 += G2 * gamma * cn1 * iL02
         # combination 1: corner 0, tip 1, edge 0 -> 3
         D = 0.5 * (l01 + l03 - l13)
-        gamma = D * iL03 * h1 - gamma0[t, 1]
-        K03 += G8 * gamma * cn1 * iL03
+        gamma = D * iL03 * h1 - g0[1 * B + i]
+        B1_03 += G2 * gamma * cn1 * iL03
         # combination 2: corner 0, tip 2, edge 0 -> 1
         D = 0.5 * (l02 + l01 - l12)
-        gamma = D * iL01 * h2 - gamma0[t, 2]
-        K01 += G8 * gamma * cn2 * iL01
+        gamma = D * iL01 * h2 - g0[2 * B + i]
+        B2_01 += G2 * gamma * cn2 * iL01
         # combination 3: corner 0, tip 2, edge 0 -> 3
         D = 0.5 * (l02 + l03 - l23)
-        gamma = D * iL03 * h2 - gamma0[t, 3]
-        K03 += G8 * gamma * cn2 * iL03
+        gamma = D * iL03 * h2 - g0[3 * B + i]
+        B2_03 += G2 * gamma * cn2 * iL03
         # combination 4: corner 0, tip 3, edge 0 -> 1
         D = 0.5 * (l03 + l01 - l13)
-        gamma = D * iL01 * h3 - gamma0[t, 4]
-        K01 += G8 * gamma * cn3 * iL01
+        gamma = D * iL01 * h3 - g0[4 * B + i]
+        B3_01 += G2 * gamma * cn3 * iL01
         # combination 5: corner 0, tip 3, edge 0 -> 2
         D = 0.5 * (l03 + l02 - l23)
-        gamma = D * iL02 * h3 - gamma0[t, 5]
-        K02 += G8 * gamma * cn3 * iL02
+        gamma = D * iL02 * h3 - g0[5 * B + i]
+        B3_02 += G2 * gamma * cn3 * iL02
         # combination 6: corner 1, tip 0, edge 1 -> 2
         D = 0.5 * (l01 + l12 - l02)
-        gamma = D * iL12 * h0 - gamma0[t, 6]
-        K12 += G8 * gamma * cn0 * iL12
+        gamma = D * iL12 * h0 - g0[6 * B + i]
+        B0_12 += G2 * gamma * cn0 * iL12
         # combination 7: corner 1, tip 0, edge 1 -> 3
         D = 0.5 * (l01 + l13 - l03)
-        gamma = D * iL13 * h0 - gamma0[t, 7]
-        K13 += G8 * gamma * cn0 * iL13
+        gamma = D * iL13 * h0 - g0[7 * B + i]
+        B0_13 += G2 * gamma * cn0 * iL13
         # combination 8: corner 1, tip 2, edge 1 -> 0
         D = 0.5 * (l12 + l01 - l02)
-        gamma = D * iL01 * h2 - gamma0[t, 8]
-        K10 += G8 * gamma * cn2 * iL01
+        gamma = D * iL01 * h2 - g0[8 * B + i]
+        B2_01 -= G2 * gamma * cn2 * iL01
         # combination 9: corner 1, tip 2, edge 1 -> 3
         D = 0.5 * (l12 + l13 - l23)
-        gamma = D * iL13 * h2 - gamma0[t, 9]
-        K13 += G8 * gamma * cn2 * iL13
+        gamma = D * iL13 * h2 - g0[9 * B + i]
+        B2_13 += G2 * gamma * cn2 * iL13
         # combination 10: corner 1, tip 3, edge 1 -> 0
         D = 0.5 * (l13 + l01 - l03)
-        gamma = D * iL01 * h3 - gamma0[t, 10]
-        K10 += G8 * gamma * cn3 * iL01
+        gamma = D * iL01 * h3 - g0[10 * B + i]
+        B3_01 -= G2 * gamma * cn3 * iL01
         # combination 11: corner 1, tip 3, edge 1 -> 2
         D = 0.5 * (l13 + l12 - l23)
-        gamma = D * iL12 * h3 - gamma0[t, 11]
-        K12 += G8 * gamma * cn3 * iL12
+        gamma = D * iL12 * h3 - g0[11 * B + i]
+        B3_12 += G2 * gamma * cn3 * iL12
         # combination 12: corner 2, tip 0, edge 2 -> 1
         D = 0.5 * (l02 + l12 - l01)
-        gamma = D * iL12 * h0 - gamma0[t, 12]
-        K21 += G8 * gamma * cn0 * iL12
+        gamma = D * iL12 * h0 - g0[12 * B + i]
+        B0_12 -= G2 * gamma * cn0 * iL12
         # combination 13: corner 2, tip 0, edge 2 -> 3
         D = 0.5 * (l02 + l23 - l03)
-        gamma = D * iL23 * h0 - gamma0[t, 13]
-        K23 += G8 * gamma * cn0 * iL23
+        gamma = D * iL23 * h0 - g0[13 * B + i]
+        B0_23 += G2 * gamma * cn0 * iL23
         # combination 14: corner 2, tip 1, edge 2 -> 0
         D = 0.5 * (l12 + l02 - l01)
-        gamma = D * iL02 * h1 - gamma0[t, 14]
-        K20 += G8 * gamma * cn1 * iL02
+        gamma = D * iL02 * h1 - g0[14 * B + i]
+        B1_02 -= G2 * gamma * cn1 * iL02
         # combination 15: corner 2, tip 1, edge 2 -> 3
         D = 0.5 * (l12 + l23 - l13)
-        gamma = D * iL23 * h1 - gamma0[t, 15]
-        K23 += G8 * gamma * cn1 * iL23
+        gamma = D * iL23 * h1 - g0[15 * B + i]
+        B1_23 += G2 * gamma * cn1 * iL23
         # combination 16: corner 2, tip 3, edge 2 -> 0
         D = 0.5 * (l23 + l02 - l03)
-        gamma = D * iL02 * h3 - gamma0[t, 16]
-        K20 += G8 * gamma * cn3 * iL02
+        gamma = D * iL02 * h3 - g0[16 * B + i]
+        B3_02 -= G2 * gamma * cn3 * iL02
         # combination 17: corner 2, tip 3, edge 2 -> 1
         D = 0.5 * (l23 + l12 - l13)
-        gamma = D * iL12 * h3 - gamma0[t, 17]
-        K21 += G8 * gamma * cn3 * iL12
+        gamma = D * iL12 * h3 - g0[17 * B + i]
+        B3_12 -= G2 * gamma * cn3 * iL12
         # combination 18: corner 3, tip 0, edge 3 -> 1
         D = 0.5 * (l03 + l13 - l01)
-        gamma = D * iL13 * h0 - gamma0[t, 18]
-        K31 += G8 * gamma * cn0 * iL13
+        gamma = D * iL13 * h0 - g0[18 * B + i]
+        B0_13 -= G2 * gamma * cn0 * iL13
         # combination 19: corner 3, tip 0, edge 3 -> 2
         D = 0.5 * (l03 + l23 - l02)
-        gamma = D * iL23 * h0 - gamma0[t, 19]
-        K32 += G8 * gamma * cn0 * iL23
+        gamma = D * iL23 * h0 - g0[19 * B + i]
+        B0_23 -= G2 * gamma * cn0 * iL23
         # combination 20: corner 3, tip 1, edge 3 -> 0
         D = 0.5 * (l13 + l03 - l01)
-        gamma = D * iL03 * h1 - gamma0[t, 20]
-        K30 += G8 * gamma * cn1 * iL03
+        gamma = D * iL03 * h1 - g0[20 * B + i]
+        B1_03 -= G2 * gamma * cn1 * iL03
         # combination 21: corner 3, tip 1, edge 3 -> 2
         D = 0.5 * (l13 + l23 - l12)
-        gamma = D * iL23 * h1 - gamma0[t, 21]
-        K32 += G8 * gamma * cn1 * iL23
+        gamma = D * iL23 * h1 - g0[21 * B + i]
+        B1_23 -= G2 * gamma * cn1 * iL23
         # combination 22: corner 3, tip 2, edge 3 -> 0
         D = 0.5 * (l23 + l03 - l02)
-        gamma = D * iL03 * h2 - gamma0[t, 22]
-        K30 += G8 * gamma * cn2 * iL03
+        gamma = D * iL03 * h2 - g0[22 * B + i]
+        B2_03 -= G2 * gamma * cn2 * iL03
         # combination 23: corner 3, tip 2, edge 3 -> 1
         D = 0.5 * (l23 + l13 - l12)
-        gamma = D * iL13 * h2 - gamma0[t, 23]
-        K31 += G8 * gamma * cn2 * iL13
-        f0 = (0.0, 0.0, 0.0)
-        f1 = (0.0, 0.0, 0.0)
-        f2 = (0.0, 0.0, 0.0)
-        f3 = (0.0, 0.0, 0.0)
-        f0 = axpy(K01, d01, f0)
-        f1 = axpy(-(K10), d01, f1)
-        f0 = axpy(K02, d02, f0)
-        f2 = axpy(-(K20), d02, f2)
-        f0 = axpy(K03, d03, f0)
-        f3 = axpy(-(K30), d03, f3)
-        f1 = axpy(K12, d12, f1)
-        f2 = axpy(-(K21), d12, f2)
-        f1 = axpy(K13, d13, f1)
-        f3 = axpy(-(K31), d13, f3)
-        f2 = axpy(K23, d23, f2)
-        f3 = axpy(-(K32), d23, f3)
-        put(ft, t, 0, f0)
-        put(ft, t, 1, f1)
-        put(ft, t, 2, f2)
-        put(ft, t, 3, f3)
+        gamma = D * iL13 * h2 - g0[23 * B + i]
+        B2_13 -= G2 * gamma * cn2 * iL13
+        U0 = axpy(B0_23, d23, axpy(B0_13, d13, axpy(B0_12, d12, (0.0, 0.0, 0.0))))
+        U1 = axpy(B1_23, d23, axpy(B1_03, d03, axpy(B1_02, d02, (0.0, 0.0, 0.0))))
+        U2 = axpy(B2_13, d13, axpy(B2_03, d03, axpy(B2_01, d01, (0.0, 0.0, 0.0))))
+        U3 = axpy(B3_12, d12, axpy(B3_02, d02, axpy(B3_01, d01, (0.0, 0.0, 0.0))))
+        T = (U0[0] + U1[0] + U2[0] + U3[0], U0[1] + U1[1] + U2[1] + U3[1], U0[2] + U1[2] + U2[2] + U3[2])
+        f0 = lin(1.0 / 3.0, T, -4.0 / 3.0, U0)
+        f1 = lin(1.0 / 3.0, T, -4.0 / 3.0, U1)
+        f2 = lin(1.0 / 3.0, T, -4.0 / 3.0, U2)
+        f3 = lin(1.0 / 3.0, T, -4.0 / 3.0, U3)
+        s[OUT + 0 * B + i] = f0[0]
+        s[OUT + 1 * B + i] = f0[1]
+        s[OUT + 2 * B + i] = f0[2]
+        s[OUT + 3 * B + i] = f1[0]
+        s[OUT + 4 * B + i] = f1[1]
+        s[OUT + 5 * B + i] = f1[2]
+        s[OUT + 6 * B + i] = f2[0]
+        s[OUT + 7 * B + i] = f2[1]
+        s[OUT + 8 * B + i] = f2[2]
+        s[OUT + 9 * B + i] = f3[0]
+        s[OUT + 10 * B + i] = f3[1]
+        s[OUT + 11 * B + i] = f3[2]
     return n_flat
 
 
-@njit(cache=True, fastmath=FAST)
-def shear_balanced(x, tets, vol0, gamma0, G, out):
+@njit(**OPTIONS)
+def shear_balanced(x, tb, m, vol0, gamma0, G, out):
     """f_j -= tau S_F e on the tip, + tau S_F e / 3 on each base vertex a, m, l; returns the first flattened tetrahedron, or -1."""
-    G2 = 0.5 * G
-    for t in range(tets.shape[0]):
-        n0, n1, n2, n3 = tets[t, 0], tets[t, 1], tets[t, 2], tets[t, 3]
-        x0, x1, x2, x3 = vec(x, n0), vec(x, n1), vec(x, n2), vec(x, n3)
-        d01 = sub(x1, x0)
-        l01 = dot(d01, d01)
-        iL01 = 1.0 / np.sqrt(l01)
-        d02 = sub(x2, x0)
-        l02 = dot(d02, d02)
-        iL02 = 1.0 / np.sqrt(l02)
-        d03 = sub(x3, x0)
-        l03 = dot(d03, d03)
-        iL03 = 1.0 / np.sqrt(l03)
-        d12 = sub(x2, x1)
-        l12 = dot(d12, d12)
-        iL12 = 1.0 / np.sqrt(l12)
-        d13 = sub(x3, x1)
-        l13 = dot(d13, d13)
-        iL13 = 1.0 / np.sqrt(l13)
-        d23 = sub(x3, x2)
-        l23 = dot(d23, d23)
-        iL23 = 1.0 / np.sqrt(l23)
-        c0 = cross(d13, d12)
-        cn0 = np.sqrt(dot(c0, c0))
-        c1 = cross(d02, d03)
-        cn1 = np.sqrt(dot(c1, c1))
-        c2 = cross(d03, d01)
-        cn2 = np.sqrt(dot(c2, c2))
-        c3 = cross(d01, d02)
-        cn3 = np.sqrt(dot(c3, c3))
-        V6 = dot(d01, c1)
-        if V6 <= FLAT * 6.0 * vol0[t]:
-            return t
-        iV6 = 1.0 / V6
-        h0 = cn0 * iV6
-        h1 = cn1 * iV6
-        h2 = cn2 * iV6
-        h3 = cn3 * iV6
-        B0_12 = 0.0
-        B0_13 = 0.0
-        B0_23 = 0.0
-        B1_02 = 0.0
-        B1_03 = 0.0
-        B1_23 = 0.0
-        B2_01 = 0.0
-        B2_03 = 0.0
-        B2_13 = 0.0
-        B3_01 = 0.0
-        B3_02 = 0.0
-        B3_12 = 0.0
-        # combination 0: corner 0, tip 1, edge 0 -> 2
-        D = 0.5 * (l01 + l02 - l12)
-        gamma = D * iL02 * h1 - gamma0[t, 0]
-        B1_02 += G2 * gamma * cn1 * iL02
-        # combination 1: corner 0, tip 1, edge 0 -> 3
-        D = 0.5 * (l01 + l03 - l13)
-        gamma = D * iL03 * h1 - gamma0[t, 1]
-        B1_03 += G2 * gamma * cn1 * iL03
-        # combination 2: corner 0, tip 2, edge 0 -> 1
-        D = 0.5 * (l02 + l01 - l12)
-        gamma = D * iL01 * h2 - gamma0[t, 2]
-        B2_01 += G2 * gamma * cn2 * iL01
-        # combination 3: corner 0, tip 2, edge 0 -> 3
-        D = 0.5 * (l02 + l03 - l23)
-        gamma = D * iL03 * h2 - gamma0[t, 3]
-        B2_03 += G2 * gamma * cn2 * iL03
-        # combination 4: corner 0, tip 3, edge 0 -> 1
-        D = 0.5 * (l03 + l01 - l13)
-        gamma = D * iL01 * h3 - gamma0[t, 4]
-        B3_01 += G2 * gamma * cn3 * iL01
-        # combination 5: corner 0, tip 3, edge 0 -> 2
-        D = 0.5 * (l03 + l02 - l23)
-        gamma = D * iL02 * h3 - gamma0[t, 5]
-        B3_02 += G2 * gamma * cn3 * iL02
-        # combination 6: corner 1, tip 0, edge 1 -> 2
-        D = 0.5 * (l01 + l12 - l02)
-        gamma = D * iL12 * h0 - gamma0[t, 6]
-        B0_12 += G2 * gamma * cn0 * iL12
-        # combination 7: corner 1, tip 0, edge 1 -> 3
-        D = 0.5 * (l01 + l13 - l03)
-        gamma = D * iL13 * h0 - gamma0[t, 7]
-        B0_13 += G2 * gamma * cn0 * iL13
-        # combination 8: corner 1, tip 2, edge 1 -> 0
-        D = 0.5 * (l12 + l01 - l02)
-        gamma = D * iL01 * h2 - gamma0[t, 8]
-        B2_01 -= G2 * gamma * cn2 * iL01
-        # combination 9: corner 1, tip 2, edge 1 -> 3
-        D = 0.5 * (l12 + l13 - l23)
-        gamma = D * iL13 * h2 - gamma0[t, 9]
-        B2_13 += G2 * gamma * cn2 * iL13
-        # combination 10: corner 1, tip 3, edge 1 -> 0
-        D = 0.5 * (l13 + l01 - l03)
-        gamma = D * iL01 * h3 - gamma0[t, 10]
-        B3_01 -= G2 * gamma * cn3 * iL01
-        # combination 11: corner 1, tip 3, edge 1 -> 2
-        D = 0.5 * (l13 + l12 - l23)
-        gamma = D * iL12 * h3 - gamma0[t, 11]
-        B3_12 += G2 * gamma * cn3 * iL12
-        # combination 12: corner 2, tip 0, edge 2 -> 1
-        D = 0.5 * (l02 + l12 - l01)
-        gamma = D * iL12 * h0 - gamma0[t, 12]
-        B0_12 -= G2 * gamma * cn0 * iL12
-        # combination 13: corner 2, tip 0, edge 2 -> 3
-        D = 0.5 * (l02 + l23 - l03)
-        gamma = D * iL23 * h0 - gamma0[t, 13]
-        B0_23 += G2 * gamma * cn0 * iL23
-        # combination 14: corner 2, tip 1, edge 2 -> 0
-        D = 0.5 * (l12 + l02 - l01)
-        gamma = D * iL02 * h1 - gamma0[t, 14]
-        B1_02 -= G2 * gamma * cn1 * iL02
-        # combination 15: corner 2, tip 1, edge 2 -> 3
-        D = 0.5 * (l12 + l23 - l13)
-        gamma = D * iL23 * h1 - gamma0[t, 15]
-        B1_23 += G2 * gamma * cn1 * iL23
-        # combination 16: corner 2, tip 3, edge 2 -> 0
-        D = 0.5 * (l23 + l02 - l03)
-        gamma = D * iL02 * h3 - gamma0[t, 16]
-        B3_02 -= G2 * gamma * cn3 * iL02
-        # combination 17: corner 2, tip 3, edge 2 -> 1
-        D = 0.5 * (l23 + l12 - l13)
-        gamma = D * iL12 * h3 - gamma0[t, 17]
-        B3_12 -= G2 * gamma * cn3 * iL12
-        # combination 18: corner 3, tip 0, edge 3 -> 1
-        D = 0.5 * (l03 + l13 - l01)
-        gamma = D * iL13 * h0 - gamma0[t, 18]
-        B0_13 -= G2 * gamma * cn0 * iL13
-        # combination 19: corner 3, tip 0, edge 3 -> 2
-        D = 0.5 * (l03 + l23 - l02)
-        gamma = D * iL23 * h0 - gamma0[t, 19]
-        B0_23 -= G2 * gamma * cn0 * iL23
-        # combination 20: corner 3, tip 1, edge 3 -> 0
-        D = 0.5 * (l13 + l03 - l01)
-        gamma = D * iL03 * h1 - gamma0[t, 20]
-        B1_03 -= G2 * gamma * cn1 * iL03
-        # combination 21: corner 3, tip 1, edge 3 -> 2
-        D = 0.5 * (l13 + l23 - l12)
-        gamma = D * iL23 * h1 - gamma0[t, 21]
-        B1_23 -= G2 * gamma * cn1 * iL23
-        # combination 22: corner 3, tip 2, edge 3 -> 0
-        D = 0.5 * (l23 + l03 - l02)
-        gamma = D * iL03 * h2 - gamma0[t, 22]
-        B2_03 -= G2 * gamma * cn2 * iL03
-        # combination 23: corner 3, tip 2, edge 3 -> 1
-        D = 0.5 * (l23 + l13 - l12)
-        gamma = D * iL13 * h2 - gamma0[t, 23]
-        B2_13 -= G2 * gamma * cn2 * iL13
-        U0 = axpy(B0_23, d23, axpy(B0_13, d13, axpy(B0_12, d12, (0.0, 0.0, 0.0))))
-        U1 = axpy(B1_23, d23, axpy(B1_03, d03, axpy(B1_02, d02, (0.0, 0.0, 0.0))))
-        U2 = axpy(B2_13, d13, axpy(B2_03, d03, axpy(B2_01, d01, (0.0, 0.0, 0.0))))
-        U3 = axpy(B3_12, d12, axpy(B3_02, d02, axpy(B3_01, d01, (0.0, 0.0, 0.0))))
-        T = (U0[0] + U1[0] + U2[0] + U3[0], U0[1] + U1[1] + U2[1] + U3[1], U0[2] + U1[2] + U2[2] + U3[2])
-        f0 = lin(1.0 / 3.0, T, -4.0 / 3.0, U0)
-        f1 = lin(1.0 / 3.0, T, -4.0 / 3.0, U1)
-        f2 = lin(1.0 / 3.0, T, -4.0 / 3.0, U2)
-        f3 = lin(1.0 / 3.0, T, -4.0 / 3.0, U3)
-        add_to(out, n0, f0)
-        add_to(out, n1, f1)
-        add_to(out, n2, f2)
-        add_to(out, n3, f3)
+    s = np.empty(SCRATCH)
+    for blk in range((m + B - 1) // B):
+        gather(x, tb, blk, s)
+        if shear_balanced_block(s, blk, vol0, gamma0, G) > 0:
+            return first_flat(s, blk, m)
+        scatter(out, tb, blk, m, s)
     return -1
 
 
-@njit(cache=True, fastmath=FAST)
-def shear_balanced_tets(x, tets, vol0, gamma0, G, ft, flat, first, stop):
-    """shear_balanced per tetrahedron for t in [first, stop) into ft (m, 4, 3); flattened ones flagged in flat."""
-    G2 = 0.5 * G
+@njit(**OPTIONS)
+def shear_balanced_tets(x, tb, m, vol0, gamma0, G, ft, flat, first, stop):
+    """shear_balanced for the tetrahedra [first, stop) into ft (m, 4, 3); flattened ones flagged in flat."""
+    s = np.empty(SCRATCH)
     n_flat = 0
-    for t in range(first, stop):
-        n0, n1, n2, n3 = tets[t, 0], tets[t, 1], tets[t, 2], tets[t, 3]
-        x0, x1, x2, x3 = vec(x, n0), vec(x, n1), vec(x, n2), vec(x, n3)
+    for blk in range(first // B, (stop + B - 1) // B):
+        gather(x, tb, blk, s)
+        shear_balanced_block(s, blk, vol0, gamma0, G)
+        n_flat += put(ft, flat, blk, first, stop, s)
+    return n_flat
+
+
+@njit(**OPTIONS)
+def shear_variational_block(s, blk, vol0, gamma0, cG):
+    """shear_variational on the lanes of block blk: positions from s, forces and flattening margins into s; returns the count of flattened lanes."""
+    g0 = gamma0[blk * 24 * B:(blk + 1) * 24 * B]
+    v0 = vol0[blk * B:(blk + 1) * B]
+    n_flat = 0
+    for i in range(B):
+        x0 = (s[0 * B + i], s[1 * B + i], s[2 * B + i])
+        x1 = (s[3 * B + i], s[4 * B + i], s[5 * B + i])
+        x2 = (s[6 * B + i], s[7 * B + i], s[8 * B + i])
+        x3 = (s[9 * B + i], s[10 * B + i], s[11 * B + i])
         d01 = sub(x1, x0)
         l01 = dot(d01, d01)
-        iL01 = 1.0 / np.sqrt(l01)
+        L01 = np.sqrt(l01)
         d02 = sub(x2, x0)
         l02 = dot(d02, d02)
-        iL02 = 1.0 / np.sqrt(l02)
+        L02 = np.sqrt(l02)
         d03 = sub(x3, x0)
         l03 = dot(d03, d03)
-        iL03 = 1.0 / np.sqrt(l03)
+        L03 = np.sqrt(l03)
         d12 = sub(x2, x1)
         l12 = dot(d12, d12)
-        iL12 = 1.0 / np.sqrt(l12)
+        L12 = np.sqrt(l12)
         d13 = sub(x3, x1)
         l13 = dot(d13, d13)
-        iL13 = 1.0 / np.sqrt(l13)
+        L13 = np.sqrt(l13)
         d23 = sub(x3, x2)
         l23 = dot(d23, d23)
-        iL23 = 1.0 / np.sqrt(l23)
+        L23 = np.sqrt(l23)
         c0 = cross(d13, d12)
         cn0 = np.sqrt(dot(c0, c0))
         c1 = cross(d02, d03)
@@ -701,142 +646,680 @@ def shear_balanced_tets(x, tets, vol0, gamma0, G, ft, flat, first, stop):
         c3 = cross(d01, d02)
         cn3 = np.sqrt(dot(c3, c3))
         V6 = dot(d01, c1)
-        if V6 <= FLAT * 6.0 * vol0[t]:
-            flat[t] = 1
-            n_flat += 1
-            continue
-        iV6 = 1.0 / V6
+        margin = V6 - FLAT * 6.0 * v0[i]
+        s[FLAG + i] = margin
+        n_flat += margin <= 0.0
+        a1 = L01
+        a2 = a1 * L02
+        a3 = a2 * L03
+        a4 = a3 * L12
+        a5 = a4 * L13
+        a6 = a5 * L23
+        r = 1.0 / (a6 * V6)
+        iV6 = r * a6
+        r = r * V6
+        iL23 = r * a5
+        r = r * L23
+        iL13 = r * a4
+        r = r * L13
+        iL12 = r * a3
+        r = r * L12
+        iL03 = r * a2
+        r = r * L03
+        iL02 = r * a1
+        r = r * L02
+        iL01 = r
         h0 = cn0 * iV6
         h1 = cn1 * iV6
         h2 = cn2 * iV6
         h3 = cn3 * iV6
-        B0_12 = 0.0
-        B0_13 = 0.0
-        B0_23 = 0.0
-        B1_02 = 0.0
-        B1_03 = 0.0
-        B1_23 = 0.0
-        B2_01 = 0.0
-        B2_03 = 0.0
-        B2_13 = 0.0
-        B3_01 = 0.0
-        B3_02 = 0.0
-        B3_12 = 0.0
+        W01 = 0.0
+        W02 = 0.0
+        W03 = 0.0
+        W12 = 0.0
+        W13 = 0.0
+        W23 = 0.0
+        P0 = 0.0
+        P1 = 0.0
+        P2 = 0.0
+        P3 = 0.0
+        half = 0.5 * cG * v0[i]
         # combination 0: corner 0, tip 1, edge 0 -> 2
         D = 0.5 * (l01 + l02 - l12)
-        gamma = D * iL02 * h1 - gamma0[t, 0]
-        B1_02 += G2 * gamma * cn1 * iL02
+        gamma = D * iL02 * h1 - g0[0 * B + i]
+        E = half * gamma * iL02 * h1
+        P = E * D
+        W01 += E
+        W12 -= E
+        W02 += E - P * iL02 * iL02
+        P1 += P
         # combination 1: corner 0, tip 1, edge 0 -> 3
         D = 0.5 * (l01 + l03 - l13)
-        gamma = D * iL03 * h1 - gamma0[t, 1]
-        B1_03 += G2 * gamma * cn1 * iL03
+        gamma = D * iL03 * h1 - g0[1 * B + i]
+        E = half * gamma * iL03 * h1
+        P = E * D
+        W01 += E
+        W13 -= E
+        W03 += E - P * iL03 * iL03
+        P1 += P
         # combination 2: corner 0, tip 2, edge 0 -> 1
         D = 0.5 * (l02 + l01 - l12)
-        gamma = D * iL01 * h2 - gamma0[t, 2]
-        B2_01 += G2 * gamma * cn2 * iL01
+        gamma = D * iL01 * h2 - g0[2 * B + i]
+        E = half * gamma * iL01 * h2
+        P = E * D
+        W02 += E
+        W12 -= E
+        W01 += E - P * iL01 * iL01
+        P2 += P
         # combination 3: corner 0, tip 2, edge 0 -> 3
         D = 0.5 * (l02 + l03 - l23)
-        gamma = D * iL03 * h2 - gamma0[t, 3]
-        B2_03 += G2 * gamma * cn2 * iL03
+        gamma = D * iL03 * h2 - g0[3 * B + i]
+        E = half * gamma * iL03 * h2
+        P = E * D
+        W02 += E
+        W23 -= E
+        W03 += E - P * iL03 * iL03
+        P2 += P
         # combination 4: corner 0, tip 3, edge 0 -> 1
         D = 0.5 * (l03 + l01 - l13)
-        gamma = D * iL01 * h3 - gamma0[t, 4]
-        B3_01 += G2 * gamma * cn3 * iL01
+        gamma = D * iL01 * h3 - g0[4 * B + i]
+        E = half * gamma * iL01 * h3
+        P = E * D
+        W03 += E
+        W13 -= E
+        W01 += E - P * iL01 * iL01
+        P3 += P
         # combination 5: corner 0, tip 3, edge 0 -> 2
         D = 0.5 * (l03 + l02 - l23)
-        gamma = D * iL02 * h3 - gamma0[t, 5]
-        B3_02 += G2 * gamma * cn3 * iL02
+        gamma = D * iL02 * h3 - g0[5 * B + i]
+        E = half * gamma * iL02 * h3
+        P = E * D
+        W03 += E
+        W23 -= E
+        W02 += E - P * iL02 * iL02
+        P3 += P
         # combination 6: corner 1, tip 0, edge 1 -> 2
         D = 0.5 * (l01 + l12 - l02)
-        gamma = D * iL12 * h0 - gamma0[t, 6]
-        B0_12 += G2 * gamma * cn0 * iL12
+        gamma = D * iL12 * h0 - g0[6 * B + i]
+        E = half * gamma * iL12 * h0
+        P = E * D
+        W01 += E
+        W02 -= E
+        W12 += E - P * iL12 * iL12
+        P0 += P
         # combination 7: corner 1, tip 0, edge 1 -> 3
         D = 0.5 * (l01 + l13 - l03)
-        gamma = D * iL13 * h0 - gamma0[t, 7]
-        B0_13 += G2 * gamma * cn0 * iL13
+        gamma = D * iL13 * h0 - g0[7 * B + i]
+        E = half * gamma * iL13 * h0
+        P = E * D
+        W01 += E
+        W03 -= E
+        W13 += E - P * iL13 * iL13
+        P0 += P
         # combination 8: corner 1, tip 2, edge 1 -> 0
         D = 0.5 * (l12 + l01 - l02)
-        gamma = D * iL01 * h2 - gamma0[t, 8]
-        B2_01 -= G2 * gamma * cn2 * iL01
+        gamma = D * iL01 * h2 - g0[8 * B + i]
+        E = half * gamma * iL01 * h2
+        P = E * D
+        W12 += E
+        W02 -= E
+        W01 += E - P * iL01 * iL01
+        P2 += P
         # combination 9: corner 1, tip 2, edge 1 -> 3
         D = 0.5 * (l12 + l13 - l23)
-        gamma = D * iL13 * h2 - gamma0[t, 9]
-        B2_13 += G2 * gamma * cn2 * iL13
+        gamma = D * iL13 * h2 - g0[9 * B + i]
+        E = half * gamma * iL13 * h2
+        P = E * D
+        W12 += E
+        W23 -= E
+        W13 += E - P * iL13 * iL13
+        P2 += P
         # combination 10: corner 1, tip 3, edge 1 -> 0
         D = 0.5 * (l13 + l01 - l03)
-        gamma = D * iL01 * h3 - gamma0[t, 10]
-        B3_01 -= G2 * gamma * cn3 * iL01
+        gamma = D * iL01 * h3 - g0[10 * B + i]
+        E = half * gamma * iL01 * h3
+        P = E * D
+        W13 += E
+        W03 -= E
+        W01 += E - P * iL01 * iL01
+        P3 += P
         # combination 11: corner 1, tip 3, edge 1 -> 2
         D = 0.5 * (l13 + l12 - l23)
-        gamma = D * iL12 * h3 - gamma0[t, 11]
-        B3_12 += G2 * gamma * cn3 * iL12
+        gamma = D * iL12 * h3 - g0[11 * B + i]
+        E = half * gamma * iL12 * h3
+        P = E * D
+        W13 += E
+        W23 -= E
+        W12 += E - P * iL12 * iL12
+        P3 += P
         # combination 12: corner 2, tip 0, edge 2 -> 1
         D = 0.5 * (l02 + l12 - l01)
-        gamma = D * iL12 * h0 - gamma0[t, 12]
-        B0_12 -= G2 * gamma * cn0 * iL12
+        gamma = D * iL12 * h0 - g0[12 * B + i]
+        E = half * gamma * iL12 * h0
+        P = E * D
+        W02 += E
+        W01 -= E
+        W12 += E - P * iL12 * iL12
+        P0 += P
         # combination 13: corner 2, tip 0, edge 2 -> 3
         D = 0.5 * (l02 + l23 - l03)
-        gamma = D * iL23 * h0 - gamma0[t, 13]
-        B0_23 += G2 * gamma * cn0 * iL23
+        gamma = D * iL23 * h0 - g0[13 * B + i]
+        E = half * gamma * iL23 * h0
+        P = E * D
+        W02 += E
+        W03 -= E
+        W23 += E - P * iL23 * iL23
+        P0 += P
         # combination 14: corner 2, tip 1, edge 2 -> 0
         D = 0.5 * (l12 + l02 - l01)
-        gamma = D * iL02 * h1 - gamma0[t, 14]
-        B1_02 -= G2 * gamma * cn1 * iL02
+        gamma = D * iL02 * h1 - g0[14 * B + i]
+        E = half * gamma * iL02 * h1
+        P = E * D
+        W12 += E
+        W01 -= E
+        W02 += E - P * iL02 * iL02
+        P1 += P
         # combination 15: corner 2, tip 1, edge 2 -> 3
         D = 0.5 * (l12 + l23 - l13)
-        gamma = D * iL23 * h1 - gamma0[t, 15]
-        B1_23 += G2 * gamma * cn1 * iL23
+        gamma = D * iL23 * h1 - g0[15 * B + i]
+        E = half * gamma * iL23 * h1
+        P = E * D
+        W12 += E
+        W13 -= E
+        W23 += E - P * iL23 * iL23
+        P1 += P
         # combination 16: corner 2, tip 3, edge 2 -> 0
         D = 0.5 * (l23 + l02 - l03)
-        gamma = D * iL02 * h3 - gamma0[t, 16]
-        B3_02 -= G2 * gamma * cn3 * iL02
+        gamma = D * iL02 * h3 - g0[16 * B + i]
+        E = half * gamma * iL02 * h3
+        P = E * D
+        W23 += E
+        W03 -= E
+        W02 += E - P * iL02 * iL02
+        P3 += P
         # combination 17: corner 2, tip 3, edge 2 -> 1
         D = 0.5 * (l23 + l12 - l13)
-        gamma = D * iL12 * h3 - gamma0[t, 17]
-        B3_12 -= G2 * gamma * cn3 * iL12
+        gamma = D * iL12 * h3 - g0[17 * B + i]
+        E = half * gamma * iL12 * h3
+        P = E * D
+        W23 += E
+        W13 -= E
+        W12 += E - P * iL12 * iL12
+        P3 += P
         # combination 18: corner 3, tip 0, edge 3 -> 1
         D = 0.5 * (l03 + l13 - l01)
-        gamma = D * iL13 * h0 - gamma0[t, 18]
-        B0_13 -= G2 * gamma * cn0 * iL13
+        gamma = D * iL13 * h0 - g0[18 * B + i]
+        E = half * gamma * iL13 * h0
+        P = E * D
+        W03 += E
+        W01 -= E
+        W13 += E - P * iL13 * iL13
+        P0 += P
         # combination 19: corner 3, tip 0, edge 3 -> 2
         D = 0.5 * (l03 + l23 - l02)
-        gamma = D * iL23 * h0 - gamma0[t, 19]
-        B0_23 -= G2 * gamma * cn0 * iL23
+        gamma = D * iL23 * h0 - g0[19 * B + i]
+        E = half * gamma * iL23 * h0
+        P = E * D
+        W03 += E
+        W02 -= E
+        W23 += E - P * iL23 * iL23
+        P0 += P
         # combination 20: corner 3, tip 1, edge 3 -> 0
         D = 0.5 * (l13 + l03 - l01)
-        gamma = D * iL03 * h1 - gamma0[t, 20]
-        B1_03 -= G2 * gamma * cn1 * iL03
+        gamma = D * iL03 * h1 - g0[20 * B + i]
+        E = half * gamma * iL03 * h1
+        P = E * D
+        W13 += E
+        W01 -= E
+        W03 += E - P * iL03 * iL03
+        P1 += P
         # combination 21: corner 3, tip 1, edge 3 -> 2
         D = 0.5 * (l13 + l23 - l12)
-        gamma = D * iL23 * h1 - gamma0[t, 21]
-        B1_23 -= G2 * gamma * cn1 * iL23
+        gamma = D * iL23 * h1 - g0[21 * B + i]
+        E = half * gamma * iL23 * h1
+        P = E * D
+        W13 += E
+        W12 -= E
+        W23 += E - P * iL23 * iL23
+        P1 += P
         # combination 22: corner 3, tip 2, edge 3 -> 0
         D = 0.5 * (l23 + l03 - l02)
-        gamma = D * iL03 * h2 - gamma0[t, 22]
-        B2_03 -= G2 * gamma * cn2 * iL03
+        gamma = D * iL03 * h2 - g0[22 * B + i]
+        E = half * gamma * iL03 * h2
+        P = E * D
+        W23 += E
+        W02 -= E
+        W03 += E - P * iL03 * iL03
+        P2 += P
         # combination 23: corner 3, tip 2, edge 3 -> 1
         D = 0.5 * (l23 + l13 - l12)
-        gamma = D * iL13 * h2 - gamma0[t, 23]
-        B2_13 -= G2 * gamma * cn2 * iL13
-        U0 = axpy(B0_23, d23, axpy(B0_13, d13, axpy(B0_12, d12, (0.0, 0.0, 0.0))))
-        U1 = axpy(B1_23, d23, axpy(B1_03, d03, axpy(B1_02, d02, (0.0, 0.0, 0.0))))
-        U2 = axpy(B2_13, d13, axpy(B2_03, d03, axpy(B2_01, d01, (0.0, 0.0, 0.0))))
-        U3 = axpy(B3_12, d12, axpy(B3_02, d02, axpy(B3_01, d01, (0.0, 0.0, 0.0))))
-        T = (U0[0] + U1[0] + U2[0] + U3[0], U0[1] + U1[1] + U2[1] + U3[1], U0[2] + U1[2] + U2[2] + U3[2])
-        f0 = lin(1.0 / 3.0, T, -4.0 / 3.0, U0)
-        f1 = lin(1.0 / 3.0, T, -4.0 / 3.0, U1)
-        f2 = lin(1.0 / 3.0, T, -4.0 / 3.0, U2)
-        f3 = lin(1.0 / 3.0, T, -4.0 / 3.0, U3)
-        put(ft, t, 0, f0)
-        put(ft, t, 1, f1)
-        put(ft, t, 2, f2)
-        put(ft, t, 3, f3)
+        gamma = D * iL13 * h2 - g0[23 * B + i]
+        E = half * gamma * iL13 * h2
+        P = E * D
+        W23 += E
+        W12 -= E
+        W13 += E - P * iL13 * iL13
+        P2 += P
+        b = P0 / (cn0 * cn0)
+        D = 0.5 * (l13 + l12 - l23)
+        W13 += b * (l12 - D)
+        W12 += b * (l13 - D)
+        W23 += b * D
+        b = P1 / (cn1 * cn1)
+        D = 0.5 * (l02 + l03 - l23)
+        W02 += b * (l03 - D)
+        W03 += b * (l02 - D)
+        W23 += b * D
+        b = P2 / (cn2 * cn2)
+        D = 0.5 * (l03 + l01 - l13)
+        W03 += b * (l01 - D)
+        W01 += b * (l03 - D)
+        W13 += b * D
+        b = P3 / (cn3 * cn3)
+        D = 0.5 * (l01 + l02 - l12)
+        W01 += b * (l02 - D)
+        W02 += b * (l01 - D)
+        W12 += b * D
+        A = 2.0 * (P0 + P1 + P2 + P3) * iV6
+        f0 = (0.0, 0.0, 0.0)
+        f1 = (0.0, 0.0, 0.0)
+        f2 = (0.0, 0.0, 0.0)
+        f3 = (0.0, 0.0, 0.0)
+        f0 = axpy(2.0 * W01, d01, f0)
+        f1 = axpy(-(2.0 * W01), d01, f1)
+        f0 = axpy(2.0 * W02, d02, f0)
+        f2 = axpy(-(2.0 * W02), d02, f2)
+        f0 = axpy(2.0 * W03, d03, f0)
+        f3 = axpy(-(2.0 * W03), d03, f3)
+        f1 = axpy(2.0 * W12, d12, f1)
+        f2 = axpy(-(2.0 * W12), d12, f2)
+        f1 = axpy(2.0 * W13, d13, f1)
+        f3 = axpy(-(2.0 * W13), d13, f3)
+        f2 = axpy(2.0 * W23, d23, f2)
+        f3 = axpy(-(2.0 * W23), d23, f3)
+        f0 = axpy(A, c0, f0)
+        f1 = axpy(A, c1, f1)
+        f2 = axpy(A, c2, f2)
+        f3 = axpy(A, c3, f3)
+        s[OUT + 0 * B + i] = f0[0]
+        s[OUT + 1 * B + i] = f0[1]
+        s[OUT + 2 * B + i] = f0[2]
+        s[OUT + 3 * B + i] = f1[0]
+        s[OUT + 4 * B + i] = f1[1]
+        s[OUT + 5 * B + i] = f1[2]
+        s[OUT + 6 * B + i] = f2[0]
+        s[OUT + 7 * B + i] = f2[1]
+        s[OUT + 8 * B + i] = f2[2]
+        s[OUT + 9 * B + i] = f3[0]
+        s[OUT + 10 * B + i] = f3[1]
+        s[OUT + 11 * B + i] = f3[2]
     return n_flat
 
 
-@njit(cache=True, fastmath=FAST)
-def shear_variational(x, tets, vol0, gamma0, cG, out):
+@njit(**OPTIONS)
+def shear_variational(x, tb, m, vol0, gamma0, cG, out):
     """f = -dW/dx, W = (c/2) G V0 sum_s gamma_s^2 (cG = c G); returns the first flattened tetrahedron, or -1."""
+    s = np.empty(SCRATCH)
+    for blk in range((m + B - 1) // B):
+        gather(x, tb, blk, s)
+        if shear_variational_block(s, blk, vol0, gamma0, cG) > 0:
+            return first_flat(s, blk, m)
+        scatter(out, tb, blk, m, s)
+    return -1
+
+
+@njit(**OPTIONS)
+def shear_variational_tets(x, tb, m, vol0, gamma0, cG, ft, flat, first, stop):
+    """shear_variational for the tetrahedra [first, stop) into ft (m, 4, 3); flattened ones flagged in flat."""
+    s = np.empty(SCRATCH)
+    n_flat = 0
+    for blk in range(first // B, (stop + B - 1) // B):
+        gather(x, tb, blk, s)
+        shear_variational_block(s, blk, vol0, gamma0, cG)
+        n_flat += put(ft, flat, blk, first, stop, s)
+    return n_flat
+
+
+@njit(cache=True, fastmath=FAST)
+def shear_corner_reference(x, tets, vol0, gamma0, G, out):
+    """Literal eq. 5: f_a += (1/4) tau S_F e, tau = G gamma, S_F = cn_j / 2, e = d_am / L_am; returns the first flattened tetrahedron, or -1. Tetrahedron by tetrahedron (the reference of ``shear_corner``)."""
+    G8 = 0.125 * G
+    for t in range(tets.shape[0]):
+        n0, n1, n2, n3 = tets[t, 0], tets[t, 1], tets[t, 2], tets[t, 3]
+        x0, x1, x2, x3 = vec(x, n0), vec(x, n1), vec(x, n2), vec(x, n3)
+        d01 = sub(x1, x0)
+        l01 = dot(d01, d01)
+        iL01 = 1.0 / np.sqrt(l01)
+        d02 = sub(x2, x0)
+        l02 = dot(d02, d02)
+        iL02 = 1.0 / np.sqrt(l02)
+        d03 = sub(x3, x0)
+        l03 = dot(d03, d03)
+        iL03 = 1.0 / np.sqrt(l03)
+        d12 = sub(x2, x1)
+        l12 = dot(d12, d12)
+        iL12 = 1.0 / np.sqrt(l12)
+        d13 = sub(x3, x1)
+        l13 = dot(d13, d13)
+        iL13 = 1.0 / np.sqrt(l13)
+        d23 = sub(x3, x2)
+        l23 = dot(d23, d23)
+        iL23 = 1.0 / np.sqrt(l23)
+        c0 = cross(d13, d12)
+        cn0 = np.sqrt(dot(c0, c0))
+        c1 = cross(d02, d03)
+        cn1 = np.sqrt(dot(c1, c1))
+        c2 = cross(d03, d01)
+        cn2 = np.sqrt(dot(c2, c2))
+        c3 = cross(d01, d02)
+        cn3 = np.sqrt(dot(c3, c3))
+        V6 = dot(d01, c1)
+        if V6 <= FLAT * 6.0 * vol0[t]:
+            return t
+        iV6 = 1.0 / V6
+        h0 = cn0 * iV6
+        h1 = cn1 * iV6
+        h2 = cn2 * iV6
+        h3 = cn3 * iV6
+        K01 = 0.0
+        K02 = 0.0
+        K03 = 0.0
+        K10 = 0.0
+        K12 = 0.0
+        K13 = 0.0
+        K20 = 0.0
+        K21 = 0.0
+        K23 = 0.0
+        K30 = 0.0
+        K31 = 0.0
+        K32 = 0.0
+        # combination 0: corner 0, tip 1, edge 0 -> 2
+        D = 0.5 * (l01 + l02 - l12)
+        gamma = D * iL02 * h1 - gamma0[t, 0]
+        K02 += G8 * gamma * cn1 * iL02
+        # combination 1: corner 0, tip 1, edge 0 -> 3
+        D = 0.5 * (l01 + l03 - l13)
+        gamma = D * iL03 * h1 - gamma0[t, 1]
+        K03 += G8 * gamma * cn1 * iL03
+        # combination 2: corner 0, tip 2, edge 0 -> 1
+        D = 0.5 * (l02 + l01 - l12)
+        gamma = D * iL01 * h2 - gamma0[t, 2]
+        K01 += G8 * gamma * cn2 * iL01
+        # combination 3: corner 0, tip 2, edge 0 -> 3
+        D = 0.5 * (l02 + l03 - l23)
+        gamma = D * iL03 * h2 - gamma0[t, 3]
+        K03 += G8 * gamma * cn2 * iL03
+        # combination 4: corner 0, tip 3, edge 0 -> 1
+        D = 0.5 * (l03 + l01 - l13)
+        gamma = D * iL01 * h3 - gamma0[t, 4]
+        K01 += G8 * gamma * cn3 * iL01
+        # combination 5: corner 0, tip 3, edge 0 -> 2
+        D = 0.5 * (l03 + l02 - l23)
+        gamma = D * iL02 * h3 - gamma0[t, 5]
+        K02 += G8 * gamma * cn3 * iL02
+        # combination 6: corner 1, tip 0, edge 1 -> 2
+        D = 0.5 * (l01 + l12 - l02)
+        gamma = D * iL12 * h0 - gamma0[t, 6]
+        K12 += G8 * gamma * cn0 * iL12
+        # combination 7: corner 1, tip 0, edge 1 -> 3
+        D = 0.5 * (l01 + l13 - l03)
+        gamma = D * iL13 * h0 - gamma0[t, 7]
+        K13 += G8 * gamma * cn0 * iL13
+        # combination 8: corner 1, tip 2, edge 1 -> 0
+        D = 0.5 * (l12 + l01 - l02)
+        gamma = D * iL01 * h2 - gamma0[t, 8]
+        K10 += G8 * gamma * cn2 * iL01
+        # combination 9: corner 1, tip 2, edge 1 -> 3
+        D = 0.5 * (l12 + l13 - l23)
+        gamma = D * iL13 * h2 - gamma0[t, 9]
+        K13 += G8 * gamma * cn2 * iL13
+        # combination 10: corner 1, tip 3, edge 1 -> 0
+        D = 0.5 * (l13 + l01 - l03)
+        gamma = D * iL01 * h3 - gamma0[t, 10]
+        K10 += G8 * gamma * cn3 * iL01
+        # combination 11: corner 1, tip 3, edge 1 -> 2
+        D = 0.5 * (l13 + l12 - l23)
+        gamma = D * iL12 * h3 - gamma0[t, 11]
+        K12 += G8 * gamma * cn3 * iL12
+        # combination 12: corner 2, tip 0, edge 2 -> 1
+        D = 0.5 * (l02 + l12 - l01)
+        gamma = D * iL12 * h0 - gamma0[t, 12]
+        K21 += G8 * gamma * cn0 * iL12
+        # combination 13: corner 2, tip 0, edge 2 -> 3
+        D = 0.5 * (l02 + l23 - l03)
+        gamma = D * iL23 * h0 - gamma0[t, 13]
+        K23 += G8 * gamma * cn0 * iL23
+        # combination 14: corner 2, tip 1, edge 2 -> 0
+        D = 0.5 * (l12 + l02 - l01)
+        gamma = D * iL02 * h1 - gamma0[t, 14]
+        K20 += G8 * gamma * cn1 * iL02
+        # combination 15: corner 2, tip 1, edge 2 -> 3
+        D = 0.5 * (l12 + l23 - l13)
+        gamma = D * iL23 * h1 - gamma0[t, 15]
+        K23 += G8 * gamma * cn1 * iL23
+        # combination 16: corner 2, tip 3, edge 2 -> 0
+        D = 0.5 * (l23 + l02 - l03)
+        gamma = D * iL02 * h3 - gamma0[t, 16]
+        K20 += G8 * gamma * cn3 * iL02
+        # combination 17: corner 2, tip 3, edge 2 -> 1
+        D = 0.5 * (l23 + l12 - l13)
+        gamma = D * iL12 * h3 - gamma0[t, 17]
+        K21 += G8 * gamma * cn3 * iL12
+        # combination 18: corner 3, tip 0, edge 3 -> 1
+        D = 0.5 * (l03 + l13 - l01)
+        gamma = D * iL13 * h0 - gamma0[t, 18]
+        K31 += G8 * gamma * cn0 * iL13
+        # combination 19: corner 3, tip 0, edge 3 -> 2
+        D = 0.5 * (l03 + l23 - l02)
+        gamma = D * iL23 * h0 - gamma0[t, 19]
+        K32 += G8 * gamma * cn0 * iL23
+        # combination 20: corner 3, tip 1, edge 3 -> 0
+        D = 0.5 * (l13 + l03 - l01)
+        gamma = D * iL03 * h1 - gamma0[t, 20]
+        K30 += G8 * gamma * cn1 * iL03
+        # combination 21: corner 3, tip 1, edge 3 -> 2
+        D = 0.5 * (l13 + l23 - l12)
+        gamma = D * iL23 * h1 - gamma0[t, 21]
+        K32 += G8 * gamma * cn1 * iL23
+        # combination 22: corner 3, tip 2, edge 3 -> 0
+        D = 0.5 * (l23 + l03 - l02)
+        gamma = D * iL03 * h2 - gamma0[t, 22]
+        K30 += G8 * gamma * cn2 * iL03
+        # combination 23: corner 3, tip 2, edge 3 -> 1
+        D = 0.5 * (l23 + l13 - l12)
+        gamma = D * iL13 * h2 - gamma0[t, 23]
+        K31 += G8 * gamma * cn2 * iL13
+        f0 = (0.0, 0.0, 0.0)
+        f1 = (0.0, 0.0, 0.0)
+        f2 = (0.0, 0.0, 0.0)
+        f3 = (0.0, 0.0, 0.0)
+        f0 = axpy(K01, d01, f0)
+        f1 = axpy(-(K10), d01, f1)
+        f0 = axpy(K02, d02, f0)
+        f2 = axpy(-(K20), d02, f2)
+        f0 = axpy(K03, d03, f0)
+        f3 = axpy(-(K30), d03, f3)
+        f1 = axpy(K12, d12, f1)
+        f2 = axpy(-(K21), d12, f2)
+        f1 = axpy(K13, d13, f1)
+        f3 = axpy(-(K31), d13, f3)
+        f2 = axpy(K23, d23, f2)
+        f3 = axpy(-(K32), d23, f3)
+        add_to(out, n0, f0)
+        add_to(out, n1, f1)
+        add_to(out, n2, f2)
+        add_to(out, n3, f3)
+    return -1
+
+
+@njit(cache=True, fastmath=FAST)
+def shear_balanced_reference(x, tets, vol0, gamma0, G, out):
+    """f_j -= tau S_F e on the tip, + tau S_F e / 3 on each base vertex a, m, l; returns the first flattened tetrahedron, or -1. Tetrahedron by tetrahedron (the reference of ``shear_balanced``)."""
+    G2 = 0.5 * G
+    for t in range(tets.shape[0]):
+        n0, n1, n2, n3 = tets[t, 0], tets[t, 1], tets[t, 2], tets[t, 3]
+        x0, x1, x2, x3 = vec(x, n0), vec(x, n1), vec(x, n2), vec(x, n3)
+        d01 = sub(x1, x0)
+        l01 = dot(d01, d01)
+        iL01 = 1.0 / np.sqrt(l01)
+        d02 = sub(x2, x0)
+        l02 = dot(d02, d02)
+        iL02 = 1.0 / np.sqrt(l02)
+        d03 = sub(x3, x0)
+        l03 = dot(d03, d03)
+        iL03 = 1.0 / np.sqrt(l03)
+        d12 = sub(x2, x1)
+        l12 = dot(d12, d12)
+        iL12 = 1.0 / np.sqrt(l12)
+        d13 = sub(x3, x1)
+        l13 = dot(d13, d13)
+        iL13 = 1.0 / np.sqrt(l13)
+        d23 = sub(x3, x2)
+        l23 = dot(d23, d23)
+        iL23 = 1.0 / np.sqrt(l23)
+        c0 = cross(d13, d12)
+        cn0 = np.sqrt(dot(c0, c0))
+        c1 = cross(d02, d03)
+        cn1 = np.sqrt(dot(c1, c1))
+        c2 = cross(d03, d01)
+        cn2 = np.sqrt(dot(c2, c2))
+        c3 = cross(d01, d02)
+        cn3 = np.sqrt(dot(c3, c3))
+        V6 = dot(d01, c1)
+        if V6 <= FLAT * 6.0 * vol0[t]:
+            return t
+        iV6 = 1.0 / V6
+        h0 = cn0 * iV6
+        h1 = cn1 * iV6
+        h2 = cn2 * iV6
+        h3 = cn3 * iV6
+        B0_12 = 0.0
+        B0_13 = 0.0
+        B0_23 = 0.0
+        B1_02 = 0.0
+        B1_03 = 0.0
+        B1_23 = 0.0
+        B2_01 = 0.0
+        B2_03 = 0.0
+        B2_13 = 0.0
+        B3_01 = 0.0
+        B3_02 = 0.0
+        B3_12 = 0.0
+        # combination 0: corner 0, tip 1, edge 0 -> 2
+        D = 0.5 * (l01 + l02 - l12)
+        gamma = D * iL02 * h1 - gamma0[t, 0]
+        B1_02 += G2 * gamma * cn1 * iL02
+        # combination 1: corner 0, tip 1, edge 0 -> 3
+        D = 0.5 * (l01 + l03 - l13)
+        gamma = D * iL03 * h1 - gamma0[t, 1]
+        B1_03 += G2 * gamma * cn1 * iL03
+        # combination 2: corner 0, tip 2, edge 0 -> 1
+        D = 0.5 * (l02 + l01 - l12)
+        gamma = D * iL01 * h2 - gamma0[t, 2]
+        B2_01 += G2 * gamma * cn2 * iL01
+        # combination 3: corner 0, tip 2, edge 0 -> 3
+        D = 0.5 * (l02 + l03 - l23)
+        gamma = D * iL03 * h2 - gamma0[t, 3]
+        B2_03 += G2 * gamma * cn2 * iL03
+        # combination 4: corner 0, tip 3, edge 0 -> 1
+        D = 0.5 * (l03 + l01 - l13)
+        gamma = D * iL01 * h3 - gamma0[t, 4]
+        B3_01 += G2 * gamma * cn3 * iL01
+        # combination 5: corner 0, tip 3, edge 0 -> 2
+        D = 0.5 * (l03 + l02 - l23)
+        gamma = D * iL02 * h3 - gamma0[t, 5]
+        B3_02 += G2 * gamma * cn3 * iL02
+        # combination 6: corner 1, tip 0, edge 1 -> 2
+        D = 0.5 * (l01 + l12 - l02)
+        gamma = D * iL12 * h0 - gamma0[t, 6]
+        B0_12 += G2 * gamma * cn0 * iL12
+        # combination 7: corner 1, tip 0, edge 1 -> 3
+        D = 0.5 * (l01 + l13 - l03)
+        gamma = D * iL13 * h0 - gamma0[t, 7]
+        B0_13 += G2 * gamma * cn0 * iL13
+        # combination 8: corner 1, tip 2, edge 1 -> 0
+        D = 0.5 * (l12 + l01 - l02)
+        gamma = D * iL01 * h2 - gamma0[t, 8]
+        B2_01 -= G2 * gamma * cn2 * iL01
+        # combination 9: corner 1, tip 2, edge 1 -> 3
+        D = 0.5 * (l12 + l13 - l23)
+        gamma = D * iL13 * h2 - gamma0[t, 9]
+        B2_13 += G2 * gamma * cn2 * iL13
+        # combination 10: corner 1, tip 3, edge 1 -> 0
+        D = 0.5 * (l13 + l01 - l03)
+        gamma = D * iL01 * h3 - gamma0[t, 10]
+        B3_01 -= G2 * gamma * cn3 * iL01
+        # combination 11: corner 1, tip 3, edge 1 -> 2
+        D = 0.5 * (l13 + l12 - l23)
+        gamma = D * iL12 * h3 - gamma0[t, 11]
+        B3_12 += G2 * gamma * cn3 * iL12
+        # combination 12: corner 2, tip 0, edge 2 -> 1
+        D = 0.5 * (l02 + l12 - l01)
+        gamma = D * iL12 * h0 - gamma0[t, 12]
+        B0_12 -= G2 * gamma * cn0 * iL12
+        # combination 13: corner 2, tip 0, edge 2 -> 3
+        D = 0.5 * (l02 + l23 - l03)
+        gamma = D * iL23 * h0 - gamma0[t, 13]
+        B0_23 += G2 * gamma * cn0 * iL23
+        # combination 14: corner 2, tip 1, edge 2 -> 0
+        D = 0.5 * (l12 + l02 - l01)
+        gamma = D * iL02 * h1 - gamma0[t, 14]
+        B1_02 -= G2 * gamma * cn1 * iL02
+        # combination 15: corner 2, tip 1, edge 2 -> 3
+        D = 0.5 * (l12 + l23 - l13)
+        gamma = D * iL23 * h1 - gamma0[t, 15]
+        B1_23 += G2 * gamma * cn1 * iL23
+        # combination 16: corner 2, tip 3, edge 2 -> 0
+        D = 0.5 * (l23 + l02 - l03)
+        gamma = D * iL02 * h3 - gamma0[t, 16]
+        B3_02 -= G2 * gamma * cn3 * iL02
+        # combination 17: corner 2, tip 3, edge 2 -> 1
+        D = 0.5 * (l23 + l12 - l13)
+        gamma = D * iL12 * h3 - gamma0[t, 17]
+        B3_12 -= G2 * gamma * cn3 * iL12
+        # combination 18: corner 3, tip 0, edge 3 -> 1
+        D = 0.5 * (l03 + l13 - l01)
+        gamma = D * iL13 * h0 - gamma0[t, 18]
+        B0_13 -= G2 * gamma * cn0 * iL13
+        # combination 19: corner 3, tip 0, edge 3 -> 2
+        D = 0.5 * (l03 + l23 - l02)
+        gamma = D * iL23 * h0 - gamma0[t, 19]
+        B0_23 -= G2 * gamma * cn0 * iL23
+        # combination 20: corner 3, tip 1, edge 3 -> 0
+        D = 0.5 * (l13 + l03 - l01)
+        gamma = D * iL03 * h1 - gamma0[t, 20]
+        B1_03 -= G2 * gamma * cn1 * iL03
+        # combination 21: corner 3, tip 1, edge 3 -> 2
+        D = 0.5 * (l13 + l23 - l12)
+        gamma = D * iL23 * h1 - gamma0[t, 21]
+        B1_23 -= G2 * gamma * cn1 * iL23
+        # combination 22: corner 3, tip 2, edge 3 -> 0
+        D = 0.5 * (l23 + l03 - l02)
+        gamma = D * iL03 * h2 - gamma0[t, 22]
+        B2_03 -= G2 * gamma * cn2 * iL03
+        # combination 23: corner 3, tip 2, edge 3 -> 1
+        D = 0.5 * (l23 + l13 - l12)
+        gamma = D * iL13 * h2 - gamma0[t, 23]
+        B2_13 -= G2 * gamma * cn2 * iL13
+        U0 = axpy(B0_23, d23, axpy(B0_13, d13, axpy(B0_12, d12, (0.0, 0.0, 0.0))))
+        U1 = axpy(B1_23, d23, axpy(B1_03, d03, axpy(B1_02, d02, (0.0, 0.0, 0.0))))
+        U2 = axpy(B2_13, d13, axpy(B2_03, d03, axpy(B2_01, d01, (0.0, 0.0, 0.0))))
+        U3 = axpy(B3_12, d12, axpy(B3_02, d02, axpy(B3_01, d01, (0.0, 0.0, 0.0))))
+        T = (U0[0] + U1[0] + U2[0] + U3[0], U0[1] + U1[1] + U2[1] + U3[1], U0[2] + U1[2] + U2[2] + U3[2])
+        f0 = lin(1.0 / 3.0, T, -4.0 / 3.0, U0)
+        f1 = lin(1.0 / 3.0, T, -4.0 / 3.0, U1)
+        f2 = lin(1.0 / 3.0, T, -4.0 / 3.0, U2)
+        f3 = lin(1.0 / 3.0, T, -4.0 / 3.0, U3)
+        add_to(out, n0, f0)
+        add_to(out, n1, f1)
+        add_to(out, n2, f2)
+        add_to(out, n3, f3)
+    return -1
+
+
+@njit(cache=True, fastmath=FAST)
+def shear_variational_reference(x, tets, vol0, gamma0, cG, out):
+    """f = -dW/dx, W = (c/2) G V0 sum_s gamma_s^2 (cG = c G); returns the first flattened tetrahedron, or -1. Tetrahedron by tetrahedron (the reference of ``shear_variational``)."""
     for t in range(tets.shape[0]):
         n0, n1, n2, n3 = tets[t, 0], tets[t, 1], tets[t, 2], tets[t, 3]
         x0, x1, x2, x3 = vec(x, n0), vec(x, n1), vec(x, n2), vec(x, n3)
@@ -1147,321 +1630,3 @@ def shear_variational(x, tets, vol0, gamma0, cG, out):
         add_to(out, n2, f2)
         add_to(out, n3, f3)
     return -1
-
-
-@njit(cache=True, fastmath=FAST)
-def shear_variational_tets(x, tets, vol0, gamma0, cG, ft, flat, first, stop):
-    """shear_variational per tetrahedron for t in [first, stop) into ft (m, 4, 3); flattened ones flagged in flat."""
-    n_flat = 0
-    for t in range(first, stop):
-        n0, n1, n2, n3 = tets[t, 0], tets[t, 1], tets[t, 2], tets[t, 3]
-        x0, x1, x2, x3 = vec(x, n0), vec(x, n1), vec(x, n2), vec(x, n3)
-        d01 = sub(x1, x0)
-        l01 = dot(d01, d01)
-        iL01 = 1.0 / np.sqrt(l01)
-        d02 = sub(x2, x0)
-        l02 = dot(d02, d02)
-        iL02 = 1.0 / np.sqrt(l02)
-        d03 = sub(x3, x0)
-        l03 = dot(d03, d03)
-        iL03 = 1.0 / np.sqrt(l03)
-        d12 = sub(x2, x1)
-        l12 = dot(d12, d12)
-        iL12 = 1.0 / np.sqrt(l12)
-        d13 = sub(x3, x1)
-        l13 = dot(d13, d13)
-        iL13 = 1.0 / np.sqrt(l13)
-        d23 = sub(x3, x2)
-        l23 = dot(d23, d23)
-        iL23 = 1.0 / np.sqrt(l23)
-        c0 = cross(d13, d12)
-        cn0 = np.sqrt(dot(c0, c0))
-        c1 = cross(d02, d03)
-        cn1 = np.sqrt(dot(c1, c1))
-        c2 = cross(d03, d01)
-        cn2 = np.sqrt(dot(c2, c2))
-        c3 = cross(d01, d02)
-        cn3 = np.sqrt(dot(c3, c3))
-        V6 = dot(d01, c1)
-        if V6 <= FLAT * 6.0 * vol0[t]:
-            flat[t] = 1
-            n_flat += 1
-            continue
-        iV6 = 1.0 / V6
-        h0 = cn0 * iV6
-        h1 = cn1 * iV6
-        h2 = cn2 * iV6
-        h3 = cn3 * iV6
-        W01 = 0.0
-        W02 = 0.0
-        W03 = 0.0
-        W12 = 0.0
-        W13 = 0.0
-        W23 = 0.0
-        P0 = 0.0
-        P1 = 0.0
-        P2 = 0.0
-        P3 = 0.0
-        half = 0.5 * cG * vol0[t]
-        # combination 0: corner 0, tip 1, edge 0 -> 2
-        D = 0.5 * (l01 + l02 - l12)
-        gamma = D * iL02 * h1 - gamma0[t, 0]
-        E = half * gamma * iL02 * h1
-        P = E * D
-        W01 += E
-        W12 -= E
-        W02 += E - P * iL02 * iL02
-        P1 += P
-        # combination 1: corner 0, tip 1, edge 0 -> 3
-        D = 0.5 * (l01 + l03 - l13)
-        gamma = D * iL03 * h1 - gamma0[t, 1]
-        E = half * gamma * iL03 * h1
-        P = E * D
-        W01 += E
-        W13 -= E
-        W03 += E - P * iL03 * iL03
-        P1 += P
-        # combination 2: corner 0, tip 2, edge 0 -> 1
-        D = 0.5 * (l02 + l01 - l12)
-        gamma = D * iL01 * h2 - gamma0[t, 2]
-        E = half * gamma * iL01 * h2
-        P = E * D
-        W02 += E
-        W12 -= E
-        W01 += E - P * iL01 * iL01
-        P2 += P
-        # combination 3: corner 0, tip 2, edge 0 -> 3
-        D = 0.5 * (l02 + l03 - l23)
-        gamma = D * iL03 * h2 - gamma0[t, 3]
-        E = half * gamma * iL03 * h2
-        P = E * D
-        W02 += E
-        W23 -= E
-        W03 += E - P * iL03 * iL03
-        P2 += P
-        # combination 4: corner 0, tip 3, edge 0 -> 1
-        D = 0.5 * (l03 + l01 - l13)
-        gamma = D * iL01 * h3 - gamma0[t, 4]
-        E = half * gamma * iL01 * h3
-        P = E * D
-        W03 += E
-        W13 -= E
-        W01 += E - P * iL01 * iL01
-        P3 += P
-        # combination 5: corner 0, tip 3, edge 0 -> 2
-        D = 0.5 * (l03 + l02 - l23)
-        gamma = D * iL02 * h3 - gamma0[t, 5]
-        E = half * gamma * iL02 * h3
-        P = E * D
-        W03 += E
-        W23 -= E
-        W02 += E - P * iL02 * iL02
-        P3 += P
-        # combination 6: corner 1, tip 0, edge 1 -> 2
-        D = 0.5 * (l01 + l12 - l02)
-        gamma = D * iL12 * h0 - gamma0[t, 6]
-        E = half * gamma * iL12 * h0
-        P = E * D
-        W01 += E
-        W02 -= E
-        W12 += E - P * iL12 * iL12
-        P0 += P
-        # combination 7: corner 1, tip 0, edge 1 -> 3
-        D = 0.5 * (l01 + l13 - l03)
-        gamma = D * iL13 * h0 - gamma0[t, 7]
-        E = half * gamma * iL13 * h0
-        P = E * D
-        W01 += E
-        W03 -= E
-        W13 += E - P * iL13 * iL13
-        P0 += P
-        # combination 8: corner 1, tip 2, edge 1 -> 0
-        D = 0.5 * (l12 + l01 - l02)
-        gamma = D * iL01 * h2 - gamma0[t, 8]
-        E = half * gamma * iL01 * h2
-        P = E * D
-        W12 += E
-        W02 -= E
-        W01 += E - P * iL01 * iL01
-        P2 += P
-        # combination 9: corner 1, tip 2, edge 1 -> 3
-        D = 0.5 * (l12 + l13 - l23)
-        gamma = D * iL13 * h2 - gamma0[t, 9]
-        E = half * gamma * iL13 * h2
-        P = E * D
-        W12 += E
-        W23 -= E
-        W13 += E - P * iL13 * iL13
-        P2 += P
-        # combination 10: corner 1, tip 3, edge 1 -> 0
-        D = 0.5 * (l13 + l01 - l03)
-        gamma = D * iL01 * h3 - gamma0[t, 10]
-        E = half * gamma * iL01 * h3
-        P = E * D
-        W13 += E
-        W03 -= E
-        W01 += E - P * iL01 * iL01
-        P3 += P
-        # combination 11: corner 1, tip 3, edge 1 -> 2
-        D = 0.5 * (l13 + l12 - l23)
-        gamma = D * iL12 * h3 - gamma0[t, 11]
-        E = half * gamma * iL12 * h3
-        P = E * D
-        W13 += E
-        W23 -= E
-        W12 += E - P * iL12 * iL12
-        P3 += P
-        # combination 12: corner 2, tip 0, edge 2 -> 1
-        D = 0.5 * (l02 + l12 - l01)
-        gamma = D * iL12 * h0 - gamma0[t, 12]
-        E = half * gamma * iL12 * h0
-        P = E * D
-        W02 += E
-        W01 -= E
-        W12 += E - P * iL12 * iL12
-        P0 += P
-        # combination 13: corner 2, tip 0, edge 2 -> 3
-        D = 0.5 * (l02 + l23 - l03)
-        gamma = D * iL23 * h0 - gamma0[t, 13]
-        E = half * gamma * iL23 * h0
-        P = E * D
-        W02 += E
-        W03 -= E
-        W23 += E - P * iL23 * iL23
-        P0 += P
-        # combination 14: corner 2, tip 1, edge 2 -> 0
-        D = 0.5 * (l12 + l02 - l01)
-        gamma = D * iL02 * h1 - gamma0[t, 14]
-        E = half * gamma * iL02 * h1
-        P = E * D
-        W12 += E
-        W01 -= E
-        W02 += E - P * iL02 * iL02
-        P1 += P
-        # combination 15: corner 2, tip 1, edge 2 -> 3
-        D = 0.5 * (l12 + l23 - l13)
-        gamma = D * iL23 * h1 - gamma0[t, 15]
-        E = half * gamma * iL23 * h1
-        P = E * D
-        W12 += E
-        W13 -= E
-        W23 += E - P * iL23 * iL23
-        P1 += P
-        # combination 16: corner 2, tip 3, edge 2 -> 0
-        D = 0.5 * (l23 + l02 - l03)
-        gamma = D * iL02 * h3 - gamma0[t, 16]
-        E = half * gamma * iL02 * h3
-        P = E * D
-        W23 += E
-        W03 -= E
-        W02 += E - P * iL02 * iL02
-        P3 += P
-        # combination 17: corner 2, tip 3, edge 2 -> 1
-        D = 0.5 * (l23 + l12 - l13)
-        gamma = D * iL12 * h3 - gamma0[t, 17]
-        E = half * gamma * iL12 * h3
-        P = E * D
-        W23 += E
-        W13 -= E
-        W12 += E - P * iL12 * iL12
-        P3 += P
-        # combination 18: corner 3, tip 0, edge 3 -> 1
-        D = 0.5 * (l03 + l13 - l01)
-        gamma = D * iL13 * h0 - gamma0[t, 18]
-        E = half * gamma * iL13 * h0
-        P = E * D
-        W03 += E
-        W01 -= E
-        W13 += E - P * iL13 * iL13
-        P0 += P
-        # combination 19: corner 3, tip 0, edge 3 -> 2
-        D = 0.5 * (l03 + l23 - l02)
-        gamma = D * iL23 * h0 - gamma0[t, 19]
-        E = half * gamma * iL23 * h0
-        P = E * D
-        W03 += E
-        W02 -= E
-        W23 += E - P * iL23 * iL23
-        P0 += P
-        # combination 20: corner 3, tip 1, edge 3 -> 0
-        D = 0.5 * (l13 + l03 - l01)
-        gamma = D * iL03 * h1 - gamma0[t, 20]
-        E = half * gamma * iL03 * h1
-        P = E * D
-        W13 += E
-        W01 -= E
-        W03 += E - P * iL03 * iL03
-        P1 += P
-        # combination 21: corner 3, tip 1, edge 3 -> 2
-        D = 0.5 * (l13 + l23 - l12)
-        gamma = D * iL23 * h1 - gamma0[t, 21]
-        E = half * gamma * iL23 * h1
-        P = E * D
-        W13 += E
-        W12 -= E
-        W23 += E - P * iL23 * iL23
-        P1 += P
-        # combination 22: corner 3, tip 2, edge 3 -> 0
-        D = 0.5 * (l23 + l03 - l02)
-        gamma = D * iL03 * h2 - gamma0[t, 22]
-        E = half * gamma * iL03 * h2
-        P = E * D
-        W23 += E
-        W02 -= E
-        W03 += E - P * iL03 * iL03
-        P2 += P
-        # combination 23: corner 3, tip 2, edge 3 -> 1
-        D = 0.5 * (l23 + l13 - l12)
-        gamma = D * iL13 * h2 - gamma0[t, 23]
-        E = half * gamma * iL13 * h2
-        P = E * D
-        W23 += E
-        W12 -= E
-        W13 += E - P * iL13 * iL13
-        P2 += P
-        b = P0 / (cn0 * cn0)
-        D = 0.5 * (l13 + l12 - l23)
-        W13 += b * (l12 - D)
-        W12 += b * (l13 - D)
-        W23 += b * D
-        b = P1 / (cn1 * cn1)
-        D = 0.5 * (l02 + l03 - l23)
-        W02 += b * (l03 - D)
-        W03 += b * (l02 - D)
-        W23 += b * D
-        b = P2 / (cn2 * cn2)
-        D = 0.5 * (l03 + l01 - l13)
-        W03 += b * (l01 - D)
-        W01 += b * (l03 - D)
-        W13 += b * D
-        b = P3 / (cn3 * cn3)
-        D = 0.5 * (l01 + l02 - l12)
-        W01 += b * (l02 - D)
-        W02 += b * (l01 - D)
-        W12 += b * D
-        A = 2.0 * (P0 + P1 + P2 + P3) * iV6
-        f0 = (0.0, 0.0, 0.0)
-        f1 = (0.0, 0.0, 0.0)
-        f2 = (0.0, 0.0, 0.0)
-        f3 = (0.0, 0.0, 0.0)
-        f0 = axpy(2.0 * W01, d01, f0)
-        f1 = axpy(-(2.0 * W01), d01, f1)
-        f0 = axpy(2.0 * W02, d02, f0)
-        f2 = axpy(-(2.0 * W02), d02, f2)
-        f0 = axpy(2.0 * W03, d03, f0)
-        f3 = axpy(-(2.0 * W03), d03, f3)
-        f1 = axpy(2.0 * W12, d12, f1)
-        f2 = axpy(-(2.0 * W12), d12, f2)
-        f1 = axpy(2.0 * W13, d13, f1)
-        f3 = axpy(-(2.0 * W13), d13, f3)
-        f2 = axpy(2.0 * W23, d23, f2)
-        f3 = axpy(-(2.0 * W23), d23, f3)
-        f0 = axpy(A, c0, f0)
-        f1 = axpy(A, c1, f1)
-        f2 = axpy(A, c2, f2)
-        f3 = axpy(A, c3, f3)
-        put(ft, t, 0, f0)
-        put(ft, t, 1, f1)
-        put(ft, t, 2, f2)
-        put(ft, t, 3, f3)
-    return n_flat

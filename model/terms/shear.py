@@ -23,8 +23,10 @@ import numpy as np
 
 from . import Term, register
 from ._kernels import COMBOS, volume_gradient_numpy
-from ._shear_kernels import (shear_balanced, shear_balanced_tets, shear_corner,
-                             shear_corner_tets, shear_strains, shear_variational,
+from ._blocks import blocked, blocked_tets
+from ._shear_kernels import (shear_balanced, shear_balanced_reference, shear_balanced_tets,
+                             shear_corner, shear_corner_reference, shear_corner_tets,
+                             shear_strains, shear_variational, shear_variational_reference,
                              shear_variational_tets)
 from ._threads import TwoThreads
 from ..errors import ModelError, DegenerateTetError
@@ -37,8 +39,12 @@ READINGS = {"corner": 0, "balanced": 1, "variational": 2}
 # docstrings carry each reading's derivation): the edges d_ab, squared lengths l_ab, face
 # vectors c_j and 6V once per tetrahedron, then the 24 strains
 #     gamma_s = D / L_am * |c_j| / (6V) - gamma0_s,   D = d_aj . d_am = (l_aj + l_am - l_jm) / 2.
+# The kernels run over blocks of tetrahedra (model/terms/_blocks.py); the references, the same
+# maths tetrahedron by tetrahedron, are what the tests hold them to.
 KERNELS = {0: shear_corner, 1: shear_balanced, 2: shear_variational}
 PER_TET = {0: shear_corner_tets, 1: shear_balanced_tets, 2: shear_variational_tets}
+REFERENCE = {0: shear_corner_reference, 1: shear_balanced_reference,
+             2: shear_variational_reference}
 
 
 def strains_numpy(x, tets, gamma0):
@@ -97,6 +103,9 @@ class Shear(Term):
         self.gamma0 = np.zeros((mesh.n_tets, 24))
         self.gamma0 = self.strains(mesh.points)
         self._threads = None
+        # the kernels' data in the blocked layout (model/terms/_blocks.py)
+        self._blocked = (blocked_tets(mesh.tets), mesh.n_tets, blocked(self.vol0),
+                         blocked(self.gamma0))
 
     def describe(self):
         return f"shear/{self.p['reading']}"
@@ -121,8 +130,14 @@ class Shear(Term):
         if self.coef is None:
             raise ModelError(f"{self.p['reading']} shear with c='auto' is not calibrated yet: "
                              "build the model with model.build, or pass a number for c")
-        k = self.scale * self.G * self.coef
-        return KERNELS[self.reading], (self.mesh.tets, self.vol0, self.gamma0, k)
+        return KERNELS[self.reading], (*self._blocked, self._factor())
+
+    def _factor(self):
+        return self.scale * self.G * self.coef
+
+    def reference_kernel(self):
+        self.kernel()        # the same checks
+        return REFERENCE[self.reading], (self.mesh.tets, self.vol0, self.gamma0, self._factor())
 
     def threaded_kernel(self):
         if self._threads is None:

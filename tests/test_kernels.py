@@ -1,0 +1,104 @@
+"""The blocked force kernels (model/terms/_blocks.py) against the tetrahedron-by-tetrahedron
+kernels they replaced, kept as each term's ``reference_kernel()``: the same forces to round-off
+on lattice and unstructured meshes at random deformations, the two-thread mode the same bits
+as the serial kernel, and the same first flattened element."""
+import numba
+import numpy as np
+import pytest
+
+from model import Material
+from model.terms import make_term
+from model.terms._blocks import B, blocked
+from model.mesh import cube
+
+from conftest import perturbed
+
+MAT = Material(E=10e3, nu=0.45, rho=1000.0)
+# every term whose kernel has a reference, with its parameters (c fixed: no calibration)
+TERMS = {
+    "corner": ("shear", {"reading": "corner", "c": 0.4}),
+    "balanced": ("shear", {"reading": "balanced", "c": 0.6}),
+    "variational": ("shear", {"reading": "variational", "c": 0.3}),
+}
+# lattice and unstructured meshes; sizes not a multiple of the block (a padded last block)
+MESHES = {"five": lambda: cube(6, 0.03, "five"), "six": lambda: cube(5, 0.02, "six"),
+          "bcc": lambda: cube(4, 0.03, "bcc"),
+          "unstructured": lambda: cube(5, 0.03, "unstructured", seed=2)}
+_meshes = {}
+
+
+def mesh_of(name):
+    if name not in _meshes:
+        _meshes[name] = MESHES[name]()
+    return _meshes[name]
+
+
+def forces(kernel, x, start):
+    fn, args = kernel
+    out = start.copy()
+    assert fn(x, *args, out) == -1
+    return out
+
+
+def test_meshes_have_a_padded_last_block():
+    assert any(mesh_of(name).n_tets % B for name in MESHES)
+
+
+def test_blocked_layout():
+    a = np.arange(3 * 37, dtype=float).reshape(37, 3)
+    b = blocked(a).reshape(-1, 3, B)
+    t = np.arange(37)
+    assert np.array_equal(b[t // B, :, t % B], a)
+    assert np.array_equal(b[-1, :, 37 % B:], np.repeat(a[-1][:, None], B - 37 % B, axis=1))
+
+
+@pytest.mark.parametrize("key", TERMS)
+@pytest.mark.parametrize("family", MESHES)
+def test_kernel_equals_its_reference(key, family):
+    """Relative 1e-12 of the force scale, adding into a non-zero ``out`` as kernels do."""
+    mesh = mesh_of(family)
+    t = make_term(*TERMS[key][:1], mesh, MAT, **TERMS[key][1])
+    for seed, amplitude in ((1, 0.005), (2, 0.02)):
+        x = perturbed(mesh, amplitude, seed=seed)
+        start = np.random.default_rng(seed).standard_normal(x.shape)
+        want = forces(t.reference_kernel(), x, np.zeros_like(x))
+        scale = np.abs(want).max()
+        assert scale > 0
+        got = forces(t.kernel(), x, start * scale) - start * scale
+        assert np.abs(got - want).max() <= 1e-12 * scale
+
+
+@pytest.mark.parametrize("key", TERMS)
+def test_kernel_reports_the_first_flattened_tetrahedron_as_its_reference(key):
+    mesh = cube(6, 0.02, "five")
+    t = make_term(*TERMS[key][:1], mesh, MAT, **TERMS[key][1])
+    m = mesh.n_tets
+    for flatten in ((m - 1,), (3 * B + 5, 40), (7, m - 2)):
+        x = mesh.points.copy()
+        for k in flatten:
+            x[mesh.tets[k, 3]] = x[mesh.tets[k, :3]].mean(axis=0)
+        fn, args = t.kernel()
+        ref, ref_args = t.reference_kernel()
+        got = fn(x, *args, np.zeros_like(x))
+        assert got == ref(x, *ref_args, np.zeros_like(x))
+        assert got >= 0        # a tetrahedron flattened, or one turned inside out by the move
+
+
+THREADED = [k for k in TERMS
+            if make_term(*TERMS[k][:1], cube(2, 0.01, "five"), MAT, **TERMS[k][1])
+            .threaded_kernel() is not None]
+
+
+@pytest.mark.skipif(numba.config.NUMBA_NUM_THREADS < 2, reason="one thread")
+@pytest.mark.parametrize("key", THREADED)
+@pytest.mark.parametrize("family", MESHES)
+def test_threaded_kernel_equals_serial_bit_for_bit_and_the_reference(key, family):
+    mesh = mesh_of(family)
+    t = make_term(*TERMS[key][:1], mesh, MAT, **TERMS[key][1])
+    x = perturbed(mesh, 0.02, seed=5)
+    numba.set_num_threads(2)
+    start = np.full_like(x, 0.25)
+    two = forces(t.threaded_kernel(), x, start)
+    assert np.array_equal(two, forces(t.kernel(), x, start))
+    want = forces(t.reference_kernel(), x, np.zeros_like(x))
+    assert np.abs(two - start - want).max() <= 1e-12 * np.abs(want).max()
