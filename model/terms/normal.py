@@ -13,13 +13,99 @@ import numpy as np
 from numba import njit
 
 from . import CalibratedTerm, register
+from ._blocks import (B, FLAG, OPTIONS, OUT, SCRATCH, blocked, blocked_tets, first_flat, gather,
+                      scatter)
+from ._kernels import axpy, dot, sub
 
 # the three edges at each corner: (corner, other end)
 CORNER_EDGES = np.array([[(a, j) for j in range(4) if j != a] for a in range(4)], dtype=np.int64)
+# the six edges (p, q), p < q, in the order of the blocked kernel's reciprocal rest lengths
+PAIRS = np.array([(0, 1), (0, 2), (0, 3), (1, 2), (1, 3), (2, 3)], dtype=np.int64)
+
+
+@njit(**OPTIONS)
+def normal_block(s, blk, vol0, inv_rest, coef_G):
+    """The forces of block blk's lanes (model/terms/_blocks.py). Each edge pq's strain
+    eps_pq = L_pq / R_pq - 1 belongs to both its corners, so the edge carries
+    f_p += S_pq d_pq, f_q -= S_pq d_pq with S_pq = 2 c_n G V0 (2 eps_pq - mean_p - mean_q)
+    / (R_pq L_pq), mean_a the mean strain of the three edges at a. The six 1 / L come from one
+    division. Returns the count of lanes with a collapsed edge."""
+    v0 = vol0[blk * B:(blk + 1) * B]
+    iR = inv_rest[blk * 6 * B:(blk + 1) * 6 * B]
+    n_flat = 0
+    for i in range(B):
+        x0 = (s[i], s[B + i], s[2 * B + i])
+        x1 = (s[3 * B + i], s[4 * B + i], s[5 * B + i])
+        x2 = (s[6 * B + i], s[7 * B + i], s[8 * B + i])
+        x3 = (s[9 * B + i], s[10 * B + i], s[11 * B + i])
+        d01, d02, d03 = sub(x1, x0), sub(x2, x0), sub(x3, x0)
+        d12, d13, d23 = sub(x2, x1), sub(x3, x1), sub(x3, x2)
+        l01, l02, l03 = dot(d01, d01), dot(d02, d02), dot(d03, d03)
+        l12, l13, l23 = dot(d12, d12), dot(d13, d13), dot(d23, d23)
+        margin = min(l01, l02, l03, l12, l13, l23)
+        s[FLAG + i] = margin
+        n_flat += margin <= 0.0
+        L01, L02, L03 = np.sqrt(l01), np.sqrt(l02), np.sqrt(l03)
+        L12, L13, L23 = np.sqrt(l12), np.sqrt(l13), np.sqrt(l23)
+        # 1 / L_pq from one division: r = 1 / (product), peeled off from the last
+        a2 = L01 * L02
+        a3 = a2 * L03
+        a4 = a3 * L12
+        a5 = a4 * L13
+        r = 1.0 / (a5 * L23)
+        iL23 = r * a5
+        r = r * L23
+        iL13 = r * a4
+        r = r * L13
+        iL12 = r * a3
+        r = r * L12
+        iL03 = r * a2
+        r = r * L03
+        iL02 = r * L01
+        iL01 = r * L02
+        r01, r02, r03 = iR[i], iR[B + i], iR[2 * B + i]
+        r12, r13, r23 = iR[3 * B + i], iR[4 * B + i], iR[5 * B + i]
+        e01, e02, e03 = L01 * r01 - 1.0, L02 * r02 - 1.0, L03 * r03 - 1.0
+        e12, e13, e23 = L12 * r12 - 1.0, L13 * r13 - 1.0, L23 * r23 - 1.0
+        m0 = (e01 + e02 + e03) / 3.0
+        m1 = (e01 + e12 + e13) / 3.0
+        m2 = (e02 + e12 + e23) / 3.0
+        m3 = (e03 + e13 + e23) / 3.0
+        k = 2.0 * coef_G * v0[i]
+        S01 = k * (2.0 * e01 - m0 - m1) * r01 * iL01
+        S02 = k * (2.0 * e02 - m0 - m2) * r02 * iL02
+        S03 = k * (2.0 * e03 - m0 - m3) * r03 * iL03
+        S12 = k * (2.0 * e12 - m1 - m2) * r12 * iL12
+        S13 = k * (2.0 * e13 - m1 - m3) * r13 * iL13
+        S23 = k * (2.0 * e23 - m2 - m3) * r23 * iL23
+        f0 = axpy(S01, d01, axpy(S02, d02, (S03 * d03[0], S03 * d03[1], S03 * d03[2])))
+        f1 = axpy(-S01, d01, axpy(S12, d12, (S13 * d13[0], S13 * d13[1], S13 * d13[2])))
+        f2 = axpy(-S02, d02, axpy(-S12, d12, (S23 * d23[0], S23 * d23[1], S23 * d23[2])))
+        f3 = axpy(-S03, d03, axpy(-S13, d13, (-S23 * d23[0], -S23 * d23[1], -S23 * d23[2])))
+        for c in range(3):
+            s[OUT + c * B + i] = f0[c]
+            s[OUT + (3 + c) * B + i] = f1[c]
+            s[OUT + (6 + c) * B + i] = f2[c]
+            s[OUT + (9 + c) * B + i] = f3[c]
+    return n_flat
+
+
+@njit(**OPTIONS)
+def normal_forces(x, tb, m, vol0, inv_rest, coef_G, out):
+    """The per-corner edge-strain deviation forces, block by block; returns the first
+    tetrahedron with a collapsed edge, or -1."""
+    s = np.empty(SCRATCH)
+    for blk in range((m + B - 1) // B):
+        gather(x, tb, blk, s)
+        if normal_block(s, blk, vol0, inv_rest, coef_G) > 0:
+            return first_flat(s, blk, m)
+        scatter(out, tb, blk, m, s)
+    return -1
 
 
 @njit(cache=True, fastmath=True)
-def normal_forces(x, tets, vol0, rest_len, coef_G, out):
+def normal_forces_reference(x, tets, vol0, rest_len, coef_G, out):
+    """Corner by corner, tetrahedron by tetrahedron (the reference of ``normal_forces``)."""
     d = np.empty((3, 3))
     ln = np.empty(3)
     eps = np.empty(3)
@@ -76,9 +162,17 @@ class Normal(CalibratedTerm):
     def __init__(self, mesh, material, scale=1.0, **params):
         super().__init__(mesh, material, scale, **params)
         self.rest_len = np.linalg.norm(edge_vectors(mesh.points, mesh.tets), axis=-1)
+        rest = np.linalg.norm(mesh.points[mesh.tets[:, PAIRS[:, 1]]]
+                              - mesh.points[mesh.tets[:, PAIRS[:, 0]]], axis=-1)
+        self._blocked = (blocked_tets(mesh.tets), mesh.n_tets, blocked(self.vol0),
+                         blocked(1.0 / rest))
 
     def kernel_args(self, k):
-        return normal_forces, (self.mesh.tets, self.vol0, self.rest_len, k * self.G)
+        return normal_forces, (*self._blocked, k * self.G)
+
+    def reference_kernel(self):
+        k = self.kernel()[1][-1]          # the same checks (calibrated)
+        return normal_forces_reference, (self.mesh.tets, self.vol0, self.rest_len, k)
 
     def calibration_residuals(self, x, rows):
         """The deviatoric edge strains (r, 4, 3) of the tetrahedra ``rows`` and their weights
