@@ -245,7 +245,8 @@ def model_run(case, mesh_name, mesh, bc, model_name, s, ref):
     except FINDINGS as exc:   # no equilibrium found, or a metric undefined: a finding
         r.update(blank, static_failed=str(exc))
     r.update(dict.fromkeys(FINITE))
-    r.update(dict.fromkeys(ref.quantities_at_load or ()))
+    if not s.static_only:    # a static-only run has no load phase, whatever its reference has
+        r.update(dict.fromkeys(ref.quantities_at_load or ()))
     if (ref.nonlinear is not None or ref.nonlinear_failed) and not s.static_only:
         r["finite_failed"] = finite_failed or ref.nonlinear_failed
         if st is not None and ref.nonlinear is not None:

@@ -118,7 +118,7 @@ def test_two_levels_are_not_decided_in_the_report():
 
 
 def test_a_reference_above_a_fifth_of_an_error_leaves_it_not_resolved():
-    """VERDICTS.md rule 1: a reference whose estimate is more than a fifth of the smallest
+    """A reference whose estimate is more than a fifth of the smallest
     error it judges cannot judge it: 'not resolved', in the margin sentence and the tables,
     and the verdict is left out of the headline's counts."""
     from cases.studies.convergence.report import _reference_margin, unresolved, verdict_cell

@@ -9,7 +9,7 @@ no order can be observed: the extrapolation then assumes first order, the lowest
 model shows, which gives the smallest floor the two errors allow. With four or more levels a
 least-squares fit of all of them is reported as well, and the larger uncertainty kept. Every
 uncertainty includes the values' own (``u``: the reference's error estimate, each error being
-known to within it), combined in quadrature as u_val (docs/VERDICTS.md rule 10).
+known to within it), combined in quadrature as u_val.
 
 A floor is an error that has stopped falling within its uncertainty and stays above zero beyond
 it; a sequence that is still falling is never one because its fit is poor:

@@ -21,8 +21,8 @@ GATED = catalogue.gated("disp_rel_l2", "reaction_rel_err", "e_inf", "moduli_rel_
                         "anisotropy_AU", "mms_order", "mms_rel_l2", "patch_error", "dt_error",
                         "dt_order")
 BUDGETS = (0.1, 0.02)   # error targets of the cost table: the cheapest run reaching each
-# a reference whose estimate is more than a fifth of an error cannot judge it (VERDICTS.md rule
-# 1): the errors below this many times its estimate are "not resolved"
+# a reference whose estimate is more than a fifth of an error cannot judge it: the errors below
+# this many times its estimate are "not resolved"
 REF_MARGIN = 5.0
 ISOTROPIC_TOL = 0.01    # every C_eff modulus within this of the target's: the lattice is it
 
@@ -80,7 +80,7 @@ def definitions():
         "levels no order is observed: first order is assumed and the verdict is 'not decided' "
         "in the report (`pbcm run convergence` decides, on four levels). 'not resolved' marks "
         f"a fit whose finest error is below {REF_MARGIN:g} x its reference's estimate: that "
-        "reference cannot judge it (docs/VERDICTS.md rule 1). 'cancellation' marks a series "
+        "reference cannot judge it. 'cancellation' marks a series "
         "whose error is not monotone in h or whose "
         "stiffness ratio crosses 1: an error falling through zero is small at one level by "
         "accident, so such a run is never on a cost front.",
@@ -103,8 +103,8 @@ TWO_LEVELS = ("two levels observe no order: a floor, a slow convergence and a ri
 
 def decided(f):
     """Whether a fit's verdict is decided: 'exact' on any levels; 'converges', 'floor' and
-    'diverges' on three levels or more (VERDICTS.md rule 14: two levels observe no order, and
-    the finer levels overturn their verdicts)."""
+    'diverges' on three levels or more (two levels observe no order, and the finer levels
+    overturn their verdicts)."""
     return f.get("verdict") == "exact" or (f.get("verdict") in VERDICTS
                                            and (f.get("levels") or 0) >= 3)
 
@@ -159,7 +159,7 @@ def conclusion(s, data):
                 f"{np.median([f['e_inf'] for f in floors[m]]):.2g})" for m in floored)
                 or "none"))
         if loose:
-            head += (f"; not resolved (VERDICTS.md rule 1: the reference's estimate more than a "
+            head += (f"; not resolved (the reference's estimate more than a "
                      f"fifth of the finest error, left out of these counts): {len(loose)} fits, "
                      "on " + ", ".join(sorted({f"{k[0]} {k[1]}" for k in loose})))
     if undecided:
@@ -227,14 +227,14 @@ def _tensor_vs_verdicts(s, data, eff):
 
 def unresolved_below(ref):
     """The error below which the reference ``ref`` (its summary) cannot judge a run: REF_MARGIN
-    times its own estimate (VERDICTS.md rule 1: an estimate more than a fifth of an error)."""
+    times its own estimate (an estimate more than a fifth of an error cannot judge it)."""
     return REF_MARGIN * (ref.get("error_estimate") or 0.0)
 
 
 def _reference_margin(data):
     """How far below the errors it judges each reference is: the smallest error of a run
     that is not exact, over the reference's own estimate, per problem; where that is under
-    REF_MARGIN the runs it cannot judge are 'not resolved' (VERDICTS.md rule 1)."""
+    REF_MARGIN the runs it cannot judge are 'not resolved'."""
     exact = {(f["case"], f["bc"], f["mesh"], f["model"]) for f in data["fits"]
              if f.get("verdict") == "exact"}
     parts = []
