@@ -237,8 +237,8 @@ def blocked(name, args, doc, before, per_tet):
         + [f"    {line}" for line in before]
         # the block's own slices: an index the compiler sees is never negative (so no
         # wraparound select, and SIMD loads rather than gathers)
-        + ["    g0 = gamma0[blk * 24 * B:(blk + 1) * 24 * B]", "    v0 = vol0[blk * B:(blk + 1) * B]",
-           "    n_flat = 0", "    for i in range(B):"]
+        + ["    g0 = gamma0[blk * 24 * B:(blk + 1) * 24 * B]",
+           "    v0 = vol0[blk * B:(blk + 1) * B]", "    n_flat = 0", "    for i in range(B):"]
         + [pad + x for x in lane] + ["    return n_flat"])
     serial = "\n".join(
         ["", "", "", "@njit(**OPTIONS)", f"def {name}(x, tb, m, {data}, out):",
