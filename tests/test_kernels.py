@@ -21,6 +21,7 @@ TERMS = {
     "variational": ("shear", {"reading": "variational", "c": 0.3}),
     "normal": ("normal", {"c": 0.7}),
     "fem_linear": ("fem_linear", {}),
+    "fem_corotated": ("fem_corotated", {}),
 }
 # the terms whose kernel reports an edge of zero length rather than a flattened tetrahedron
 COLLAPSED_EDGE = {"normal"}
@@ -107,3 +108,21 @@ def test_threaded_kernel_equals_serial_bit_for_bit_and_the_reference(key, family
     assert np.array_equal(two, forces(t.kernel(), x, start))
     want = forces(t.reference_kernel(), x, np.zeros_like(x))
     assert np.abs(two - start - want).max() <= 1e-12 * np.abs(want).max()
+
+
+@pytest.mark.parametrize("family", MESHES)
+def test_corotated_kernel_equals_its_reference_far_from_rest(family):
+    """Large rotations and stretches: the polar iteration runs many steps, lanes of one block
+    converging at different steps."""
+    from conftest import rotation
+    mesh = mesh_of(family)
+    t = make_term("fem_corotated", mesh, MAT)
+    c = mesh.points.mean(axis=0)
+    x = perturbed(mesh, 0.02, seed=3) - c
+    # a rotation of 2.5 rad to 3 rad, growing along x, and a stretch: every tetrahedron turned
+    # far, and differently
+    turn = np.stack([rotation([1, 2, 3], a) for a in 2.5 + 0.5 * x[:, 0] / np.ptp(x[:, 0])])
+    x = np.einsum("nij,nj->ni", turn, x * [1.3, 0.8, 1.1]) + c
+    want = forces(t.reference_kernel(), x, np.zeros_like(x))
+    got = forces(t.kernel(), x, np.zeros_like(x))
+    assert np.abs(got - want).max() <= 1e-12 * np.abs(want).max()

@@ -21,7 +21,7 @@ from numba import njit
 from . import Term, register
 from ._blocks import B, FLAG, OPTIONS, OUT, SCRATCH, blocked, blocked_tets, first_flat, gather, \
     scatter
-from ._kernels import (add_piola_forces, cofactor, deformation_gradient,
+from ._kernels import (add_piola_forces, cofactor, cross, deformation_gradient,
                        deformation_gradients_numpy, dot, lin, piola_forces_numpy,
                        rest_shape_inverse, sub)
 from .volume import FLAT
@@ -135,9 +135,98 @@ def polar_rotation(F):
     return R
 
 
+POLAR = 19 * B     # the co-rotated block's own scratch: F (9 rows), R (9 rows), converged
+
+
+@njit(**OPTIONS)
+def corotated_block(s, r, blk, data, lam, mu):
+    """Co-rotated forces of block blk's lanes (model/terms/_blocks.py), ``data`` as for
+    :func:`linear_block`. The polar rotation is :func:`polar_rotation`'s iteration run on all
+    lanes at once: a lane that has converged keeps its R (the same R, lane by lane, as the
+    tetrahedron-by-tetrahedron loop), and the block stops when every lane has. Returns the
+    count of lanes with det F <= FLAT (which are not iterated)."""
+    p = data[blk * 10 * B:(blk + 1) * 10 * B]
+    n_flat = 0
+    for i in range(B):
+        x0 = (s[i], s[B + i], s[2 * B + i])
+        e1 = sub((s[3 * B + i], s[4 * B + i], s[5 * B + i]), x0)
+        e2 = sub((s[6 * B + i], s[7 * B + i], s[8 * B + i]), x0)
+        e3 = sub((s[9 * B + i], s[10 * B + i], s[11 * B + i]), x0)
+        r0, r1, r2 = ((p[i], p[B + i], p[2 * B + i]), (p[3 * B + i], p[4 * B + i], p[5 * B + i]),
+                      (p[6 * B + i], p[7 * B + i], p[8 * B + i]))
+        F = (lin(e1[0], r0, 1.0, lin(e2[0], r1, e3[0], r2)),
+             lin(e1[1], r0, 1.0, lin(e2[1], r1, e3[1], r2)),
+             lin(e1[2], r0, 1.0, lin(e2[2], r1, e3[2], r2)))
+        margin = dot(F[0], cross(F[1], F[2])) - FLAT
+        s[FLAG + i] = margin
+        n_flat += margin <= 0.0
+        for a in range(3):
+            for b in range(3):
+                r[(3 * a + b) * B + i] = F[a][b]
+                r[(9 + 3 * a + b) * B + i] = F[a][b]
+        r[18 * B + i] = 1.0 if margin <= 0.0 else 0.0
+    for _ in range(30):
+        active = 0
+        for i in range(B):
+            R = ((r[9 * B + i], r[10 * B + i], r[11 * B + i]),
+                 (r[12 * B + i], r[13 * B + i], r[14 * B + i]),
+                 (r[15 * B + i], r[16 * B + i], r[17 * B + i]))
+            C = cofactor(R)
+            h = 0.5 / dot(R[0], C[0])
+            Rn = (lin(0.5, R[0], h, C[0]), lin(0.5, R[1], h, C[1]), lin(0.5, R[2], h, C[2]))
+            d0, d1, d2 = sub(Rn[0], R[0]), sub(Rn[1], R[1]), sub(Rn[2], R[2])
+            change = max(abs(d0[0]), abs(d0[1]), abs(d0[2]), abs(d1[0]), abs(d1[1]),
+                         abs(d1[2]), abs(d2[0]), abs(d2[1]), abs(d2[2]))
+            keep = r[18 * B + i] > 0.0
+            for a in range(3):
+                for b in range(3):
+                    r[(9 + 3 * a + b) * B + i] = R[a][b] if keep else Rn[a][b]
+            done = keep or change < 1e-14
+            r[18 * B + i] = 1.0 if done else 0.0
+            active += not done
+        if active == 0:
+            break
+    for i in range(B):
+        F = ((r[i], r[B + i], r[2 * B + i]), (r[3 * B + i], r[4 * B + i], r[5 * B + i]),
+             (r[6 * B + i], r[7 * B + i], r[8 * B + i]))
+        R = ((r[9 * B + i], r[10 * B + i], r[11 * B + i]),
+             (r[12 * B + i], r[13 * B + i], r[14 * B + i]),
+             (r[15 * B + i], r[16 * B + i], r[17 * B + i]))
+        tr = dot(R[0], F[0]) + dot(R[1], F[1]) + dot(R[2], F[2]) - 3.0    # tr(R^T F - I)
+        P = (lin(2.0 * mu, F[0], lam * tr - 2.0 * mu, R[0]),
+             lin(2.0 * mu, F[1], lam * tr - 2.0 * mu, R[1]),
+             lin(2.0 * mu, F[2], lam * tr - 2.0 * mu, R[2]))
+        v = p[9 * B + i]
+        f0 = (0.0, 0.0, 0.0)
+        for c in range(3):
+            rc = (p[3 * c * B + i], p[(3 * c + 1) * B + i], p[(3 * c + 2) * B + i])
+            f = (-v * dot(P[0], rc), -v * dot(P[1], rc), -v * dot(P[2], rc))
+            for k in range(3):
+                s[OUT + (3 * c + 3 + k) * B + i] = f[k]
+            f0 = sub(f0, f)
+        for k in range(3):
+            s[OUT + k * B + i] = f0[k]
+    return n_flat
+
+
+@njit(**OPTIONS)
+def corotated_forces(x, tb, m, data, lam, mu, out):
+    """Co-rotated constant-strain tetrahedra, block by block; returns the first flattened
+    one, or -1."""
+    s = np.empty(SCRATCH)
+    r = np.empty(POLAR)
+    for blk in range((m + B - 1) // B):
+        gather(x, tb, blk, s)
+        if corotated_block(s, r, blk, data, lam, mu) > 0:
+            return first_flat(s, blk, m)
+        scatter(out, tb, blk, m, s)
+    return -1
+
+
 @njit(cache=True, fastmath=True)
-def corotated_forces(x, tets, Dinv, vol0, lam, mu, out):
-    """Co-rotated constant-strain tetrahedra; returns the first flattened one, or -1."""
+def corotated_forces_reference(x, tets, Dinv, vol0, lam, mu, out):
+    """Co-rotated constant-strain tetrahedra; returns the first flattened one, or -1.
+    Tetrahedron by tetrahedron (the reference of ``corotated_forces``)."""
     for t in range(tets.shape[0]):
         F, J = deformation_gradient(x, tets, t, Dinv)
         if J <= FLAT:
@@ -244,7 +333,18 @@ class FemCorotated(_ConstantStrain):
     """Co-rotated linear tetrahedra (polar rotation)."""
 
     name = "fem_corotated"
-    _kernel = staticmethod(corotated_forces)
+
+    def __init__(self, mesh, material, scale=1.0, **params):
+        super().__init__(mesh, material, scale, **params)
+        self._blocked = (blocked_tets(mesh.tets), mesh.n_tets, blocked(
+            np.concatenate([self.Dinv.reshape(-1, 9), self.vol0[:, None]], axis=1)))
+
+    def kernel(self):
+        return corotated_forces, (*self._blocked, self.lam, self.mu)
+
+    def reference_kernel(self):
+        return corotated_forces_reference, (self.mesh.tets, self.Dinv, self.vol0, self.lam,
+                                            self.mu)
 
     def piola(self, F):
         R, S = polar_numpy(F)
