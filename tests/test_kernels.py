@@ -49,6 +49,19 @@ def test_meshes_have_a_padded_last_block():
     assert any(mesh_of(name).n_tets % B for name in MESHES)
 
 
+def test_rsqrt_is_the_reciprocal_root_to_round_off():
+    from numba import njit
+    from model.terms._blocks import rsqrt
+
+    @njit
+    def all_of(a):
+        return np.array([rsqrt(v) for v in a])
+
+    a = np.concatenate([np.logspace(-36.9, 37.9, 20001),
+                        np.random.default_rng(0).uniform(0.5, 2.0, 1000)])
+    assert np.abs(all_of(a) * np.sqrt(a) - 1).max() <= 4 * np.finfo(float).eps
+
+
 def test_blocked_layout():
     a = np.arange(3 * 37, dtype=float).reshape(37, 3)
     b = blocked(a).reshape(-1, 3, B)

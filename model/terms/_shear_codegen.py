@@ -46,8 +46,9 @@ def e(p, q):
 
 def frame(check):
     """Per tetrahedron: corners, edges, squared and reciprocal lengths, face vectors, 6V,
-    reciprocal heights; ``check`` is the flattening test (a string of code, or None).
-    ``INVERSES`` marks where the reciprocals are taken (see ``SERIAL`` and ``BLOCK``)."""
+    reciprocal heights; ``check`` is the flattening test (a string of code, or None). The
+    reciprocal lengths and the face norms are markers, written by each variant (``SERIAL``:
+    the double-precision root; ``BLOCK``: :func:`model.terms._blocks.rsqrt`)."""
     lines = ["n0, n1, n2, n3 = tets[t, 0], tets[t, 1], tets[t, 2], tets[t, 3]",
              "x0, x1, x2, x3 = vec(x, n0), vec(x, n1), vec(x, n2), vec(x, n3)"]
     for p, q in PAIRS:
@@ -55,22 +56,10 @@ def frame(check):
                   f"{INVERSE_LENGTH}{p}{q}"]
     for j in range(4):
         a, m, l = FACE[j]
-        lines += [f"c{j} = cross(d{e(a, m)}, d{e(a, l)})", f"cn{j} = np.sqrt(dot(c{j}, c{j}))"]
-    lines += ["V6 = dot(d01, c1)", f"if {check}:", FLATTENED_ACTION, INVERSES]
+        lines += [f"c{j} = cross(d{e(a, m)}, d{e(a, l)})", f"{FACE_NORM}{j}"]
+    lines += ["V6 = dot(d01, c1)", f"if {check}:", FLATTENED_ACTION, "iV6 = 1.0 / V6"]
     lines += [f"h{j} = cn{j} * iV6" for j in range(4)]
     return lines
-
-
-def inverses():
-    """1 / V6 and the six 1 / L_pq from one division (the divider is what a lane waits on):
-    with the running products a_k of L01, L02, ..., L23, r = 1 / (a_6 V6), then each
-    reciprocal is r times the product of the others, peeled off from the last."""
-    names = [f"L{p}{q}" for p, q in PAIRS]
-    lines = [f"a1 = {names[0]}"] + [f"a{k + 1} = a{k} * {names[k]}" for k in range(1, 6)]
-    lines += ["r = 1.0 / (a6 * V6)", "iV6 = r * a6", "r = r * V6"]
-    for k in range(5, 0, -1):
-        lines += [f"i{names[k]} = r * a{k}", f"r = r * {names[k]}"]
-    return lines + [f"i{names[0]} = r"]
 
 
 def strain(s, a, j, m):
@@ -100,11 +89,11 @@ def edge_forces(coef):
 
 FLATTENED = "V6 <= FLAT * 6.0 * vol0[t]"
 # what the serial and the per-tetrahedron (threaded) variants do at these two places
-FLATTENED_ACTION, SCATTER, INVERSES = "@flattened@", "@scatter@", "@inverses@"
-INVERSE_LENGTH = "@inverse_length@"
-SERIAL = {FLATTENED_ACTION: ["    return t"],
+FLATTENED_ACTION, SCATTER = "@flattened@", "@scatter@"
+INVERSE_LENGTH, FACE_NORM = "@inverse_length@", "@face_norm@"
+SERIAL = {**{f"{FACE_NORM}{j}": [f"cn{j} = np.sqrt(dot(c{j}, c{j}))"] for j in range(4)},
+          FLATTENED_ACTION: ["    return t"],
           SCATTER: [f"add_to(out, n{i}, f{i})" for i in range(4)],
-          INVERSES: ["iV6 = 1.0 / V6"],
           **{f"{INVERSE_LENGTH}{p}{q}": [f"iL{p}{q} = 1.0 / np.sqrt(l{p}{q})"] for p, q in PAIRS}}
 # in a block (model/terms/_blocks.py): the corners from the scratch array, the flattening
 # margin kept and counted (the lane goes on: its forces are never added), the forces stored
@@ -117,8 +106,9 @@ BLOCK = {"n0, n1, n2, n3 = tets[t, 0], tets[t, 1], tets[t, 2], tets[t, 3]": [],
          FLATTENED_ACTION: [],
          SCATTER: [f"s[OUT + {3 * c + k} * B + i] = f{c}[{k}]"
                    for c in range(4) for k in range(3)],
-         INVERSES: inverses(),
-         **{f"{INVERSE_LENGTH}{p}{q}": [f"L{p}{q} = np.sqrt(l{p}{q})"] for p, q in PAIRS}}
+         **{f"{INVERSE_LENGTH}{p}{q}": [f"iL{p}{q} = rsqrt(l{p}{q})"] for p, q in PAIRS},
+         **{f"{FACE_NORM}{j}": [f"cc{j} = dot(c{j}, c{j})", f"cn{j} = cc{j} * rsqrt(cc{j})"]
+            for j in range(4)}}
 
 
 def corner():
@@ -285,7 +275,7 @@ def source():
             f"_kernels.py sha256 {helpers}", f"_blocks.py sha256 {blocks}", '"""',
             "import numpy as np", "from numba import njit", "",
             "from ._blocks import (B, FLAG, OPTIONS, OUT, SCRATCH, first_flat, gather, put,",
-            "                      scatter)",
+            "                      rsqrt, scatter)",
             "from ._kernels import add_to, axpy, cross, dot, lin, sub, vec",
             "from .volume import FLAT", "",
             "# fast maths without reassociation: the serial and the per-tetrahedron twins then",

@@ -3,13 +3,13 @@
 Each reading's derivation is in the docstring of its writer there.
 
 _kernels.py sha256 1ec64e200bb30940
-_blocks.py sha256 01aaaefbaa14feb9
+_blocks.py sha256 4fc5816367f59b0e
 """
 import numpy as np
 from numba import njit
 
 from ._blocks import (B, FLAG, OPTIONS, OUT, SCRATCH, first_flat, gather, put,
-                      scatter)
+                      rsqrt, scatter)
 from ._kernels import add_to, axpy, cross, dot, lin, sub, vec
 from .volume import FLAT
 
@@ -171,54 +171,39 @@ def shear_corner_block(s, blk, vol0, gamma0, G):
         x3 = (s[9 * B + i], s[10 * B + i], s[11 * B + i])
         d01 = sub(x1, x0)
         l01 = dot(d01, d01)
-        L01 = np.sqrt(l01)
+        iL01 = rsqrt(l01)
         d02 = sub(x2, x0)
         l02 = dot(d02, d02)
-        L02 = np.sqrt(l02)
+        iL02 = rsqrt(l02)
         d03 = sub(x3, x0)
         l03 = dot(d03, d03)
-        L03 = np.sqrt(l03)
+        iL03 = rsqrt(l03)
         d12 = sub(x2, x1)
         l12 = dot(d12, d12)
-        L12 = np.sqrt(l12)
+        iL12 = rsqrt(l12)
         d13 = sub(x3, x1)
         l13 = dot(d13, d13)
-        L13 = np.sqrt(l13)
+        iL13 = rsqrt(l13)
         d23 = sub(x3, x2)
         l23 = dot(d23, d23)
-        L23 = np.sqrt(l23)
+        iL23 = rsqrt(l23)
         c0 = cross(d13, d12)
-        cn0 = np.sqrt(dot(c0, c0))
+        cc0 = dot(c0, c0)
+        cn0 = cc0 * rsqrt(cc0)
         c1 = cross(d02, d03)
-        cn1 = np.sqrt(dot(c1, c1))
+        cc1 = dot(c1, c1)
+        cn1 = cc1 * rsqrt(cc1)
         c2 = cross(d03, d01)
-        cn2 = np.sqrt(dot(c2, c2))
+        cc2 = dot(c2, c2)
+        cn2 = cc2 * rsqrt(cc2)
         c3 = cross(d01, d02)
-        cn3 = np.sqrt(dot(c3, c3))
+        cc3 = dot(c3, c3)
+        cn3 = cc3 * rsqrt(cc3)
         V6 = dot(d01, c1)
         margin = V6 - FLAT * 6.0 * v0[i]
         s[FLAG + i] = margin
         n_flat += margin <= 0.0
-        a1 = L01
-        a2 = a1 * L02
-        a3 = a2 * L03
-        a4 = a3 * L12
-        a5 = a4 * L13
-        a6 = a5 * L23
-        r = 1.0 / (a6 * V6)
-        iV6 = r * a6
-        r = r * V6
-        iL23 = r * a5
-        r = r * L23
-        iL13 = r * a4
-        r = r * L13
-        iL12 = r * a3
-        r = r * L12
-        iL03 = r * a2
-        r = r * L03
-        iL02 = r * a1
-        r = r * L02
-        iL01 = r
+        iV6 = 1.0 / V6
         h0 = cn0 * iV6
         h1 = cn1 * iV6
         h2 = cn2 * iV6
@@ -400,54 +385,39 @@ def shear_balanced_block(s, blk, vol0, gamma0, G):
         x3 = (s[9 * B + i], s[10 * B + i], s[11 * B + i])
         d01 = sub(x1, x0)
         l01 = dot(d01, d01)
-        L01 = np.sqrt(l01)
+        iL01 = rsqrt(l01)
         d02 = sub(x2, x0)
         l02 = dot(d02, d02)
-        L02 = np.sqrt(l02)
+        iL02 = rsqrt(l02)
         d03 = sub(x3, x0)
         l03 = dot(d03, d03)
-        L03 = np.sqrt(l03)
+        iL03 = rsqrt(l03)
         d12 = sub(x2, x1)
         l12 = dot(d12, d12)
-        L12 = np.sqrt(l12)
+        iL12 = rsqrt(l12)
         d13 = sub(x3, x1)
         l13 = dot(d13, d13)
-        L13 = np.sqrt(l13)
+        iL13 = rsqrt(l13)
         d23 = sub(x3, x2)
         l23 = dot(d23, d23)
-        L23 = np.sqrt(l23)
+        iL23 = rsqrt(l23)
         c0 = cross(d13, d12)
-        cn0 = np.sqrt(dot(c0, c0))
+        cc0 = dot(c0, c0)
+        cn0 = cc0 * rsqrt(cc0)
         c1 = cross(d02, d03)
-        cn1 = np.sqrt(dot(c1, c1))
+        cc1 = dot(c1, c1)
+        cn1 = cc1 * rsqrt(cc1)
         c2 = cross(d03, d01)
-        cn2 = np.sqrt(dot(c2, c2))
+        cc2 = dot(c2, c2)
+        cn2 = cc2 * rsqrt(cc2)
         c3 = cross(d01, d02)
-        cn3 = np.sqrt(dot(c3, c3))
+        cc3 = dot(c3, c3)
+        cn3 = cc3 * rsqrt(cc3)
         V6 = dot(d01, c1)
         margin = V6 - FLAT * 6.0 * v0[i]
         s[FLAG + i] = margin
         n_flat += margin <= 0.0
-        a1 = L01
-        a2 = a1 * L02
-        a3 = a2 * L03
-        a4 = a3 * L12
-        a5 = a4 * L13
-        a6 = a5 * L23
-        r = 1.0 / (a6 * V6)
-        iV6 = r * a6
-        r = r * V6
-        iL23 = r * a5
-        r = r * L23
-        iL13 = r * a4
-        r = r * L13
-        iL12 = r * a3
-        r = r * L12
-        iL03 = r * a2
-        r = r * L03
-        iL02 = r * a1
-        r = r * L02
-        iL01 = r
+        iV6 = 1.0 / V6
         h0 = cn0 * iV6
         h1 = cn1 * iV6
         h2 = cn2 * iV6
@@ -621,54 +591,39 @@ def shear_variational_block(s, blk, vol0, gamma0, cG):
         x3 = (s[9 * B + i], s[10 * B + i], s[11 * B + i])
         d01 = sub(x1, x0)
         l01 = dot(d01, d01)
-        L01 = np.sqrt(l01)
+        iL01 = rsqrt(l01)
         d02 = sub(x2, x0)
         l02 = dot(d02, d02)
-        L02 = np.sqrt(l02)
+        iL02 = rsqrt(l02)
         d03 = sub(x3, x0)
         l03 = dot(d03, d03)
-        L03 = np.sqrt(l03)
+        iL03 = rsqrt(l03)
         d12 = sub(x2, x1)
         l12 = dot(d12, d12)
-        L12 = np.sqrt(l12)
+        iL12 = rsqrt(l12)
         d13 = sub(x3, x1)
         l13 = dot(d13, d13)
-        L13 = np.sqrt(l13)
+        iL13 = rsqrt(l13)
         d23 = sub(x3, x2)
         l23 = dot(d23, d23)
-        L23 = np.sqrt(l23)
+        iL23 = rsqrt(l23)
         c0 = cross(d13, d12)
-        cn0 = np.sqrt(dot(c0, c0))
+        cc0 = dot(c0, c0)
+        cn0 = cc0 * rsqrt(cc0)
         c1 = cross(d02, d03)
-        cn1 = np.sqrt(dot(c1, c1))
+        cc1 = dot(c1, c1)
+        cn1 = cc1 * rsqrt(cc1)
         c2 = cross(d03, d01)
-        cn2 = np.sqrt(dot(c2, c2))
+        cc2 = dot(c2, c2)
+        cn2 = cc2 * rsqrt(cc2)
         c3 = cross(d01, d02)
-        cn3 = np.sqrt(dot(c3, c3))
+        cc3 = dot(c3, c3)
+        cn3 = cc3 * rsqrt(cc3)
         V6 = dot(d01, c1)
         margin = V6 - FLAT * 6.0 * v0[i]
         s[FLAG + i] = margin
         n_flat += margin <= 0.0
-        a1 = L01
-        a2 = a1 * L02
-        a3 = a2 * L03
-        a4 = a3 * L12
-        a5 = a4 * L13
-        a6 = a5 * L23
-        r = 1.0 / (a6 * V6)
-        iV6 = r * a6
-        r = r * V6
-        iL23 = r * a5
-        r = r * L23
-        iL13 = r * a4
-        r = r * L13
-        iL12 = r * a3
-        r = r * L12
-        iL03 = r * a2
-        r = r * L03
-        iL02 = r * a1
-        r = r * L02
-        iL01 = r
+        iV6 = 1.0 / V6
         h0 = cn0 * iV6
         h1 = cn1 * iV6
         h2 = cn2 * iV6

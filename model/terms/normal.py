@@ -14,7 +14,7 @@ from numba import njit
 
 from . import CalibratedTerm, register
 from ._blocks import (B, FLAG, OPTIONS, OUT, SCRATCH, blocked, blocked_tets, first_flat, gather,
-                      scatter)
+                      rsqrt, scatter)
 from ._kernels import axpy, dot, sub
 
 # the three edges at each corner: (corner, other end)
@@ -28,8 +28,8 @@ def normal_block(s, blk, vol0, inv_rest, coef_G):
     """The forces of block blk's lanes (model/terms/_blocks.py). Each edge pq's strain
     eps_pq = L_pq / R_pq - 1 belongs to both its corners, so the edge carries
     f_p += S_pq d_pq, f_q -= S_pq d_pq with S_pq = 2 c_n G V0 (2 eps_pq - mean_p - mean_q)
-    / (R_pq L_pq), mean_a the mean strain of the three edges at a. The six 1 / L come from one
-    division. Returns the count of lanes with a collapsed edge."""
+    / (R_pq L_pq), mean_a the mean strain of the three edges at a; 1 / L by
+    :func:`model.terms._blocks.rsqrt`. Returns the count of lanes with a collapsed edge."""
     v0 = vol0[blk * B:(blk + 1) * B]
     iR = inv_rest[blk * 6 * B:(blk + 1) * 6 * B]
     n_flat = 0
@@ -45,24 +45,10 @@ def normal_block(s, blk, vol0, inv_rest, coef_G):
         margin = min(l01, l02, l03, l12, l13, l23)
         s[FLAG + i] = margin
         n_flat += margin <= 0.0
-        L01, L02, L03 = np.sqrt(l01), np.sqrt(l02), np.sqrt(l03)
-        L12, L13, L23 = np.sqrt(l12), np.sqrt(l13), np.sqrt(l23)
-        # 1 / L_pq from one division: r = 1 / (product), peeled off from the last
-        a2 = L01 * L02
-        a3 = a2 * L03
-        a4 = a3 * L12
-        a5 = a4 * L13
-        r = 1.0 / (a5 * L23)
-        iL23 = r * a5
-        r = r * L23
-        iL13 = r * a4
-        r = r * L13
-        iL12 = r * a3
-        r = r * L12
-        iL03 = r * a2
-        r = r * L03
-        iL02 = r * L01
-        iL01 = r * L02
+        iL01, iL02, iL03 = rsqrt(l01), rsqrt(l02), rsqrt(l03)
+        iL12, iL13, iL23 = rsqrt(l12), rsqrt(l13), rsqrt(l23)
+        L01, L02, L03 = l01 * iL01, l02 * iL02, l03 * iL03
+        L12, L13, L23 = l12 * iL12, l13 * iL13, l23 * iL23
         r01, r02, r03 = iR[i], iR[B + i], iR[2 * B + i]
         r12, r13, r23 = iR[3 * B + i], iR[4 * B + i], iR[5 * B + i]
         e01, e02, e03 = L01 * r01 - 1.0, L02 * r02 - 1.0, L03 * r03 - 1.0
