@@ -20,7 +20,6 @@ TERMS = {
     "balanced": ("shear", {"reading": "balanced", "c": 0.6}),
     "variational": ("shear", {"reading": "variational", "c": 0.3}),
     "normal": ("normal", {"c": 0.7}),
-    "fem_linear": ("fem_linear", {}),
     "fem_corotated": ("fem_corotated", {}),
 }
 # the terms whose kernel reports an edge of zero length rather than a flattened tetrahedron

@@ -27,84 +27,9 @@ from ._kernels import (add_piola_forces, cofactor, cross, deformation_gradient,
 from .volume import FLAT
 
 
-@njit(**OPTIONS)
-def linear_block(s, blk, data, lam, mu):
-    """Small-strain forces of block blk's lanes (model/terms/_blocks.py): ``data`` holds
-    each tetrahedron's Dm^-1 (row by row) and V0 in the blocked layout, F = Ds Dm^-1, P = 2 mu
-    eps + lam tr(eps) I, f_c = -V0 P (row c of Dm^-1) on corners 1..3 and minus their sum
-    on corner 0. Returns the count of lanes with det F <= FLAT."""
-    p = data[blk * 10 * B:(blk + 1) * 10 * B]
-    n_flat = 0
-    for i in range(B):
-        x00, x01, x02 = s[i], s[B + i], s[2 * B + i]
-        e10, e11, e12 = s[3 * B + i] - x00, s[4 * B + i] - x01, s[5 * B + i] - x02
-        e20, e21, e22 = s[6 * B + i] - x00, s[7 * B + i] - x01, s[8 * B + i] - x02
-        e30, e31, e32 = s[9 * B + i] - x00, s[10 * B + i] - x01, s[11 * B + i] - x02
-        r00, r01, r02 = p[i], p[B + i], p[2 * B + i]
-        r10, r11, r12 = p[3 * B + i], p[4 * B + i], p[5 * B + i]
-        r20, r21, r22 = p[6 * B + i], p[7 * B + i], p[8 * B + i]
-        F00 = e10 * r00 + e20 * r10 + e30 * r20
-        F01 = e10 * r01 + e20 * r11 + e30 * r21
-        F02 = e10 * r02 + e20 * r12 + e30 * r22
-        F10 = e11 * r00 + e21 * r10 + e31 * r20
-        F11 = e11 * r01 + e21 * r11 + e31 * r21
-        F12 = e11 * r02 + e21 * r12 + e31 * r22
-        F20 = e12 * r00 + e22 * r10 + e32 * r20
-        F21 = e12 * r01 + e22 * r11 + e32 * r21
-        F22 = e12 * r02 + e22 * r12 + e32 * r22
-        J = (F00 * (F11 * F22 - F12 * F21) + F01 * (F12 * F20 - F10 * F22)
-             + F02 * (F10 * F21 - F11 * F20))
-        margin = J - FLAT
-        s[FLAG + i] = margin
-        n_flat += margin <= 0.0
-        sh = lam * (F00 + F11 + F22 - 3.0) - 2.0 * mu
-        P00 = 2.0 * mu * F00 + sh
-        P11 = 2.0 * mu * F11 + sh
-        P22 = 2.0 * mu * F22 + sh
-        P01 = mu * (F01 + F10)
-        P02 = mu * (F02 + F20)
-        P12 = mu * (F12 + F21)
-        v = -p[9 * B + i]
-        f10 = v * (P00 * r00 + P01 * r01 + P02 * r02)
-        f11 = v * (P01 * r00 + P11 * r01 + P12 * r02)
-        f12 = v * (P02 * r00 + P12 * r01 + P22 * r02)
-        f20 = v * (P00 * r10 + P01 * r11 + P02 * r12)
-        f21 = v * (P01 * r10 + P11 * r11 + P12 * r12)
-        f22 = v * (P02 * r10 + P12 * r11 + P22 * r12)
-        f30 = v * (P00 * r20 + P01 * r21 + P02 * r22)
-        f31 = v * (P01 * r20 + P11 * r21 + P12 * r22)
-        f32 = v * (P02 * r20 + P12 * r21 + P22 * r22)
-        s[OUT + i] = -f10 - f20 - f30
-        s[OUT + B + i] = -f11 - f21 - f31
-        s[OUT + 2 * B + i] = -f12 - f22 - f32
-        s[OUT + 3 * B + i] = f10
-        s[OUT + 4 * B + i] = f11
-        s[OUT + 5 * B + i] = f12
-        s[OUT + 6 * B + i] = f20
-        s[OUT + 7 * B + i] = f21
-        s[OUT + 8 * B + i] = f22
-        s[OUT + 9 * B + i] = f30
-        s[OUT + 10 * B + i] = f31
-        s[OUT + 11 * B + i] = f32
-    return n_flat
-
-@njit(**OPTIONS)
-def linear_forces(x, tb, m, data, lam, mu, out):
-    """Small-strain constant-strain tetrahedra, block by block; returns the first flattened
-    one, or -1."""
-    s = np.empty(SCRATCH)
-    for blk in range((m + B - 1) // B):
-        gather(x, tb, blk, s)
-        if linear_block(s, blk, data, lam, mu) > 0:
-            return first_flat(s, blk, m)
-        scatter(out, tb, blk, m, s)
-    return -1
-
-
 @njit(cache=True, fastmath=True)
-def linear_forces_reference(x, tets, Dinv, vol0, lam, mu, out):
-    """Small-strain constant-strain tetrahedra; returns the first flattened one, or -1.
-    Tetrahedron by tetrahedron (the reference of ``linear_forces``)."""
+def linear_forces(x, tets, Dinv, vol0, lam, mu, out):
+    """Small-strain constant-strain tetrahedra; returns the first flattened one, or -1."""
     for t in range(tets.shape[0]):
         F, J = deformation_gradient(x, tets, t, Dinv)
         if J <= FLAT:
@@ -140,8 +65,10 @@ POLAR = 19 * B     # the co-rotated block's own scratch: F (9 rows), R (9 rows),
 
 @njit(**OPTIONS)
 def corotated_block(s, r, blk, data, lam, mu):
-    """Co-rotated forces of block blk's lanes (model/terms/_blocks.py), ``data`` as for
-    :func:`linear_block`. The polar rotation is :func:`polar_rotation`'s iteration run on all
+    """Co-rotated forces of block blk's lanes (model/terms/_blocks.py): ``data`` holds each
+    tetrahedron's Dm^-1 (row by row) and V0 in the blocked layout, F = Ds Dm^-1, P = 2 mu
+    (F - R) + lam tr(R^T F - I) R, f_c = -V0 P (row c of Dm^-1) on corners 1..3 and minus
+    their sum on corner 0. The polar rotation is :func:`polar_rotation`'s iteration run on all
     lanes at once: a lane that has converged keeps its R (the same R, lane by lane, as the
     tetrahedron-by-tetrahedron loop), and the block stops when every lane has. Returns the
     count of lanes with det F <= FLAT (which are not iterated)."""
@@ -294,18 +221,7 @@ class FemLinear(_ConstantStrain):
     rotation_invariant = False
     angular_momentum = False
 
-    def __init__(self, mesh, material, scale=1.0, **params):
-        super().__init__(mesh, material, scale, **params)
-        # Dm^-1 and V0 per tetrahedron in the blocked layout (model/terms/_blocks.py)
-        self._blocked = (blocked_tets(mesh.tets), mesh.n_tets, blocked(
-            np.concatenate([self.Dinv.reshape(-1, 9), self.vol0[:, None]], axis=1)))
-
-    def kernel(self):
-        return linear_forces, (*self._blocked, self.lam, self.mu)
-
-    def reference_kernel(self):
-        return linear_forces_reference, (self.mesh.tets, self.Dinv, self.vol0, self.lam,
-                                         self.mu)
+    _kernel = staticmethod(linear_forces)
 
     def _eps(self, F):
         return 0.5 * (F + np.transpose(F, (0, 2, 1))) - np.eye(3)
