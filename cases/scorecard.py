@@ -369,7 +369,8 @@ def case_findings(name, quantities, runs, patch_tests=(), estimate_key="p2_error
                     f"({cell(ok[-1][1])})"
             tied = list(ok[0][2])
             if tied:
-                line += f"; tied with {ok[0][1].model} within u_val {rel(p.u_model_form, 2)}: " \
+                line += f"; tied with {ok[0][1].model} (within u_val {rel(p.u_model_form, 2)} " \
+                        "and the two medians' spread over the meshes): " \
                         f"{', '.join(tied)}"
             first = [f"{m} (first without {mesh})"
                      for m, mesh in population_contenders(p).items() if m not in tied]
