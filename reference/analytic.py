@@ -11,14 +11,6 @@ def uniaxial_sliding(points, strain, nu, axis=1):
     return u
 
 
-def simple_shear(points, gamma, plane=(0, 1)):
-    """Simple shear u_i = gamma x_j for plane (i, j) (engineering shear strain gamma)."""
-    i, j = plane
-    u = np.zeros_like(np.asarray(points, dtype=float))
-    u[:, i] = gamma * points[:, j]
-    return u
-
-
 def self_weight(points, E, nu, rho, g, height, axis=1):
     """Exact 3-D solution of a prismatic block standing on its base x_axis = 0, top
     x_axis = height traction-free, lateral faces free, under gravity g [m/s^2] along -axis:

@@ -421,11 +421,6 @@ def saddle_factor(A, b, accept=1e-8):
     return lu, check_finite("the mixed Newton step", x)
 
 
-def saddle_solve(A, b, accept=1e-8):
-    """The mixed form's tangent solved for ``b`` (see :func:`saddle_factor`)."""
-    return saddle_factor(A, b, accept)[1]
-
-
 class SaddleSolver:
     """The mixed form's tangents of one Newton solve, each to a relative residual ``rtol``
     (an inexact Newton's forcing term): the last factorisation preconditions GMRES on the
