@@ -38,7 +38,8 @@ class ErrorModelError(ValueError):
 @dataclass(frozen=True)
 class Parts:
     """One run's errors, signed, relative to the continuum (``total`` = ``model_form`` +
-    ``discretisation`` for a scalar; bounded by their magnitudes' sum for a norm)."""
+    ``discretisation`` for a scalar; bounded by their magnitudes' sum for a norm); None for
+    a part that failed (a mode unpaired against the continuum)."""
 
     model_form: float
     discretisation: float
@@ -164,6 +165,13 @@ class Norm:
             return None
         if self.unpaired and run["model"] != self.p1 and run.get(self.unpaired):
             return None
+        # a continuum mode unpaired fails the comparison against the continuum alone
+        lost = self.unpaired_total and run.get(self.unpaired_total)
+        lost_p1 = self.unpaired_total and (p1_run or {}).get(self.unpaired_total)
+        if lost or lost_p1:
+            return Parts(float(_array("model-form error", mf)),
+                         None if lost_p1 else float(_array("discretisation error", disc)),
+                         None)
         if run["model"] == self.p1:
             mf = 0.0           # P1 against itself, whatever its own run key says
         return Parts(*(float(_array(n, v)) for n, v in (

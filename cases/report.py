@@ -129,7 +129,8 @@ def build_report(case, s, runs, fields, out):
     opening, costs_of_replacing = [], []
     if case.decompositions():
         opening, costs_of_replacing = scorecard.case_findings(
-            case.name, case.decompositions(), runs, case.patch_tests, case.headline_estimate)
+            case.name, case.decompositions(), runs, case.patch_tests, case.headline_estimate,
+            case.per_mesh_continuum)
     lines = opening + case.conclusion(s, runs)
     if s.quick:     # a preview on fewer meshes: it decides nothing the full run could reverse
         lines = [f"Quick: not decided (`{case.command()}` decides, on every mesh); a "

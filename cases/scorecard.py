@@ -83,8 +83,9 @@ class Population:
         return {self.quantity.p1, *SAME_LAW.get(self.quantity.p1, ())}
 
     def errors(self, model, part):
-        """[|part| or None per run] of ``model``."""
-        return [None if p is None else abs(getattr(p, part)) for p in self.parts[model]]
+        """[|part| or None per run] of ``model`` (None: the run, or that part, failed)."""
+        return [None if p is None or getattr(p, part) is None else abs(getattr(p, part))
+                for p in self.parts[model]]
 
     def standings(self, part="model_form"):
         """``error_model.standings`` of the models other than the identity checks (P1 itself
@@ -97,7 +98,8 @@ class Population:
     def discretisation(self):
         """FEM P1's |discretisation error| on each mesh (the same for every model there)."""
         runs = self.parts.get(self.quantity.p1, [])
-        return [abs(p.discretisation) for p in runs if p is not None]
+        return [abs(p.discretisation) for p in runs
+                if p is not None and p.discretisation is not None]
 
 
 def populations(runs_by_case, declared, quick, patch_tests, estimate_keys):
@@ -324,7 +326,8 @@ def describe(entry, rng=None):
     return text
 
 
-def case_findings(name, quantities, runs, patch_tests=(), estimate_key="p2_error_estimate"):
+def case_findings(name, quantities, runs, patch_tests=(), estimate_key="p2_error_estimate",
+                  per_mesh_continuum=()):
     """(opening lines, tables) of one case's report on the error model, for each of its
     decomposed ``quantities`` (``Case.decompositions``): per boundary condition, the closest
     and farthest model by model-form error with the discretisation error the meshes share,
@@ -336,6 +339,7 @@ def case_findings(name, quantities, runs, patch_tests=(), estimate_key="p2_error
         @staticmethod
         def decompositions():
             return tuple(quantities)
+    Declared.per_mesh_continuum = tuple(per_mesh_continuum)
     pops = populations({name: runs}, {name: Declared}, {name: False},
                        {name: set(patch_tests)}, {name: estimate_key})
     lines, tables = [], []
@@ -365,8 +369,9 @@ def case_findings(name, quantities, runs, patch_tests=(), estimate_key="p2_error
         if ok:
             first = "first (fewest unpaired modes, then the error)" if p.lost and any(
                 p.unpaired.values()) else "closest"
-            line += f"{first} {ok[0][1].model} ({cell(ok[0][1])}), farthest {ok[-1][1].model} " \
-                    f"({cell(ok[-1][1])})"
+            # the farthest is the last of every model, a failed one included
+            line += f"{first} {ok[0][1].model} ({cell(ok[0][1])}), farthest {st[-1][1].model} " \
+                    f"({cell(st[-1][1])})"
             tied = list(ok[0][2])
             if tied:
                 line += f"; tied with {ok[0][1].model} (within u_val {rel(p.u_model_form, 2)} " \
@@ -436,8 +441,8 @@ def case_findings(name, quantities, runs, patch_tests=(), estimate_key="p2_error
                             "on the same tetrahedra, beside the total against the continuum "
                             f"(u_val: model-form {rel(p.u_model_form, 2)}, total "
                             f"{rel(p.u_continuum, 2)}"
-                            + (", the reference's spread over the meshes exceeding its "
-                               "estimate" if p.spread_defect else "")
+                            + (", its estimate widened to the reference's spread over the "
+                               "meshes, which exceeds it" if p.spread_defect else "")
                             + (", the reference's estimate alone: each mesh poses its own "
                                "continuum problem" if p.per_mesh else "") + "):",
                             ["bc", "rank", "model", "model-form", "total"]

@@ -390,3 +390,15 @@ def test_the_sliding_bases_dynamics_are_not_scored(quick):
     clamped = [r for r in runs if r["bc"] == "clamped" and r["model"] == "fem-linear"]
     assert sliding and all(r[k] is None for r in sliding for k in SCORED_DYNAMICS)
     assert clamped and all(r["reaction_time_rel_l2"] is not None for r in clamped)
+
+
+def test_a_profiles_shape_is_read_from_its_second_differences():
+    """A barrel (one bulge falling to both ends), a waist, a period-2 alternation and a
+    uniform profile are named as such, so that a 5-layer score never calls a barrel an
+    alternation."""
+    from cases.library.paper_cube_report import shape
+    assert shape([0.3319, 0.4375, 0.4571, 0.4375, 0.3319]) == "a barrel"
+    assert shape([0.28, 0.2199, 0.2187, 0.2199, 0.28]) == "a waist"
+    assert shape([0.1452, 0.1233, 0.1452, 0.1233, 0.1452]) == "alternating"
+    assert shape([0.38] * 5) == "uniform"
+    assert shape([0.1, 0.2, 0.2, 0.25, 0.1]) == "uneven"

@@ -582,3 +582,25 @@ def test_the_index_names_a_model_whose_forces_do_not_balance(tmp_path):
     assert "a up to 0.2 (torsion/five/clamped)" in said and " b up to" not in said
     assert "c up to 1e-06 (torsion/five/clamped)" in said
     assert _imbalance(tmp_path, ["b"]) == ""
+
+
+def test_the_farthest_model_of_a_case_includes_one_that_failed():
+    """A case's opening names as farthest the last model of the population, a model whose
+    runs failed at the median included, never the last of those that gave a number."""
+    runs = _torsion_runs({(mesh, m): q for mesh in ("five", "six")
+                          for m, q in (("fem-linear", 1.0), ("a", 1.1), ("b", 1.3))})
+    for r in runs:
+        if r["model"] == "b":
+            r["torque_nm"] = None
+    lines, _ = scorecard.case_findings(
+        "torsion", [E.Scalar("torque_nm", "torque_fem_nm", "torque")], runs)
+    assert "closest a (" in lines[0] and "farthest b (failed, 0 of 2)" in lines[0]
+
+
+def test_a_mode_unpaired_against_the_continuum_fails_the_total_only():
+    """A run whose modes all pair with P1 but one of whose continuum modes is unpaired keeps
+    its model-form error and has no total: the total comparison counts it as failed."""
+    q = E.Norm("mf", "tot", "modes", unpaired="lost", unpaired_total="lost_c")
+    p1 = {"model": "fem-linear", "mf": 0.0, "tot": 0.05, "lost": 0, "lost_c": 0}
+    parts = q.parts({"model": "a", "mf": 0.02, "tot": 0.06, "lost": 0, "lost_c": 2}, p1)
+    assert (parts.model_form, parts.discretisation, parts.total) == (0.02, 0.05, None)
