@@ -21,6 +21,10 @@ The last block is padded with copies of the last tetrahedron (its index and its 
 its lanes compute a real element; only the first ``m`` lanes are ever added or stored.
 A flattened element is flagged in row ``FLAG`` of ``s`` (its margin: <= 0 when flattened)
 and counted; the driver then reports the first one (:func:`first_flat`).
+
+Numba's cache keys a compiled kernel on its own file only: after editing this one, run
+``python model/terms/_shear_codegen.py`` (the generated file records this file's hash) and
+clear ``model/terms/__pycache__`` for the other kernels that use it (``fem``, ``normal``).
 """
 import numpy as np
 from numba import njit
@@ -118,7 +122,3 @@ def first_flat(s, blk, m):
             return blk * B + i
     return -1
 
-
-def block_range(first, stop):
-    """The blocks holding the tetrahedra [first, stop)."""
-    return first // B, n_blocks(stop)
