@@ -295,7 +295,7 @@ class Case(abc.ABC):
     qoi_errors: ClassVar[tuple] = ()
     quantity_compared: ClassVar[tuple] = ()   # the names quantity_metrics returns
     notes: ClassVar[tuple] = ()
-    fem_solver: ClassVar[str] = "auto"    # the linear FEM solver (reference.fem.linear_solve)
+    fem_solver: ClassVar[str] = "auto"    # the linear FEM solver (reference.solvers.linear_solve)
     draws_stress: ClassVar[bool] = False   # True: the case draws its own max |tau| panels
     magnify: ClassVar[float] = 5.0         # displacement magnification of the panels
     static: ClassVar[bool] = True          # False: no static displacement (modes)

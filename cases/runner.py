@@ -408,7 +408,7 @@ def _compute(case, s, mesh_name, bc, mesh_of, step, models, refs=None):
 
 def _mesh_in_worker(job):
     """Every bc of one mesh, in one worker: the bcs share the mesh and the FEM stiffness
-    matrices (reference.fem keeps the last ones assembled), which a (mesh, bc) per worker
+    matrices (reference.assembly keeps the last ones assembled), which a (mesh, bc) per worker
     would assemble twice."""
     case, s, mesh_name, store, reuse_full = job
     mesh_of = _built_once(case, s, warn=False)      # the parent said them

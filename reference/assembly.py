@@ -11,9 +11,15 @@ For u = phi_i e_a and v = phi_j e_b (a, b the components of local dofs i, j):
     lam div u div v + 2 mu eps(u) : eps(v)
         = lam d_a phi_i d_b phi_j + mu (delta_ab grad phi_i . grad phi_j + d_b phi_i d_a phi_j)
 """
+import collections
+import hashlib
+
 import numpy as np
 import scipy.sparse as sp
 from numba import njit
+
+from model.errors import MaterialError
+from model.material import poisson_message
 
 
 @njit(cache=True)
@@ -65,4 +71,40 @@ def elasticity_matrix(basis, lam, mu):
     return sp.csr_matrix((values.ravel(), (rows, cols)), shape=(basis.N, basis.N))
 
 
-__all__ = ["elasticity_matrix", "scalar_gradients"]
+# the last few stiffness matrices assembled, by mesh, element and Lame constants: a case solves
+# one mesh under several boundary conditions
+_STIFFNESS = collections.OrderedDict()
+STIFFNESS_CACHE = 4
+
+
+def stiffness(basis, lam, mu):
+    """The linear elastic stiffness matrix (CSR) of ``basis``, reused when the same mesh,
+    element and constants were assembled recently (the arrays are compared by content).
+    Callers must not modify it."""
+    m = basis.mesh
+    key = (hashlib.blake2b(np.ascontiguousarray(m.p).tobytes()
+                           + np.ascontiguousarray(m.t).tobytes(), digest_size=16).digest(),
+           type(basis.elem).__name__, type(basis.elem.elem).__name__, basis.X.shape,
+           float(lam), float(mu))
+    if key in _STIFFNESS:
+        _STIFFNESS.move_to_end(key)
+        return _STIFFNESS[key]
+    K = elasticity_matrix(basis, lam, mu)
+    _STIFFNESS[key] = K
+    while len(_STIFFNESS) > STIFFNESS_CACHE:
+        _STIFFNESS.popitem(last=False)
+    return K
+
+
+def lame(E, nu):
+    """(lambda, mu) after checking E > 0 and -1 < nu < 0.5."""
+    if not (np.isfinite(E) and E > 0):
+        raise MaterialError(f"Young's modulus E must be a finite number > 0 Pa, got {E!r}")
+    if not np.isfinite(nu):
+        raise MaterialError(f"Poisson's ratio nu must be a finite number, got {nu!r}")
+    if not -1.0 < nu < 0.5:
+        raise MaterialError(poisson_message(nu))
+    return E * nu / ((1 + nu) * (1 - 2 * nu)), E / (2 * (1 + nu))
+
+
+__all__ = ["elasticity_matrix", "lame", "scalar_gradients", "stiffness"]

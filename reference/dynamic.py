@@ -17,10 +17,11 @@ import scipy.sparse as sp
 
 from model.bc import bc_arrays
 from model.errors import MaterialError, ModelError
-from .fem import (dirichlet_dofs, dof_hats, element_basis, lame, skfem_mesh, spd_factor,
-                  stiffness)
+from .assembly import lame, stiffness
+from .discretisation import dirichlet_dofs, dof_hats, element_basis, skfem_mesh
 from .linear import body_load, dof_component
 from .modal import lumped, mass_matrix
+from .solvers import spd_factor
 
 # a mode whose stiffness is below this fraction of the largest is a rigid motion
 RIGID_TOL = 1e-12
@@ -54,7 +55,7 @@ def solve(mesh, E, nu, rho, dirichlet_of_t, t_end, dt=None, damping=0.0, element
     dirichlet_of_t : callable t -> mapping node -> (ux, uy, uz) (None for a free component),
         the same ``bc_of_t`` the particle model takes (e.g. ``model.bc.Ramp``); the set of
         prescribed components must not change. P2 midpoints follow
-        ``reference.fem.prescribed_edges`` at every step.
+        ``reference.discretisation.prescribed_edges`` at every step.
     dt : the step [s] of method "newmark"; default half the P-wave transit time of the
         smallest tetrahedron height, halved again for P2 (the explicit limit: every mode the
         mesh resolves is resolved in time; the trapezoidal rule hardly damps modes it does not

@@ -17,10 +17,11 @@ from skfem import Basis, ElementTetP1, FacetBasis
 from model.bc import bc_arrays, load_fractions
 from model.errors import ConvergenceError, ModelError
 from ._neohookean import neohookean
-from .assembly import scalar_gradients
-from .fem import (INTORDER, NewtonSolver, check_finite, dirichlet_dofs, element_basis, lame,
-                  parent_of, probe, refine_with_data, SaddleSolver, skfem_mesh, stress_measures,
-                  stress_on_input)
+from .assembly import lame, scalar_gradients
+from .discretisation import (INTORDER, dirichlet_dofs, element_basis, parent_of, probe,
+                             refine_with_data, skfem_mesh)
+from .solvers import NewtonSolver, SaddleSolver, check_finite
+from .stress import stress_measures, stress_on_input
 from .linear import body_load, converged_from, dof_component, traction_load, transfer_to_nodes
 
 # above this Poisson ratio ``converged(mixed="auto")`` solves the mixed (u, p) form: the
@@ -32,7 +33,7 @@ NESTED_MAX_ITER = 10
 # inexact Newton (Eisenstat and Walker's second choice): an iteration's tangent is solved to a
 # relative residual eta of at most ETA_MAX, tighter as Newton's residual falls, and never
 # tighter than the step to the tolerance needs (ETA_FLOOR_SHARE x tolerance / residual) or
-# than fem.linear_solve's own 1e-10: AMG-CG does a third of the iterations, the solution
+# than solvers.linear_solve's own 1e-10: AMG-CG does a third of the iterations, the solution
 # is the same to the tolerance
 ETA_MAX = 1e-3
 ETA_FLOOR_SHARE = 0.1

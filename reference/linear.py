@@ -9,9 +9,11 @@ from skfem.models.elasticity import linear_stress
 
 from model.bc import bc_arrays
 from model.errors import ModelError
-from .fem import (INTORDER, check_finite, dirichlet_dofs, dof_hats, element_basis, lame,
-                  linear_solve, probe, refine_with_data, skfem_mesh, stiffness,
-                  stress_measures, stress_on_input)
+from .assembly import lame, stiffness
+from .discretisation import (INTORDER, dirichlet_dofs, dof_hats, element_basis, probe,
+                             refine_with_data, skfem_mesh)
+from .solvers import check_finite, linear_solve
+from .stress import stress_measures, stress_on_input
 
 
 @dataclass
@@ -96,8 +98,8 @@ def solve(mesh, E, nu, dirichlet, body_force=None, traction=None, element="P1", 
         points (P2 midpoints, refined nodes) on boundary facets whose three vertices are
         prescribed; NaN leaves a component free there (declare the prescribed surfaces this
         way when a free face lies between two of them, e.g. a body one element thick); linear
-        interpolation when None (see ``reference.fem.prescribed_edges``).
-    solver : "auto", "direct" or "amg" (see ``reference.fem.linear_solve``).
+        interpolation when None (see ``reference.discretisation.prescribed_edges``).
+    solver : "auto", "direct" or "amg" (see ``reference.solvers.linear_solve``).
     """
     lam, mu = lame(E, nu)
     n = mesh.n_nodes

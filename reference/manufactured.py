@@ -18,7 +18,7 @@ import numpy as np
 from skfem import Basis, Functional
 
 from model.errors import ModelError
-from .fem import lame
+from .assembly import lame
 
 
 @dataclass(frozen=True)

@@ -10,7 +10,8 @@ from skfem.helpers import dot
 
 from model.bc import bc_arrays
 from model.errors import MaterialError, ModelError
-from .fem import dirichlet_dofs, element_basis, lame, refine_with_data, skfem_mesh, stiffness
+from .assembly import lame, stiffness
+from .discretisation import dirichlet_dofs, element_basis, refine_with_data, skfem_mesh
 
 
 @BilinearForm
@@ -19,14 +20,14 @@ def mass_form(u, v, w):
 
 
 # the product of two shape functions of degree p has degree 2p: the stiffness's quadrature
-# (reference.fem.INTORDER, exact for gradients) under-integrates it, and a one-point rule makes
+# (reference.discretisation.INTORDER, exact for gradients) under-integrates it, and a one-point rule makes
 # every P1 element's mass matrix rho V / 16 in every entry instead of rho V (1 + delta_ij) / 20
 MASS_INTORDER = {"P1": 2, "P2": 4}
 
 
 def mass_matrix(m, element, rho):
     """The consistent mass matrix (CSR) of ``element`` on the scikit-fem mesh ``m``,
-    integrated exactly; its dofs are those of ``reference.fem.element_basis(m, element)``."""
+    integrated exactly; its dofs are those of ``reference.discretisation.element_basis(m, element)``."""
     return (rho * asm(mass_form, element_basis(m, element,
                                                intorder=MASS_INTORDER[element]))).tocsr()
 

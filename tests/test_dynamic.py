@@ -146,7 +146,7 @@ def test_modal_ramp_equals_the_matrix_exponential(zeta):
     from skfem import BilinearForm, Basis, ElementTetP1, ElementVector, asm
     from skfem.helpers import dot
     from skfem.models.elasticity import lame_parameters, linear_elasticity
-    from reference.fem import skfem_mesh
+    from reference.discretisation import skfem_mesh
     mesh = cube(3, 0.032, "six")
     top, bottom = mesh.nodes_on_plane("y", 0.032), mesh.nodes_on_plane("y", 0.0)
     held = {int(i): (0.0, 0.0, 0.0) for i in bottom}

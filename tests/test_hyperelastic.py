@@ -9,7 +9,9 @@ from scipy.optimize import brentq
 from model.errors import ConvergenceError, ModelError
 from model.mesh import box, cube
 from reference import hyperelastic, linear
-from reference.fem import DIRECT_MAX_DOFS, lame, skfem_mesh
+from reference.assembly import lame
+from reference.discretisation import skfem_mesh
+from reference.solvers import DIRECT_MAX_DOFS
 from reference.hyperelastic import Discretisation
 
 E, L = 10e3, 0.01
@@ -214,7 +216,7 @@ def test_auto_takes_the_mixed_form_above_the_locking_threshold(nu, mixed):
 def test_prolongation_to_the_refined_mesh_is_exact_for_the_coarse_space(element, family):
     """A linear (P1) or quadratic (P2) vector field given on the coarse mesh is reproduced at
     every dof of the mesh refined once, to round-off; the P1 pressure by the hats too."""
-    from reference.fem import element_basis
+    from reference.discretisation import element_basis
     from reference.hyperelastic import _hats, prolong
     from reference.linear import dof_component
     m = skfem_mesh(cube(3, L, family))
@@ -295,13 +297,13 @@ def test_the_mixed_form_reuses_a_factorisation_and_reaches_the_same_solution(mon
     """A barrel at nu = 0.499 (mixed P2/P1, 30 % compression in 3 steps): GMRES on the last
     factorisation solves most tangents, to the solution (and the Newton iterations) of a
     factorisation at every iteration."""
-    from reference import fem
+    from reference import solvers
     mesh = cube(4, L, "six")
     bc = {int(i): (0.0, 0.0, 0.0) for i in mesh.nodes_on_plane("z", 0.0)}
     bc.update({int(i): (0.0, 0.0, -0.3 * L) for i in mesh.nodes_on_plane("z", L)})
     reused = hyperelastic.solve(mesh, E, 0.499, bc, element="P2", mixed=True, load_steps=3)
 
-    class EveryTime(fem.SaddleSolver):
+    class EveryTime(solvers.SaddleSolver):
         def __call__(self, A, b, doflocs=None, comp=None, rtol=1e-10):
             self.lu = None
             return super().__call__(A, b, rtol=rtol)

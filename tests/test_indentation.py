@@ -1,6 +1,6 @@
 """Indentation poses one problem on every mesh and for every model: the punch (a flat face and
 a sloping rim) is one displacement field declared by geometry, prescribed at the models' nodes
-and, through a reference.fem.Region, at every boundary point of every refinement."""
+and, through a reference.discretisation.Region, at every boundary point of every refinement."""
 import numpy as np
 
 from cases.library.indentation import (CASE, DEPTH_MM, PATCH_MM, RIM_MM, SIZE_MM, in_patch,
@@ -8,7 +8,7 @@ from cases.library.indentation import (CASE, DEPTH_MM, PATCH_MM, RIM_MM, SIZE_MM
 from cases.runner import reaction_along
 from reference import linear
 from reference.linear import dof_component
-from reference.fem import Region
+from reference.discretisation import Region
 
 SPACING = 8.0     # coarse: the face is one lattice cell, resolved by the refinements
 MM = 1e-3

@@ -142,7 +142,7 @@ def test_p1_element_mass_matrix_is_rho_v_over_20_times_1_plus_delta():
     """The consistent mass of one tetrahedron, by hand: M_ij = rho V (1 + delta_ij) / 20 per
     component (a one-point rule gives rho V / 16 everywhere)."""
     from model.mesh import TetMesh
-    from reference.fem import skfem_mesh
+    from reference.discretisation import skfem_mesh
     X = np.array([[0.0, 0, 0], [0.02, 0, 0], [0.003, 0.01, 0], [0.004, 0.002, 0.015]])
     V = abs(np.linalg.det(X[1:] - X[0])) / 6
     M = modal.mass_matrix(skfem_mesh(TetMesh(X, np.array([[0, 1, 2, 3]]))), "P1", 1000.0)
@@ -157,7 +157,7 @@ def test_mass_matrix_integrates_the_square_of_a_field_it_represents(element, pow
     """u = x^p (p the element's degree) is represented exactly, so u.M u must be
     rho int x^(2p) dV = rho L^(2p+3) / (2p + 1) on the cube [0, L]^3: exact only with a
     quadrature of degree 2p."""
-    from reference.fem import element_basis, skfem_mesh
+    from reference.discretisation import element_basis, skfem_mesh
     L, rho = 0.032, 1000.0
     m = skfem_mesh(cube(3, L, "six"))
     M = modal.mass_matrix(m, element, rho)
@@ -279,7 +279,7 @@ def slab_bc(mesh, h, push):
 def test_new_points_are_prescribed_only_on_fully_prescribed_facets():
     """Two held neighbours on a free face do not hold the edge between them (the old rule
     did); a face whose three vertices are held is held."""
-    from reference.fem import prescribed_edges, skfem_mesh
+    from reference.discretisation import prescribed_edges, skfem_mesh
     mesh = cube(3, L, "six")
     m = skfem_mesh(mesh)
     mask = np.zeros((mesh.n_nodes, 3), bool)
@@ -384,7 +384,7 @@ def test_iterative_solver_converges_on_a_thin_bending_slab():
 def test_a_newton_solve_goes_direct_after_the_first_stagnation(monkeypatch):
     """The tangents of one Newton solve: once AMG stagnated and the direct solver took over,
     the later ones are solved directly at once; a converged AMG solve changes nothing."""
-    from reference import fem
+    from reference import solvers
     asked = []
 
     def fake(A, b, doflocs, comp, solver="auto", rtol=1e-10):
@@ -392,25 +392,25 @@ def test_a_newton_solve_goes_direct_after_the_first_stagnation(monkeypatch):
         said = {1: "amg-cg (default aggregation)", 2: "direct (default aggregation stagnated)"}
         return b, {"solver": said.get(len(asked), "direct"), "iterations": 0}
 
-    monkeypatch.setattr(fem, "linear_solve", fake)
-    solve = fem.NewtonSolver()
+    monkeypatch.setattr(solvers, "linear_solve", fake)
+    solve = solvers.NewtonSolver()
     for _ in range(4):
         solve(None, np.zeros(3), None, None)
     assert asked == ["auto", "auto", "direct", "direct"]
     asked.clear()
-    fem.NewtonSolver("amg")(None, np.zeros(3), None, None)
+    solvers.NewtonSolver("amg")(None, np.zeros(3), None, None)
     assert asked == ["amg"]
 
 
 def test_solver_falls_back_or_names_the_direct_solver(monkeypatch):
-    from reference import fem
+    from reference import solvers
     mesh = cube(3, L, "five")
     held = {0: (0.0, 0.0, 0.0)}            # gravity's torque is free: CG cannot converge
-    monkeypatch.setattr(fem, "DIRECT_MAX_DOFS", 0)
-    monkeypatch.setattr(fem, "available_memory", lambda: 0)
+    monkeypatch.setattr(solvers, "DIRECT_MAX_DOFS", 0)
+    monkeypatch.setattr(solvers, "available_memory", lambda: 0)
     with pytest.raises(ConvergenceError, match='solver="direct"'):
         linear.solve(mesh, E, 0.3, held, body_force=(0, -9810.0, 0))
-    monkeypatch.setattr(fem, "available_memory", lambda: 2**40)
+    monkeypatch.setattr(solvers, "available_memory", lambda: 2**40)
     bc = {int(i): (0.0, 0.0, 0.0) for i in mesh.nodes_on_plane("y", 0.0)}
     r = linear.solve(mesh, E, 0.3, bc, body_force=(0, -9810.0, 0))
     assert r.info["solver"].startswith("amg-cg")
@@ -423,7 +423,8 @@ def test_stiffness_is_reused_for_the_same_mesh_element_and_constants():
     the matrix; another element, constant or mesh assembles afresh, and every matrix equals a
     fresh assembly."""
     from reference.assembly import elasticity_matrix
-    from reference.fem import element_basis, skfem_mesh, stiffness
+    from reference.assembly import stiffness
+    from reference.discretisation import element_basis, skfem_mesh
 
     def basis(n=3, element="P1"):
         return element_basis(skfem_mesh(cube(n, 0.01, "five")), element)
@@ -444,7 +445,7 @@ def test_numba_stiffness_is_scikit_fems_linear_elasticity_form(element):
     from skfem import asm
     from skfem.models.elasticity import linear_elasticity
     from reference.assembly import elasticity_matrix
-    from reference.fem import element_basis, skfem_mesh
+    from reference.discretisation import element_basis, skfem_mesh
     mesh = cube(3, 0.02, "unstructured", seed=3)
     basis = element_basis(skfem_mesh(mesh), element)
     ours = elasticity_matrix(basis, 3.7e4, 1.3e4)
@@ -458,7 +459,7 @@ def test_numba_stiffness_energy_of_a_homogeneous_strain_is_the_closed_form(eleme
     """u = eps x on a cube of volume V: u^T K u = V (lam tr(eps)^2 + 2 mu eps:eps), exactly
     (the field is in P1 and P2), and a rigid rotation carries no energy."""
     from reference.assembly import elasticity_matrix
-    from reference.fem import element_basis, skfem_mesh
+    from reference.discretisation import element_basis, skfem_mesh
     L, lam, mu = 0.02, 3.7e4, 1.3e4
     basis = element_basis(skfem_mesh(cube(3, L, "six")), element)
     K = elasticity_matrix(basis, lam, mu)

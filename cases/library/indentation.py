@@ -5,7 +5,7 @@ punch force, the surface profile along the centre line, and the peak shear stres
 edge of the punch's face.
 
 The punch is one displacement field declared by geometry (``punch``): each model prescribes
-it at its top nodes, the references (a ``reference.fem.Region``) at every boundary point of
+it at its top nodes, the references (a ``reference.discretisation.Region``) at every boundary point of
 every refinement, so every mesh and every model poses the same continuum problem. The rim
 keeps the prescribed field continuous: a square prescribed alone would be a different
 problem for a model (whose free neighbours taper it over one element) and for a refined
@@ -17,7 +17,7 @@ import numpy as np
 from model.mesh import cube
 from model.terms.shear import Shear
 from .. import metrics as M
-from reference.fem import Region
+from reference.discretisation import Region
 from ..error_model import Scalar
 from ..framework import Case, Knob, MM, Settings
 from . import common

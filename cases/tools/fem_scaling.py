@@ -1,5 +1,5 @@
 """Time and peak memory of a large P1 reference solve, and the direct/AMG crossover that
-sets ``reference.fem.DIRECT_MAX_DOFS``; docs/architecture.md says where it is used.
+sets ``reference.solvers.DIRECT_MAX_DOFS``; docs/architecture.md says where it is used.
 
     python -m cases.tools.fem_scaling [--n 70]    # n nodes per side of the unit cube: 3 n^3 unknowns
     python -m cases.tools.fem_scaling --solvers   # direct and AMG-CG on the same P1 and P2 systems
