@@ -1,6 +1,7 @@
 """Isotropic linear-elastic material constants (SI units)."""
 from dataclasses import dataclass
 import math
+import numbers
 
 from .errors import MaterialError
 
@@ -23,7 +24,7 @@ class Material:
     def __post_init__(self):
         for name in ("E", "nu", "rho"):
             v = getattr(self, name)
-            if not isinstance(v, (int, float)) or not math.isfinite(v):
+            if not isinstance(v, numbers.Real) or not math.isfinite(v):
                 raise MaterialError(f"Material.{name} must be a finite number, got {v!r}")
         if self.E <= 0:
             raise MaterialError(f"Young's modulus E must be > 0 Pa, got {self.E}")
@@ -48,6 +49,18 @@ class Material:
         return self.E * self.nu / ((1.0 + self.nu) * (1.0 - 2.0 * self.nu))
 
     @property
+    def lame(self):
+        """The Lame parameters (lambda, mu), mu the shear modulus."""
+        return self.lam, self.G
+
+    @property
     def p_wave_speed(self):
         """Dilatational wave speed sqrt((K + 4G/3) / rho)."""
         return math.sqrt((self.K + 4.0 * self.G / 3.0) / self.rho)
+
+
+def lame(E, nu):
+    """The Lame parameters (lambda, mu) of Young's modulus ``E`` [Pa] and Poisson's ratio
+    ``nu``, checked as a :class:`Material` checks them: how a function that takes the two
+    loose (the FEM references) gets its constants."""
+    return Material(E, nu).lame

@@ -18,9 +18,6 @@ import numpy as np
 import scipy.sparse as sp
 from numba import njit
 
-from model.errors import MaterialError
-from model.material import poisson_message
-
 
 @njit(cache=True)
 def _elasticity_values(grad, comp, dx, lam, mu, out):
@@ -96,15 +93,4 @@ def stiffness(basis, lam, mu):
     return K
 
 
-def lame(E, nu):
-    """(lambda, mu) after checking E > 0 and -1 < nu < 0.5."""
-    if not (np.isfinite(E) and E > 0):
-        raise MaterialError(f"Young's modulus E must be a finite number > 0 Pa, got {E!r}")
-    if not np.isfinite(nu):
-        raise MaterialError(f"Poisson's ratio nu must be a finite number, got {nu!r}")
-    if not -1.0 < nu < 0.5:
-        raise MaterialError(poisson_message(nu))
-    return E * nu / ((1 + nu) * (1 - 2 * nu)), E / (2 * (1 + nu))
-
-
-__all__ = ["elasticity_matrix", "lame", "scalar_gradients", "stiffness"]
+__all__ = ["elasticity_matrix", "scalar_gradients", "stiffness"]

@@ -16,8 +16,9 @@ import scipy.linalg
 import scipy.sparse as sp
 
 from model.bc import bc_arrays
-from model.errors import MaterialError, ModelError
-from .assembly import lame, stiffness
+from model.errors import ModelError
+from model.material import Material
+from .assembly import stiffness
 from .discretisation import dirichlet_dofs, dof_hats, element_basis, skfem_mesh
 from .linear import body_load, dof_component
 from .modal import lumped, mass_matrix
@@ -72,9 +73,7 @@ def solve(mesh, E, nu, rho, dirichlet_of_t, t_end, dt=None, damping=0.0, element
     """
     if method not in ("newmark", "modal"):
         raise ModelError(f"method must be 'newmark' or 'modal', got {method!r}")
-    lam, mu = lame(E, nu)
-    if not (np.isfinite(rho) and rho > 0):
-        raise MaterialError(f"density rho must be > 0 kg/m^3, got {rho!r}")
+    lam, mu = Material(E, nu, rho).lame
     if mass not in ("consistent", "lumped"):
         raise ModelError(f"mass must be 'consistent' or 'lumped', got {mass!r}")
     if not (math.isfinite(t_end) and t_end > 0):

@@ -16,8 +16,9 @@ from skfem import Basis, ElementTetP1, FacetBasis
 
 from model.bc import bc_arrays, load_fractions
 from model.errors import ConvergenceError, ModelError
+from model.material import lame
 from ._neohookean import neohookean
-from .assembly import lame, scalar_gradients
+from .assembly import scalar_gradients
 from .discretisation import (INTORDER, dirichlet_dofs, element_basis, parent_of, probe,
                              refine_with_data, skfem_mesh)
 from .solvers import NewtonSolver, SaddleSolver, check_finite

@@ -9,7 +9,8 @@ from skfem.models.elasticity import linear_stress
 
 from model.bc import bc_arrays
 from model.errors import ModelError
-from .assembly import lame, stiffness
+from model.material import lame
+from .assembly import stiffness
 from .discretisation import (INTORDER, dirichlet_dofs, dof_hats, element_basis, probe,
                              refine_with_data, skfem_mesh)
 from .solvers import check_finite, linear_solve

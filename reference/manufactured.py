@@ -18,7 +18,7 @@ import numpy as np
 from skfem import Basis, Functional
 
 from model.errors import ModelError
-from .assembly import lame
+from model.material import lame
 
 
 @dataclass(frozen=True)

@@ -9,8 +9,9 @@ from skfem import BilinearForm, asm
 from skfem.helpers import dot
 
 from model.bc import bc_arrays
-from model.errors import MaterialError, ModelError
-from .assembly import lame, stiffness
+from model.errors import ModelError
+from model.material import Material
+from .assembly import stiffness
 from .discretisation import dirichlet_dofs, element_basis, refine_with_data, skfem_mesh
 
 
@@ -51,9 +52,7 @@ def lumped(M):
 def frequencies(mesh, E, nu, rho, dirichlet, k=6, mass="consistent", element="P2", refine=0):
     """The ``k`` lowest eigenfrequencies of the structure clamped by ``dirichlet`` (values
     must be zero there; ``{}`` for free-free, whose six rigid modes come first at 0 Hz)."""
-    lam, mu = lame(E, nu)
-    if not (np.isfinite(rho) and rho > 0):
-        raise MaterialError(f"density rho must be > 0 kg/m^3, got {rho!r}")
+    lam, mu = Material(E, nu, rho).lame
     if mass not in ("consistent", "lumped"):
         raise ModelError(f"mass must be 'consistent' or 'lumped', got {mass!r}")
     mask, vals = bc_arrays(dirichlet, mesh.n_nodes)

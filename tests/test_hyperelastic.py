@@ -7,9 +7,9 @@ import pytest
 from scipy.optimize import brentq
 
 from model.errors import ConvergenceError, ModelError
+from model.material import lame
 from model.mesh import box, cube
 from reference import hyperelastic, linear
-from reference.assembly import lame
 from reference.discretisation import skfem_mesh
 from reference.solvers import DIRECT_MAX_DOFS
 from reference.hyperelastic import Discretisation

@@ -9,7 +9,7 @@ import pytest
 from model.errors import ModelError
 from model.mesh import cube
 from reference import linear
-from reference.assembly import lame
+from model.material import lame
 from reference.manufactured import l2_error, manufactured, prescribed_faces, solve, waves
 from cases.studies.convergence.manufactured import orders, run_entry
 from cases.studies.convergence.verification import spec

@@ -1,5 +1,7 @@
 """FEM references against closed forms, at several Poisson ratios so that a swapped
 lambda/mu cannot pass."""
+import re
+
 import numpy as np
 import pytest
 
@@ -242,6 +244,21 @@ def test_amg_and_direct_agree():
     assert a.info["solver"].startswith("amg-cg") and rel(a.u, d.u) < 1e-8
     again = linear.solve(mesh, E, 0.3, bc, element="P2", solver="amg")
     assert np.array_equal(a.u, again.u)      # pyamg's random spectral estimate is seeded
+
+
+def test_the_references_take_their_lame_constants_and_checks_from_material():
+    """The Lame constants the references use are the Material's, bit for bit, and a material
+    the model refuses the references refuse with the same message."""
+    from model import Material
+    from model.material import lame
+    for E_, nu in ((10e3, 0.45), (10000, 0.3), (2.5e5, -0.2), (1e3, 0.499)):
+        mat = Material(E_, nu)
+        assert lame(E_, nu) == (mat.lam, mat.G)
+    for E_, nu in ((E, 0.5), (E, -1.0), (-E, 0.3), (float("nan"), 0.3)):
+        with pytest.raises(MaterialError) as by_model:
+            Material(E_, nu)
+        with pytest.raises(MaterialError, match=re.escape(str(by_model.value))):
+            linear.p1_stiffness(cube(2, L, "five"), E_, nu)
 
 
 def test_bad_input():
