@@ -11,7 +11,9 @@ from ...framework import Study
 from ...store import OFF
 from . import report
 from .problems import PROBLEMS
-from .study import ConvergenceSettings, fits, run
+from .cost import judge
+from .fit import EXACT
+from .study import ConvergenceSettings, cancelling, fits, run
 
 # what metrics.json records of a run, all the report is drawn from
 RECORDED = ("runs", "fits", "references", "elasticity", "cost", "manufactured", "patch",
@@ -53,6 +55,10 @@ class Convergence(Study):
         # the fits are derived from the recorded runs and references: drawn again by the
         # current rule, never recomputing a run
         data["fits"] = fits(data["runs"], data["references"])
+        if data.get("cost"):
+            data["cost"] = judge(data["cost"], data["runs"], EXACT, cancelling(data["fits"]),
+                                 {(r["case"], r["bc"]): r.get("error_estimate") or 0.0
+                                  for r in data["references"]})
         return s, data
 
 

@@ -31,15 +31,30 @@ import math
 import numpy as np
 from scipy.optimize import brentq, least_squares
 
+from ...error_model import ROUND_OFF
+
 FS_THREE, FS_TWO = 1.25, 3.0   # Roache's safety factors for 3+ and for 2 levels
 ASSUMED_ORDER = 1.0            # the order assumed with two levels
 GROWTH = 1.1                   # error at the finest level above this x the coarsest: diverges
 # errors all below this are the reference itself: the static solver's tolerance (1e-12 of
 # E h^2) and the nonlinearity left at the study's scaled load (strains about 5e-5)
 EXACT = 1e-4
+# at or below this an error (or a stiffness ratio's distance to 1) is round-off or the
+# reference's own level: never an error that falls through zero
+ROUND_LEVEL = max(EXACT, ROUND_OFF)
 ORDER_RANGE = (0.05, 8.0)      # orders the three-level equation is solved over
 # the finest levels falling at a lower order have stopped: halving h removes under 4 % of it
 ORDER_MIN = ORDER_RANGE[0]
+# a limit whose uncertainty exceeds the finest error times Roache's factor (with the values'
+# own, in quadrature) bounds nothing the finest error does not: a clean extrapolation to zero
+# carries exactly that band, so a wider one cannot tell convergence from a floor at the finest
+# level: 'not decided'
+# a level where every model's displacement error is the same to within this (relative to
+# their median), while their stiffness ratios spread ten times as much, tests nothing: the
+# error there is the mesh's, not the models'
+SAME_ERROR = 0.02
+UNDECIDED = "not decided"
+UNDECIDED_WHY = "uncertainty larger than what it bounds"
 
 
 @dataclass(frozen=True)
@@ -48,7 +63,8 @@ class Fit:
     extrapolated limit (never below 0; None where no extrapolation is made), ``e_inf_err``
     its uncertainty, ``verdict`` 'exact', 'converges', 'floor', 'diverges' or 'not
     asymptotic' (a family that is not self-similar, or a limit the levels put below zero),
-    ``why`` one sentence, ``levels`` the number of mesh sizes used."""
+    ``why`` one sentence, ``levels`` the number of mesh sizes used; 'not decided' where the
+    limit's uncertainty is larger than what it bounds (``bounds_nothing``)."""
 
     order: float
     e_inf: float
@@ -65,7 +81,23 @@ class Fit:
             return "exact"
         if self.verdict == "floor":
             return f"floor {self.e_inf:.2g} +- {self.e_inf_err:.1g}"
+        if self.verdict == UNDECIDED:
+            return f"{UNDECIDED} ({UNDECIDED_WHY})"
         return self.verdict
+
+
+def bounds_nothing(err, finest, u=0.0):
+    """Whether a limit's uncertainty ``err`` is larger than what it bounds: above the finest
+    error ``finest`` times Roache's factor, the values' uncertainty ``u`` in quadrature (the
+    band of a clean extrapolation to zero; a wider one leaves a floor at the finest level as
+    likely as convergence)."""
+    return err > math.hypot(FS_THREE * finest, u) * (1 + 1e-9)
+
+
+def _undecided(n, e_inf, err, finest, why):
+    return Fit(None, e_inf, err, UNDECIDED,
+               f"{why}; the limit's uncertainty {err:.2g} exceeds the finest error {finest:.2g} "
+               f"(times {FS_THREE:g}): it decides nothing", n)
 
 
 def observed_order(h, e):
@@ -180,6 +212,8 @@ def fit(h, e, nested=True, u=0.0):
             return Fit(p_obs, e_inf, err, "floor",
                        f"{stopped}: the error stays at {e_inf:.3g} +- {err:.2g}, which no "
                        "refinement removes", n)
+        if bounds_nothing(err, e[-1], u):
+            return _undecided(n, e_inf, err, e[-1], stopped)
         return Fit(p_obs, e_inf, err, "converges",
                    f"{stopped} at {e_inf:.2g} +- {err:.2g}, not distinguishable from zero", n)
     e_inf, err, p = extrapolate(h, e)
@@ -193,6 +227,9 @@ def fit(h, e, nested=True, u=0.0):
                    f"the extrapolated limit {e_inf:.3g} +- {err:.2g} is below zero: the levels "
                    "are not in the asymptotic range", n)
     e_inf = max(e_inf, 0.0)
+    if n >= 3 and e_inf - err <= 0 and bounds_nothing(err, e[-1], u):
+        return _undecided(n, e_inf, err, e[-1], "still falling" + (
+            f" at order {p:.2g}" if p is not None else ", without an observed order"))
     if n >= 3 and p is None:
         # still falling, but its changes do not shrink as a power of h: no limit, no floor
         return Fit(None, e_inf, err, "converges",
@@ -223,16 +260,46 @@ def ratio_limit(h, ratios, nested=True):
 def cancellation(e, ratios=None):
     """Why the errors over the levels (h descending) may cancel rather than converge, or None:
     an error sequence that is not monotone, or a stiffness ratio that crosses 1 (an error that
-    falls through zero looks small at one level by accident)."""
-    d = np.diff(np.asarray(e, float))
+    falls through zero looks small at one level by accident). Round-off is never cancellation:
+    errors at or below ROUND_LEVEL count as equal, and a ratio within it of 1 is on neither
+    side."""
+    d = np.diff(np.maximum(np.asarray(e, float), ROUND_LEVEL))
     if len(d) and np.any(d > 0) and np.any(d < 0):
         return "the error is not monotone in h"
     if ratios is not None and len(ratios) > 1:
-        side = np.sign(np.asarray(ratios, float) - 1.0)
+        gap = np.asarray(ratios, float) - 1.0
+        side = np.where(np.abs(gap) <= ROUND_LEVEL, 0.0, np.sign(gap))
         if np.any(side > 0) and np.any(side < 0):
             return "the stiffness ratio crosses 1"
     return None
 
 
+def blind_levels(runs):
+    """{(case, bc, mesh, h_mm): why} of the levels that test nothing: three models or more
+    solved there, their displacement errors (above EXACT) all within SAME_ERROR of their
+    median while their stiffness ratios spread more than ten times as much (the models differ,
+    the displacement does not: the mesh leaves them nothing to differ in). Such a level is
+    left out of every fit of its family."""
+    groups = {}
+    for r in runs:
+        if r.get("disp_rel_l2") is not None:
+            groups.setdefault((r["case"], r["bc"], r["mesh"], r["h_mm"]), []).append(r)
+    out = {}
+    for k, rs in groups.items():
+        e = np.array([r["disp_rel_l2"] for r in rs])
+        ratios = np.array([r["reaction_ratio"] for r in rs
+                           if r.get("reaction_ratio") is not None])
+        if len(rs) < 3 or e.max() < EXACT or len(ratios) < 3 or ratios.min() <= 0:
+            continue
+        spread = float(np.abs(e / np.median(e) - 1).max())
+        r_spread = float(ratios.max() / ratios.min() - 1)
+        if spread <= SAME_ERROR and r_spread > 10 * spread:
+            out[k] = {"error": float(np.median(e)), "error_spread": spread,
+                      "ratios": [float(ratios.min()), float(ratios.max())],
+                      "models": len(rs)}
+    return out
+
+
 __all__ = ["Fit", "fit", "extrapolate", "observed_order", "still_falling", "ratio_limit",
-           "cancellation", "EXACT", "ORDER_MIN"]
+           "cancellation", "bounds_nothing", "EXACT", "ORDER_MIN", "ROUND_LEVEL", "UNDECIDED",
+           "SAME_ERROR", "blind_levels"]

@@ -3,7 +3,8 @@ affine strains, scaled to the linear regime, is imposed on the boundary nodes of
 and the interior nodes relax; a consistent discretisation reproduces the affine field exactly.
 The error is the strain the model's solution misses: the RMS over the tetrahedra of
 |eps_h - eps| / |eps| (Frobenius), eps_h the symmetric gradient of the solution's linear
-interpolation; the worst of the six strains is the model's consistency error on the family.
+interpolation; the worst of the six strains is the model's patch error on the family (a strain
+error with every boundary node prescribed: not a fit's consistency limit).
 The irregular families are the unstructured one and each lattice with its interior nodes moved
 at random (``model.mesh.perturbed``)."""
 import numpy as np

@@ -10,7 +10,9 @@ from ...runner import jsonable
 from .plots import directional_young, error_vs_h, pareto
 from .elasticity import ANGLES_DEG, PATCH_MM
 from .problems import PROBLEMS
-from .fit import EXACT, ORDER_MIN
+from .cost import cheapest as cheapest_run
+from .fit import EXACT, FS_THREE, ORDER_MIN, ROUND_LEVEL, UNDECIDED, UNDECIDED_WHY
+from .fit import SAME_ERROR, blind_levels
 from .study import FEM_P1, MAX_NODES
 from .verification_report import (gate_rows as verification_gate_rows, manufactured_section,
                                   patch_section, steps_section)
@@ -68,22 +70,41 @@ def definitions():
         "'diverges' when the finest error exceeds the coarsest by 10 %; 'not asymptotic' on a "
         "family whose meshes are not self-similar (unstructured: never extrapolated) or where "
         "the extrapolated limit lies below zero beyond its uncertainty (a limit is never below "
-        "0; a stiffness ratio's limit never at or below 0); 'floor' (a consistency error no "
-        "refinement removes) when the error has stopped falling within its uncertainty and "
+        "0; a stiffness ratio's limit never at or below 0); 'floor' (a consistency limit: the "
+        "error no refinement removes) when the error has stopped falling within its uncertainty and "
         "stays above zero beyond it: either the finest levels have stopped (their two changes "
         "not both falls larger than the values' uncertainty u, the reference's estimate, or "
         f"a fall at an order below {ORDER_MIN:g} over them; the floor is the finest error +- "
         "1.25 x the larger change, with u) or, still falling at an observed order, the "
         "extrapolated e_inf exceeds its +- (a constant plus a decaying part); a sequence still "
-        "falling without an observed order is never a floor; otherwise 'converges' (with the "
-        "order when one is observed). Every +- includes u in quadrature (u_val). With two "
+        "falling without an observed order is never a floor; "
+        f"'{UNDECIDED}' ({UNDECIDED_WHY}) where a limit that is not a floor carries an "
+        f"uncertainty above {FS_THREE:g} x the finest error (the band of a clean extrapolation "
+        "to zero; a wider one cannot tell convergence from a floor at the finest level); "
+        "otherwise 'converges' (with the order when one is observed). Every +- includes u in quadrature (u_val). With two "
         "levels no order is observed: first order is assumed and the verdict is 'not decided' "
         "in the report (`pbcm run convergence` decides, on four levels). 'not resolved' marks "
         f"a fit whose finest error is below {REF_MARGIN:g} x its reference's estimate: that "
         "reference cannot judge it. 'cancellation' marks a series "
         "whose error is not monotone in h or whose "
         "stiffness ratio crosses 1: an error falling through zero is small at one level by "
-        "accident, so such a run is never on a cost front.",
+        f"accident, so such a run is never on a cost front; errors at or below {ROUND_LEVEL:g} "
+        "(round-off, the 'exact' level) count as equal and a ratio within it of 1 is on "
+        "neither side: round-off is never cancellation. A level where every model's error is "
+        f"the same to within {SAME_ERROR:.0%} while their stiffness ratios spread ten times as "
+        "much tests nothing (the error is the mesh's) and is left out of its family's fits.",
+        "patch test with every boundary node prescribed (patch error): the strain error of a "
+        "cube whose boundary nodes all follow a homogeneous strain, the interior relaxed; it "
+        "checks consistency at the scale of one lattice and is a different number from the "
+        "consistency limit.",
+        "consistency limit: a fit's floor e_inf, the displacement error that no refinement "
+        "removes in one problem (the consistency limit of the sliding cube: its uniaxial "
+        "stress with traction-free sides, no node of the sides prescribed).",
+        "reaching a target only by cancellation (accuracy per cost): a run's error at or below "
+        "the target on a mesh where FEM P1's is above it: the discretisation error, shared by "
+        "every model on the mesh, exceeds the target, and the model's model-form error (at "
+        "least the difference of the two errors) offsets it; such a run is named, never "
+        "picked.",
         "C_eff: 6 x 6 in Voigt order (xx, yy, zz, yz, xz, xy), engineering shear; E_i = "
         "1 / S_ii, nu_ij = -S_ij / S_ii, G = 1 / S_44.. with S = C_eff^-1 (symmetric part); "
         "A_U = 5 G_V / G_R + K_V / K_R - 6 (0 for isotropy); K/K and mu_k/2G: the bulk "
@@ -152,7 +173,8 @@ def conclusion(s, data):
             "problem x mesh family combinations): ")
     if any(f["verdict"] != "exact" for m in models for f in by[m]):
         head += (
-            f"converging on every fit its reference resolves: {', '.join(conv) or 'none'}; "
+            "converging on every fit where a limit is decided: " + (_converging(
+                conv, data["fits"], loose, total) or "none") + "; "
             "stopping at a floor that no refinement removes: " + ("; ".join(
                 f"{m} in {len(floors[m])} of {total} ({len(by[m])} with a limit or a trend; "
                 "median floor "
@@ -162,12 +184,16 @@ def conclusion(s, data):
             head += (f"; not resolved (the reference's estimate more than a "
                      f"fifth of the finest error, left out of these counts): {len(loose)} fits, "
                      "on " + ", ".join(sorted({f"{k[0]} {k[1]}" for k in loose})))
+    wide = [f for f in data["fits"] if f.get("verdict") == UNDECIDED]
+    if wide:
+        head += (f"; {UNDECIDED} ({UNDECIDED_WHY}: a limit whose +- exceeds "
+                 f"{FS_THREE:g} x the finest error): {len(wide)} fits")
     if undecided:
         head += ("; " if head.endswith(")") or head.endswith("none") else "") + (
             f"not decided: {undecided} fits ({TWO_LEVELS}; `pbcm run convergence` decides, on "
             "four levels)")
     out.append(head + f" (loads scaled by {s.load_scale:g}: the linear regime, so that a floor "
-               "is the model's consistency error, not geometric nonlinearity).")
+               "is the model's consistency limit, not geometric nonlinearity).")
     odd = [f for f in data["fits"] if f.get("verdict") == "not asymptotic"]
     if odd:
         out.append(f"Not asymptotic ({len(odd)} fits, not extrapolated or with a limit below "
@@ -196,6 +222,60 @@ def conclusion(s, data):
                    + ", ".join(f"{m} ({n} of the front's points)" for m, n in counts.items())
                    + f", over {len(c['groups'])} problems.")
     return out
+
+
+def _tally(model, fits, loose):
+    """{what: [where]} of a model's fits that do not converge: 'not asymptotic', 'not
+    decided (uncertainty ...)', 'not decided (two levels)', 'not resolved', 'floor',
+    'diverges'; 'converging or exact' holds the rest."""
+    out = {}
+    for f in fits:
+        if f["model"] != model:
+            continue
+        where = (f["case"], f["bc"], f["mesh"])
+        if (f["case"], f["bc"], f["mesh"], f["model"]) in loose:
+            what = "not resolved"
+        elif f.get("verdict") == UNDECIDED:
+            what = f"{UNDECIDED} ({UNDECIDED_WHY})"
+        elif f.get("verdict") in VERDICTS and not decided(f):
+            what = f"{UNDECIDED} (two levels)"
+        elif f.get("verdict") in ("converges", "exact"):
+            what = "converging or exact"
+        else:
+            what = f.get("verdict", "n/a")
+        out.setdefault(what, []).append(where)
+    return out
+
+
+def _places(where, fits):
+    """'cantilever clamped six, every problem on unstructured': the (case, bc, mesh) in
+    ``where``, a family named once where it holds every problem fitted on it."""
+    problems = {}
+    for f in fits:
+        problems.setdefault(f["mesh"], set()).add((f["case"], f["bc"]))
+    whole = [m for m in dict.fromkeys(w[2] for w in where) if len(problems[m]) > 1
+             and {(c, b) for c, b, mm in where if mm == m} >= problems[m]]
+    return ", ".join([f"{c} {b} {m}" for c, b, m in where if m not in whole]
+                     + [f"every problem on {m}" for m in whole])
+
+
+def _converging(conv, fits, loose, total):
+    """The converging models, those with the same tally together, each with what the tables
+    say of its other fits: 'FEM P1, fem-linear (converging or exact on 7 of 16; not
+    asymptotic on 5: ...; ...)'."""
+    groups = {}
+    for m in conv:
+        t = _tally(m, fits, loose)
+        k = tuple(sorted((w, tuple(v)) for w, v in t.items()))
+        groups.setdefault(k, (t, []))[1].append(m)
+    parts = []
+    for t, ms in groups.values():
+        rest = [f"{w} on {len(v)}: {_places(v, fits)}" for w, v in t.items()
+                if w != "converging or exact"]
+        parts.append(", ".join(ms) + f" (converging or exact on "
+                     f"{len(t.get('converging or exact', []))} of {total}"
+                     + "".join(f"; {r}" for r in rest) + ")")
+    return "; ".join(parts)
 
 
 def _tensor_vs_verdicts(s, data, eff):
@@ -303,7 +383,7 @@ def build(out, study, s, data):
         f"{', '.join(s.models)}, and FEM P1 (scikit-fem) on the same mesh as the yardstick.",
         f"Loads of each case scaled by {s.load_scale:g}: every model answers in its linear "
         "regime, so its limit h -> 0 is the linear continuum and what remains there is its "
-        "consistency error, not geometric nonlinearity (the subject of large-compression).",
+        "consistency limit, not geometric nonlinearity (the subject of large-compression).",
         "Reference per problem: FEM P2 on the 'five' mesh at each spacing of its ladder; the "
         "three finest levels give an order p and the finest level's error estimate; "
         "Richardson's extrapolation of the field from the two finest, u_f + (u_f - u_c) "
@@ -324,7 +404,8 @@ def build(out, study, s, data):
     doc.p(_reference_margin(data))
     doc.h(2, "Verification")
     doc.p("Before the models are judged against the references, the references are verified "
-          "against exact solutions, every model meets the patch test "
+          "against exact solutions, every model is put to the patch test with every boundary "
+          "node prescribed "
           "(cases/studies/convergence/verification.toml declares both) and the particle runs' "
           "time step is checked.")
     manufactured_section(doc, data)
@@ -388,10 +469,42 @@ def _problem_section(doc, out, s, data, name, bc):
                            fmt(f.get("ratio_inf")) if f.get("ratio_inf") is not None
                            else f"n/a ({f.get('ratio_why') or 'no ratio'})"])
     doc.table(header, rows)
+    blind = blind_text(data, name, bc)
+    if blind:
+        doc.p(blind)
     png = f"convergence_{name}_{bc}.png"
     error_vs_h(out / png, f"{name}, {bc}: displacement error against h",
                      list(s.meshes), list(s.models), series, FEM_P1)
     doc.img(png, f"{name}, {bc}: error against h, per mesh family (FEM P1 in black)")
+
+
+def blind_text(data, name, bc):
+    """The levels of problem ``name``/``bc`` that test nothing (``blind_levels``), with why:
+    those left out of the fits, and those kept because fewer than three levels would remain;
+    None where there is none."""
+    blind = {k: v for k, v in blind_levels(data["runs"]).items() if k[:2] == (name, bc)}
+    if not blind:
+        return None
+    problem = PROBLEMS.get(name)
+    left = {(f["mesh"], h) for f in data.get("fits", ()) if (f["case"], f["bc"]) == (name, bc)
+            for h in f.get("left_out_mm") or ()}
+    said = {True: [], False: []}
+    for (_, _, mesh, h), b in blind.items():
+        why = problem.blind_why(h) if problem is not None else None
+        said[(mesh, h) in left].append(
+            f"h = {h:.3g} mm on {mesh}: every one of the {b['models']} models' displacement "
+            f"error there is {b['error']:.3g} to within {b['error_spread']:.1%}, while their "
+            f"{problem.label if problem else 'stiffness'} ratios span {b['ratios'][0]:.3g} to "
+            f"{b['ratios'][1]:.3g}: the displacement does not depend on the model, so the "
+            "error is the mesh's and the level tests nothing" + (f" ({why})" if why else ""))
+    out = []
+    if said[True]:
+        out.append("Left out of the fits (the table shows them, no verdict, order or limit "
+                   "uses them): " + "; ".join(said[True]) + ".")
+    if said[False]:
+        out.append("Kept in the fits, as fewer than three levels would remain, though it "
+                   "tests nothing: " + "; ".join(said[False]) + ".")
+    return " ".join(out)
 
 
 def verdict_cell(f, finest, below):
@@ -399,7 +512,9 @@ def verdict_cell(f, finest, below):
     cannot decide it, ', not resolved' where its finest error ``finest`` is below what the
     reference can judge (``below``), ', cancellation' where the series may cancel."""
     v = f.get("verdict", "n/a")
-    if v in VERDICTS and not decided(f):
+    if v == UNDECIDED:
+        v = f"{UNDECIDED} ({UNDECIDED_WHY})"
+    elif v in VERDICTS and not decided(f):
         v = "not decided (two levels)"
     elif v != "exact" and finest is not None and finest < below:
         v += ", not resolved"
@@ -444,18 +559,27 @@ def _cost_section(doc, out, s, data):
         return (f"{p['model']} ({p['mesh']}, h {p['h_mm']:.3g}: {p['cost_us']:.3g} us, "
                 f"e {p['disp_rel_l2']:.2g})")
 
-    def cheapest(g, target):      # never a run whose series may cancel
-        ok = [p for p in g["points"] if p["disp_rel_l2"] <= target
-              and not p.get("cancellation")]
-        return point(min(ok, key=lambda p: p["cost_us"])) if ok else "none"
+    def pick(g, target):
+        best, by_c = cheapest_run(g["points"], target)
+        return (point(best) if best else "none") + ("; reaching it only by cancellation, not "
+                                                   "picked: " + "; ".join(
+            f"{point(p)}, FEM P1 {p['p1_error']:.2g} there" for p in by_c) if by_c else "")
     for g in c["groups"]:
         rows.append([f"{g['case']} {g['bc']}", len(g["points"]),
                      "; ".join(point(g["points"][i]) for i in g["front"]),
-                     cheapest(g, BUDGETS[0]), cheapest(g, BUDGETS[1])])
+                     pick(g, BUDGETS[0]), pick(g, BUDGETS[1])])
     doc.p("The Pareto front of each problem: the runs no other run beats in both step cost "
           "and displacement error, cheapest first; and the cheapest run that reaches an error "
           "target. A run whose series may cancel rather than converge (its error not monotone "
-          "in h, or its stiffness ratio crossing 1) is never on the front nor the cheapest.")
+          "in h, or its stiffness ratio crossing 1; round-off never counts) is never on the "
+          "front nor the cheapest, nor is a run whose error is below FEM P1's on the same mesh "
+          "and level by more than the reference's estimate (its lead is its model-form error "
+          "offsetting the discretisation error every model on that mesh shares), nor a run at "
+          "a level left out of the fits because it tests nothing. A run that "
+          "reaches a target on a mesh where FEM P1 does not reaches it only by cancellation: "
+          "the discretisation error alone exceeds the target there, and the model gets below "
+          "it only because its model-form error (at least the difference of the two errors) "
+          "offsets it; such runs are named in the cell and never picked.")
     doc.table(["problem", "runs", "front", f"cheapest with e <= {BUDGETS[0]:g}",
                f"cheapest with e <= {BUDGETS[1]:g}"], rows)
     pareto(out / "pareto.png", c["groups"], list(s.models), EXACT)

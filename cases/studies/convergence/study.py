@@ -19,7 +19,8 @@ from ...runner import FINDINGS, free_components, jsonable
 from ...workers import dearest_first, one_blas_thread
 from .cost import accuracy_per_cost
 from .elasticity import table as elasticity_table
-from .fit import EXACT, cancellation, fit, observed_order, ratio_limit
+from .fit import (EXACT, SAME_ERROR, blind_levels, cancellation, fit, observed_order,
+                  ratio_limit)
 from .problems import PROBLEMS
 from .manufactured import units as manufactured_units
 from .patch import units as patch_units
@@ -344,15 +345,24 @@ def fits(runs, references=()):
     the stiffness ratio extrapolated alike (never on a family that is not self-similar, never
     a limit at or below zero) and the series flagged where it may cancel rather than
     converge. ``references`` (their summaries) give each error's own uncertainty: its
-    problem's reference error estimate."""
+    problem's reference error estimate. A level that tests nothing (``blind_levels``) is left
+    out of its family's fits where three levels remain (recorded in ``left_out_mm``); with
+    fewer it stays, and the report says it tests nothing."""
     u_ref = {(r["case"], r["bc"]): r.get("error_estimate") or 0.0 for r in references}
+    blind = blind_levels(runs)
     out = []
     keys = dict.fromkeys((r["case"], r["mesh"], r["bc"], r["model"]) for r in runs)
     for case, mesh, bc, model in keys:
         rs = sorted((r for r in runs if (r["case"], r["mesh"], r["bc"], r["model"])
                      == (case, mesh, bc, model) and r.get("disp_rel_l2") is not None),
                     key=lambda r: -r["h_mm"])
-        row = {"case": case, "mesh": mesh, "bc": bc, "model": model, "levels": len(rs)}
+        dropped = [r["h_mm"] for r in rs if (case, bc, mesh, r["h_mm"]) in blind]
+        if len(rs) - len(dropped) >= 3:     # left out where an order can still be observed
+            rs = [r for r in rs if (case, bc, mesh, r["h_mm"]) not in blind]
+        else:
+            dropped = []
+        row = {"case": case, "mesh": mesh, "bc": bc, "model": model, "levels": len(rs),
+               "left_out_mm": dropped}
         if len(rs) < 2:
             out.append({**row, "order": None, "e_inf": None, "e_inf_err": None,
                         "verdict": "not enough levels", "why": "fewer than two levels solved",
@@ -375,6 +385,12 @@ def fits(runs, references=()):
         row["cancellation"] = cancellation([r["disp_rel_l2"] for r in rs], ratios)
         out.append(row)
     return out
+
+
+def cancelling(fitted):
+    """The (case, mesh, bc, model) of the fits whose series may cancel."""
+    return {(f["case"], f["mesh"], f["bc"], f["model"]) for f in fitted
+            if f.get("cancellation")}
 
 
 def run(s, workers=None, log=True, bench=None, store=OFF):
@@ -422,13 +438,14 @@ def run(s, workers=None, log=True, bench=None, store=OFF):
     runs = [r for rs in rows for r in rs]
     summaries = [ref.summary() for ref in refs]
     fitted = fits(runs, summaries)
-    cancelling = {(f["case"], f["mesh"], f["bc"], f["model"]) for f in fitted
-                  if f.get("cancellation")}
     data = {"runs": runs, "fits": fitted, "references": summaries,
-            "elasticity": eff, "cost": accuracy_per_cost(runs, bench, EXACT, cancelling),
+            "elasticity": eff, "cost": accuracy_per_cost(
+                runs, bench, EXACT, cancelling(fitted),
+                {(r["case"], r["bc"]): r.get("error_estimate") or 0.0 for r in summaries}),
             **verification}
     return jsonable(data)
 
 
-__all__ = ["ConvergenceSettings", "run", "fits", "levels", "solve_reference", "family_runs",
+__all__ = ["ConvergenceSettings", "run", "fits", "cancelling", "blind_levels", "SAME_ERROR",
+           "levels", "solve_reference", "family_runs",
            "reference_unit", "family_unit", "StoredReference", "ReferenceValues", "FEM_P1"]
