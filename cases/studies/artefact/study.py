@@ -236,7 +236,7 @@ def _model_rows(model, factors, name, spec, mesh, s, u_refs):
     # the paper's RK4 run on its own lattice (a dense eigenproblem: 5 nodes per side only)
     rate = P.growth_rate(pm, mesh, "clamped") if spec[1] == P.NODES_PER_SIDE else None
     return [{**base, "bc": bc, "load": load, "growth_rate_1_s": rate,
-             "flutter": None if rate is None else rate > s.damping / 2,
+             "flutter": None if rate is None else rate > 0.0,
              **cell(pm, mesh, spec[1], bc, load, u_refs[(bc, load)])}
             for bc in s.bcs for load in loads]
 
@@ -292,43 +292,46 @@ def run(s, workers=None, log=True, bench=None, store=OFF):
                      **bench_costs(bench, list(s.models))})
 
 
+PAPER_TETS = 5 * (P.NODES_PER_SIDE - 1) ** 3     # the mirrored five cube: 320 tetrahedra
+
+
 def bench_costs(bench, models):
     """What the study takes from the bench document ``bench``: each model's step over msm's
-    on the paper's cube (``step_costs``) and its spread over the bench's rounds and sizes
-    (``step_ranges``), with the sizes and rounds that spread covers."""
+    on the paper's cube (``step_costs``) and its spread over the bench's rounds at that size
+    (``step_ranges``), with the size and rounds that spread covers."""
+    rows = [r for r in (bench or {}).get("rows", []) if r["tets"] == PAPER_TETS]
     return {"step_vs_msm": step_costs(bench, models),
             "step_vs_msm_range": step_ranges(bench, models),
-            "bench_spread": None if not bench else {
-                "tets": sorted({r["tets"] for r in bench.get("rows", [])}),
-                "rounds": max([r.get("rounds") or 0 for r in bench.get("rows", [])],
-                              default=0)}}
+            "bench_spread": None if not rows else {
+                "tets": [PAPER_TETS],
+                "rounds": max([r.get("rounds") or 0 for r in rows], default=0)}}
+
+
+def _paper_row(bench, model):
+    """The bench's row of ``model`` at the paper's size (PAPER_TETS), or None."""
+    return next((r for r in (bench or {}).get("rows", []) if r["model"] == model
+                 and r["tets"] == PAPER_TETS and r.get("step_vs_msm") is not None), None)
 
 
 def step_ranges(bench, models):
-    """{model: [smallest, largest]} of its RK4 step over msm's over every round and every size
-    the bench timed (each size's in-round ratios [smallest-largest]); a literal reading's is
-    its calibrated reading's (the same kernel); None where the bench lacks the model."""
+    """{model: [smallest, largest]} of its RK4 step over msm's over the bench's rounds at the
+    paper's size (PAPER_TETS: one population, never pooled with other sizes); a literal
+    reading's is its calibrated reading's (the same kernel); None where the bench lacks the
+    model at that size or its range."""
     out = {}
-    rows = (bench or {}).get("rows", [])
     for m in models:
-        timed = m.replace("-literal", "")
-        spans = [r.get("step_vs_msm_range") or [r["step_vs_msm"]] * 2 for r in rows
-                 if r["model"] == timed and r.get("step_vs_msm") is not None]
-        out[m] = ([float(min(lo for lo, _ in spans)), float(max(hi for _, hi in spans))]
-                  if spans else None)
+        r = _paper_row(bench, m.replace("-literal", ""))
+        span = None if r is None else r.get("step_vs_msm_range")
+        out[m] = [float(span[0]), float(span[1])] if span else None
     return out
 
 
 def step_costs(bench, models):
-    """Each model's RK4 step over msm's on the paper's 125-node five cube (320 tetrahedra),
-    from the bench's in-process ratios; a literal reading costs what its calibrated one does
-    (the constant only scales the same kernel)."""
-    from ...costs import step_cost_us
-    tets = 5 * (P.NODES_PER_SIDE - 1) ** 3
-    msm = step_cost_us(bench, "msm", tets)
+    """Each model's RK4 step over msm's on the paper's 125-node five cube (320 tetrahedra):
+    the bench's in-round ratio at that size, the number every report prints for it; a literal
+    reading costs what its calibrated one does (the constant only scales the same kernel)."""
     out = {}
     for m in models:
-        timed = m.replace("-literal", "")
-        c = step_cost_us(bench, timed, tets)
-        out[m] = None if c is None or not msm else c / msm
+        r = _paper_row(bench, m.replace("-literal", ""))
+        out[m] = None if r is None else float(r["step_vs_msm"])
     return out
