@@ -193,6 +193,7 @@ def lines(root, models, pops=(), quick=False):
                    + _finest(conv, [m for m in rest if any(
                        not isinstance(v, tuple) for v in lim[m].values())], nolimit)
                    + _irregular(conv, models)
+                   + _beyond_the_patch(conv, models)
                    + " ([convergence](convergence/report.md)).")
     truth = _load(root, MEASURED, "metrics.json")
     if truth and truth.get("headline"):
@@ -217,6 +218,33 @@ def lines(root, models, pops=(), quick=False):
         out.append(f"**What causes the bulge/neck?** {_cause_numbers(art)}")
     out += recommendation(root, models, pops, quick, rows)
     return out
+
+
+def _beyond_the_patch(conv, models):
+    """'. The patch test is necessary, not sufficient: ...': per model, where the convergence
+    study's other problems (bending, torsion, the clamped cube: every fit but the sliding
+    cube's) diverge or stop at a floor under refinement, so that no limit of the patch test
+    is read as the model's distance to the continuum everywhere."""
+    fits = [f for f in conv.get("fits", []) if f["model"] in models
+            and not (f["case"] == "paper-cube" and f["bc"] == "sliding")]
+    if not fits:
+        return ""
+
+    def where(m, verdict):
+        return [f"{f['case']}/{f['bc']} on {f['mesh']}" for f in fits
+                if f["model"] == m and f["verdict"] == verdict]
+    div = {m: where(m, "diverges") for m in models if where(m, "diverges")}
+    floor = {m: where(m, "floor") for m in models if where(m, "floor")}
+    n = {m: sum(f["model"] == m for f in fits) for m in models}
+    said = ("; the patch test is necessary, not sufficient: on the study's other problems "
+            "(bending, torsion, the clamped cube; each fit a problem on one mesh family) ")
+    said += ("the error grows under refinement (diverges, a failure: no limit exists) for "
+             + "; ".join(f"{m} ({len(v)} of {n[m]} fits: {', '.join(v)})"
+                         for m, v in div.items()) if div else "no model's error grows")
+    if floor:
+        said += ("; it stops at a floor no refinement removes for " + ", ".join(
+            f"{m} ({len(v)} of {n[m]})" for m, v in floor.items()))
+    return said
 
 
 def _limit_ties(limits_, said="tied within their +-"):
@@ -430,6 +458,17 @@ def recommendation(root, models, pops, quick, bench_rows):
                 "or one case is left out)" if others else
                 f"; the closest other, on {n} case/bc population{'s' if n > 1 else ''}, is "
                 f"{named(fin, b, others, True)}{linear}") if b else ""
+        # the geometric means may order the models otherwise than the mean ranks: said, so
+        # that the order shown is never read as the only one the data allow
+        if b and fin[b][1] is not None:
+            lower = [m for m, e in fin.items() if m != b and not scorecard.failed(e)
+                     and e[1] is not None and not e[3] and e[1] < fin[b][1]]
+            if lower:
+                said += ("; by geometric mean " + ", ".join(
+                    f"{m} ({rel(fin[m][1])})" for m in sorted(lower, key=lambda m: fin[m][1]))
+                    + f" come before {b} ({rel(fin[b][1])}): mean rank and geometric mean "
+                    "disagree, so neither order decides")
+        said += _how_finite(pops, p1_lin)
         cands = [b] + others if b else []
         failing = [f"{m} ({fin[m][2]} failed runs)" for m in cands if fin[m][2]]
         # the models a failed run put after the rest, named with what they would have scored
@@ -484,6 +523,28 @@ def recommendation(root, models, pops, quick, bench_rows):
                         "unpaired mode)"))
         out.append(line + ".")
     return out[:5] if len(out) > 1 else []
+
+
+def _how_finite(pops, linear_law, nearly=0.05):
+    """'; how far each load is from the linear regime: ...': per population at finite load,
+    the linear law's model-form error there (``linear_law`` against P1 with the reference's
+    law on the same tetrahedra: its linearisation error), so that a load the linear law
+    meets within ``nearly`` is named as testing a nearly linear response."""
+    at = {}
+    for p in pops:
+        if p.finite and not p.patch_test and linear_law in p.parts:
+            st = next((s for _, s, _ in p.standings() if s.model == linear_law), None)
+            if st is not None and math.isfinite(st.score):
+                at[p.label] = st.score
+    if not at:
+        return ""
+    near = sorted((k for k, v in at.items() if v <= nearly), key=at.get)
+    far = sorted((k for k, v in at.items() if v > nearly), key=at.get)
+    return (f"; how finite the loads are ({linear_law}'s linearisation error there, the median "
+            "over the meshes): " + (f"within {nearly:g} on {len(near)} of {len(at)} "
+                                    f"populations ({', '.join(f'{k} {rel(at[k])}' for k in near)}"
+                                    "), a nearly linear response" if near else "none nearly linear")
+            + (f"; beyond it: {', '.join(f'{k} {rel(at[k])}' for k in far)}" if far else ""))
 
 
 def _discretisation(pops, finite):

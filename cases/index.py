@@ -271,16 +271,19 @@ TERMS = {
     "ratio to fem-linear's with its range over the bench's rounds.",
     "calibrated / literal": "a shear reading with c fitted so that its deviatoric moduli are "
     "closest to 2G (calibrated), or with the paper's c = 1 (literal).",
-    "patch test": "a problem with a homogeneous exact answer (the sliding cube): a consistent "
-    "discretisation reproduces it on any mesh; a model that does not has a consistency error.",
+    "patch test": "a problem with a homogeneous exact answer that a consistent "
+    "discretisation reproduces on any mesh, in two forms named apart: the sliding cube (a "
+    "case's boundary conditions; its error under refinement gives the consistency limit) and "
+    "the patch test with every boundary node prescribed (the convergence study's patch_error, "
+    "on regular and irregular patches); a model that fails either has a consistency error.",
     "population": "the runs of one case under one boundary condition: what a median, a range "
     "or a criterion is taken over (never pooled across populations).",
     "identity check": "a comparison whose answer is known to be zero by construction (FEM P1 "
     "against itself; the FEM laws in the linear regime, where they coincide with P1's; FEM "
     "P1 on a patch test it reproduces exactly): it tests the pipeline, never ranks a model.",
-    "unit": "the unit of analysis of a study: one (mesh size, base) configuration of the "
-    "artefact study, over which its signatures are compared; in the scorecard, the mesh "
-    "family (leaving one out tests whether an order holds).",
+    "unit of analysis": "what an order must survive losing: in the scorecard and the case "
+    "reports, the mesh family (leaving one out tests whether an order holds); the artefact "
+    "study calls its (mesh size, base) cells configurations, not units.",
     "leak": "how much of a smooth test field (a barrel, a Gaussian bulge) the period-2 "
     "signature reads as alternation on a given number of layers; a signature below the leak "
     "of smooth fields is not resolved.",

@@ -604,3 +604,40 @@ def test_a_mode_unpaired_against_the_continuum_fails_the_total_only():
     p1 = {"model": "fem-linear", "mf": 0.0, "tot": 0.05, "lost": 0, "lost_c": 0}
     parts = q.parts({"model": "a", "mf": 0.02, "tot": 0.06, "lost": 0, "lost_c": 2}, p1)
     assert (parts.model_form, parts.discretisation, parts.total) == (0.02, 0.05, None)
+
+
+def test_how_far_names_the_problems_beyond_the_patch_test_where_a_model_diverges():
+    """The consistency limit comes from the sliding cube alone; the answer also names, per
+    model, the convergence fits of the other problems that diverge or stop at a floor (the
+    sliding cube's own fits are not counted twice)."""
+    from cases.answers import _beyond_the_patch
+    fits = [{"case": "cantilever", "bc": "clamped", "mesh": "six", "model": "a",
+             "verdict": "diverges"},
+            {"case": "torsion", "bc": "clamped", "mesh": "six", "model": "a",
+             "verdict": "floor"},
+            {"case": "paper-cube", "bc": "sliding", "mesh": "six", "model": "a",
+             "verdict": "diverges"},
+            {"case": "cantilever", "bc": "clamped", "mesh": "six", "model": "b",
+             "verdict": "converges"}]
+    said = _beyond_the_patch({"fits": fits}, ["a", "b"])
+    assert "for a (1 of 2 fits: cantilever/clamped on six)" in said
+    assert "floor no refinement removes for a (1 of 2)" in said and "b (" not in said
+
+
+def test_how_finite_each_load_is_reads_the_linear_laws_error_at_the_load(tmp_path):
+    """Each population at finite load is named with the linear law's model-form error there:
+    within 0.05 a nearly linear response, beyond it a finite one."""
+    from cases.answers import _how_finite
+    from cases.index import populations
+
+    def at_load(r, lin):
+        mf = {"fem-neohookean": 0.0, "fem-linear": lin, "a": 0.2}[r["model"]]
+        return dict(r, nh_error_estimate=0.01, finite_failed=None,
+                    torque_at_load_nm=1.1 + mf, torque_at_load_fem_nm=1.0)
+    runs = [at_load(r, 0.011) for r in _torsion_runs(
+        {(mesh, m): 1.2 for mesh in ("five", "six") for m in ("fem-linear", "fem-neohookean",
+                                                                "a")})]
+    _case_folder(tmp_path, "torsion", runs)
+    pops, _ = populations(tmp_path, ["torsion"])
+    said = _how_finite(pops, "fem-linear")
+    assert "within 0.05 on 1 of 1 populations (torsion/clamped at the load 0.011)" in said
