@@ -221,30 +221,32 @@ def lines(root, models, pops=(), quick=False):
 
 
 def _beyond_the_patch(conv, models):
-    """'. The patch test is necessary, not sufficient: ...': per model, where the convergence
-    study's other problems (bending, torsion, the clamped cube: every fit but the sliding
-    cube's) diverge or stop at a floor under refinement, so that no limit of the patch test
-    is read as the model's distance to the continuum everywhere."""
+    """'; beyond the patch test ...': per model, where the convergence study's other problems
+    (bending, torsion, the clamped cube: every fit but the sliding cube's) diverge or stop at
+    a floor under refinement, so that no patch-test limit is read as the model's distance to
+    the continuum everywhere."""
+    # a verdict on two levels observes no order: only three levels or more decide one
     fits = [f for f in conv.get("fits", []) if f["model"] in models
-            and not (f["case"] == "paper-cube" and f["bc"] == "sliding")]
-    if not fits:
-        return ""
+            and not (f["case"] == "paper-cube" and f["bc"] == "sliding")
+            and (f.get("levels") or 0) >= 3]
 
     def where(m, verdict):
-        return [f"{f['case']}/{f['bc']} on {f['mesh']}" for f in fits
-                if f["model"] == m and f["verdict"] == verdict]
-    div = {m: where(m, "diverges") for m in models if where(m, "diverges")}
-    floor = {m: where(m, "floor") for m in models if where(m, "floor")}
+        cases = {}
+        for f in fits:
+            if f["model"] == m and f["verdict"] == verdict:
+                cases.setdefault(f["case"], []).append(f["mesh"])
+        return "; ".join(f"{c} on {', '.join(v)}" for c, v in cases.items())
     n = {m: sum(f["model"] == m for f in fits) for m in models}
-    said = ("; the patch test is necessary, not sufficient: on the study's other problems "
-            "(bending, torsion, the clamped cube; each fit a problem on one mesh family) ")
-    said += ("the error grows under refinement (diverges, a failure: no limit exists) for "
-             + "; ".join(f"{m} ({len(v)} of {n[m]} fits: {', '.join(v)})"
-                         for m, v in div.items()) if div else "no model's error grows")
-    if floor:
-        said += ("; it stops at a floor no refinement removes for " + ", ".join(
-            f"{m} ({len(v)} of {n[m]})" for m, v in floor.items()))
-    return said
+    div = {m: where(m, "diverges") for m in models if where(m, "diverges")}
+    floor = {m: sum(f["model"] == m and f["verdict"] == "floor" for f in fits) for m in models}
+    if not fits:
+        return ""
+    return ("; beyond the patch test (the study's bending, torsion and clamped-cube fits, "
+            "one per problem and mesh family), the error grows under refinement for "
+            + (", ".join(f"{m} ({v})" for m, v in div.items()) if div else "no model")
+            + ("; stops at a floor in " + ", ".join(f"{floor[m]} of {n[m]} for {m}"
+                                                    for m in models if floor[m])
+               if any(floor.values()) else ""))
 
 
 def _limit_ties(limits_, said="tied within their +-"):
@@ -540,11 +542,13 @@ def _how_finite(pops, linear_law, nearly=0.05):
         return ""
     near = sorted((k for k, v in at.items() if v <= nearly), key=at.get)
     far = sorted((k for k, v in at.items() if v > nearly), key=at.get)
-    return (f"; how finite the loads are ({linear_law}'s linearisation error there, the median "
-            "over the meshes): " + (f"within {nearly:g} on {len(near)} of {len(at)} "
-                                    f"populations ({', '.join(f'{k} {rel(at[k])}' for k in near)}"
-                                    "), a nearly linear response" if near else "none nearly linear")
-            + (f"; beyond it: {', '.join(f'{k} {rel(at[k])}' for k in far)}" if far else ""))
+    def short(k):
+        return k.replace(" at the load", "")
+    return (f"; {linear_law}'s linearisation error at each load (median over the meshes): "
+            + (f"nearly linear, within {nearly:g}: "
+               + ", ".join(f"{short(k)} {rel(at[k])}" for k in near) if near else
+               f"none within {nearly:g}")
+            + (f"; beyond: {', '.join(f'{short(k)} {rel(at[k])}' for k in far)}" if far else ""))
 
 
 def _discretisation(pops, finite):
@@ -633,12 +637,10 @@ def _measured_line(truth, models):
             f"{fmt(100 * h['strain'], 4)} % compression (bonded plates, {h['mesh']} mesh), each "
             f"model read against its u_val = sqrt(u_D^2 + u_input^2 + u_num^2), "
             f"{_span(val['u_val'].values())} mm (u_D the beads' noise "
-            f"{fmt(val['u_d'], 2)}; u_input the model's own bead RMS over the unmeasured plate "
-            f"friction, plate travel and nu, each input's half range, in quadrature, on the "
-            f"{val['mesh']} mesh, {_span(val['u_input'].values())}, which holds each model's "
-            f"own response to nu there, locking included; u_num the neo-Hookean reference's "
-            f"change over its last refinement, {fmt(val['u_num'], 2)}, the same for every "
-            f"model): ")
+            f"{fmt(val['u_d'], 2)}; u_input each unmeasured input's half range of the model's "
+            f"bead RMS (plate friction, travel, nu; locking included) in quadrature, on the "
+            f"{val['mesh']} mesh, {_span(val['u_input'].values())}; u_num the reference's "
+            f"last refinement, {fmt(val['u_num'], 2)}): ")
     if NH in v:
         u_nh = val.get("continuum_u_val")
         said += (f"the neo-Hookean continuum is {fmt(v[NH]['bead_rms_mm'])} mm RMS off"
