@@ -139,6 +139,8 @@ DESCRIPTORS = frozenset({
     "model_info", "nodes", "tets", "h_mm", "dyn_dt_s", "dyn_steps", "dyn_t_end_s", "label",
     "why", "verdict", "levels", "metric", "dropped", "dyn_reaction_t_s", "homogeneous_failed",
     "finite_failed",
+    # the convergence study's levels left out of a fit (each a spacing in mm), with why
+    "left_out_mm",
     # the artefact study's factors: the mesh split and size, the model's parts, the load
     "split", "nodes_per_side", "unmatched_faces", "load", "family", "reading",
     "constant", "normal", "flutter",
