@@ -236,11 +236,11 @@ def _beyond_the_patch(conv, models):
             if f["model"] == m and f["verdict"] == verdict:
                 cases.setdefault(f["case"], []).append(f["mesh"])
         return "; ".join(f"{c} on {', '.join(v)}" for c, v in cases.items())
-    n = {m: sum(f["model"] == m for f in fits) for m in models}
-    div = {m: where(m, "diverges") for m in models if where(m, "diverges")}
-    floor = {m: sum(f["model"] == m and f["verdict"] == "floor" for f in fits) for m in models}
     if not fits:
         return ""
+    n = {m: sum(f["model"] == m for f in fits) for m in models}
+    div = {m: w for m in models if (w := where(m, "diverges"))}
+    floor = {m: sum(f["model"] == m and f["verdict"] == "floor" for f in fits) for m in models}
     return ("; beyond the patch test (the study's bending, torsion and clamped-cube fits, "
             "one per problem and mesh family), the error grows under refinement for "
             + (", ".join(f"{m} ({v})" for m, v in div.items()) if div else "no model")
@@ -542,6 +542,7 @@ def _how_finite(pops, linear_law, nearly=0.05):
         return ""
     near = sorted((k for k, v in at.items() if v <= nearly), key=at.get)
     far = sorted((k for k, v in at.items() if v > nearly), key=at.get)
+
     def short(k):
         return k.replace(" at the load", "")
     return (f"; {linear_law}'s linearisation error at each load (median over the meshes): "

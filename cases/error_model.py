@@ -163,19 +163,16 @@ class Norm:
         disc = (p1_run or {}).get(self.total)
         if any(v is None for v in (mf, tot, disc)):
             return None
-        if self.unpaired and run["model"] != self.p1 and run.get(self.unpaired):
+        if run["model"] == self.p1:
+            mf = 0.0           # P1 against itself, whatever its own run key says
+        elif self.unpaired and run.get(self.unpaired):
             return None
         # a continuum mode unpaired fails the comparison against the continuum alone
         lost = self.unpaired_total and run.get(self.unpaired_total)
         lost_p1 = self.unpaired_total and (p1_run or {}).get(self.unpaired_total)
-        if lost or lost_p1:
-            return Parts(float(_array("model-form error", mf)),
-                         None if lost_p1 else float(_array("discretisation error", disc)),
-                         None)
-        if run["model"] == self.p1:
-            mf = 0.0           # P1 against itself, whatever its own run key says
-        return Parts(*(float(_array(n, v)) for n, v in (
-            ("model-form error", mf), ("discretisation error", disc), ("total error", tot))))
+        return Parts(float(_array("model-form error", mf)),
+                     None if lost_p1 else float(_array("discretisation error", disc)),
+                     None if lost or lost_p1 else float(_array("total error", tot)))
 
 
 def at_load(q):
@@ -239,11 +236,10 @@ def standings(by_model, u, lost=None):
     number (unpaired modes)}, ranked on before the error. Returns [(rank, Standing, tied)],
     best first: a model whose score is within the uncertainty of a difference (``u`` and the
     two medians' ``Standing.spread`` over the meshes, in quadrature) of the first of a group
-    (and that lost as many parts) shares that group's rank; ``tied`` names every other model within that
-    uncertainty of it
-    (pair by pair, never chained, so two neighbours across a rank boundary are still said
-    tied); failed runs count against their model, and models that all failed their median
-    share the last rank."""
+    (and that lost as many parts) shares that group's rank; ``tied`` names every other model
+    within that uncertainty of it (pair by pair, never chained, so two neighbours across a
+    rank boundary are still said tied); failed runs count against their model, and models
+    that all failed their median share the last rank."""
     lost = lost or {}
     u = max(u, ROUND_OFF)       # round-off never orders two models
     st = sorted((Standing(m, tuple(abs(v) for v in vs if v is not None), len(vs))

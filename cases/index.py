@@ -174,7 +174,8 @@ def index_documents(root, cases, studies=(), missing=()):
           "own continuum problem). Each cell is the median over the meshes "
           "[smallest-largest], n of N runs; a failed run counts against its model; models "
           "within u_val and the two medians' spread over the meshes of the first of a group "
-          "share its rank, and a cell names every model within that of it (tied). Colours in the HTML: "
+          "share its rank, and a cell names every model within that of it (tied). Colours in "
+          "the HTML: "
           + ", ".join(f"{label}" for _, _, label in BANDS) + ", red also for a failed run. "
           "Quick-mode cases are marked. The last rows are measured against reality (the "
           "Truth Cube's beads).")
@@ -212,7 +213,8 @@ TERMS = {
     "converged continuum; the same for every model on that mesh.",
     "total error": "(Q_model - Q_c) / |Q_c| = model-form error + discretisation error for a "
     "scalar (over load steps each is its largest component, and the two parts bound the "
-    "total); for a norm the parts bound the total by the triangle inequality; for the modes, paired by shape separately against P1 "
+    "total); for a norm the parts bound the total by the triangle inequality; for the "
+    "modes, paired by shape separately against P1 "
     "and against the continuum, they need not bound it. A small total with a large "
     "model-form error is two errors cancelling.",
     "u_val": "the validation uncertainty sqrt(u_num^2 + u_input^2 + u_D^2) (ASME V&V 20) a "
@@ -233,7 +235,8 @@ TERMS = {
     "lost (unpaired "
     "modes), then by the median over the meshes with a failed run counted as infinitely "
     "wrong (so a failure never removes a population from anyone's comparison); models within "
-    "u_val and the medians' spread over the meshes of the first of a group share its rank; a model with a failed run ranks after "
+    "u_val and the medians' spread over the meshes of the first of a group share its rank; "
+    "a model with a failed run ranks after "
     "every model without one. Beside it the geometric mean over the cases of the population "
     "medians, each floored at its population's u_val, with its range over the rankings that "
     "leave one mesh family out; 'failed' where a population failed at the median (no finite "

@@ -183,7 +183,7 @@ def at_load_quantities(case, mesh, bc, s, u, reaction):
     at_load``) from a solution (u, reaction) there: the reaction on the driven nodes or one
     of the case's quantities of interest; {} where the case decomposes none at the load."""
     q = case.decomposed
-    if at_load(q) is None or at_load(q) not in case.decompositions():
+    if at_load(q) not in case.decompositions():     # None (no quantity at the load) never is
         return {}
     if q.key == "reaction_n":
         driven = case.driven(mesh, bc, s)

@@ -233,12 +233,13 @@ class LargeCompression(Case):
                    "over the load steps; a model nearer the continuum than that twin is less "
                    "locked, not closer to the law, and the model-form error here ranks "
                    "closeness to a locked mesh." if twin else None)
-        return [x for x in (locking,) if x] + [common.best_and_worst(runs, "force_rel_err_max", "Force-strain curve",
-                                      estimate_key=nh),
-                common.best_and_worst(runs, "lateral_rel_err_max", "Lateral expansion",
-                                      estimate_key=nh),
-                " ".join(filter(None, (line, self._agreement(runs), common.failures(runs),
-                                       self._homogeneous_failures(runs))))]
+        return ([locking] if locking else []) + [
+            common.best_and_worst(runs, "force_rel_err_max", "Force-strain curve",
+                                  estimate_key=nh),
+            common.best_and_worst(runs, "lateral_rel_err_max", "Lateral expansion",
+                                  estimate_key=nh),
+            " ".join(filter(None, (line, self._agreement(runs), common.failures(runs),
+                                   self._homogeneous_failures(runs))))]
 
     @staticmethod
     def _homogeneous_failures(runs):

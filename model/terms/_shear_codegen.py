@@ -196,13 +196,9 @@ def expand(lines, variant):
 def reference(name, args, doc, before, per_tet):
     """The tetrahedron-by-tetrahedron kernel ``name_reference``: each tetrahedron's forces
     added into ``out`` as they are computed. What the blocked kernels are tested against."""
-    pad = " " * 8
-    return "\n".join(
-        ["", "", "", "@njit(cache=True, fastmath=FAST)", f"def {name}_reference({args}):",
-         f'    """{doc} Tetrahedron by tetrahedron (the reference of ``{name}``)."""']
-        + [f"    {line}" for line in before]
-        + ["    for t in range(tets.shape[0]):"] + [pad + x for x in expand(per_tet, SERIAL)]
-        + ["    return -1"])
+    return strains_function(f"{name}_reference", args,
+                            f"{doc} Tetrahedron by tetrahedron (the reference of ``{name}``).",
+                            before, per_tet)
 
 
 def in_block(line):
@@ -256,7 +252,8 @@ def blocked(name, args, doc, before, per_tet):
 
 
 def strains_function(name, args, doc, before, per_tet):
-    """The strains, tetrahedron by tetrahedron (calibration and stresses, not the forces)."""
+    """A kernel ``name`` that runs ``per_tet`` tetrahedron by tetrahedron: the strains
+    (calibration and stresses) and each reading's reference forces."""
     pad = " " * 8
     return "\n".join(
         ["", "", "", "@njit(cache=True, fastmath=FAST)", f"def {name}({args}):",
