@@ -522,7 +522,10 @@ def recommendation(root, models, pops, quick, bench_rows):
                      + (f"at model-form error up to {fmt(worst_of[cheapest])} on a case"
                         if math.isfinite(worst_of[cheapest]) else
                         "but failed at the median on a case (a run with no number, or an "
-                        "unpaired mode)"))
+                        "unpaired mode)")
+                     # a failed run is never left out of what the pick says of a model
+                     + (f", with {lin[cheapest][2]} failed runs (no number, or a mode "
+                        "unpaired)" if lin[cheapest][2] else ""))
         out.append(line + ".")
     return out[:5] if len(out) > 1 else []
 
