@@ -101,8 +101,14 @@ def ratio_text(row, base):
     return fmt(r, 2) + (f" [{fmt(rng[0], 2)}-{fmt(rng[1], 2)}]" if rng else "")
 
 
-def table(root, models, pops=()):
-    """(header, rows): one row per model of the scorecard."""
+# a quick run's cell for a verdict the full run decides
+QUICK_CELL = "quick: not decided"
+
+
+def table(root, models, pops=(), quick=False):
+    """(header, rows): one row per model of the scorecard; ``quick``: the verdicts (model-form
+    rankings, limits, whether a run comes to rest) say 'quick: not decided', the measurements
+    stay."""
     from . import scorecard
     conv = _load(root, "convergence", "metrics.json")
     cube = _load(root, "paper-cube", "metrics.json")
@@ -124,12 +130,15 @@ def table(root, models, pops=()):
                       if r["bc"] == "clamped")
         clamped = sum(r["bc"] == "clamped" for r in mine)
         b, fl = _bench_row(bench, m), _bench_row(bench, "fem-linear")
-        rows.append([m, _overall_cell(linear, m, pops, False, spread[False]),
-                     _overall_cell(finite, m, pops, True, spread[True]),
-                     worst(limits(conv, m)) if conv else "n/a",
+        conv_quick = bool(conv and conv["parameters"]["quick"])
+        rows.append([m, QUICK_CELL if quick else
+                     _overall_cell(linear, m, pops, False, spread[False]),
+                     QUICK_CELL if quick else _overall_cell(finite, m, pops, True, spread[True]),
+                     QUICK_CELL if conv_quick else worst(limits(conv, m)) if conv else "n/a",
                      fmt(max(el)) if el else "n/a", fmt(max(alt)) if alt else "n/a",
-                     ("grows beyond the damping" if flutter else "stable under the damping")
-                     + f" ({clamped - flutter} of {clamped} clamped runs stable)"
+                     QUICK_CELL if quick and clamped else
+                     ("grows beyond the damping" if flutter else "comes to rest")
+                     + f" ({clamped - flutter} of {clamped} clamped runs come to rest)"
                      if clamped else "n/a",
                      (f"{fmt(b['cpu_s_per_simulated_s'])} ({ratio_text(b, fl)} x fem-linear)"
                       if b and fl and b is not fl else
@@ -164,7 +173,9 @@ def lines(root, models, pops=(), quick=False):
         out.append(f"**Which reading?** {_decisive(art)}")
     else:
         out.append("**Which reading?** Not computed: run `pbcm run artefact`.")
-    out.append(_cost_of_replacing(pops, models, quick) + _imbalance(root, models))
+    # a quick run's imbalance holds for its few meshes only: said by the full run
+    out.append(_cost_of_replacing(pops, models, quick)
+               + ("" if quick else _imbalance(root, models)))
     if conv:
         lim = {m: limits(conv, m) for m in models}
         # below the patch tolerance on every lattice, and converging on the irregular ones
@@ -241,10 +252,12 @@ def _beyond_the_patch(conv, models):
     n = {m: sum(f["model"] == m for f in fits) for m in models}
     div = {m: w for m in models if (w := where(m, "diverges"))}
     floor = {m: sum(f["model"] == m and f["verdict"] == "floor" for f in fits) for m in models}
-    return ("; beyond the patch test (the study's bending, torsion and clamped-cube fits, "
-            "one per problem and mesh family), the error grows under refinement for "
+    return ("; beyond the patch test (the study's bending, torsion and clamped-cube fits of "
+            "three levels or more, one per problem and mesh family: the sliding cube's and "
+            "two-level fits, which the convergence report also counts, left out), the error "
+            "grows under refinement for "
             + (", ".join(f"{m} ({v})" for m, v in div.items()) if div else "no model")
-            + ("; stops at a floor in " + ", ".join(f"{floor[m]} of {n[m]} for {m}"
+            + ("; stops at a floor in " + ", ".join(f"{floor[m]} of those {n[m]} for {m}"
                                                     for m in models if floor[m])
                if any(floor.values()) else ""))
 
@@ -303,11 +316,14 @@ def _single_runs_u(values, u, what):
 
 
 def _finest(conv, models, lattices):
-    """'; there, the error on the finest level: ...': each model's sliding-cube error at the
-    smallest h it ran on the lattices without a limit (a number where no limit exists), read
-    against the reference's stated estimate there."""
-    said, values = [], []
+    """'; there, the error on the finest level: on x: ...': per lattice without a limit, each
+    model's sliding-cube error at the smallest h it ran there (a number where no limit
+    exists), read against the reference's stated estimate."""
+    est = [r.get("error_estimate") or 0.0 for r in conv.get("references", [])
+           if (r["case"], r["bc"]) == CONSISTENCY]
+    per = []
     for lattice in lattices:
+        said, values = [], []
         for m in models:
             rs = [r for r in conv.get("runs", []) if (r["case"], r["bc"]) == CONSISTENCY
                   and r["mesh"] == lattice and r["model"] == m
@@ -316,11 +332,12 @@ def _finest(conv, models, lattices):
                 r = min(rs, key=lambda r: r["h_mm"])
                 said.append(f"{m} {fmt(r['disp_rel_l2'], 2)} at {fmt(r['h_mm'], 3)} mm")
                 values.append((m, r["disp_rel_l2"]))
-    est = [r.get("error_estimate") or 0.0 for r in conv.get("references", [])
-           if (r["case"], r["bc"]) == CONSISTENCY]
-    return (f"; there, the error at the finest level (no limit: not a consistency limit; "
-            + _single_runs_u(values, max(est, default=0.0), "the reference's estimate") + "): "
-            + ", ".join(said)) if said else ""
+        if said:
+            per.append(f"on {lattice}: {', '.join(said)} ("
+                       + _single_runs_u(values, max(est, default=0.0),
+                                        "the reference's estimate") + ")")
+    return ("; there, the error at the finest level (no limit: not a consistency limit): "
+            + "; ".join(per)) if per else ""
 
 
 def _worst_limit(lim):
@@ -340,11 +357,14 @@ def _cost_of_replacing(pops, models, quick):
         loose = scorecard.unresolved(pops, models, finite)
         rng = scorecard.spread(pops, models, finite)
         if ranked:
-            used = [p for p in pops if p.finite == finite and not p.patch_test]
+            used = [p for p in pops if p.finite == finite and p.ranked]
             n, c = len(used), len({p.case for p in used})
+            us = [p.u_model_form for p in used]
             said.append(f"{regime} (over {c} case{'s' if c > 1 else ''}, {n} case/bc "
                         f"population{'s' if n > 1 else ''}"
-                        + (", so one case decides it" if c == 1 else "") + "): " + ", ".join(
+                        + (", so one case decides it" if c == 1 else "")
+                        + (f"; their u_val {_span(us)}, each score floored at its own"
+                           if us else "") + "): " + ", ".join(
                 f"{m} " + (f"failed ({e[3]} of {e[4]} populations failed at the median"
                            + (f"; {fmt(e[1])} over the others" if e[1] is not None else "")
                            + ")" if e[3] else fmt(e[1]) if e[1] is not None else "n/a")
@@ -363,7 +383,21 @@ def _cost_of_replacing(pops, models, quick):
             "meshes [its range when one mesh family is left out]; a failed run counts against "
             "its model, and a model with a failed run (no number; at the load, no converged "
             "solve) ranks after every model without one: "
-            + "; ".join(said) + " (the scorecard below).")
+            + "; ".join(said) + _locking(pops) + " (the scorecard below).")
+
+
+def _locking(pops):
+    """'; left out of the ranking ...': the locking-prone populations, shown in the scorecard
+    and never pooled, with how far their twin is from the continuum."""
+    out = []
+    for p in pops:
+        if p.locking and not p.patch_test:
+            d = p.discretisation()
+            out.append(p.label + (f" (FEM P1 up to {rel(max(d))} from the continuum there)"
+                                  if d else ""))
+    return ("; left out of the ranking, locking-prone (FEM P1, the twin, locks there: its "
+            "model-form error ranks closeness to a locked mesh): " + ", ".join(out)
+            if out else "")
 
 
 # a model's internal forces balance where their net sum is round-off against their sizes
@@ -450,7 +484,7 @@ def recommendation(root, models, pops, quick, bench_rows):
                    + ".")
     if fin and p1_fin:
         b, others = best(fin, True)
-        n = len([p for p in pops if p.finite and not p.patch_test])
+        n = len([p for p in pops if p.finite and p.ranked])
         order = [m for _, m, _, _ in scorecard.ranked(lin)] if lin else []
         linear = (f"; in the linear regime it ranks {order.index(b) + 1} of {len(order)}"
                   + (f" with {lin[b][2]} failed runs" if lin[b][2] else "")
@@ -535,19 +569,23 @@ def _how_finite(pops, linear_law, nearly=0.05):
     the linear law's model-form error there (``linear_law`` against P1 with the reference's
     law on the same tetrahedra: its linearisation error), so that a load the linear law
     meets within ``nearly`` is named as testing a nearly linear response."""
-    at = {}
+    at, locked = {}, set()
     for p in pops:
         if p.finite and not p.patch_test and linear_law in p.parts:
             st = next((s for _, s, _ in p.standings() if s.model == linear_law), None)
             if st is not None and math.isfinite(st.score):
                 at[p.label] = st.score
+                if p.locking:
+                    locked.add(p.label)
     if not at:
         return ""
     near = sorted((k for k, v in at.items() if v <= nearly), key=at.get)
     far = sorted((k for k, v in at.items() if v > nearly), key=at.get)
 
     def short(k):
-        return k.replace(" at the load", "")
+        return k.replace(" at the load", "") + (
+            " (locking-prone: against a locked twin, so its locking too)" if k in locked
+            else "")
     return (f"; {linear_law}'s linearisation error at each load (median over the meshes): "
             + (f"nearly linear, within {nearly:g}: "
                + ", ".join(f"{short(k)} {rel(at[k])}" for k in near) if near else
@@ -627,8 +665,12 @@ def validation(truth):
 
 
 def _span(values):
+    """'lo-hi' of the values to two figures, one value where they agree."""
     v = list(values)
-    return f"{fmt(min(v), 2)}-{fmt(max(v), 2)}" if v else "n/a"
+    if not v:
+        return "n/a"
+    lo, hi = fmt(min(v), 2), fmt(max(v), 2)
+    return lo if lo == hi else f"{lo}-{hi}"
 
 
 def _measured_line(truth, models):

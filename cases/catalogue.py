@@ -220,8 +220,9 @@ declare("linear_scale", "1", "linear-regime scale",
 # ---------------------------------------------------------------- the case's load
 declare("disp_rel_l2_nh_p1", "1", "disp L2 NH vs P1",
         "at the case's load: ||u_model - u_P1|| / ||u_P1|| over the free components, against "
-        "FEM P1 with the neo-Hookean law on the same tetrahedra (the model-form error at the "
-        "load; fem-neohookean's is its distance to that twin, an identity check).", "max")
+        "FEM P1 with the neo-Hookean law on the same tetrahedra (a field's distance to that "
+        "twin, read for fem-linear's linearisation; the model-form error that ranks is the "
+        "case's own quantity at the load; fem-neohookean's is an identity check).", "max")
 declare("disp_rel_l2_nh", "1", "disp L2 NH",
         "at the case's load: ||u_model - u_ref|| / ||u_ref|| over the free components, "
         "against the converged neo-Hookean P2 reference at the particle nodes (fem-linear's "

@@ -246,6 +246,9 @@ class Case(abc.ABC):
         problem (a closed form read at the mesh's nodes, a load on the mesh's own nodes): the
         continuum values' spread over the meshes is then no numerical uncertainty, and u_num
         is the reference's estimate alone.
+    locking_prone : the boundary conditions where FEM P1, the model-form twin, locks (constant-
+        strain tetrahedra near incompressibility): its model-form error ranks closeness to a
+        locked mesh, so the population is shown and said, never pooled in the overall ranking.
     decomposed : what the error model (``cases.error_model``) splits into model-form error
         (against FEM P1 with the same law on the same tetrahedra) and discretisation error
         (FEM P1 against the continuum): a ``Scalar`` quantity or a ``Norm``; None: the case
@@ -288,6 +291,7 @@ class Case(abc.ABC):
     headline_estimate: ClassVar[str] = "p2_error_estimate"
     patch_tests: ClassVar[tuple] = ()
     per_mesh_continuum: ClassVar[tuple] = ()
+    locking_prone: ClassVar[tuple] = ()
     decomposed: ClassVar[object] = None
     decomposed_at_load: ClassVar[object] = AT_LOAD
     gated: ClassVar[tuple] = ()

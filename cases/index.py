@@ -69,7 +69,8 @@ def scorecard_rows(pops, data, models):
     rows = []
     for p in pops:
         mode = " (quick)" if p.quick else ""
-        label = p.label + mode + (" (patch test)" if p.patch_test else "")
+        label = p.label + mode + (" (patch test)" if p.patch_test else "") + (
+            " (locking-prone: shown, not in the overall ranking)" if p.locking else "")
         disc = p.discretisation()
         law = "neo-Hookean" if p.finite else "linear"
         shared = (f"{rel(np.median(disc))} [{rel_range(min(disc), max(disc))}]" if disc
@@ -94,7 +95,7 @@ def conclusion(pops, models, quick):
         means = scorecard.overall(pops, models, finite)
         if not means:
             continue
-        n = len([p for p in pops if p.finite == finite and not p.patch_test])
+        n = len([p for p in pops if p.finite == finite and p.ranked])
         loose = scorecard.unresolved(pops, models, finite)
         rng = scorecard.spread(pops, models, finite)
         if quick:
@@ -102,7 +103,7 @@ def conclusion(pops, models, quick):
                        "for every mesh).")
             continue
         out.append(f"Model-form ranking, {regime}, over its {n} populations other than patch "
-                   "tests (each model's "
+                   "tests and locking-prone problems (each model's "
                    "mean rank, a population ranking its models first by unpaired modes, then "
                    "by the median over the meshes with a failed run counted as infinitely "
                    "wrong; the geometric mean of its "
@@ -115,11 +116,14 @@ def conclusion(pops, models, quick):
                                  for (a, b), mesh in loose.items() if a == m)
                        for rank, m, entry, tie in scorecard.ranked(means)) + ".")
     worst = {}
-    for p in pops:
+    for p in ([] if quick else pops):     # a quick run's farthest holds for its meshes only
         for _, s, _ in p.standings():
             if s.runs and (s.model not in worst or s.score > worst[s.model][0]):
                 worst[s.model] = (s.score, p)
-    if worst:
+    if quick:
+        out.append("Where each model is farthest from FEM P1: quick: not decided (run `pbcm "
+                   "report` for every mesh).")
+    elif worst:
         out.append("Where each model is farthest from FEM P1 (median model-form error, a failed "
                    "run counted as infinitely wrong): " + "; ".join(
                        f"{m} in {p.label} ("
@@ -150,7 +154,7 @@ def index_documents(root, cases, studies=(), missing=()):
               f"the cases found: {', '.join(cases)}.")
     for line in answers.lines(root, models, pops, quick):
         doc.p(line)
-    header, rows = answers.table(root, models, pops)
+    header, rows = answers.table(root, models, pops, quick)
     doc.table(header, rows)
     doc.p(f"Definitions of every column and metric: [glossary]({GLOSSARY}).")
     shown = [n for n in studies if (root / n / "metrics.json").is_file()]
@@ -222,8 +226,9 @@ TERMS = {
     "of one continuum problem, in quadrature (for a model-form error, the distance "
     "between FEM laws that coincide in the linear regime, FEM P1's own run against the "
     "twin a field is measured on, or the solver's tolerance), u_input "
-    "the sensitivity to inputs nobody measured (0 for the library's cases, whose material and "
-    "load are given, not measured; the Truth Cube's plate friction, travel and nu), u_D the "
+    "the sensitivity to inputs nobody measured (0 for the library's cases: each poses its "
+    "material and load exactly, so a model and FEM are compared on one stated problem and no "
+    "input of it is unknown; the Truth Cube's plate friction, travel and nu), u_D the "
     "measurement's noise (0 where nothing is measured). Two errors closer than u_val are "
     "tied; two medians over the meshes are tied within u_val and both medians' spread over "
     "the meshes (half the range of the medians with one mesh left out), in quadrature. On "

@@ -68,12 +68,13 @@ def _continuum_key(runs, metric):
                  if err_name(q) == metric and ref_name(q) in keys and ref_name(q) != q), None)
 
 
-def uncertainty(runs, metric, estimate_key="p2_error_estimate"):
+def uncertainty(runs, metric, estimate_key="p2_error_estimate", per_mesh=False):
     """(u_num, the spread exceeds the estimate) of a comparison of ``metric`` over ``runs`` (one
     continuum problem on several meshes): the reference's largest estimate combined in
     quadrature with the spread of the continuum's value across the meshes
-    (``error_model.u_num``)."""
-    key = _continuum_key(runs, metric)
+    (``error_model.u_num``); ``per_mesh``: each mesh poses its own continuum problem, so the
+    values' spread is no uncertainty and u_num is the estimate alone."""
+    key = None if per_mesh else _continuum_key(runs, metric)
     values = {}
     if key:
         for r in runs:
@@ -87,43 +88,56 @@ def uncertainty(runs, metric, estimate_key="p2_error_estimate"):
 def _standings(runs, metric, u, lost_key=None):
     """``error_model.standings`` of ``metric`` over one population: every run a model had
     counts, a run without a value as infinitely wrong; ``lost_key`` the run key counting the
-    parts a run lost (unpaired modes), ranked on first."""
-    by, lost = {}, {}
+    parts a run lost (unpaired modes): a run that lost one is a failed run, as in the error
+    model."""
+    by = {}
     for r in runs:
-        by.setdefault(r["model"], []).append(r.get(metric))
-        if lost_key:
-            lost[r["model"]] = lost.get(r["model"], 0) + (r.get(lost_key) or 0)
-    return standings(by, u, lost)
+        by.setdefault(r["model"], []).append(
+            None if lost_key and r.get(lost_key) else r.get(metric))
+    return standings(by, u)
 
 
-def _u_text(u, defect, field=False):
+def _lost(runs, lost_key):
+    """{model: parts lost over its runs} (unpaired modes), the models that lost none left
+    out."""
+    lost = {}
+    for r in runs:
+        if lost_key and r.get(lost_key):
+            lost[r["model"]] = lost.get(r["model"], 0) + r[lost_key]
+    return lost
+
+
+def _u_text(u, defect, field=False, per_mesh=False):
     """'u_num U' and what it holds: the reference's estimate and its spread over the meshes
-    in quadrature, or the estimate alone for a field (no one value to spread)."""
-    return f"u_num {rel(u, 2)}" + (
-        " (the reference's estimate: a field has no one value to spread over the meshes)"
-        if field else ", mostly the spread over the meshes" if defect else "")
+    in quadrature, or the estimate alone (a field has no one value to spread; each mesh its
+    own continuum problem), and the two medians' spread over the meshes a tie also reads."""
+    held = (" (the reference's estimate: a field has no one value to spread over the meshes)"
+            if field else " (the estimate alone: each mesh its own continuum problem)"
+            if per_mesh else ", mostly the continuum's spread over the meshes" if defect
+            else "")
+    return f"u_num {rel(u, 2)}{held} and the two medians' spread over the meshes"
 
 
-def ranking(runs, metric, label, estimate_key="p2_error_estimate", lost_key=None):
+def ranking(runs, metric, label, estimate_key="p2_error_estimate", lost_key=None,
+            per_mesh=()):
     """A table (one item of a report's findings): per population (boundary condition) the
-    models by median ``metric`` over every run they had (a run without a value counts against
-    its model, as infinitely wrong), best first, with the range and 'n of N runs'; a model
-    within the reference's u_num (``uncertainty``) of the first of a group shares its order,
-    and every model names those within u_num of it (the reference cannot order them)."""
+    models by median ``metric`` over every run they had (a run without a value, or one that
+    lost a part, counts against its model, as infinitely wrong), best first, with the range
+    and 'n of N runs'; a model within the reference's u_num (``uncertainty``) and the two
+    medians' spread of the first of a group shares its order, and every model names those
+    within it (the comparison cannot order them); ``per_mesh``: the boundary conditions where
+    each mesh poses its own continuum problem."""
     rows = []
     for bc, rs in populations(runs).items():
-        u, defect = uncertainty(rs, metric, estimate_key)
-        lost = {}
-        for r in rs:
-            lost[r["model"]] = lost.get(r["model"], 0) + ((r.get(lost_key) or 0) if lost_key
-                                                           else 0)
+        u, defect = uncertainty(rs, metric, estimate_key, bc in per_mesh)
+        lost = _lost(rs, lost_key)
         for rank, s, tie in _standings(rs, metric, u, lost_key):
             note = []
             if lost.get(s.model):
-                note.append(f"{lost[s.model]} unpaired modes (failed, ranked first)")
+                note.append(f"{lost[s.model]} unpaired modes (each run with one failed)")
             if tie:
-                note.append(f"tied with {', '.join(tie)} "
-                            f"({_u_text(u, defect, _continuum_key(rs, metric) is None)})")
+                held = _u_text(u, defect, _continuum_key(rs, metric) is None, bc in per_mesh)
+                note.append(f"tied with {', '.join(tie)} (within {held})")
             if s.failed:
                 note.append(f"{s.failed} failed, counted against it")
             rows.append([bc, rank, s.model, *_stats(s), "; ".join(note)])
@@ -147,16 +161,18 @@ def _cell(s):
 
 
 def best_and_worst(runs, metric, what, exact=False, estimate_key="p2_error_estimate",
-                   lost_key=None):
+                   lost_key=None, per_mesh=()):
     """Per population (boundary condition), one line naming the model closest to FEM and the
     farthest by median ``metric`` over every run (a run without a value counts against its
-    model); the models within the reference's u_num (``uncertainty``) of the closest are named
-    tied with it, the line says so where that exceeds a fifth of the smallest error it ranks
-    (``exact``: the metric is against a closed form, which has no estimate), and it names the
-    models with failed runs; ``lost_key``: the run key of the parts a run lost (unpaired
-    modes), ranked on first and named."""
+    model); the models within the reference's u_num (``uncertainty``) and the two medians'
+    spread of the closest are named tied with it, the line says so where u_num exceeds a
+    fifth of the smallest error it ranks (``exact``: the metric is against a closed form,
+    which has no estimate), and it names the models with failed runs; ``lost_key``: the run
+    key of the parts a run lost (unpaired modes): such a run is a failed run, and named;
+    ``per_mesh``: the boundary conditions where each mesh poses its own continuum problem."""
     def line_of(rs):
-        u, defect = (0.0, False) if exact else uncertainty(rs, metric, estimate_key)
+        own = rs[0]["bc"] in per_mesh
+        u, defect = (0.0, False) if exact else uncertainty(rs, metric, estimate_key, own)
         st = _standings(rs, metric, u, lost_key)
         if not st or not any(s.values for _, s, _ in st):
             return f"No model gave {what}."
@@ -167,20 +183,16 @@ def best_and_worst(runs, metric, what, exact=False, estimate_key="p2_error_estim
         if failed:
             line += (" Failed runs, counted against their model: " + ", ".join(
                 f"{s.model} ({s.failed} of {s.runs})" for s in failed) + ".")
-        if lost_key:
-            lost = {}
-            for r in rs:
-                lost[r["model"]] = lost.get(r["model"], 0) + (r.get(lost_key) or 0)
-            unpaired = [f"{m} ({k})" for m, k in lost.items() if k]
-            if unpaired:
-                line += (" Unpaired modes, failed modes ranked on before the error: "
-                         + ", ".join(unpaired) + ".")
+        unpaired = [f"{m} ({k})" for m, k in _lost(rs, lost_key).items()]
+        if unpaired:
+            line += (" Unpaired modes (a run with one is a failed run): "
+                     + ", ".join(unpaired) + ".")
         if exact:
             return line
         tied = list(st[0][2])
         if tied:
             line += (f" Tied with {best.model} within the reference's "
-                     f"{_u_text(u, defect, _continuum_key(rs, metric) is None)}: "
+                     f"{_u_text(u, defect, _continuum_key(rs, metric) is None, own)}: "
                      f"{', '.join(tied)}.")
         smallest = min(min(s.values) for _, s, _ in st if s.values)
         if u > smallest / 5:

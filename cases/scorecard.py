@@ -46,6 +46,15 @@ class Population:
     # each mesh poses its own continuum problem (the case's ``per_mesh_continuum``): the
     # values' spread over the meshes is no uncertainty, u_num is the estimate alone
     per_mesh: bool = False
+    # FEM P1, the twin, locks here (the case's ``locking_prone``): shown, never pooled
+    locking: bool = False
+
+    @property
+    def ranked(self):
+        """Whether the overall ranking pools this population: neither a patch test (pass or
+        fail, the consistency limit's subject) nor locking-prone (its model-form error ranks
+        closeness to a locked mesh)."""
+        return not self.patch_test and not self.locking
 
     @property
     def unpaired(self):
@@ -123,11 +132,13 @@ def populations(runs_by_case, declared, quick, patch_tests, estimate_keys):
                                        q.posed or estimate_keys[case],
                                        " at the load" if at_load else "",
                                        bc in getattr(declared[case], "per_mesh_continuum",
-                                                     ())))
+                                                     ()),
+                                       bc in getattr(declared[case], "locking_prone", ())))
     return out
 
 
-def _population(case, bc, q, rs, quick, patch_test, estimate_key, where, per_mesh=False):
+def _population(case, bc, q, rs, quick, patch_test, estimate_key, where, per_mesh=False,
+                locking=False):
     dec = E.decomposed(rs, q)
     failed_modes = getattr(q, "unpaired", None)
     failed_total = getattr(q, "unpaired_total", None)
@@ -152,7 +163,7 @@ def _population(case, bc, q, rs, quick, patch_test, estimate_key, where, per_mes
     cont = [] if per_mesh else [_first(v) for v in cont.values() if v is not None]
     u_c, defect = E.u_num(max(est) if est else None, cont)
     return Population(case, bc, q, parts, u_mf, u_c, defect, patch_test, quick, meshes, lost,
-                      lost_total=lost_total, where=where, per_mesh=per_mesh)
+                      lost_total=lost_total, where=where, per_mesh=per_mesh, locking=locking)
 
 
 def _key(q):
@@ -218,7 +229,7 @@ def _subsets(pops, finite):
     """[(what was left out, the populations without it)]: each mesh family, then each case
     where the regime has more than one (the case is a unit too: an order one case decides is
     not resolved)."""
-    cases = sorted({p.case for p in pops if p.finite == finite and not p.patch_test})
+    cases = sorted({p.case for p in pops if p.finite == finite and p.ranked})
     out = [(mesh, [p.without(mesh) for p in pops]) for mesh in _meshes(pops, finite)]
     if len(cases) > 1:
         out += [(case, [p for p in pops if p.case != case]) for case in cases]
@@ -249,9 +260,9 @@ def overall(pops, models, finite=False):
     solve) against its model; each case weighs one (its boundary conditions are averaged
     first: two bcs of one case are not two independent observations); each score floored at
     its population's model-form uncertainty; P1 itself left out (an identity check), and the
-    patch tests (pass or fail, the consistency limit's subject: never pooled with the rest);
+    populations ``Population.ranked`` leaves out (patch tests, locking-prone problems);
     a model with any failed run ranks after every model without one (``_order``)."""
-    used = [p for p in pops if p.finite == finite and not p.patch_test]
+    used = [p for p in pops if p.finite == finite and p.ranked]
     out = {}
     for m in models:
         mine = [p for p in used if m in p.parts and m not in p.identity]
@@ -275,9 +286,9 @@ def overall(pops, models, finite=False):
 
 def largest(pops, model, finite=False):
     """A model's largest population score (the median over the meshes, a failed run counted
-    as infinitely wrong) over the populations of one regime other than patch tests, or None
-    where it ran in none."""
-    scores = [s.score for p in pops if p.finite == finite and not p.patch_test
+    as infinitely wrong) over the ranked populations of one regime, or None where it ran in
+    none."""
+    scores = [s.score for p in pops if p.finite == finite and p.ranked
               for _, s, _ in p.standings() if s.model == model]
     return max(scores) if scores else None
 

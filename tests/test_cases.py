@@ -198,8 +198,9 @@ def test_rankings_tie_models_within_u_num_of_a_groups_first():
     (table,) = common.ranking(runs, "err", "error")
     assert [r[2] for r in table.rows] == ["a", "b", "c", "d"]
     alone = " (the reference's estimate: a field has no one value to spread over the meshes)"
-    assert [r[-1] for r in table.rows] == [f"tied with b (u_num 0.01{alone})",
-                                           f"tied with a (u_num 0.01{alone})", "", ""]
+    within = f"u_num 0.01{alone} and the two medians' spread over the meshes"
+    assert [r[-1] for r in table.rows] == [f"tied with b (within {within})",
+                                           f"tied with a (within {within})", "", ""]
     assert [r[1] for r in table.rows] == [1, 1, 3, 4]
     line = common.best_and_worst(runs, "err", "Error")
     assert "from a (" in line and "to d (" in line and ": b." in line
@@ -213,7 +214,8 @@ def test_rankings_tie_models_within_u_num_of_a_groups_first():
 def test_ties_widen_to_the_continuums_spread_over_the_meshes():
     """u_num combines the estimate and the continuum's spread over the meshes in quadrature:
     two meshes whose references give 1.0 and 1.1 (spread 0.095 > estimate 0.01) tie errors
-    0.10 and 0.15, and the note says the spread set it."""
+    0.10 and 0.15, and the note says the spread set it; where each mesh poses its own
+    continuum problem the spread is no uncertainty and the two are not tied."""
     from cases import rankings
     runs = [{"model": m, "mesh": mesh, "bc": "clamped", "q_rel_err": e, "q_mm": 1.0,
              "q_fem_mm": ref, "p2_error_estimate": 0.01}
@@ -221,7 +223,13 @@ def test_ties_widen_to_the_continuums_spread_over_the_meshes():
     u, defect = rankings.uncertainty(runs, "q_rel_err")
     assert u == pytest.approx(np.hypot(0.01, 0.1 / 1.05)) and defect
     (table,) = rankings.ranking(runs, "q_rel_err", "error")
-    assert table.rows[1][-1] == "tied with a (u_num 0.096, mostly the spread over the meshes)"
+    assert table.rows[1][-1] == ("tied with a (within u_num 0.096, mostly the continuum's "
+                                 "spread over the meshes and the two medians' spread over "
+                                 "the meshes)")
+    per = rankings.uncertainty(runs, "q_rel_err", per_mesh=True)
+    assert per == (pytest.approx(0.01), False)       # each mesh its own problem: no spread
+    (own,) = rankings.ranking(runs, "q_rel_err", "error", per_mesh=("clamped",))
+    assert own.rows[1][-1] == ""     # 0.05 apart, beyond the estimate alone: not tied
 
 
 def test_rankings_keep_populations_apart_and_count_failed_runs():

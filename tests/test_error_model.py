@@ -349,12 +349,15 @@ def test_consistency_limits_closer_than_their_uncertainty_are_tied():
     assert _limit_ties(chain) == " (tied within their +-: v, b; b, n)"   # v, n: 0.13 > 0.042
 
 
-def test_what_to_pick_is_computed_and_names_what_is_not_decided(tmp_path):
+def test_what_to_pick_is_computed_and_names_what_is_not_decided(tmp_path, monkeypatch):
     """The recommendation names FEM P1 as an identity check with the discretisation error every
     model pays, the closest approximation in the linear regime, and 'not decided' at finite
-    load where one mesh reverses the order, with the candidates' failures at a case's load."""
-    from cases.answers import recommendation
+    load where one mesh reverses the order, with the candidates' failures at a case's load;
+    a locking-prone population is left out of the ranking and named."""
+    from cases.answers import _cost_of_replacing, recommendation
     from cases.index import populations
+    from cases.library.large_compression import CASE as LARGE
+    monkeypatch.setattr(type(LARGE), "locking_prone", ())
     lin = {}
     for mesh in ("five", "six"):
         lin.update({(mesh, "fem-linear"): 1.2, (mesh, "a"): 1.1, (mesh, "b"): 1.5})
@@ -384,6 +387,14 @@ def test_what_to_pick_is_computed_and_names_what_is_not_decided(tmp_path):
     assert "with failed runs (no converged solve at the load): b (1 failed runs)" in lines[2]
     assert recommendation(tmp_path, ["a"], pops, True, {}) == [
         "**What to pick?** Quick: not decided (`pbcm report` decides)."]
+    monkeypatch.undo()                 # the case as declared: its bonded cube locks
+    locked, _ = populations(tmp_path, ["torsion", "large-compression"])
+    assert [p.ranked for p in locked if p.case == "large-compression"] == [False]
+    said = _cost_of_replacing(locked, ["a", "b"], False)
+    assert "finite load" not in said.split("(the scorecard")[0].split("; left out")[0]
+    assert ("left out of the ranking, locking-prone (FEM P1, the twin, locks there: its "
+            "model-form error ranks closeness to a locked mesh): large-compression/clamped "
+            "(FEM P1 up to 0.2 from the continuum there)") in said
 
 
 def test_no_equilibrium_at_a_linear_cases_load_is_a_failed_run_of_its_load_population(tmp_path):
@@ -506,9 +517,11 @@ def test_a_total_with_unpaired_continuum_modes_ranks_after_one_without():
     assert order.index("b") < order.index("a")
     (table,) = rankings.ranking(runs, "tot", "error", lost_key="lost_c")
     assert [r[2] for r in table.rows][-1] == "a"
-    assert "9 unpaired modes (failed, ranked first)" in table.rows[-1][-1]
+    assert "9 unpaired modes (each run with one failed)" in table.rows[-1][-1]
+    assert table.rows[-1][3:6] == ["failed", "", "0 of 1"]     # its run failed, not 0.03
     line = rankings.best_and_worst(runs, "tot", "Error", lost_key="lost_c")
     assert "to a (" in line and "Unpaired modes" in line and "a (9)" in line
+    assert "a (1 of 1)" in line          # named among the failed runs
 
 
 def test_truth_cube_u_input_adds_each_unmeasured_inputs_half_range_in_quadrature():
@@ -624,7 +637,41 @@ def test_how_far_names_the_problems_beyond_the_patch_test_where_a_model_diverges
     fits.append(dict(fits[-1], verdict="diverges", levels=2))
     said = _beyond_the_patch({"fits": fits}, ["a", "b"])
     assert "grows under refinement for a (cantilever on six)" in said
-    assert "floor in 1 of 2 for a" in said and "for b" not in said
+    assert "floor in 1 of those 2 for a" in said and "for b" not in said
+
+
+def test_the_finest_level_is_said_per_lattice_with_its_own_ties():
+    """Where no limit exists, each lattice's finest-level errors are listed under its name,
+    and ties are read within one lattice, never across two."""
+    from cases.answers import _finest
+    runs = [{"case": "paper-cube", "bc": "sliding", "mesh": mesh, "model": m, "h_mm": h,
+             "disp_rel_l2": e}
+            for mesh, vals in (("bcc", {"a": 0.09, "b": 0.0900001}),
+                               ("unstructured", {"a": 0.0900002, "b": 0.5}))
+            for m, e in vals.items() for h in (2.0, 4.0)]
+    said = _finest({"runs": runs, "references": [{"case": "paper-cube", "bc": "sliding",
+                                                  "error_estimate": 1e-6}]},
+                   ["a", "b"], ["bcc", "unstructured"])
+    bcc, unstructured = said.split("; on ")
+    assert bcc.startswith("; there, the error at the finest level") and "on bcc: a 0.09" in bcc
+    assert "tied: a, b" in bcc
+    assert unstructured.startswith("unstructured: a 0.09 at 2 mm, b 0.5 at 2 mm")
+    assert "no two within it" in unstructured
+
+
+def test_a_quick_index_table_decides_no_verdict(tmp_path):
+    """A quick run's table says 'quick: not decided' for the model-form rankings and whether
+    the runs come to rest, never a number the full run could contradict."""
+    from cases.answers import QUICK_CELL, table
+    from cases.index import populations
+    _case_folder(tmp_path, "torsion", _torsion_runs({(mesh, m): v for mesh in ("five", "six")
+                                                     for m, v in (("fem-linear", 1.2),
+                                                                  ("a", 1.1))}))
+    pops, _ = populations(tmp_path, ["torsion"])
+    _, rows = table(tmp_path, ["a"], pops, quick=True)
+    assert rows[0][1:3] == [QUICK_CELL, QUICK_CELL]
+    _, full = table(tmp_path, ["a"], pops)
+    assert QUICK_CELL not in full[0]
 
 
 def test_how_finite_each_load_is_reads_the_linear_laws_error_at_the_load(tmp_path):

@@ -64,10 +64,10 @@ def test_rankings_failures_and_verdicts_worked_by_hand():
     assert [v for _, _, v in table["m2"]] == ["worsens", "worsens", "worsens", "fixes"]
     doc = {"parameters": {"models": models}, "rankings": rank}
     text = " ".join(R.conclusion(doc))
-    # leaving one population out: m1 is 0.25 (cantilever left) or 1 (paper cube left)
-    assert "the best normal-stress extension is m1" in text
-    assert "its model-form errors (against FEM P1 on the same tetrahedra) are 0.5 [0.25-1]" \
-        in text
+    # leaving one population out: m1 is 0.25 (cantilever left) or 1 (paper cube left), m2
+    # 0.5 or 2: the ranges overlap, so no best is named
+    assert "among the normal-stress extensions not decided between m1, m2" in text
+    assert "m1 0.5 [0.25-1], m2 1 [0.5-2]; m1 not resolved from the paper model's" in text
     assert "m1 fixes 3 of them: paper-cube/clamped model-form error" in text \
         and "0.2 -> 0.05" in text
     assert "m2 fixes 1 of them: C_eff on six 0.04 -> 0.005 and worsens" in text
@@ -77,26 +77,48 @@ def test_headline_says_when_no_candidate_beats_the_paper_model():
     errs = {"torsion": {BASE: 0.1, "m1": 0.2, "m2": 0.4, YARDSTICK: 0.1}}
     models, data = _doc(errs, {}, {})
     doc = {"parameters": {"models": models}, "rankings": R.rankings(data, models)}
+    # one population: no range leaving one out, so no best is named
     assert R.conclusion(doc)[0].startswith(
-        "Over the 1 case populations of the library no normal-stress extension beats the "
-        "paper model; the closest is m1: its model-form errors (against FEM P1 on the same "
-        "tetrahedra) are 2 times")
+        "Over the 1 pooled populations of the library, among the normal-stress extensions "
+        "not decided between m1, m2 (their ranges leaving one population out overlap): ")
+    assert "m1 2, m2 4; m1 above the paper model's on every population left out" in \
+        R.conclusion(doc)[0]
 
 
-def test_a_population_with_a_failed_run_leaves_every_mean_and_is_said():
-    """Every model's geometric mean is over the same populations, those where every model
-    has a result (before, a model's mean left out the case where it failed, the others' did
-    not); the failure is said as 'fails' on its criterion."""
+def test_a_population_with_a_failed_run_stays_and_counts_against_its_model():
+    """Every model's geometric mean is over the same populations, a candidate's failure
+    among them: the model that failed has no mean, is ranked last and said failed (never a
+    mean over the populations it survived); the others keep the population; the failure is
+    said as 'fails' on its criterion; a patch test and a locking-prone problem are not
+    pooled, and candidates identical everywhere are said to be one observation."""
     errs = {"torsion": {BASE: 0.2, "m1": None, "m2": 0.1, YARDSTICK: 0.1},
             "cantilever": {BASE: 0.1, "m1": 0.05, "m2": 0.2, YARDSTICK: 0.1}}
     models, data = _doc(errs, {}, {})
     data["case_runs"][1]["failed"] = "static: no equilibrium"
     rank = R.rankings(data, models)
-    assert rank["overall_over"] == 1
-    assert rank["overall"]["m1"] == pytest.approx(0.5)
-    assert rank["overall"]["m2"] == pytest.approx(2.0)
+    assert rank["overall_over"] == 2 and rank["overall_failed"]["m1"] == 1
+    assert rank["overall"]["m1"] is None
+    assert rank["overall"]["m2"] == pytest.approx(1.0)
+    assert R.order(rank["overall"])[-1] == "m1"
     _, table = R.fixes(rank, models)
     assert table["m1"][0][2] == "fails"
+    lead = R.conclusion({"parameters": {"models": models}, "rankings": rank})[0]
+    assert "m1 failed (no result on 1 of 2 populations)" in lead and "the best is m2" in lead
+    # a locking-prone problem and a patch test are shown, never pooled
+    more = {**errs, "large-compression": {BASE: 0.2, "m1": 0.1, "m2": 0.1, YARDSTICK: 0.4},
+            "paper-cube": {BASE: 0.1, "m1": 0.1, "m2": 0.1, YARDSTICK: 0.0}}
+    _, data = _doc(more, {}, {})
+    for r in data["case_runs"]:
+        r["bc"] = "sliding" if r["case"] == "paper-cube" else "clamped"
+    rank = R.rankings(data, models)
+    assert rank["overall_over"] == 2
+    assert rank["left_out"] == ["large-compression/clamped", "paper-cube/sliding"]
+    # identical on every population: said as one observation
+    twin = {c: {**es, "m1": es["m2"]} for c, es in errs.items()}
+    _, data = _doc(twin, {}, {})
+    lead = R.conclusion({"parameters": {"models": models},
+                         "rankings": R.rankings(data, models)})[0]
+    assert "Identical on every population (one observation, not several): m1 = m2" in lead
 
 
 @pytest.fixture(scope="module")

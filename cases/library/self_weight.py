@@ -124,7 +124,8 @@ class SelfWeight(Case):
 
     def conclusion(self, s, runs):
         slide = [r for r in runs if r["bc"] == "sliding"]
-        out = [common.best_and_worst(runs, "top_settlement_rel_err", "Top settlement")]
+        out = [common.best_and_worst(runs, "top_settlement_rel_err", "Top settlement",
+                                     per_mesh=self.per_mesh_continuum)]
         r = next((r for r in slide if r.get("top_settlement_fem_mm") is not None), None)
         if r:
             out.append(f"Sliding base: FEM P2 settles {r['top_settlement_fem_mm']:.4g} mm, the "
@@ -136,7 +137,8 @@ class SelfWeight(Case):
 
     def findings(self, s, runs):
         return {bc: common.ranking([r for r in runs if r["bc"] == bc],
-                                   "top_settlement_rel_err", "settlement error")
+                                   "top_settlement_rel_err", "settlement error",
+                                   per_mesh=self.per_mesh_continuum)
                 for bc in s.bcs} | {"Failures": [common.failures(runs)]}
 
 

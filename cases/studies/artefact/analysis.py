@@ -724,8 +724,8 @@ def consistency(cells):
     """Hypothesis (c), the model's consistency: per conforming mesh with the linear regime
     (the sliding cube at 1e-3 of the push is a patch test) from DECISIVE layers, the rank
     correlation over the distinct approximations (the control left out) between the
-    signature at the push on the sliding base and the patch-test error, signed and on
-    |signature|, with models agreeing to SAME (3 significant figures) and to COARSE (2)
+    signature at the push on the sliding base and the sliding cube's linear-load error, signed
+    and on |signature|, with models agreeing to SAME (3 significant figures) and to COARSE (2)
     counted once, each with its 95 % interval; the verdict where all four agree, else 'not
     decided'; not testable on a mesh whose configuration does not decide or where no model's
     signature is clear (on both normalisations, against its uncertainty): the standard of all
@@ -1166,7 +1166,8 @@ def answer(cells, models=None):
     open_ = ([paper] + ([skipped] if skipped else [])
              + ([f"{_names(unresolved)} (not resolved on any configuration)"]
                 if unresolved else [])
-             + ([f"{_names(failed)} (failed on every configuration)"] if failed else [])
+             + ([f"{_names(failed)} (failed on every configuration that decides)"]
+                if failed else [])
              + ([f"{_compress(unclear)} (no clear signature on any configuration)"]
                 if unclear and (own_any or fem_units) else [])
              + [f"{_compress(ns_)} ({v[len('not decided ('):-1]})"

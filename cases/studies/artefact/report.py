@@ -62,9 +62,10 @@ def conclusion(doc):
     preview that decides nothing."""
     lines = [f"**What causes the bulge/neck pattern.** {doc['answer']['text']}",
              f"**Which reading.** {doc['verdict']['text']}", doc["how_sure"]]
-    if doc["parameters"].get("quick"):
+    if doc["parameters"].get("quick"):     # the cells below show what it measured
         return ["**Quick: not decided** (`pbcm run artefact` decides, on meshes of 9 and 17 "
-                "nodes per side); what the quick cells show, as a preview:"] + lines
+                "nodes per side): the cells and tables below are a preview of its few meshes "
+                "and decide nothing."]
     return lines
 
 
@@ -444,9 +445,10 @@ def _consistency(d, cs, us=()):
     d.h(2, "(c) The model's consistency")
     d.p("Per conforming mesh with the linear load (from 9 nodes per side: 17 has no linear "
         "load): the rank correlation over the distinct models (FEM P1 left out) between the "
-        "signature at the push and the patch-test error (the displacement error at "
+        "signature at the push and the sliding cube's linear-load error (the displacement "
+        "error at "
         f"{LINEAR_SCALE:g} of the push), both on the sliding base, signed and on |signature|, "
-        f"with models whose signature and patch error agree to {SAME:g} (3 significant "
+        f"with models whose signature and that error agree to {SAME:g} (3 significant "
         f"figures) and to {COARSE:g} (2) counted once (near-duplicate variants are one "
         "observation), each with its 95 % interval (Fisher z, variance 1.06 / (n - 3)); "
         f"'tracks' where the interval lies above 0 and the correlation is 0.7 or more, 'does "

@@ -80,39 +80,68 @@ def discretisation(data):
     return out
 
 
-def _complete(errors, models):
-    """The populations where every model has a result (the only ones a mean may use)."""
-    return [e for e in errors.values() if all(e.get(m) is not None for m in models)
-            and e.get(BASE)]
+def pooled(pop):
+    """Whether the overall mean pools the population ``case/bc``: neither a patch test (pass
+    or fail, never pooled with the rest) nor locking-prone (its model-form error ranks
+    closeness to a locked mesh), as the case declares it."""
+    from ...registry import CASES
+    case, _, bc = pop.partition("/")
+    c = CASES.get(case)
+    return c is None or (bc not in c.patch_tests and bc not in c.locking_prone)
+
+
+def _complete(errors):
+    """The pooled populations where the paper model has a nonzero result (the ratios' base);
+    a candidate's failure there stays in (``_gmean``)."""
+    return [e for pop, e in errors.items() if pooled(pop) and e.get(BASE)]
 
 
 def _gmean(m, es):
     """The geometric mean of ``m``'s errors over the paper model's; 0 where ``m`` has no
-    error in some population (FEM P1 against itself), never a mean over its nonzero ones."""
-    r = [e[m] / e[BASE] for e in es if e[BASE] > 0]
-    if not r:
+    error in some population (FEM P1 against itself), never a mean over its nonzero ones;
+    None where ``m`` failed in one (a failure is never left out)."""
+    if not es or any(e.get(m) is None for e in es):
         return None
+    r = [e[m] / e[BASE] for e in es]
     return 0.0 if min(r) == 0 else float(np.exp(np.mean(np.log(r))))
 
 
 def overall(errors, models):
-    """The geometric mean, over the populations where every model has a result, of each
-    model's error over the paper model's (below 1: better than the paper's model); None
-    without any."""
-    complete = _complete(errors, models)
+    """The geometric mean, over the pooled populations where the paper model has a result,
+    of each model's error over the paper model's (below 1: better than the paper's model);
+    None for a model that failed in one of them (``overall_failed`` counts them)."""
+    complete = _complete(errors)
     return {m: _gmean(m, complete) for m in models}
+
+
+def overall_failed(errors, models):
+    """{model: the pooled populations where it has no result though the paper model has}."""
+    complete = _complete(errors)
+    return {m: sum(e.get(m) is None for e in complete) for m in models}
 
 
 def overall_range(errors, models):
     """{model: [low, high]}: the geometric mean leaving one population out, its lowest and
     highest (a ranking one population decides is no ranking)."""
-    complete = _complete(errors, models)
+    complete = _complete(errors)
     out = {}
     for m in models:
         loo = [v for v in (_gmean(m, complete[:k] + complete[k + 1:])
                            for k in range(len(complete))) if v is not None]
         out[m] = [min(loo), max(loo)] if loo else None
     return out
+
+
+def identical(errors, models, digits=3):
+    """[[model, ...]]: groups of models whose errors agree to ``digits`` significant figures
+    in every population (one observation, not several)."""
+    def key(m):
+        return tuple(None if e.get(m) is None else float(f"{e[m]:.{digits}g}")
+                     for e in errors.values())
+    groups = {}
+    for m in models:
+        groups.setdefault(key(m), []).append(m)
+    return [g for g in groups.values() if len(g) > 1]
 
 
 def alternations(data, models):
@@ -157,7 +186,10 @@ def rankings(data, models):
             "discretisation": discretisation(data),
             "overall": overall(errors, models),
             "overall_range": overall_range(errors, models),
-            "overall_over": len(_complete(errors, models)),
+            "overall_over": len(_complete(errors)),
+            "overall_failed": overall_failed(errors, models),
+            "left_out": [p for p in errors if not pooled(p)],
+            "identical": identical(errors, models),
             "alternation": alternations(data, models),
             "floors": floors(data, models),
             "tensors": tensors(data, models), "cost": data["cost_vs_fem_linear"]}
@@ -264,6 +296,54 @@ def fixes(rank, models):
                 for m in models if m not in (BASE, YARDSTICK)}
 
 
+def _overlap(a, b):
+    return a is None or b is None or (a[0] <= b[1] and b[0] <= a[1])
+
+
+def _lead(rank, cands):
+    """The headline's first line: the candidates by geometric mean over the pooled
+    populations, with their range leaving one population out; a best is named only where its
+    range overlaps no other candidate's, and it beats the paper model only where its range
+    lies below 1; failures, identical candidates and the populations left out are said."""
+    rng = rank.get("overall_range", {})
+    fails = rank.get("overall_failed", {})
+    n = rank.get("overall_over", len(rank["case_errors"]))
+    ranked = [m for m in order(rank["overall"]) if m in cands]
+
+    def said(m):
+        if rank["overall"][m] is None:
+            return f"{short(m)} failed (no result on {fails.get(m, 0)} of {n} populations)"
+        r = rng.get(m)
+        return f"{short(m)} {fmt(rank['overall'][m])}" + (f" [{fmt(r[0])}-{fmt(r[1])}]"
+                                                          if r else "")
+    ok = [m for m in ranked if rank["overall"][m] is not None]
+    if not ok:
+        return (f"Over the {n} pooled populations of the library no candidate has a result "
+                "on every one: " + ", ".join(said(m) for m in ranked) + ".")
+    b = ok[0]
+    level = [m for m in ok[1:] if _overlap(rng.get(b), rng.get(m))]
+    r = rng.get(b) or [rank["overall"][b]] * 2
+    versus = ("below the paper model's on every population left out" if r[1] < 1 else
+              "above the paper model's on every population left out" if r[0] > 1 else
+              "not resolved from the paper model's (its range reaches 1)")
+    lead = (f"not decided between {', '.join(short(m) for m in [b] + level)} (their ranges "
+            "leaving one population out overlap)" if level else f"the best is {short(b)}")
+    same = [" = ".join(short(m) for m in g) for g in rank.get("identical", [])
+            if set(g) <= set(cands)]
+    out = (f"Over the {n} pooled populations of the library, among the normal-stress "
+           f"extensions {lead}: the geometric mean of each one's model-form errors (against "
+           f"FEM P1 on the same tetrahedra) over the paper model's ({BASE}) [its range leaving "
+           f"one population out]: " + ", ".join(said(m) for m in ranked)
+           + f"; {short(b)} {versus}.")
+    if same:
+        out += (" Identical on every population (one observation, not several): "
+                + "; ".join(same) + ".")
+    if rank.get("left_out"):
+        out += (" Not pooled: " + ", ".join(rank["left_out"]) + " (patch tests and "
+                "locking-prone problems, shown in the table apart).")
+    return out
+
+
 def conclusion(data):
     """The study's headline, from a metrics document."""
     models = data["parameters"]["models"]
@@ -271,26 +351,7 @@ def conclusion(data):
     fs, table = fixes(rank, models)
     cands = [m for m in models if m not in (BASE, YARDSTICK)]
     lines = []
-    best = [m for m in order(rank["overall"]) if m in cands]
-    if best and rank["overall"][best[0]] is not None:
-        lead = (f"Over the {len(rank['case_errors'])} case populations of the library the best "
-                f"normal-stress extension is {short(best[0])}"
-                if rank["overall"][best[0]] < 1 else
-                f"Over the {len(rank['case_errors'])} case populations of the library no "
-                "normal-stress "
-                f"extension beats the paper model; the closest is {short(best[0])}")
-        rng = rank.get("overall_range", {})
-
-        def said(m):
-            r = rng.get(m)
-            return fmt(rank["overall"][m]) + (f" [{fmt(r[0])}-{fmt(r[1])}]" if r else "")
-        lines.append(
-            f"{lead}: its model-form errors (against FEM P1 on the same tetrahedra) are "
-            f"{said(best[0])} times the paper model's ({BASE}) in "
-            f"geometric mean over the {rank.get('overall_over', len(rank['case_errors']))} "
-            "case/boundary-condition populations where every model has a result [its range "
-            "leaving one population out]; the others: "
-            + ", ".join(f"{short(m)} {said(m)}" for m in best[1:]) + ".")
+    lines.append(_lead(rank, cands))
     cost = {m: rank["cost"].get(m) for m in cands if rank["cost"].get(m) is not None}
     if cost and rank["cost"].get(BASE) is not None:
         lines.append(f"Each adds cost: at {COST_TETS:.0e} tetrahedra an RK4 step of the "
@@ -347,7 +408,9 @@ def build(out, study, s, doc):
     rank, models = doc["rankings"], list(s.models)
     cases = list(rank["case_errors"])
     d = Document(f"pbcm report: {study.name}")
-    d.opening(conclusion(doc))
+    d.opening(["**Quick: not decided** (`pbcm run extensions` decides, on every case's full "
+               "meshes): the tables below are a preview and decide nothing."]
+              if s.quick else conclusion(doc))
     d.p("Generated by `pbcm run extensions` (or `pbcm run extensions --rewrite`, from the same "
         "recorded runs): every number is computed from the runs recorded in metrics.json, but "
         "the step costs, which are `pbcm bench`'s (reports/bench/bench.json).")
@@ -373,8 +436,11 @@ def build(out, study, s, doc):
           "discretisation error on the same meshes (replacing FEM costs more than FEM's "
           "distance from the continuum there). The FEM P1 of a finite-load case is "
           "neo-Hookean, so fem-linear's error there is its linearisation.",
-          f"overall: geometric mean over the cases of the model-form error over {BASE}'s "
-          "(below 1: closer to FEM P1 than the paper's model).",
+          f"overall: geometric mean over the pooled populations (neither patch tests nor "
+          f"locking-prone problems) of the model-form error over {BASE}'s (below 1: closer "
+          "to FEM P1 than the paper's model); a model that failed on one has none, and is "
+          "ranked last; a best is named only where its range leaving one population out "
+          "overlaps no other's.",
           "bulge/neck artefact: the largest |alternation| of the paper cube's layer profile "
           "beyond FEM's over the mean lateral displacement, over the model's meshes and bases "
           f"(0 for the continuum); a failure from {ALTERNATION_CLEAR:g}.",
@@ -389,7 +455,8 @@ def build(out, study, s, doc):
     d.h(2, "Ranking by model-form error")
     by = order(rank["overall"])
     d.table(["rank", "model", "overall"] + cases,
-            [[str(i + 1), short(m), fmt(rank["overall"][m])]
+            [[str(i + 1), short(m), "failed" if rank["overall"][m] is None
+              and rank.get("overall_failed", {}).get(m) else fmt(rank["overall"][m])]
              + [fmt(rank["case_errors"][c][m]) for c in cases] for i, m in enumerate(by)])
     figures.grouped_bars(Path(out) / "case_errors.png", cases, [short(m) for m in models],
                          [[rank["case_errors"][c][m] or np.nan for m in models] for c in cases],
@@ -401,7 +468,8 @@ def build(out, study, s, doc):
                          and f"{r['mesh']}/{r['bc']}" == ks[0]) for c, ks in gone.items()}
         d.p("Left out of every comparison, because no model (FEM included) has a result there: "
             + "; ".join(f"{c} on {', '.join(ks)} ({first[c]})" for c, ks in gone.items()) + ".")
-    d.p("Best per case: " + "; ".join(
+    d.p("Smallest median per case (an order of medians over the meshes, resolved against no "
+        "uncertainty): " + "; ".join(
         f"{c} {short(order(rank['case_errors'][c])[0])}" for c in cases) + ".")
     dropped = {}
     for r in doc["case_runs"]:

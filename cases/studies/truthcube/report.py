@@ -226,10 +226,20 @@ def conclusion(doc):
     return lines
 
 
+def opening(doc):
+    """The conclusion, or for a quick run the line that says it decides nothing: a quick run
+    has no variants of the inputs nobody measured, so no u_input to read the beads against."""
+    if doc["parameters"].get("quick"):
+        return ["**Quick: not decided** (`pbcm run truth-cube` decides: a quick run has no "
+                "variants of the inputs nobody measured, so no u_input to read the beads "
+                "against); the tables below are a preview of its one mesh and decide nothing."]
+    return conclusion(doc)
+
+
 def build(out, study, s, doc):
     out = Path(out)
     d = Document(f"pbcm report: {study.name}")
-    d.opening(conclusion(doc))
+    d.opening(opening(doc))
     d.h(2, "What was run")
     ref = [r for r in doc["references"] if r["model"] == NH and r["variant"] == DEFAULT
            and r.get("error_estimate") is not None]
