@@ -185,27 +185,32 @@ def lines(root, models, pops=(), quick=False):
         rest = sorted((m for m in models if m not in passed), key=lambda m: _largest(lim[m]))
         nolimit = sorted({k for m in rest for k, v in lim[m].items()
                           if not isinstance(v, tuple)})
-        out.append("**How far from the continuum?** " + (
-            "Quick: not decided (`pbcm run convergence` decides); " if conv["parameters"][
-                "quick"] else "")
-                   + "The consistency limit, the sliding cube's error as the mesh is refined "
-                   "(a patch test; the largest over the lattices, +- the extrapolation's "
-                   "uncertainty; beside it each family where the model has no limit, and "
-                   "what its fit found there): "
-                   + ", ".join(f"{m} {_pm(_worst_limit(lim[m]))}" + _no_limit(lim[m])
-                               for m in rest if _worst_limit(lim[m]))
-                   + _limit_ties(sorted(((m, _worst_limit(lim[m])) for m in rest
-                                         if _worst_limit(lim[m])), key=lambda x: x[1][0]),
-                                 "tied within their +- on the lattices, whatever each does on "
-                                 "the families where it has no limit")
-                   + (f"; below {PATCH_TOL:g}: {', '.join(passed)}" if passed else "")
-                   + (f"; no limit on {', '.join(nolimit)}" if nolimit else "")
-                   + _diverging(lim)
-                   + _finest(conv, [m for m in rest if any(
-                       not isinstance(v, tuple) for v in lim[m].values())], nolimit)
-                   + _irregular(conv, models)
-                   + _beyond_the_patch(conv, models)
-                   + " ([convergence](convergence/report.md)).")
+        if conv["parameters"]["quick"]:     # the patches are the full run's: said
+            out.append("**How far from the continuum?** Quick: not decided (`pbcm run "
+                       "convergence` decides, on its finer levels); on the same patches as "
+                       "the full run" + _irregular(conv, models)
+                       + " ([convergence](convergence/report.md)).")
+        else:
+            out.append("**How far from the continuum?** "
+                       + "The consistency limit, the sliding cube's error as the mesh is "
+                       "refined (a patch test; the largest over the lattices, +- the "
+                       "extrapolation's "
+                       "uncertainty; beside it each family where the model has no limit, and "
+                       "what its fit found there): "
+                       + ", ".join(f"{m} {_pm(_worst_limit(lim[m]))}" + _no_limit(lim[m])
+                                   for m in rest if _worst_limit(lim[m]))
+                       + _limit_ties(sorted(((m, _worst_limit(lim[m])) for m in rest
+                                             if _worst_limit(lim[m])), key=lambda x: x[1][0]),
+                                     "tied within their +- on the lattices, whatever each does "
+                                     "on the families where it has no limit")
+                       + (f"; below {PATCH_TOL:g}: {', '.join(passed)}" if passed else "")
+                       + (f"; no limit on {', '.join(nolimit)}" if nolimit else "")
+                       + _diverging(lim)
+                       + _finest(conv, [m for m in rest if any(
+                           not isinstance(v, tuple) for v in lim[m].values())], nolimit)
+                       + _irregular(conv, models)
+                       + _beyond_the_patch(conv, models)
+                       + " ([convergence](convergence/report.md)).")
     truth = _load(root, MEASURED, "metrics.json")
     if truth and truth.get("headline"):
         out.append(_measured_line(truth, models) if not truth["parameters"]["quick"] else

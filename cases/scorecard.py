@@ -433,8 +433,8 @@ def case_findings(name, quantities, runs, patch_tests=(), estimate_key="p2_error
                 line += ("; closer to the continuum than P1 only by cancelling its error: "
                          + ", ".join(cancel))
             if level:
-                line += (f"; as far from the continuum as P1 within u_val {rel(p.u_continuum, 2)}: "
-                         + ", ".join(level))
+                line += ("; as far from the continuum as P1 within u_val "
+                         f"{rel(p.u_continuum, 2)}: " + ", ".join(level))
         lines.append(line + ".")
         rows = [[p.bc, rank, s.model, cell(s, tie), cell_of(p.errors(s.model, "total"))
                  + (f"; {p.unpaired_total[s.model]} of {p.quantity.count * s.runs} modes "

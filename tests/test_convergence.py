@@ -277,8 +277,8 @@ def test_study_metrics_do_not_depend_on_the_workers(study, tmp_path):
 
 
 def test_index_opens_with_the_answers_and_lists_the_study(study, tmp_path, capsys):
-    """`pbcm index` rewrites the index from the folders present: the answers first (the
-    consistency limits from the convergence study's patch-test fits), their table, then the
+    """`pbcm index` rewrites the index from the folders present: the answers first (a quick
+    convergence study decides no limit, its irregular patches are said), their table, then the
     studies (this one in quick mode, linked) and the scorecard; a missing case is named, and
     the index answers over the cases found."""
     from cases.registry import CASES
@@ -289,9 +289,11 @@ def test_index_opens_with_the_answers_and_lists_the_study(study, tmp_path, capsy
     md = (tmp_path / "index.md").read_text()
     first = md.split("\n\n")[1]
     assert first.startswith("**Which reading?** Not computed: run `pbcm run artefact`.")
-    # a quick study decides nothing; its limits are shown as a preview, with their fit's +-
+    # a quick study decides no limit; the irregular patches are the full run's own
     assert "**How far from the continuum?** Quick: not decided (`pbcm run convergence` " \
-        "decides); The consistency limit" in md
+        "decides, on its finer levels); on the same patches as the full run; the patch " \
+        "test with every boundary node prescribed" in md
+    assert "The consistency limit" not in md.split("**How far from the continuum?**")[1]
     # the patch test's irregular patches: msm (springs) misses the strain by over 10 %
     irregular = md.split("on the patch named, against the exact linear field; one "
                          "run each, ")[1].split(" ([convergence]")[0].split(

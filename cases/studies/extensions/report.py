@@ -359,7 +359,8 @@ def conclusion(data):
                      f"times fem-linear's, the paper model's {fmt(rank['cost'][BASE])} times.")
     if not fs:
         lines.append(f"{BASE} fails none of the criteria checked here (model-form error "
-                     f"within {FEM_FACTOR:g}x FEM P1's discretisation error, C_eff within {ISOTROPIC_TOL:g} of the target, no "
+                     f"within {FEM_FACTOR:g}x FEM P1's discretisation error, C_eff within "
+                     f"{ISOTROPIC_TOL:g} of the target, no "
                      f"bulge/neck alternation below {ALTERNATION_CLEAR:g} of the mean lateral "
                      "displacement).")
         return lines
