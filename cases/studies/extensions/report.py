@@ -134,10 +134,10 @@ def overall_range(errors, models):
 
 def identical(errors, models, digits=3):
     """[[model, ...]]: groups of models whose errors agree to ``digits`` significant figures
-    in every population (one observation, not several)."""
+    in every pooled population (one observation of the overall mean, not several)."""
     def key(m):
         return tuple(None if e.get(m) is None else float(f"{e[m]:.{digits}g}")
-                     for e in errors.values())
+                     for pop, e in errors.items() if pooled(pop))
     groups = {}
     for m in models:
         groups.setdefault(key(m), []).append(m)
@@ -323,9 +323,10 @@ def _lead(rank, cands):
     b = ok[0]
     level = [m for m in ok[1:] if _overlap(rng.get(b), rng.get(m))]
     r = rng.get(b) or [rank["overall"][b]] * 2
-    versus = ("below the paper model's on every population left out" if r[1] < 1 else
-              "above the paper model's on every population left out" if r[0] > 1 else
-              "not resolved from the paper model's (its range reaches 1)")
+    versus = ("closer to FEM P1 than the paper model whichever population is left out"
+              if r[1] < 1 else
+              "farther from FEM P1 than the paper model whichever population is left out"
+              if r[0] > 1 else "not resolved from the paper model (its range reaches 1)")
     lead = (f"not decided between {', '.join(short(m) for m in [b] + level)} (their ranges "
             "leaving one population out overlap)" if level else f"the best is {short(b)}")
     same = [" = ".join(short(m) for m in g) for g in rank.get("identical", [])
@@ -336,11 +337,11 @@ def _lead(rank, cands):
            f"one population out]: " + ", ".join(said(m) for m in ranked)
            + f"; {short(b)} {versus}.")
     if same:
-        out += (" Identical on every population (one observation, not several): "
+        out += (" Identical on every pooled population (one observation, not several): "
                 + "; ".join(same) + ".")
     if rank.get("left_out"):
         out += (" Not pooled: " + ", ".join(rank["left_out"]) + " (patch tests and "
-                "locking-prone problems, shown in the table apart).")
+                "locking-prone problems: in the table, not in the mean).")
     return out
 
 
