@@ -157,6 +157,9 @@ def _stats(s):
 
 def _cell(s):
     med, rng, n = _stats(s)
+    if math.isinf(s.score):     # more runs failed than gave a number: no median to give
+        return (f"{med}: {len(s.values)} of {s.runs} runs gave "
+                + ", ".join(rel(v) for v in s.values) if s.values else f"{med}, {n} runs")
     return f"median {med}" + (f" [{rng}]" if rng else "") + f", {n} runs"
 
 

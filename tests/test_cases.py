@@ -410,3 +410,16 @@ def test_a_profiles_shape_is_read_from_its_second_differences():
     assert shape([0.1452, 0.1233, 0.1452, 0.1233, 0.1452]) == "alternating"
     assert shape([0.38] * 5) == "uniform"
     assert shape([0.1, 0.2, 0.3, 0.3, 0.1]) == "uneven"
+
+
+def test_a_line_says_failed_at_the_median_with_the_runs_that_gave_a_number():
+    """Where more of a model's runs failed than gave a number, its line gives no median: it
+    says 'failed at the median' and lists the numbers the other runs gave."""
+    from cases import rankings
+    runs = [{"model": m, "mesh": mesh, "bc": "clamped", "err": e, "p2_error_estimate": 0.01}
+            for mesh, (a, b) in (("five", (0.1, 0.226)), ("six", (0.1, None)),
+                                 ("bcc", (0.1, None)), ("unstructured", (0.1, None)))
+            for m, e in (("a", a), ("b", b))]
+    line = rankings.best_and_worst(runs, "err", "Error")
+    assert "to b (failed at the median: 1 of 4 runs gave 0.226)" in line
+    assert "b (3 of 4)" in line
