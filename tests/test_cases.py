@@ -176,12 +176,14 @@ def test_paper_cube_conclusion_groups_the_artefact_by_model():
     first = R.conclusion(Config(), runs)[0]
     assert first.startswith("In the paper's own 5-layer view (which cannot tell a smooth bump "
                             "from an alternation, so it decides nothing")
-    assert first.endswith("the paper's bulge/neck sign pattern shows clearly in msm (on "
+    assert first.endswith("the paper's bulge/neck sign pattern with an alternation of at least "
+                          "0.01 of the mean lateral displacement shows in msm (on "
                           "five/sliding, six/sliding) and pbcm-balanced (on five/sliding), not "
                           "in the converged FEM.")
     faint = [dict(run, alternation_rel=0.001)]
     assert R.conclusion(Config(), faint)[0].endswith(
-        "no model shows the paper's bulge/neck sign pattern clearly, nor does the converged FEM.")
+        "no model shows the paper's bulge/neck sign pattern with an alternation of at least 0.01 "
+        "of the mean lateral displacement, nor does the converged FEM.")
     assert "and in the converged FEM on five/sliding." in R.conclusion(
         Config(), [dict(run, paper_pattern_fem=True)])[0]
 
