@@ -206,8 +206,7 @@ def lines(root, models, pops=(), quick=False):
                        + (f"; below {PATCH_TOL:g}: {', '.join(passed)}" if passed else "")
                        + (f"; no limit on {', '.join(nolimit)}" if nolimit else "")
                        + _diverging(lim)
-                       + _finest(conv, [m for m in rest if any(
-                           not isinstance(v, tuple) for v in lim[m].values())], nolimit)
+                       + _finest(conv, {m: lim[m] for m in rest}, nolimit)
                        + _irregular(conv, models)
                        + _beyond_the_patch(conv, models)
                        + " ([convergence](convergence/report.md)).")
@@ -242,9 +241,12 @@ def _beyond_the_patch(conv, models):
     a floor under refinement, so that no patch-test limit is read as the model's distance to
     the continuum everywhere."""
     # a verdict on two levels observes no order: only three levels or more decide one
+    # nor one the study calls not resolved (its finest error below what its reference judges)
+    loose = {tuple(k) for k in conv.get("not_resolved", [])}
     fits = [f for f in conv.get("fits", []) if f["model"] in models
             and not (f["case"] == "paper-cube" and f["bc"] == "sliding")
-            and (f.get("levels") or 0) >= 3]
+            and (f.get("levels") or 0) >= 3
+            and (f["case"], f["bc"], f["mesh"], f["model"]) not in loose]
 
     def where(m, verdict):
         cases = {}
@@ -258,9 +260,9 @@ def _beyond_the_patch(conv, models):
     div = {m: w for m in models if (w := where(m, "diverges"))}
     floor = {m: sum(f["model"] == m and f["verdict"] == "floor" for f in fits) for m in models}
     return ("; beyond the patch test (the study's bending, torsion and clamped-cube fits of "
-            "three levels or more, one per problem and mesh family: the sliding cube's and "
-            "two-level fits, which the convergence report also counts, left out), the error "
-            "grows under refinement for "
+            "three levels or more, one per problem and mesh family, those it calls not "
+            "resolved left out: a subset of the convergence report's counts, which hold the "
+            "sliding cube's too), the error grows under refinement for "
             + (", ".join(f"{m} ({v})" for m, v in div.items()) if div else "no model")
             + ("; stops at a floor in " + ", ".join(f"{floor[m]} of those {n[m]} for {m}"
                                                     for m in models if floor[m])
@@ -320,16 +322,16 @@ def _single_runs_u(values, u, what):
             + (f"tied: {'; '.join(groups)}" if groups else "no two within it"))
 
 
-def _finest(conv, models, lattices):
-    """'; there, the error on the finest level: on x: ...': per lattice without a limit, each
-    model's sliding-cube error at the smallest h it ran there (a number where no limit
-    exists), read against the reference's stated estimate."""
+def _finest(conv, lims, lattices):
+    """'; there, the error on the finest level: on x: ...': per lattice, each model without a
+    limit there (``lims`` {model: its limits by family}) at the smallest h it ran there (a
+    number where no limit exists), read against the reference's stated estimate."""
     est = [r.get("error_estimate") or 0.0 for r in conv.get("references", [])
            if (r["case"], r["bc"]) == CONSISTENCY]
     per = []
     for lattice in lattices:
         said, values = [], []
-        for m in models:
+        for m in [m for m, v in lims.items() if not isinstance(v.get(lattice), tuple)]:
             rs = [r for r in conv.get("runs", []) if (r["case"], r["bc"]) == CONSISTENCY
                   and r["mesh"] == lattice and r["model"] == m
                   and r.get("disp_rel_l2") is not None]
@@ -362,6 +364,9 @@ def _cost_of_replacing(pops, models, quick):
         loose = scorecard.unresolved(pops, models, finite)
         rng = scorecard.spread(pops, models, finite)
         if ranked:
+            first_loose = [b for b in scorecard.not_resolved_from(pops, models, ranked[0][1],
+                                                                   finite)
+                           if (ranked[0][1], b) not in loose]
             used = [p for p in pops if p.finite == finite and p.ranked]
             n, c = len(used), len({p.case for p in used})
             us = [p.u_model_form for p in used]
@@ -377,8 +382,12 @@ def _cost_of_replacing(pops, models, quick):
                    else "")
                 + (f" ({e[2]} failed runs)" if e[2] else "")
                 + (f" (the same mean rank as {tie})" if tie else "")
-                + "".join(f" (not resolved from {b})" for (a, b) in loose if a == m)
-                for _, m, e, tie in ranked))
+                # its neighbour below, and for the first each model that reaches it when a
+                # unit is left out
+                + ("" if not (names := [b for (a, b) in loose if a == m]
+                              + (first_loose if k == 0 else []))
+                   else f" (not resolved from {', '.join(names)})")
+                for k, (_, m, e, tie) in enumerate(ranked)))
     if not said:
         return "**What does replacing FEM cost?** No case has a decomposed quantity."
     return ("**What does replacing FEM cost?** The model-form error, each model against FEM P1 "
@@ -392,17 +401,23 @@ def _cost_of_replacing(pops, models, quick):
 
 
 def _locking(pops):
-    """'; left out of the ranking ...': the locking-prone populations, shown in the scorecard
-    and never pooled, with how far their twin is from the continuum."""
+    """'; left out of the ranking ...': the locking-prone populations, with how far their twin
+    is from the continuum, and the finite-load populations the linear law meets within the
+    scorecard's NEARLY_LINEAR: shown in the scorecard, never pooled."""
+    from .scorecard import NEARLY_LINEAR
     out = []
     for p in pops:
         if p.locking and not p.patch_test:
             d = p.discretisation()
             out.append(p.label + (f" (FEM P1 up to {rel(max(d))} from the continuum there)"
                                   if d else ""))
-    return ("; left out of the ranking, locking-prone (FEM P1, the twin, locks there: its "
-            "model-form error ranks closeness to a locked mesh): " + ", ".join(out)
-            if out else "")
+    near = [p.label for p in pops if p.nearly_linear and not p.patch_test and not p.locking]
+    return (("; left out of the ranking, locking-prone (FEM P1, the twin, locks there: its "
+             "model-form error ranks closeness to a locked mesh): " + ", ".join(out)
+             if out else "")
+            + (f"; left out at finite load, nearly linear (fem-linear within "
+               f"{NEARLY_LINEAR:g} of neo-Hookean P1 there: the linear regime's observation "
+               "again): " + ", ".join(near) if near else ""))
 
 
 # a model's internal forces balance where their net sum is round-off against their sizes
@@ -410,25 +425,29 @@ BALANCE_TOL = 1e-8
 
 
 def _imbalance(root, models):
-    """' Internal forces that do not balance ...': the models whose net internal force
-    (net_force_rel, at the continuum's deformed state) exceeds BALANCE_TOL in some run of a
-    case folder under ``root``, with the largest and where: such a model creates momentum,
-    whatever its errors."""
+    """' Internal forces that do not balance ...': the models whose net internal force or
+    torque (net_force_rel, net_torque_rel, at the continuum's deformed state) exceeds
+    BALANCE_TOL in some run of a case folder under ``root``, with the largest and where: such
+    a model creates momentum or angular momentum, whatever its errors."""
     from .registry import CASES
-    worst = {}
-    for case in CASES:
-        for r in (_load(root, case, "metrics.json") or {}).get("runs", []):
-            v = r.get("net_force_rel")
-            if r["model"] in models and v is not None and v > BALANCE_TOL and \
-                    v > worst.get(r["model"], (0.0, ""))[0]:
-                worst[r["model"]] = (v, f"{case}/{r['mesh']}/{r['bc']}")
-    if not worst:
+    said = []
+    for key, what in (("net_force_rel", "force"), ("net_torque_rel", "torque")):
+        worst = {}
+        for case in CASES:
+            for r in (_load(root, case, "metrics.json") or {}).get("runs", []):
+                v = r.get(key)
+                if r["model"] in models and v is not None and v > BALANCE_TOL and \
+                        v > worst.get(r["model"], (0.0, ""))[0]:
+                    worst[r["model"]] = (v, f"{case}/{r['mesh']}/{r['bc']}")
+        if worst:
+            said.append(f"net {what}: " + ", ".join(f"{m} up to {rel(v)} ({w})"
+                                                   for m, (v, w) in sorted(worst.items())))
+    if not said:
         return ""
-    return (f" Internal forces that do not balance (net force above {BALANCE_TOL:g} of their "
-            "sum, at the continuum's deformed state: the model creates momentum, whatever its "
-            "errors): " + ", ".join(f"{m} up to {rel(v)} ({w})"
-                                    for m, (v, w) in sorted(worst.items())) + "; every other "
-            f"model balances to {BALANCE_TOL:g}.")
+    return (f" Internal forces that do not balance (net force or torque above {BALANCE_TOL:g} "
+            "of their sum, at the continuum's deformed state: the model creates momentum or "
+            "angular momentum, whatever its errors): " + "; ".join(said)
+            + f"; every other model balances both to {BALANCE_TOL:g}.")
 
 
 ACCURACY = 0.05     # the stated accuracy of the cost recommendation (model-form, linear)
@@ -547,7 +566,8 @@ def recommendation(root, models, pops, quick, bench_rows):
                        key=lambda m: bench_rows[m]["cpu_s_per_simulated_s"], default=None)
         line = (f"- Cost at a stated accuracy (model-form error within {ACCURACY:g} on every "
                 f"case of the linear regime, the median over its meshes): {cheap}"
-                + (" (FEM P1 itself: no approximation is within it on every case)"
+                + (" (FEM P1 itself, the yardstick of this accuracy: no approximation "
+                   "comes within it of FEM P1 on every case, so none replaces it there)"
                    if cheap == p1_lin else f" (at most {fmt(worst_of[cheap])})")
                 + f", {fmt(bench_rows[cheap]['cpu_s_per_simulated_s'])} s per simulated s on "
                 "the bench's machine (its median round; a time moves with the machine, the "
@@ -569,32 +589,35 @@ def recommendation(root, models, pops, quick, bench_rows):
     return out[:5] if len(out) > 1 else []
 
 
-def _how_finite(pops, linear_law, nearly=0.05):
+def _how_finite(pops, linear_law):
     """'; how far each load is from the linear regime: ...': per population at finite load,
     the linear law's model-form error there (``linear_law`` against P1 with the reference's
     law on the same tetrahedra: its linearisation error), so that a load the linear law
-    meets within ``nearly`` is named as testing a nearly linear response."""
+    meets within the scorecard's NEARLY_LINEAR is named as testing a nearly linear response,
+    shown and not pooled at finite load."""
+    from .scorecard import NEARLY_LINEAR, linearisation
     at, locked = {}, set()
     for p in pops:
         if p.finite and not p.patch_test and linear_law in p.parts:
-            st = next((s for _, s, _ in p.standings() if s.model == linear_law), None)
-            if st is not None and math.isfinite(st.score):
-                at[p.label] = st.score
+            v = linearisation(p)
+            if v is not None:
+                at[p.label] = v
                 if p.locking:
                     locked.add(p.label)
     if not at:
         return ""
-    near = sorted((k for k, v in at.items() if v <= nearly), key=at.get)
-    far = sorted((k for k, v in at.items() if v > nearly), key=at.get)
+    near = sorted((k for k, v in at.items() if v <= NEARLY_LINEAR), key=at.get)
+    far = sorted((k for k, v in at.items() if v > NEARLY_LINEAR), key=at.get)
 
     def short(k):
         return k.replace(" at the load", "") + (
             " (locking-prone: against a locked twin, so its locking too)" if k in locked
             else "")
     return (f"; {linear_law}'s linearisation error at each load (median over the meshes): "
-            + (f"nearly linear, within {nearly:g}: "
+            + (f"nearly linear, within {NEARLY_LINEAR:g} (the linear regime's observation "
+               "again: not pooled at finite load): "
                + ", ".join(f"{short(k)} {rel(at[k])}" for k in near) if near else
-               f"none within {nearly:g}")
+               f"none within {NEARLY_LINEAR:g}")
             + (f"; beyond: {', '.join(f'{short(k)} {rel(at[k])}' for k in far)}" if far else ""))
 
 
@@ -605,7 +628,7 @@ def _discretisation(pops, finite):
     meds = []
     for p in pops:
         d = p.discretisation()
-        if p.finite != finite or p.patch_test or not d:
+        if p.finite != finite or not p.ranked or not d:
             continue
         meds.append((float(np.median(d)), f"[{rel_range(min(d), max(d))} over the meshes]",
                      p.label + (", not resolved there: the continuum's u_num exceeds a "
@@ -776,7 +799,8 @@ def _decisive(art):
     names = {r["model"]: r["name"] for r in art["readings"]}
     words = {True: "matched", False: "missed", None: "not decided"}
     said = {"cost": "the cost (the paper's Figure 2: a step over 10x msm's; the bench's "
-                    "in-round ratio on the paper's 320-tetrahedron cube, read on its range "
+                    "in-round ratio on the 320-tetrahedron five split of the paper's 125 nodes "
+                    "(the paper's own mesh had 374 tetrahedra), read on its range "
                     "over the bench's rounds at that size alone; missed where the whole range "
                     "is below the 20 % band around 10)",
             "stable": "stability (the linearised growth rate at rest on each conforming split "

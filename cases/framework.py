@@ -453,8 +453,8 @@ class Case(abc.ABC):
     def references_line(self, s):
         """The report's sentence on what the references are (the runner's default ones)."""
         return (f"References: linear FEM P1 on the same mesh, and P2 on {s.p2_levels} uniform "
-                "refinement(s) (the converged reference, evaluated at the particle nodes) with "
-                "its own error estimate.")
+                "refinement(s) (the continuum's reference, evaluated at the particle nodes) "
+                "with its own error estimate, which the reports read it against.")
 
     def conclusion(self, s, runs):
         """Three lines that open the report, computed from the runs."""

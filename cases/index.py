@@ -116,7 +116,9 @@ def conclusion(pops, models, quick):
                                  for (a, b), mesh in loose.items() if a == m)
                        for rank, m, entry, tie in scorecard.ranked(means)) + ".")
     worst = {}
-    for p in ([] if quick else pops):     # a quick run's farthest holds for its meshes only
+    # a quick run's farthest holds for its meshes only; a locking-prone population orders
+    # closeness to a locked mesh
+    for p in ([] if quick else [p for p in pops if not p.locking]):
         for _, s, _ in p.standings():
             if s.runs and (s.model not in worst or s.score > worst[s.model][0]):
                 worst[s.model] = (s.score, p)
@@ -125,7 +127,8 @@ def conclusion(pops, models, quick):
                    "report` for every mesh).")
     elif worst:
         out.append("Where each model is farthest from FEM P1 (median model-form error, a failed "
-                   "run counted as infinitely wrong): " + "; ".join(
+                   "run counted as infinitely wrong; locking-prone problems left out): "
+                   + "; ".join(
                        f"{m} in {p.label} ("
                        + ("failed at the median" if math.isinf(v) else rel(v)) + ")"
                        for m, (v, p) in worst.items()) + ".")
@@ -246,6 +249,9 @@ TERMS = {
     "medians, each floored at its population's u_val, with its range over the rankings that "
     "leave one mesh family out; 'failed' where a population failed at the median (no finite "
     "mean exists), with the mean over the others beside it.",
+    "tied": "two errors whose difference is within the uncertainty of that difference: u_val, "
+    "and where the two are medians over the meshes, both medians' spread over the meshes in "
+    "quadrature (a single run, as on the Truth Cube, has no spread: u_val alone).",
     "not resolved": "an order of two models that reverses, or levels, when one mesh family "
     "(every population's runs on it) or one case is left out: the data cannot order them, "
     "whatever their mean ranks say; judged pair by pair (neighbours in a ranking, the first "

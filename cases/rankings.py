@@ -111,10 +111,10 @@ def _u_text(u, defect, field=False, per_mesh=False):
     """'u_num U' and what it holds: the reference's estimate and its spread over the meshes
     in quadrature, or the estimate alone (a field has no one value to spread; each mesh its
     own continuum problem), and the two medians' spread over the meshes a tie also reads."""
-    held = (" (the reference's estimate: a field has no one value to spread over the meshes)"
-            if field else " (the estimate alone: each mesh its own continuum problem)"
-            if per_mesh else ", mostly the continuum's spread over the meshes" if defect
-            else "")
+    held = (" (the estimate alone: each mesh its own continuum problem, its value read at "
+            "the mesh's own nodes)" if per_mesh else
+            " (the reference's estimate: a field has no one value to spread over the meshes)"
+            if field else ", mostly the continuum's spread over the meshes" if defect else "")
     return f"u_num {rel(u, 2)}{held} and the two medians' spread over the meshes"
 
 

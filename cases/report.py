@@ -130,7 +130,7 @@ def build_report(case, s, runs, fields, out):
     if case.decompositions():
         opening, costs_of_replacing = scorecard.case_findings(
             case.name, case.decompositions(), runs, case.patch_tests, case.headline_estimate,
-            case.per_mesh_continuum)
+            case.per_mesh_continuum, case.locking_prone)
     lines = opening + case.conclusion(s, runs)
     preview = []
     if s.quick:     # a preview on fewer meshes: it decides nothing the full run could reverse
@@ -208,7 +208,7 @@ def _finite_table(doc, case, rs):
     if rs[0].get("nh_error_estimate") is None:
         return
     shown = [catalogue.metric(n) for n in catalogue.FINITE]
-    line = (f"At the case's load, against the converged neo-Hookean reference (error estimate "
+    line = (f"At the case's load, against the neo-Hookean reference (error estimate "
             f"{rel(rs[0]['nh_error_estimate'], 2)}")
     if rs[0].get("reaction_fem_nh_n") is not None:
         line += f", reaction {fmt(rs[0]['reaction_fem_nh_n'], 4)} N"

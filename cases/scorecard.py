@@ -48,13 +48,17 @@ class Population:
     per_mesh: bool = False
     # FEM P1, the twin, locks here (the case's ``locking_prone``): shown, never pooled
     locking: bool = False
+    # at finite load, the linear law within NEARLY_LINEAR of P1 with the reference's law:
+    # the linear regime's observation again, shown and never pooled a second time
+    nearly_linear: bool = False
 
     @property
     def ranked(self):
         """Whether the overall ranking pools this population: neither a patch test (pass or
         fail, the consistency limit's subject) nor locking-prone (its model-form error ranks
-        closeness to a locked mesh)."""
-        return not self.patch_test and not self.locking
+        closeness to a locked mesh) nor, at finite load, a load the linear law meets within
+        NEARLY_LINEAR (the linear regime's observation counted twice)."""
+        return not self.patch_test and not self.locking and not self.nearly_linear
 
     @property
     def unpaired(self):
@@ -134,7 +138,22 @@ def populations(runs_by_case, declared, quick, patch_tests, estimate_keys):
                                        bc in getattr(declared[case], "per_mesh_continuum",
                                                      ()),
                                        bc in getattr(declared[case], "locking_prone", ())))
-    return out
+    return [replace(p, nearly_linear=True) if p.finite and
+            (linearisation(p) is not None and linearisation(p) <= NEARLY_LINEAR) else p
+            for p in out]
+
+
+def linearisation(p):
+    """The linear law's model-form error at a finite-load population (its median over the
+    meshes against P1 with the reference's law: the linearisation error at the load), or None
+    where it has no finite one."""
+    st = next((s for _, s, _ in p.standings() if s.model == E.P1_LINEAR), None)
+    return st.score if st is not None and math.isfinite(st.score) else None
+
+
+# a finite load the linear law meets within this (its linearisation error, model-form against
+# P1 with the reference's law) tests a nearly linear response
+NEARLY_LINEAR = 0.05
 
 
 def _population(case, bc, q, rs, quick, patch_test, estimate_key, where, per_mesh=False,
@@ -338,7 +357,7 @@ def describe(entry, rng=None):
 
 
 def case_findings(name, quantities, runs, patch_tests=(), estimate_key="p2_error_estimate",
-                  per_mesh_continuum=()):
+                  per_mesh_continuum=(), locking_prone=()):
     """(opening lines, tables) of one case's report on the error model, for each of its
     decomposed ``quantities`` (``Case.decompositions``): per boundary condition, the closest
     and farthest model by model-form error with the discretisation error the meshes share,
@@ -351,6 +370,7 @@ def case_findings(name, quantities, runs, patch_tests=(), estimate_key="p2_error
         def decompositions():
             return tuple(quantities)
     Declared.per_mesh_continuum = tuple(per_mesh_continuum)
+    Declared.locking_prone = tuple(locking_prone)
     pops = populations({name: runs}, {name: Declared}, {name: False},
                        {name: set(patch_tests)}, {name: estimate_key})
     lines, tables = [], []
@@ -367,7 +387,10 @@ def case_findings(name, quantities, runs, patch_tests=(), estimate_key="p2_error
                                         for v in p.errors(m, "model_form"))]
         ok = [(r, s, t) for r, s, t in st if math.isfinite(s.score)]
         line = (f"{where}What replacing FEM P1 costs ({p.quantity.label}, model-form error, "
-                "median over the meshes): ")
+                "median over the meshes" + ("; locking-prone: FEM P1 locks here, so the order "
+                                            "below is closeness to a locked mesh, not a "
+                                            "ranking of the models" if p.locking else "")
+                + "): ")
         if twins:
             line += (f"identity checks, P1's own law here, not ranked: {', '.join(twins)}"
                      + " (largest distance to FEM P1: " + ", ".join(
@@ -388,8 +411,8 @@ def case_findings(name, quantities, runs, patch_tests=(), estimate_key="p2_error
                 line += f"; tied with {ok[0][1].model} (within u_val {rel(p.u_model_form, 2)} " \
                         "and the two medians' spread over the meshes): " \
                         f"{', '.join(tied)}"
-            first = [f"{m} (first without {mesh})"
-                     for m, mesh in population_contenders(p).items() if m not in tied]
+            first = [f"{m} ({how})"
+                     for m, how in population_contenders(p).items() if m not in tied]
             if first:
                 line += f"; {ok[0][1].model} is not resolved from " + ", ".join(first)
         elif not same:
@@ -463,8 +486,9 @@ def case_findings(name, quantities, runs, patch_tests=(), estimate_key="p2_error
 
 
 def population_contenders(p):
-    """{model: mesh}: the models other than the closest that come first (or share the first
-    rank) when one mesh is left out: the closest is not resolved from them."""
+    """{model: 'first without MESH' or 'level with it without MESH'}: the models other than
+    the closest that come first, or share the first rank (within the uncertainty), when one
+    mesh is left out: the closest is not resolved from them."""
     st = p.standings()
     if not st:
         return {}
@@ -472,9 +496,11 @@ def population_contenders(p):
     meshes = sorted({x for ms in p.meshes.values() for x in ms})
     out = {}
     for mesh in meshes if len(meshes) > 1 else ():     # one mesh left out leaves none
-        for r, s, _ in p.without(mesh).standings():
+        alt = p.without(mesh).standings()
+        for k, (r, s, _) in enumerate(alt):
             if r == 1 and s.model != top and s.model not in out:
-                out[s.model] = mesh
+                out[s.model] = (f"first without {mesh}" if k == 0
+                                else f"level with it without {mesh}")
     return out
 
 

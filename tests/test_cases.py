@@ -425,3 +425,16 @@ def test_a_line_says_failed_at_the_median_with_the_runs_that_gave_a_number():
     line = rankings.best_and_worst(runs, "err", "Error")
     assert "to b (failed at the median: 1 of 4 runs gave 0.226)" in line
     assert "b (3 of 4)" in line
+
+
+def test_the_sliding_bases_blow_ups_are_said_apart_from_the_scored_clamped_ones():
+    """The paper cube's blow-ups are counted on the clamped base, the one scored; the sliding
+    base's (an ill-posed modal problem) are reported apart and never pooled with them."""
+    from cases.library.paper_cube_report import _blow_ups
+    runs = [{"model": "a", "bc": "clamped", "dyn_failed": None},
+            {"model": "a", "bc": "sliding", "dyn_failed": "blew up"},
+            {"model": "b", "bc": "clamped", "dyn_failed": "blew up"},
+            {"model": "b", "bc": "sliding", "dyn_failed": None}]
+    assert _blow_ups(runs) == ("Dynamic runs on the clamped base blow up for b (1 of 1 runs); "
+                               "on the sliding base (ill-posed: reported, not scored) blow up "
+                               "for a (1 of 1 runs).")

@@ -582,18 +582,21 @@ def test_a_norms_uncertainty_includes_p1s_own_distance_to_its_twin():
 
 
 def test_the_index_names_a_model_whose_forces_do_not_balance(tmp_path):
-    """A model whose net internal force exceeds round-off (1e-8 of its forces' sum) in some
-    run is named with its largest value and where, even a small 1e-6; models that balance
-    to round-off are not."""
+    """A model whose net internal force or torque exceeds round-off (1e-8 of its forces'
+    sum) in some run is named with its largest value and where, even a small 1e-6; models
+    that balance both to round-off are not."""
     from cases.answers import _imbalance
     runs = [{"mesh": "five", "bc": "clamped", "model": "a", "net_force_rel": 0.2},
             {"mesh": "six", "bc": "clamped", "model": "a", "net_force_rel": 0.05},
             {"mesh": "five", "bc": "clamped", "model": "c", "net_force_rel": 1e-6},
-            {"mesh": "five", "bc": "clamped", "model": "b", "net_force_rel": 3e-16}]
+            {"mesh": "five", "bc": "clamped", "model": "b", "net_force_rel": 3e-16},
+            {"mesh": "six", "bc": "clamped", "model": "d", "net_force_rel": 3e-16,
+             "net_torque_rel": 0.017}]
     _case_folder(tmp_path, "torsion", runs)
-    said = _imbalance(tmp_path, ["a", "b", "c"])
-    assert "a up to 0.2 (torsion/five/clamped)" in said and " b up to" not in said
+    said = _imbalance(tmp_path, ["a", "b", "c", "d"])
+    assert "net force: a up to 0.2 (torsion/five/clamped)" in said and " b up to" not in said
     assert "c up to 1e-06 (torsion/five/clamped)" in said
+    assert "net torque: d up to 0.017 (torsion/six/clamped)" in said
     assert _imbalance(tmp_path, ["b"]) == ""
 
 
@@ -622,7 +625,8 @@ def test_a_mode_unpaired_against_the_continuum_fails_the_total_only():
 def test_how_far_names_the_problems_beyond_the_patch_test_where_a_model_diverges():
     """The consistency limit comes from the sliding cube alone; the answer also names, per
     model, the convergence fits of the other problems that diverge or stop at a floor (the
-    sliding cube's own fits are not counted twice, nor a two-level fit)."""
+    sliding cube's own fits are not counted twice, nor a two-level fit, nor one the study
+    calls not resolved)."""
     from cases.answers import _beyond_the_patch
     fits = [dict(f, levels=4) for f in (
             {"case": "cantilever", "bc": "clamped", "mesh": "six", "model": "a",
@@ -638,21 +642,30 @@ def test_how_far_names_the_problems_beyond_the_patch_test_where_a_model_diverges
     said = _beyond_the_patch({"fits": fits}, ["a", "b"])
     assert "grows under refinement for a (cantilever on six)" in said
     assert "floor in 1 of those 2 for a" in said and "for b" not in said
+    # a fit the convergence study calls not resolved is counted neither way
+    loose = _beyond_the_patch({"fits": fits, "not_resolved": [["torsion", "clamped", "six",
+                                                               "a"]]}, ["a", "b"])
+    assert "floor in" not in loose and "a (cantilever on six)" in loose
 
 
 def test_the_finest_level_is_said_per_lattice_with_its_own_ties():
     """Where no limit exists, each lattice's finest-level errors are listed under its name,
-    and ties are read within one lattice, never across two."""
+    only for the models without a limit there, and ties are read within one lattice, never
+    across two."""
     from cases.answers import _finest
     runs = [{"case": "paper-cube", "bc": "sliding", "mesh": mesh, "model": m, "h_mm": h,
              "disp_rel_l2": e}
-            for mesh, vals in (("bcc", {"a": 0.09, "b": 0.0900001}),
+            for mesh, vals in (("bcc", {"a": 0.09, "b": 0.0900001, "c": 0.3}),
                                ("unstructured", {"a": 0.0900002, "b": 0.5}))
             for m, e in vals.items() for h in (2.0, 4.0)]
     said = _finest({"runs": runs, "references": [{"case": "paper-cube", "bc": "sliding",
                                                   "error_estimate": 1e-6}]},
-                   ["a", "b"], ["bcc", "unstructured"])
+                   {"a": {"bcc": "not decided", "unstructured": "diverges"},
+                    "b": {"bcc": "not decided", "unstructured": "diverges"},
+                    "c": {"bcc": (0.1, 0.01), "unstructured": "diverges"}},
+                   ["bcc", "unstructured"])
     bcc, unstructured = said.split("; on ")
+    assert "c " not in bcc            # c has a limit on bcc: no finest level said there
     assert bcc.startswith("; there, the error at the finest level") and "on bcc: a 0.09" in bcc
     assert "tied: a, b" in bcc
     assert unstructured.startswith("unstructured: a 0.09 at 2 mm, b 0.5 at 2 mm")
@@ -676,7 +689,8 @@ def test_a_quick_index_table_decides_no_verdict(tmp_path):
 
 def test_how_finite_each_load_is_reads_the_linear_laws_error_at_the_load(tmp_path):
     """Each population at finite load is named with the linear law's model-form error there:
-    within 0.05 a nearly linear response, beyond it a finite one."""
+    within 0.05 a nearly linear response, the linear regime's observation again, which the
+    finite-load ranking does not pool; beyond it a finite one, which it does."""
     from cases.answers import _how_finite
     from cases.index import populations
 
@@ -690,4 +704,14 @@ def test_how_finite_each_load_is_reads_the_linear_laws_error_at_the_load(tmp_pat
     _case_folder(tmp_path, "torsion", runs)
     pops, _ = populations(tmp_path, ["torsion"])
     said = _how_finite(pops, "fem-linear")
-    assert "nearly linear, within 0.05: torsion/clamped 0.011" in said
+    assert ("nearly linear, within 0.05 (the linear regime's observation again: not pooled "
+            "at finite load): torsion/clamped 0.011") in said
+    assert [p.ranked for p in pops if p.finite] == [False]
+    finite = tmp_path / "finite"
+    finite.mkdir()
+    _case_folder(finite, "torsion", [at_load(r, 0.08) for r in _torsion_runs(
+        {(mesh, m): 1.2 for mesh in ("five", "six") for m in ("fem-linear", "fem-neohookean",
+                                                                "a")})])
+    pops, _ = populations(finite, ["torsion"])
+    assert [p.ranked for p in pops if p.finite] == [True]
+    assert "beyond: torsion/clamped 0.08" in _how_finite(pops, "fem-linear")

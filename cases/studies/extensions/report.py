@@ -7,7 +7,6 @@ import numpy as np
 
 from ... import catalogue
 from ...document import Document, fmt
-from ...metrics import ALTERNATION_CLEAR
 from ... import figures
 from ...report import environment, write_study
 from ...runner import jsonable
@@ -215,11 +214,8 @@ def failures(rank):
             out.append({"what": f"{case} model-form error",
                         "note": f"FEM P1's discretisation error: {fmt(fem)}",
                         "kind": "case", "key": case, "base": e[BASE], "limit": FEM_FACTOR * fem})
-    alt = rank["alternation"].get(BASE)
-    if alt is not None and alt >= ALTERNATION_CLEAR:
-        out.append({"what": "bulge/neck alternation on the paper cube", "kind": "alternation",
-                    "note": "the continuum's is 0", "key": "alternation", "base": alt,
-                    "limit": ALTERNATION_CLEAR})
+    # the paper cube's alternation is its 5-layer view, which decides nothing (the artefact
+    # study decides on finer meshes): shown in the table, never a criterion
     for key, (v, e_inf, _) in rank["floors"].get(BASE, {}).get("by_fit", {}).items():
         if v in STOPS:
             out.append({"what": f"convergence of {key}", "note": v, "kind": "floor",
@@ -273,8 +269,10 @@ def judge(rank, failure, model):
     v = value(rank, failure, model)
     if failure["kind"] == "floor":
         fit = rank["floors"].get(model, {}).get("by_fit", {}).get(failure["key"])
-        if fit is None or fit[0] not in ("converges", "exact", *STOPS):
+        if fit is None:
             return v, "fails"
+        if fit[0] not in ("converges", "exact", *STOPS):     # not decided, not asymptotic
+            return v, fit[0]
         if fit[0] not in STOPS:
             return v, "fixes"
         if v is None or failure["base"] is None:
@@ -298,6 +296,21 @@ def fixes(rank, models):
 
 def _overlap(a, b):
     return a is None or b is None or (a[0] <= b[1] and b[0] <= a[1])
+
+
+def shared_ranks(by, rank):
+    """{model: its rank as text}: in the order ``by``, a model whose range leaving one
+    population out overlaps its group head's shares the head's rank (the data cannot order
+    them); a model without an overall mean (failed) ranks '-'."""
+    rng, out, head = rank.get("overall_range", {}), {}, None
+    for k, m in enumerate(by):
+        if rank["overall"].get(m) is None:
+            out[m] = "-"
+            continue
+        if head is None or not _overlap(rng.get(head), rng.get(m)):
+            head, out[head] = m, str(k + 1)
+        out[m] = out[head]
+    return out
 
 
 def _lead(rank, cands):
@@ -361,9 +374,7 @@ def conclusion(data):
     if not fs:
         lines.append(f"{BASE} fails none of the criteria checked here (model-form error "
                      f"within {FEM_FACTOR:g}x FEM P1's discretisation error, C_eff within "
-                     f"{ISOTROPIC_TOL:g} of the target, no "
-                     f"bulge/neck alternation below {ALTERNATION_CLEAR:g} of the mean lateral "
-                     "displacement).")
+                     f"{ISOTROPIC_TOL:g} of the target, no convergence floor).")
         return lines
     lines.append(f"{BASE} fails {len(fs)} criteria: " + "; ".join(
         f"{f['what']} {fmt(f['base'])}" + (f" ({f['note']})" if f.get("note") else "")
@@ -443,9 +454,10 @@ def build(out, study, s, doc):
           "to FEM P1 than the paper's model); a model that failed on one has none, and is "
           "ranked last; a best is named only where its range leaving one population out "
           "overlaps no other's.",
-          "bulge/neck artefact: the largest |alternation| of the paper cube's layer profile "
-          "beyond FEM's over the mean lateral displacement, over the model's meshes and bases "
-          f"(0 for the continuum); a failure from {ALTERNATION_CLEAR:g}.",
+          "bulge/neck alternation (shown, not a criterion): the largest |alternation| of the "
+          "paper cube's 5-layer profile beyond FEM's over the mean lateral displacement, over "
+          "the model's meshes and bases; the 5-layer view decides nothing (the artefact "
+          "study's finer meshes do).",
           "convergence floor: fits (of the convergence study) whose verdict is floor or "
           "diverges, and the median extrapolated error e_inf.",
           "C_eff: the largest relative error of its bulk modulus and five deviatoric Kelvin "
@@ -456,8 +468,9 @@ def build(out, study, s, doc):
           f"{CHANGE:.0%} or more."])
     d.h(2, "Ranking by model-form error")
     by = order(rank["overall"])
+    ranks = shared_ranks(by, rank)
     d.table(["rank", "model", "overall"] + cases,
-            [[str(i + 1), short(m), "failed" if rank["overall"][m] is None
+            [[ranks[m], short(m), "failed" if rank["overall"][m] is None
               and rank.get("overall_failed", {}).get(m) else fmt(rank["overall"][m])]
              + [fmt(rank["case_errors"][c][m]) for c in cases] for i, m in enumerate(by)])
     figures.grouped_bars(Path(out) / "case_errors.png", cases, [short(m) for m in models],
@@ -482,21 +495,21 @@ def build(out, study, s, doc):
             "already stiffer than G in the modes it adds), for " + "; ".join(
                 f"{m} on {', '.join(sorted(ms))}" for (m, _), ms in sorted(dropped.items()))
             + ": there the candidate is the paper's model.")
-    d.h(2, "Ranking by cost, artefact, convergence floor and effective elasticity")
+    d.h(2, "Cost, the 5-layer alternation, convergence floors and effective elasticity")
     lattices = sorted({e["mesh"] for e in doc["elasticity"]})
     fl = rank["floors"]
-    d.table(["model", "step / fem-linear", "alternation", "floor + diverges",
+    d.table(["model", "step / fem-linear", "alternation (5-layer view)", "floor + diverges",
              "median e_inf"] + [f"C_eff {lat}" for lat in lattices],
             [[short(m), fmt(rank["cost"].get(m)), fmt(rank["alternation"].get(m)),
               f"{fl[m]['floor'] + fl[m]['diverges']} of {fl[m]['fits']}", fmt(fl[m]["e_inf"])]
              + [fmt(rank["tensors"][m].get(lat)) for lat in lattices] for m in models])
     d.p("By cost: "
-        + ", ".join(short(m) for m in order(rank["cost"])) + "; by alternation: "
-        + ", ".join(short(m) for m in order(rank["alternation"])) + "; by floors: "
+        + ", ".join(short(m) for m in order(rank["cost"])) + "; by floors: "
         + ", ".join(short(m) for m in sorted(models, key=lambda m: (
             fl[m]["floor"] + fl[m]["diverges"], fl[m]["e_inf"] or 0.0))) + ".")
     twin, edge = doc.get("cost_same_terms", {}).get(TWIN), rank["cost"].get(CANDIDATES[0])
-    if twin is not None and edge is not None:
+    # equal to the last digit: one bench row read twice, not two timings
+    if twin is not None and edge is not None and twin != edge:
         d.p(f"The bench timed +normal_edge's terms twice, as the preset {TWIN} "
             f"({fmt(twin)}) and as +normal_edge ({fmt(edge)}), in two runs: "
             f"{abs(edge / twin - 1):.0%} apart, the spread of a cost ratio between bench runs "
