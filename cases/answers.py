@@ -631,7 +631,8 @@ def _discretisation(pops, finite):
         if p.finite != finite or not p.ranked or not d:
             continue
         meds.append((float(np.median(d)), f"[{rel_range(min(d), max(d))} over the meshes]",
-                     p.label + (", not resolved there: the continuum's u_num exceeds a "
+                     p.label + (", beyond what its reference judges: the continuum's u_num "
+                                "exceeds a "
                                 "fifth of it" if p.u_continuum > np.median(d) / 5 else "")))
     if not meds:
         return ""

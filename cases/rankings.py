@@ -200,7 +200,8 @@ def best_and_worst(runs, metric, what, exact=False, estimate_key="p2_error_estim
         smallest = min(min(s.values) for _, s, _ in st if s.values)
         if u > smallest / 5:
             line += (f" The reference's u_num ({rel(u, 2)}) exceeds a fifth of the smallest "
-                     f"error ranked ({rel(smallest, 2)}): differences below it are not resolved.")
+                     f"error ranked ({rel(smallest, 2)}): the reference cannot judge "
+                     "differences below it.")
         return line
     return " ".join(_labelled(runs, line_of))
 

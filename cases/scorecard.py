@@ -430,7 +430,8 @@ def case_findings(name, quantities, runs, patch_tests=(), estimate_key="p2_error
             line += (f". FEM P1 itself is {rel(np.median(disc))} "
                      f"[{rel_range(min(disc), max(disc))}] from the continuum on these meshes "
                      "(discretisation error"
-                     + (f"; not resolved: the continuum's own u_num, {rel(p.u_continuum, 2)}, "
+                     + (f"; beyond what the reference judges: the continuum's own u_num, "
+                        f"{rel(p.u_continuum, 2)}, "
                         "exceeds a fifth of it" if p.u_continuum > np.median(disc) / 5 else "")
                      + ")")
             # |total| < |P1's| with a model-form error: its error opposes P1's; a model that
