@@ -252,10 +252,13 @@ TERMS = {
     "tied": "two errors whose difference is within the uncertainty of that difference: u_val, "
     "and where the two are medians over the meshes, both medians' spread over the meshes in "
     "quadrature (a single run, as on the Truth Cube, has no spread: u_val alone).",
-    "not resolved": "an order of two models that reverses, or levels, when one mesh family "
-    "(every population's runs on it) or one case is left out: the data cannot order them, "
-    "whatever their mean ranks say; judged pair by pair (neighbours in a ranking, the first "
-    "against each other in a pick), never chained through a third.",
+    "not resolved": "what the data cannot establish, from one of two sources, each report "
+    "naming which: an order of two models that reverses, or levels, when one mesh family "
+    "(every population's runs on it) or one case is left out (the data cannot order them, "
+    "whatever their mean ranks say; judged pair by pair, never chained through a third); or a "
+    "value below what its uncertainty resolves (a convergence fit whose finest error is below "
+    "five times its reference's estimate; an artefact part within its u of 0). A reference "
+    "too coarse to judge a case's differences is said as such, not with this word.",
     "failed run": "a run that gave no number (no equilibrium, a metric undefined, a run that "
     "could not start): it counts against its model, as infinitely wrong, in every ranking, "
     "case table and answer; the population stays in every other model's comparison.",
