@@ -715,3 +715,20 @@ def test_how_finite_each_load_is_reads_the_linear_laws_error_at_the_load(tmp_pat
     pops, _ = populations(finite, ["torsion"])
     assert [p.ranked for p in pops if p.finite] == [True]
     assert "beyond: torsion/clamped 0.08" in _how_finite(pops, "fem-linear")
+
+
+def test_a_contender_is_said_first_or_level_without_the_mesh_left_out():
+    """'Not resolved from' says how the order fails when one mesh is left out: 'level with it'
+    where the other model then shares the first rank within the uncertainty without coming
+    first."""
+    meshes = ("five", "six", "bcc", "unstructured")
+
+    def opening(a, c):
+        v = {}
+        for k, mesh in enumerate(meshes):
+            v.update({(mesh, "fem-linear"): 1.0, (mesh, "a"): 1 + a[k], (mesh, "c"): 1 + c[k]})
+        lines, _ = scorecard.case_findings(
+            "torsion", [E.Scalar("torque_nm", "torque_fem_nm", "torque")], _torsion_runs(v))
+        return lines[0]
+    assert "a is not resolved from c (level with it without bcc)" in opening(
+        (0.1, 0.1, 0.1, 0.1), (0.105, 0.2, 0.2, 0.104))
