@@ -373,7 +373,8 @@ def _cost_of_replacing(pops, models, quick):
             said.append(f"{regime} (over {c} case{'s' if c > 1 else ''}, {n} case/bc "
                         f"population{'s' if n > 1 else ''}"
                         + (", so one case decides it" if c == 1 else "")
-                        + (f"; their u_val {_span(us)}, each score floored at its own"
+                        + (f"; their u_val {_span(us, ' to ')}, each score floored at "
+                           "its own"
                            if us else "") + "): " + ", ".join(
                 f"{m} " + (f"failed ({e[3]} of {e[4]} populations failed at the median"
                            + (f"; {fmt(e[1])} over the others" if e[1] is not None else "")
@@ -412,12 +413,17 @@ def _locking(pops):
             out.append(p.label + (f" (FEM P1 up to {rel(max(d))} from the continuum there)"
                                   if d else ""))
     near = [p.label for p in pops if p.nearly_linear and not p.patch_test and not p.locking]
+    # a failure in a population the ranking leaves out is still a failure: said
+    failed = [f"{st.model} {st.failed} of {st.runs} in {p.label}" for p in pops
+              if not p.ranked and not p.patch_test for _, st, _ in p.standings() if st.failed]
     return (("; left out of the ranking, locking-prone (FEM P1, the twin, locks there: its "
              "model-form error ranks closeness to a locked mesh): " + ", ".join(out)
              if out else "")
             + (f"; left out at finite load, nearly linear (fem-linear within "
                f"{NEARLY_LINEAR:g} of neo-Hookean P1 there: the linear regime's observation "
-               "again): " + ", ".join(near) if near else ""))
+               "again, which does not test finite strain): " + ", ".join(near) if near else "")
+            + ("; failed runs in the populations left out (failures all the same): "
+               + ", ".join(failed) if failed else ""))
 
 
 # a model's internal forces balance where their net sum is round-off against their sizes
@@ -693,13 +699,13 @@ def validation(truth):
             "within": [m for m in own if rms[m] <= u[m]]}
 
 
-def _span(values):
+def _span(values, between="-"):
     """'lo-hi' of the values to two figures, one value where they agree."""
     v = list(values)
     if not v:
         return "n/a"
     lo, hi = fmt(min(v), 2), fmt(max(v), 2)
-    return lo if lo == hi else f"{lo}-{hi}"
+    return lo if lo == hi else f"{lo}{between}{hi}"
 
 
 def _measured_line(truth, models):

@@ -102,8 +102,12 @@ def conclusion(pops, models, quick):
             out.append(f"Model-form ranking, {regime}: quick: not decided (run `pbcm report` "
                        "for every mesh).")
             continue
+        first = scorecard.ranked(means)[0][1] if means else None
+        reach = {b: mesh for b, mesh in scorecard.not_resolved_from(
+            pops, models, first, finite).items() if (first, b) not in loose} if first else {}
         out.append(f"Model-form ranking, {regime}, over its {n} populations other than patch "
-                   "tests and locking-prone problems (each model's "
+                   "tests, locking-prone problems and, at finite load, nearly linear loads "
+                   "(each model's "
                    "mean rank, a population ranking its models first by unpaired modes, then "
                    "by the median over the meshes with a failed run counted as infinitely "
                    "wrong; the geometric mean of its "
@@ -114,6 +118,9 @@ def conclusion(pops, models, quick):
                        + (f", the same mean rank as {tie}" if tie else "")
                        + "".join(f", not resolved from {b} (reverses without {mesh})"
                                  for (a, b), mesh in loose.items() if a == m)
+                       # the first against each model that reaches it when a unit is left out
+                       + "".join(f", not resolved from {b} (level or before it without "
+                                 f"{mesh})" for b, mesh in reach.items() if m == first)
                        for rank, m, entry, tie in scorecard.ranked(means)) + ".")
     worst = {}
     # a quick run's farthest holds for its meshes only; a locking-prone population orders

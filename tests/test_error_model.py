@@ -395,6 +395,9 @@ def test_what_to_pick_is_computed_and_names_what_is_not_decided(tmp_path, monkey
     assert ("left out of the ranking, locking-prone (FEM P1, the twin, locks there: its "
             "model-form error ranks closeness to a locked mesh): large-compression/clamped "
             "(FEM P1 up to 0.2 from the continuum there)") in said
+    # its failure is said all the same
+    assert ("failed runs in the populations left out (failures all the same): b 1 of 2 in "
+            "large-compression/clamped") in said
 
 
 def test_no_equilibrium_at_a_linear_cases_load_is_a_failed_run_of_its_load_population(tmp_path):

@@ -75,12 +75,12 @@ def test_rankings_failures_and_verdicts_worked_by_hand():
 
 def test_candidates_whose_ranges_overlap_share_a_rank():
     """In the ranking table a model whose range leaving one population out overlaps its group
-    head's shares that rank; a model that failed has none."""
-    rank = {"overall": {"f": 0.0, "a": 0.5, "b": 0.51, "base": 1.0, "x": None},
-            "overall_range": {"f": [0, 0], "a": [0.45, 0.58], "b": [0.46, 0.59],
+    head's shares that rank; a model that failed has none, nor the yardstick (FEM P1 itself)."""
+    rank = {"overall": {YARDSTICK: 0.0, "a": 0.5, "b": 0.51, "base": 1.0, "x": None},
+            "overall_range": {YARDSTICK: [0, 0], "a": [0.45, 0.58], "b": [0.46, 0.59],
                               "base": [1, 1]}}
-    assert R.shared_ranks(["f", "a", "b", "base", "x"], rank) == {
-        "f": "1", "a": "2", "b": "2", "base": "4", "x": "-"}
+    assert R.shared_ranks([YARDSTICK, "a", "b", "base", "x"], rank) == {
+        YARDSTICK: "-", "a": "1", "b": "1", "base": "3", "x": "-"}
 
 
 def test_headline_says_when_no_candidate_beats_the_paper_model():
@@ -275,3 +275,14 @@ def test_a_model_with_no_error_in_one_population_has_geometric_mean_zero():
             "large-compression": {BASE: 0.2, "m1": 0.1, "m2": 0.2, YARDSTICK: 0.4}}
     models, data = _doc(errs, {}, {})
     assert R.rankings(data, models)["overall"][YARDSTICK] == 0.0
+
+
+def test_a_floor_within_both_limits_uncertainty_is_no_change():
+    """A candidate's floor differs from the paper model's by less than their +- combined:
+    'no change', however large the ratio; beyond it, 'worsens'."""
+    failure = {"kind": "floor", "key": "p/clamped on six", "base": 0.0778, "base_err": 0.0296,
+               "limit": None}
+    rank = {"floors": {"m": {"by_fit": {"p/clamped on six": ["floor", 0.107, 0.0245]}},
+                       "w": {"by_fit": {"p/clamped on six": ["floor", 0.2, 0.0245]}}}}
+    assert R.judge(rank, failure, "m") == (0.107, "no change")
+    assert R.judge(rank, failure, "w") == (0.2, "worsens")
