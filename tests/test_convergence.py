@@ -530,14 +530,17 @@ def test_a_target_reached_only_by_cancellation_is_named_not_picked():
 
 def test_patch_test_and_consistency_limit_have_distinct_names():
     """'Patch test with every boundary node prescribed' (a strain error) and 'consistency
-    limit' (a fit's floor; the sliding cube's is one) are two numbers with two names: no
-    heading or sentence calls one by the other's name."""
+    limit' (the sliding cube's floor) are two numbers with two names: no heading or sentence
+    calls one by the other's name; the study defines a fit's floor, the glossary the
+    consistency limit, once."""
     from cases.document import Document
     from cases.studies.convergence.report import definitions
     from cases.studies.convergence.verification_report import _sliding, patch_section
     terms = [d.split(":")[0] for d in definitions()]
     assert "patch test with every boundary node prescribed (patch error)" in terms
-    assert "consistency limit" in terms
+    assert "floor e_inf" in terms and "consistency limit" not in terms
+    from cases.index import TERMS
+    assert "consistency limit" in TERMS
     assert not any("consistency error" in d for d in definitions())
     doc = Document("t")
     patch_section(doc, {"patch": [{"mesh": "six", "model": "m", "patch_error": 4.8e-12}]},
