@@ -137,8 +137,9 @@ def table(root, models, pops=(), quick=False):
                      QUICK_CELL if conv_quick else worst(limits(conv, m)) if conv else "n/a",
                      fmt(max(el)) if el else "n/a", fmt(max(alt)) if alt else "n/a",
                      QUICK_CELL if quick and clamped else
-                     ("grows beyond the damping" if flutter else "comes to rest")
-                     + f" ({clamped - flutter} of {clamped} clamped runs come to rest)"
+                     f"{clamped - flutter} of {clamped} clamped runs come to rest"
+                     + (f", {flutter} {'grows' if flutter == 1 else 'grow'} beyond the "
+                        "damping" if flutter else "")
                      if clamped else "n/a",
                      (f"{fmt(b['cpu_s_per_simulated_s'])} ({ratio_text(b, fl)} x fem-linear)"
                       if b and fl and b is not fl else
@@ -619,7 +620,8 @@ def _how_finite(pops, linear_law):
         return k.replace(" at the load", "") + (
             " (locking-prone: against a locked twin, so its locking too)" if k in locked
             else "")
-    return (f"; {linear_law}'s linearisation error at each load (median over the meshes): "
+    return (f"; {linear_law}'s model-form error at each load, on the case's own quantity (its "
+            "linearisation there; median over the meshes): "
             + (f"nearly linear, within {NEARLY_LINEAR:g} (the linear regime's observation "
                "again: not pooled at finite load): "
                + ", ".join(f"{short(k)} {rel(at[k])}" for k in near) if near else

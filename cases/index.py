@@ -141,7 +141,8 @@ def conclusion(pops, models, quick):
                        for m, (v, p) in worst.items()) + ".")
     failed = [f"{s.model} in {p.label} ({s.failed} of {s.runs})" for p in pops
               for _, s, _ in p.standings() if s.failed]
-    out.append("Runs without a model-form number, counted against their model: "
+    out.append("Failed runs (no model-form number, or a mode left unpaired), counted against "
+               "their model: "
                + (", ".join(failed) if failed else "none") + ".")
     return out
 
