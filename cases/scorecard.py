@@ -402,7 +402,7 @@ def case_findings(name, quantities, runs, patch_tests=(), estimate_key="p2_error
                      + ")" + ("; " if ok else ""))
         if ok:
             first = "first (fewest unpaired modes, then the error)" if p.lost and any(
-                p.unpaired.values()) else "closest"
+                p.unpaired.values()) else "nearest the locked twin" if p.locking else "closest"
             # the farthest is the last of every model, a failed one included
             line += f"{first} {ok[0][1].model} ({cell(ok[0][1])}), farthest {st[-1][1].model} " \
                     f"({cell(st[-1][1])})"

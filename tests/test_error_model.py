@@ -735,3 +735,16 @@ def test_a_contender_is_said_first_or_level_without_the_mesh_left_out():
         return lines[0]
     assert "a is not resolved from c (level with it without bcc)" in opening(
         (0.1, 0.1, 0.1, 0.1), (0.105, 0.2, 0.2, 0.104))
+
+
+def test_a_locking_prone_case_names_no_closest_model():
+    """A locking-prone population's opening says its order is closeness to a locked mesh and
+    names the model nearest the locked twin, never a 'closest' model."""
+    runs = _torsion_runs({("five", "fem-linear"): 1.3, ("five", "a"): 1.0, ("five", "b"): 1.35})
+    lines, _ = scorecard.case_findings("torsion", [E.Scalar("torque_nm", "torque_fem_nm",
+                                                            "torque")], runs,
+                                       locking_prone=("clamped",))
+    assert "locking-prone: FEM P1 locks here, so the order below is closeness to a locked " \
+        "mesh, not a ranking of the models" in lines[0]
+    assert "nearest the locked twin b (" in lines[0] and "closest" not in lines[0].split(
+        "FEM P1 itself")[0]
