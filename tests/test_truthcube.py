@@ -333,6 +333,15 @@ def test_against_the_continuum_a_model_is_read_against_its_u_val():
     assert said["b"].startswith("beyond u_val from")
 
 
+def test_against_the_continuum_the_beads_noise_is_left_out():
+    """Read against the continuum, a model's u_val loses the beads' noise (no measurement
+    enters): 0.5 with a noise of 0.3 leaves 0.4, and never below 0."""
+    from cases.studies.truthcube.report import without_noise
+    data = {"states": [{"state": 1, "floor_mm": {"total": 0.3}}]}
+    u = without_noise({1: {"a": 0.5, "b": 0.2}}, data)
+    assert u[1]["a"] == pytest.approx(0.4) and u[1]["b"] == 0.0
+
+
 def test_a_state_is_reproduced_within_the_models_u_val_there():
     """A run reproduces a state when its total bead RMS is at most its u_val at that state
     (1.0 against 1.2: yes; 1.3: no); a model without a u_val falls back to the floor."""

@@ -79,8 +79,8 @@ def finest(rows):
 def against_continuum(rows, data, mesh, u):
     """{model: its answer against the continuum on ``mesh`` (default assumptions)}: the RMS
     distance of its bead displacements from the neo-Hookean continuum's within the model's
-    u_val at every state (``u`` {state: {model: u_val}}: the measurement cannot tell them
-    apart), or the strain from which it is farther."""
+    uncertainty at every state (``u`` {state: {model: u}}, the beads' noise left out: no
+    measurement enters), or the strain from which it is farther."""
     out = {}
     for r in sorted(rows, key=lambda r: r["state"]):
         if r["mesh"] not in (mesh, "reference") or r["variant"] != DEFAULT \
@@ -107,6 +107,14 @@ def state_u_vals(data, parameters):
     return out
 
 
+def without_noise(u, data):
+    """{state: {model: sqrt(u_val^2 - u_D^2)}}: the uncertainty of a model read against the
+    continuum at the beads, where no measurement enters (u_num and u_input only)."""
+    noise = {st["state"]: st["floor_mm"]["total"] for st in data["states"]}
+    return {state: {m: float(np.sqrt(max(v ** 2 - noise.get(state, 0.0) ** 2, 0.0)))
+                    for m, v in us.items()} for state, us in u.items()}
+
+
 def analyse(data, parameters):
     rows, refs = data["rows"], data["references"]
     strains = sorted({r["strain"] for r in rows + refs})
@@ -125,7 +133,8 @@ def analyse(data, parameters):
                    if r["model"] == NH and r["strain"] == last and not r.get("failed")}
     return {"finest_mesh": mesh, "departure": said,
             "within_at_every_state": [m for m, t in said.items() if t == WITHIN_ALL],
-            "against_continuum": against_continuum(rows + refs, data["data"], mesh, u),
+            "against_continuum": against_continuum(rows + refs, data["data"], mesh,
+                                                   without_noise(u, data["data"])),
             "continuum_by_assumption_mm": assumptions,
             "u_val_by_state": u,
             "headline": {"strain": last, "floor_mm": state["floor_mm"]["total"],
@@ -209,8 +218,9 @@ def conclusion(doc):
     close = [m for m, t in vs.items() if t == WITHIN_ALL]
     far = {m: t for m, t in vs.items() if t != WITHIN_ALL}
     lines.append("**Against the continuum at the beads** (the RMS distance of a model's bead "
-                 "displacements from the continuum's, read against the model's u_val): "
-                 + (f"{', '.join(close)} stay within it at every state (the measurement "
+                 "displacements from the continuum's, read against sqrt(u_num^2 + u_input^2), "
+                 "the beads' noise left out since no measurement enters): "
+                 + (f"{', '.join(close)} stay within it at every state (the unmeasured inputs "
                     "cannot tell them from it)" if close else
                     "no model stays within it at every state")
                  + ("; " + "; ".join(f"{m} {t.replace('within', 'within it')}"
@@ -348,7 +358,8 @@ def _errors(d, doc):
     d.h(3, "Where each departs")
     d.p(f"On the {doc['finest_mesh']} mesh: from the measurement (its error beyond the noise "
         "above the floor) and from the neo-Hookean continuum under the same assumptions (the "
-        "RMS distance of their bead displacements beyond the model's u_val there).")
+        "RMS distance of their bead displacements beyond the model's u_val there, the beads' "
+        "noise left out of it: no measurement enters that comparison).")
     vs = doc["against_continuum"]
     d.table(["model", "against the measurement", "against the continuum"],
             [[m, t, vs.get(m, "(the continuum)" if m == NH else "n/a")]
