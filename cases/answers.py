@@ -12,7 +12,7 @@ import numpy as np
 
 from .costs import FILE as BENCH_FILE, FOLDER as BENCH_FOLDER
 from .document import fmt, rel, rel_range
-from .error_model import ROUND_OFF, input_spread
+from .error_model import P1_LINEAR, ROUND_OFF, input_spread
 from .metrics import PATCH_TOL
 
 COST_TETS = 1e4          # the mesh size of the cost column (tetrahedra)
@@ -399,10 +399,10 @@ def _cost_of_replacing(pops, models, quick):
             "meshes [its range when one mesh family is left out]; a failed run counts against "
             "its model, and a model with a failed run (no number; at the load, no converged "
             "solve) ranks after every model without one: "
-            + "; ".join(said) + _locking(pops) + " (the scorecard below).")
+            + "; ".join(said) + _left_out(pops) + " (the scorecard below).")
 
 
-def _locking(pops):
+def _left_out(pops):
     """'; left out of the ranking ...': the locking-prone populations, with how far their twin
     is from the continuum, and the finite-load populations the linear law meets within the
     scorecard's NEARLY_LINEAR: shown in the scorecard, never pooled."""
@@ -420,7 +420,7 @@ def _locking(pops):
     return (("; left out of the ranking, locking-prone (FEM P1, the twin, locks there: its "
              "model-form error ranks closeness to a locked mesh): " + ", ".join(out)
              if out else "")
-            + (f"; left out at finite load, nearly linear (fem-linear within "
+            + (f"; left out at finite load, nearly linear ({P1_LINEAR} within "
                f"{NEARLY_LINEAR:g} of neo-Hookean P1 there: the linear regime's observation "
                "again, which does not test finite strain): " + ", ".join(near) if near else "")
             + ("; failed runs in the populations left out (failures all the same): "

@@ -139,7 +139,7 @@ def populations(runs_by_case, declared, quick, patch_tests, estimate_keys):
                                                      ()),
                                        bc in getattr(declared[case], "locking_prone", ())))
     return [replace(p, nearly_linear=True) if p.finite and
-            (linearisation(p) is not None and linearisation(p) <= NEARLY_LINEAR) else p
+            (lin := linearisation(p)) is not None and lin <= NEARLY_LINEAR else p
             for p in out]
 
 
@@ -279,7 +279,8 @@ def overall(pops, models, finite=False):
     solve) against its model; each case weighs one (its boundary conditions are averaged
     first: two bcs of one case are not two independent observations); each score floored at
     its population's model-form uncertainty; P1 itself left out (an identity check), and the
-    populations ``Population.ranked`` leaves out (patch tests, locking-prone problems);
+    populations ``Population.ranked`` leaves out (patch tests, locking-prone problems,
+    nearly linear finite loads);
     a model with any failed run ranks after every model without one (``_order``)."""
     used = [p for p in pops if p.finite == finite and p.ranked]
     out = {}
