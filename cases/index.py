@@ -141,9 +141,13 @@ def conclusion(pops, models, quick):
                        for m, (v, p) in worst.items()) + ".")
     failed = [f"{s.model} in {p.label} ({s.failed} of {s.runs})" for p in pops
               for _, s, _ in p.standings() if s.failed]
+    # against the continuum a run fails on its own too (a continuum mode left unpaired)
+    total = [f"{s.model} in {p.label} ({s.failed} of {s.runs})" for p in pops
+             for _, s, _ in p.standings("total") if s.failed]
     out.append("Failed runs (no model-form number, or a mode left unpaired), counted against "
-               "their model: "
-               + (", ".join(failed) if failed else "none") + ".")
+               "their model: " + (", ".join(failed) if failed else "none")
+               + "; against the continuum (the total): " + (", ".join(total) if total else "none")
+               + ".")
     return out
 
 

@@ -748,3 +748,22 @@ def test_a_locking_prone_case_names_no_closest_model():
         "mesh, not a ranking of the models" in lines[0]
     assert "nearest the locked twin b (" in lines[0] and "closest" not in lines[0].split(
         "FEM P1 itself")[0]
+
+
+def test_the_scorecard_names_failures_against_the_continuum_too():
+    """A run that fails against the continuum alone (a continuum mode left unpaired, its
+    model-form number intact) is named among the failed runs of the scorecard's conclusion."""
+    from cases.index import conclusion
+    q = E.Norm("mf", "tot", "modes", unpaired="lost", unpaired_total="lost_c", count=10)
+    run = {"mesh": "six", "bc": "free"}
+    runs = [dict(run, model="fem-linear", mf=0.0, tot=0.05, lost=0, lost_c=0),
+            dict(run, model="a", mf=0.02, tot=0.03, lost=0, lost_c=9)]
+
+    class Declared:
+        @staticmethod
+        def decompositions():
+            return (q,)
+    pops = scorecard.populations({"modes": runs}, {"modes": Declared}, {"modes": False},
+                                 {"modes": set()}, {"modes": "est"})
+    last = conclusion(pops, ["fem-linear", "a"], False)[-1]
+    assert last.endswith("against the continuum (the total): a in modes/free (1 of 1).")
