@@ -230,31 +230,57 @@ class Standing:
         return (max(meds) - min(meds)) / 2 if meds else 0.0
 
 
+class Unordered(tuple):
+    """The models a standing is not ordered from (every one of them, as a tuple): ``tied``
+    those within the comparison's u_val alone (V&V 20: a difference below u_val is a tie);
+    ``unresolved`` the rest, beyond u_val but within both medians' spread over the meshes
+    (leaving one mesh out could reverse or level the order: not resolved, never called a
+    tie)."""
+
+    def __new__(cls, names, tied=()):
+        out = super().__new__(cls, names)
+        out.tied = tuple(n for n in names if n in tied)
+        return out
+
+    @property
+    def unresolved(self):
+        return tuple(n for n in self if n not in self.tied)
+
+
 def standings(by_model, u, lost=None):
     """Rank a population: ``by_model`` {model: [error magnitude or None per run]}, ``u`` the
     validation uncertainty of a difference, ``lost`` {model: failed parts of runs that gave a
-    number (unpaired modes)}, ranked on before the error. Returns [(rank, Standing, tied)],
-    best first: a model whose score is within the uncertainty of a difference (``u`` and the
-    two medians' ``Standing.spread`` over the meshes, in quadrature) of the first of a group
-    (and that lost as many parts) shares that group's rank; ``tied`` names every other model
-    within that uncertainty of it (pair by pair, never chained, so two neighbours across a
-    rank boundary are still said tied); failed runs count against their model, and models
-    that all failed their median share the last rank."""
+    number (unpaired modes)}, ranked on before the error. Returns [(rank, Standing,
+    Unordered)], best first: a model whose score is within ``u`` (tied) or within ``u`` and
+    the two medians' ``Standing.spread`` over the meshes in quadrature (not resolved) of the
+    first of a group (and that lost as many parts) shares that group's rank; the
+    :class:`Unordered` names every other model it is not ordered from, and which of them it
+    is tied with (pair by pair, never chained, so two neighbours across a rank boundary are
+    still named); failed runs count against their model, and models that all failed their
+    median share the last rank."""
     lost = lost or {}
     u = max(u, ROUND_OFF)       # round-off never orders two models
     st = sorted((Standing(m, tuple(abs(v) for v in vs if v is not None), len(vs))
                  for m, vs in by_model.items()),
                 key=lambda s: (lost.get(s.model, 0), s.score, s.model))
-    def tie(a, b):      # within the comparison's u_val and both medians' spread over meshes
-        return lost.get(a.model, 0) == lost.get(b.model, 0) and (
-            a.score == b.score or abs(a.score - b.score) < math.sqrt(
-                u ** 2 + a.spread ** 2 + b.spread ** 2))
+
+    def same(a, b):
+        return lost.get(a.model, 0) == lost.get(b.model, 0)
+
+    def tied(a, b):     # within the comparison's u_val
+        return same(a, b) and (a.score == b.score or abs(a.score - b.score) < u)
+
+    def unordered(a, b):    # or within both medians' spread over the meshes beside it
+        return same(a, b) and (tied(a, b) or abs(a.score - b.score) < math.sqrt(
+            u ** 2 + a.spread ** 2 + b.spread ** 2))
 
     out, head, rank = [], None, 0
     for k, s in enumerate(st):
-        if head is None or not tie(s, head):
+        if head is None or not unordered(s, head):
             head, rank = s, k + 1
-        out.append((rank, s, tuple(o.model for o in st if o is not s and tie(s, o))))
+        others = [o for o in st if o is not s]
+        out.append((rank, s, Unordered(tuple(o.model for o in others if unordered(s, o)),
+                                       {o.model for o in others if tied(s, o)})))
     return out
 
 

@@ -110,12 +110,12 @@ def _lost(runs, lost_key):
 def _u_text(u, defect, field=False, per_mesh=False):
     """'u_num U' and what it holds: the reference's estimate and its spread over the meshes
     in quadrature, or the estimate alone (a field has no one value to spread; each mesh its
-    own continuum problem), and the two medians' spread over the meshes a tie also reads."""
+    own continuum problem)."""
     held = (" (the estimate alone: each mesh its own continuum problem, its value read at "
             "the mesh's own nodes)" if per_mesh else
             " (the reference's estimate: a field has no one value to spread over the meshes)"
             if field else ", mostly the continuum's spread over the meshes" if defect else "")
-    return f"u_num {rel(u, 2)}{held} and the two medians' spread over the meshes"
+    return f"u_num {rel(u, 2)}{held}"
 
 
 def ranking(runs, metric, label, estimate_key="p2_error_estimate", lost_key=None,
@@ -135,9 +135,12 @@ def ranking(runs, metric, label, estimate_key="p2_error_estimate", lost_key=None
             note = []
             if lost.get(s.model):
                 note.append(f"{lost[s.model]} unpaired modes (each run with one failed)")
-            if tie:
+            if tie.tied:
                 held = _u_text(u, defect, _continuum_key(rs, metric) is None, bc in per_mesh)
-                note.append(f"tied with {', '.join(tie)} (within {held})")
+                note.append(f"tied with {', '.join(tie.tied)} (within {held})")
+            if tie.unresolved:
+                note.append(f"not resolved from {', '.join(tie.unresolved)} (beyond u_num, "
+                            "within both medians' spread over the meshes)")
             if s.failed:
                 note.append(f"{s.failed} failed, counted against it")
             rows.append([bc, rank, s.model, *_stats(s), "; ".join(note)])
@@ -192,11 +195,13 @@ def best_and_worst(runs, metric, what, exact=False, estimate_key="p2_error_estim
                      + ", ".join(unpaired) + ".")
         if exact:
             return line
-        tied = list(st[0][2])
-        if tied:
+        if st[0][2].tied:
             line += (f" Tied with {best.model} within the reference's "
                      f"{_u_text(u, defect, _continuum_key(rs, metric) is None, own)}: "
-                     f"{', '.join(tied)}.")
+                     f"{', '.join(st[0][2].tied)}.")
+        if st[0][2].unresolved:
+            line += (f" {best.model} is not resolved from {', '.join(st[0][2].unresolved)}: "
+                     "beyond u_num, within both medians' spread over the meshes.")
         smallest = min(min(s.values) for _, s, _ in st if s.values)
         if u > smallest / 5:
             line += (f" The reference's u_num ({rel(u, 2)}) exceeds a fifth of the smallest "

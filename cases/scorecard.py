@@ -206,7 +206,19 @@ def cell(standing, tied_with=None):
     else:     # the median over every run, a failed one counted as infinitely wrong
         text = (f"{rel(s.score)} [{rel_range(min(s.values), max(s.values))}] "
                 f"{len(s.values)}/{s.runs}" + (f", {s.failed} failed" if s.failed else ""))
-    return text + (f"; tied with {', '.join(tied_with)}" if tied_with else "")
+    return text + unordered_text(tied_with)
+
+
+def unordered_text(others):
+    """'; tied with A; not resolved from B (...)' of an ``error_model.Unordered`` (a plain
+    tuple: every name tied)."""
+    if not others:
+        return ""
+    tied = getattr(others, "tied", tuple(others))
+    loose = getattr(others, "unresolved", ())
+    return ((f"; tied with {', '.join(tied)}" if tied else "")
+            + (f"; not resolved from {', '.join(loose)} (beyond u_val, within both medians' "
+               "spread over the meshes)" if loose else ""))
 
 
 def unresolved(pops, models, finite=False):
@@ -408,10 +420,13 @@ def case_findings(name, quantities, runs, patch_tests=(), estimate_key="p2_error
             line += f"{first} {ok[0][1].model} ({cell(ok[0][1])}), farthest {st[-1][1].model} " \
                     f"({cell(st[-1][1])})"
             tied = list(ok[0][2])
-            if tied:
-                line += f"; tied with {ok[0][1].model} (within u_val {rel(p.u_model_form, 2)} " \
-                        "and the two medians' spread over the meshes): " \
-                        f"{', '.join(tied)}"
+            if ok[0][2].tied:
+                line += f"; tied with {ok[0][1].model} (within u_val {rel(p.u_model_form, 2)}" \
+                        f"): {', '.join(ok[0][2].tied)}"
+            if ok[0][2].unresolved:
+                line += f"; {ok[0][1].model} not resolved from " \
+                        f"{', '.join(ok[0][2].unresolved)} (beyond u_val, within both " \
+                        "medians' spread over the meshes)"
             first = [f"{m} ({how})"
                      for m, how in population_contenders(p).items() if m not in tied]
             if first:

@@ -186,13 +186,19 @@ def test_a_medians_spread_is_half_the_range_of_its_leave_one_mesh_out_medians():
     assert E.Standing("a", (1.0,), 3).spread == 0.0          # two of three failed
 
 
-def test_medians_within_their_spread_over_the_meshes_are_tied():
-    """Two medians 0.01 apart are tied when the meshes move them more than that (a
-    difference the unit of analysis does not resolve), and ranked when every mesh agrees."""
+def test_medians_within_their_spread_over_the_meshes_share_a_rank_unresolved_not_tied():
+    """Two medians 0.01 apart share a rank when the meshes move them more than that (a
+    difference the unit of analysis does not resolve), said as not resolved, never as tied;
+    within u_val they are tied; ranked apart when every mesh agrees."""
     noisy = E.standings({"a": [0.10, 0.20, 0.30], "b": [0.11, 0.21, 0.31]}, u=0.0)
     assert [(r, s.model, t) for r, s, t in noisy] == [(1, "a", ("b",)), (1, "b", ("a",))]
+    assert [(t.tied, t.unresolved) for _, _, t in noisy] == [((), ("b",)), ((), ("a",))]
+    close = E.standings({"a": [0.10, 0.20, 0.30], "b": [0.11, 0.21, 0.31]}, u=0.02)
+    assert [(t.tied, t.unresolved) for _, _, t in close] == [(("b",), ()), (("a",), ())]
     steady = E.standings({"a": [0.20, 0.20, 0.20], "b": [0.21, 0.21, 0.21]}, u=0.0)
     assert [(r, s.model, t) for r, s, t in steady] == [(1, "a", ()), (2, "b", ())]
+    assert "not resolved from b" in scorecard.unordered_text(noisy[0][2])
+    assert "tied with b" in scorecard.unordered_text(close[0][2])
 
 
 def test_the_quantity_at_the_load_is_the_linear_regimes_on_the_finite_solve():
