@@ -51,6 +51,10 @@ def _labelled(runs, line_of):
     return [f"[{bc}] {line_of(rs)}" for bc, rs in pops.items()]
 
 
+# a reference judges errors above this many times its own u_num, and orders none below
+# (a fifth of the smallest error ranked)
+JUDGES = 5
+
 # the continuum's value behind a relative error whose quantity is not named after it
 CONTINUUM_OF = {"reaction_rel_err": "reaction_fem_p2_n",
                 "reaction_rel_err_nh": "reaction_fem_nh_n",
@@ -131,8 +135,14 @@ def ranking(runs, metric, label, estimate_key="p2_error_estimate", lost_key=None
     for bc, rs in populations(runs).items():
         u, defect = uncertainty(rs, metric, estimate_key, bc in per_mesh)
         lost = _lost(rs, lost_key)
-        for rank, s, tie in _standings(rs, metric, u, lost_key):
+        st = _standings(rs, metric, u, lost_key)
+        blind = [s.model for _, s, _ in st if math.isfinite(s.score) and s.score < JUDGES * u]
+        for rank, s, tie in st:
             note = []
+            if s.model in blind:
+                rank = 1
+                note.append(f"below {JUDGES} times u_num ({rel(JUDGES * u, 2)}): not judged, "
+                            "not ordered from the models there")
             if lost.get(s.model):
                 note.append(f"{lost[s.model]} unpaired modes (each run with one failed)")
             if tie.tied:
@@ -183,8 +193,18 @@ def best_and_worst(runs, metric, what, exact=False, estimate_key="p2_error_estim
         if not st or not any(s.values for _, s, _ in st):
             return f"No model gave {what}."
         best, worst = st[0][1], st[-1][1]
-        line = (f"{what}{AGAINST}: from {best.model} ({_cell(best)}) to "
-                f"{worst.model} ({_cell(worst)}).")
+        judged = [s for _, s, _ in st if math.isfinite(s.score)]
+        blind = [s for s in judged if not exact and s.score < JUDGES * u]
+        if blind:    # a reference orders no error below five times its own u_num
+            above = [s for _, s, _ in st if s not in blind]
+            line = (f"{what}{AGAINST}: not judged below {JUDGES} times the reference's u_num "
+                    f"({rel(JUDGES * u, 2)}): " + ", ".join(f"{s.model} ({rel(s.score)})"
+                                                          for s in blind)
+                    + (f"; above it, from {above[0].model} ({_cell(above[0])}) to "
+                       f"{worst.model} ({_cell(worst)})." if above else "."))
+        else:
+            line = (f"{what}{AGAINST}: from {best.model} ({_cell(best)}) to "
+                    f"{worst.model} ({_cell(worst)}).")
         failed = [s for _, s, _ in st if s.failed]
         if failed:
             line += (" Failed runs, counted against their model: " + ", ".join(
@@ -194,6 +214,8 @@ def best_and_worst(runs, metric, what, exact=False, estimate_key="p2_error_estim
             line += (" Unpaired modes (a run with one is a failed run): "
                      + ", ".join(unpaired) + ".")
         if exact:
+            return line
+        if blind:
             return line
         if st[0][2].tied:
             line += (f" Tied with {best.model} within the reference's "
