@@ -396,9 +396,9 @@ def _cost_of_replacing(pops, models, quick):
             "with the same law on the same tetrahedra, in order of mean rank over the cases "
             "(each case weighing one, its boundary conditions averaged; the mean rank decides "
             "the order), beside it the geometric mean over the cases of the median over the "
-            "meshes [its range when one mesh family is left out]; a failed run counts against "
-            "its model, and a model with a failed run (no number; at the load, no converged "
-            "solve) ranks after every model without one: "
+            "meshes [its range when one mesh family is left out]; a failed run (no number; at "
+            "the load, no converged solve) counts against its model once, as infinitely wrong "
+            "in its population's rank: "
             + "; ".join(said) + _left_out(pops) + " (the scorecard below).")
 
 
@@ -538,7 +538,7 @@ def recommendation(root, models, pops, quick, bench_rows):
         said += _how_finite(pops, p1_lin)
         cands = [b] + others if b else []
         failing = [f"{m} ({fin[m][2]} failed runs)" for m in cands if fin[m][2]]
-        # the models a failed run put after the rest, named with what they would have scored
+        # the other models with a failed run, named with what they scored elsewhere
         left = [f"{m} (model-form error "
                 + (rel(e[1]) if e[1] is not None and not e[3] else "failed at the median")
                 + f"; {e[2]} failed runs: no converged solve at the load)"
@@ -551,7 +551,7 @@ def recommendation(root, models, pops, quick, bench_rows):
                    f"continuum; refine before choosing){said}"
                    + ("; with failed runs (no converged solve at the load): " + "; ".join(failing)
                       if failing else "")
-                   + ("; ranked after them for a failed run: " + "; ".join(left)
+                   + ("; other models with failed runs: " + "; ".join(left)
                       if left else "") + ".")
     truth = _load(root, MEASURED, "metrics.json")
     if truth and truth.get("headline"):

@@ -256,9 +256,8 @@ TERMS = {
     "modes), then by the median over the meshes with a failed run counted as infinitely "
     "wrong (so a failure never removes a population from anyone's comparison); models within "
     "u_val of the first of a group (tied), or within both medians' spread over the meshes "
-    "beside it (not resolved), share its rank; "
-    "a model with a failed run ranks after "
-    "every model without one. Beside it the geometric mean over the cases of the population "
+    "beside it (not resolved), share its rank; a failed run counts once, in its "
+    "population's rank. Beside it the geometric mean over the cases of the population "
     "medians, each floored at its population's u_val, with its range over the rankings that "
     "leave one mesh family out; 'failed' where a population failed at the median (no finite "
     "mean exists), with the mean over the others beside it.",

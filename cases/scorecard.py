@@ -233,7 +233,7 @@ def unresolved(pops, models, finite=False):
         for a, b in zip(order, order[1:]):
             # reversed, or level: an order one subset cannot keep is not resolved
             if (a, b) not in out and a in alt and b in alt and \
-                    _order(alt[a], a)[:2] >= _order(alt[b], b)[:2]:
+                    _order(alt[a], a)[:1] >= _order(alt[b], b)[:1]:
                 out[(a, b)] = left_out
     return out
 
@@ -251,7 +251,7 @@ def not_resolved_from(pops, models, first, finite=False):
             continue
         for m in after:
             if m in alt and m not in out and \
-                    _order(alt[m], m)[:2] <= _order(alt[first], first)[:2]:
+                    _order(alt[m], m)[:1] <= _order(alt[first], first)[:1]:
                 out[m] = left_out
     return out
 
@@ -293,7 +293,7 @@ def overall(pops, models, finite=False):
     its population's model-form uncertainty; P1 itself left out (an identity check), and the
     populations ``Population.ranked`` leaves out (patch tests, locking-prone problems,
     nearly linear finite loads);
-    a model with any failed run ranks after every model without one (``_order``)."""
+    a failed run counts once, as infinitely wrong in its population's rank (``_order``)."""
     used = [p for p in pops if p.finite == finite and p.ranked]
     out = {}
     for m in models:
@@ -326,9 +326,9 @@ def largest(pops, model, finite=False):
 
 
 def _order(entry, model):
-    """The ranking's order of one model: those with a failed run (no number in a population)
-    after every model without one, then by mean rank, then by geometric mean."""
-    return (failed(entry), entry[0], entry[1] or 0.0, model)
+    """The ranking's order of one model: by mean rank (a failed run already ranked where it
+    fell in its population, counted once), then by geometric mean."""
+    return (entry[0], entry[1] or 0.0, model)
 
 
 def failed(entry):
@@ -338,11 +338,11 @@ def failed(entry):
 
 def ranked(means):
     """[(rank, model, overall's entry, tied_with)], best first (``_order``); equal mean ranks
-    in the same failure class share a rank (tied)."""
+    share a rank (tied)."""
     order = sorted(means, key=lambda m: _order(means[m], m))
     out, head, rank = [], None, 0
     for k, m in enumerate(order):
-        if head is not None and _order(means[m], m)[:2] == _order(means[head], head)[:2]:
+        if head is not None and _order(means[m], m)[:1] == _order(means[head], head)[:1]:
             out.append((rank, m, means[m], head))
             continue
         head, rank = m, k + 1
@@ -364,8 +364,6 @@ def describe(entry, rng=None):
             text += f" [{rel(rng[0])}-{rel(rng[1])} leaving one mesh family out]"
     if n_failed:
         text += f", {n_failed} failed runs"
-    if failed(entry):
-        text += " (ranked after every model without a failed run)"
     return text
 
 
