@@ -226,8 +226,8 @@ declare("disp_rel_l2_nh_p1", "1", "disp L2 NH vs P1",
 declare("disp_rel_l2_nh", "1", "disp L2 NH",
         "at the case's load: ||u_model - u_ref|| / ||u_ref|| over the free components, "
         "against the converged neo-Hookean P2 reference at the particle nodes (fem-linear's "
-        "holds its linearisation error and P1's discretisation error; the first is its "
-        "difference from fem-neohookean's on the same mesh).", "max")
+        "holds the linear law's departure from the neo-Hookean field and P1's "
+        "discretisation error; the first is disp_rel_l2_nh_p1).", "max")
 declare("disp_max_rel_nh", "1", "disp max NH",
         "at the case's load: max_i |u_model,i - u_ref,i| / max_i |u_ref,i| over the free "
         "components, against the neo-Hookean reference.", "max")

@@ -289,8 +289,9 @@ def _linearisation(runs):
         lin = [r["disp_rel_l2_nh_p1"] for r in mine if r.get("disp_rel_l2_nh_p1") is not None]
         tot = [r["disp_rel_l2_nh"] for r in mine if r.get("disp_rel_l2_nh") is not None]
         if lin and tot:
-            said.append(f"[{bc}] fem-linear at the case's load: its linearisation error (its "
-                        f"displacement against neo-Hookean P1 on the same mesh) "
+            said.append(f"[{bc}] fem-linear at the case's load: its displacement field's distance "
+                        f"to neo-Hookean P1 on the same mesh (a field norm; the index's "
+                        f"linearisation error is the case's quantity instead) "
                         f"{cell(lin, len(mine))}; its total against the neo-Hookean "
                         f"reference {cell(tot, len(mine))}, which holds P1's discretisation "
                         "error too (the two are norms: they bound the total, they do not "
