@@ -72,21 +72,32 @@ def _continuum_key(runs, metric):
                  if err_name(q) == metric and ref_name(q) in keys and ref_name(q) != q), None)
 
 
-def uncertainty(runs, metric, estimate_key="p2_error_estimate", per_mesh=False):
+def uncertainty(runs, metric, estimate_key="p2_error_estimate", per_mesh=False,
+                spread_keys=()):
     """(u_num, the spread exceeds the estimate) of a comparison of ``metric`` over ``runs`` (one
     continuum problem on several meshes): the reference's largest estimate combined in
     quadrature with the spread of the continuum's value across the meshes
-    (``error_model.u_num``); ``per_mesh``: each mesh poses its own continuum problem, so the
-    values' spread is no uncertainty and u_num is the estimate alone."""
-    key = None if per_mesh else _continuum_key(runs, metric)
+    (``error_model.u_num``); ``spread_keys``: the run keys of the same reference's other
+    values, whose largest spread over the meshes counts too (one reference that disagrees
+    with itself on one quantity is that uncertain on every quantity it gives); ``per_mesh``:
+    each mesh poses its own continuum problem, so the values' spread is no uncertainty and
+    u_num is the estimate alone."""
+    if per_mesh:
+        return u_num(estimate(runs, estimate_key), [])
+    keys = [k for k in (_continuum_key(runs, metric), *spread_keys) if k]
+    est = estimate(runs, estimate_key)
+    found = [u_num(est, _last_values(runs, k)) for k in dict.fromkeys(keys)]
+    return max(found) if found else u_num(est, [])
+
+
+def _last_values(runs, key):
+    """The continuum's value under ``key`` per mesh (a sequence's last step)."""
     values = {}
-    if key:
-        for r in runs:
-            v = r.get(key)
-            if v is not None:
-                values[r["mesh"]] = float(v[-1]) if isinstance(v, (list, tuple)) else float(v)
-    u, defect = u_num(estimate(runs, estimate_key), list(values.values()))
-    return u, defect
+    for r in runs:
+        v = r.get(key)
+        if v is not None:
+            values[r["mesh"]] = float(v[-1]) if isinstance(v, (list, tuple)) else float(v)
+    return list(values.values())
 
 
 def _standings(runs, metric, u, lost_key=None):
@@ -123,7 +134,7 @@ def _u_text(u, defect, field=False, per_mesh=False):
 
 
 def ranking(runs, metric, label, estimate_key="p2_error_estimate", lost_key=None,
-            per_mesh=()):
+            per_mesh=(), spread_keys=()):
     """A table (one item of a report's findings): per population (boundary condition) the
     models by median ``metric`` over every run they had (a run without a value, or one that
     lost a part, counts against its model, as infinitely wrong), best first, with the range
@@ -133,7 +144,7 @@ def ranking(runs, metric, label, estimate_key="p2_error_estimate", lost_key=None
     each mesh poses its own continuum problem."""
     rows = []
     for bc, rs in populations(runs).items():
-        u, defect = uncertainty(rs, metric, estimate_key, bc in per_mesh)
+        u, defect = uncertainty(rs, metric, estimate_key, bc in per_mesh, spread_keys)
         lost = _lost(rs, lost_key)
         st = _standings(rs, metric, u, lost_key)
         blind = [s.model for _, s, _ in st if math.isfinite(s.score) and s.score < JUDGES * u]
@@ -146,7 +157,8 @@ def ranking(runs, metric, label, estimate_key="p2_error_estimate", lost_key=None
             if lost.get(s.model):
                 note.append(f"{lost[s.model]} unpaired modes (each run with one failed)")
             if tie.tied:
-                held = _u_text(u, defect, _continuum_key(rs, metric) is None, bc in per_mesh)
+                held = _u_text(u, defect, _continuum_key(rs, metric) is None and not spread_keys,
+                               bc in per_mesh)
                 note.append(f"tied with {', '.join(tie.tied)} (within {held})")
             if tie.unresolved:
                 note.append(f"not resolved from {', '.join(tie.unresolved)} (beyond u_num, "
@@ -177,7 +189,7 @@ def _cell(s):
 
 
 def best_and_worst(runs, metric, what, exact=False, estimate_key="p2_error_estimate",
-                   lost_key=None, per_mesh=()):
+                   lost_key=None, per_mesh=(), spread_keys=()):
     """Per population (boundary condition), one line naming the model closest to FEM and the
     farthest by median ``metric`` over every run (a run without a value counts against its
     model); the models within the reference's u_num (``uncertainty``) and the two medians'
@@ -188,7 +200,8 @@ def best_and_worst(runs, metric, what, exact=False, estimate_key="p2_error_estim
     ``per_mesh``: the boundary conditions where each mesh poses its own continuum problem."""
     def line_of(rs):
         own = rs[0]["bc"] in per_mesh
-        u, defect = (0.0, False) if exact else uncertainty(rs, metric, estimate_key, own)
+        u, defect = (0.0, False) if exact else uncertainty(rs, metric, estimate_key, own,
+                                                            spread_keys)
         st = _standings(rs, metric, u, lost_key)
         if not st or not any(s.values for _, s, _ in st):
             return f"No model gave {what}."
@@ -219,7 +232,7 @@ def best_and_worst(runs, metric, what, exact=False, estimate_key="p2_error_estim
             return line
         if st[0][2].tied:
             line += (f" Tied with {best.model} within the reference's "
-                     f"{_u_text(u, defect, _continuum_key(rs, metric) is None, own)}: "
+                     f"{_u_text(u, defect, _continuum_key(rs, metric) is None and not spread_keys, own)}: "
                      f"{', '.join(st[0][2].tied)}.")
         if st[0][2].unresolved:
             line += (f" {best.model} is not resolved from {', '.join(st[0][2].unresolved)}: "

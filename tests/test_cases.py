@@ -235,6 +235,12 @@ def test_ties_widen_to_the_continuums_spread_over_the_meshes():
     (table,) = rankings.ranking(runs, "q_rel_err", "error")
     assert table.rows[1][-1].endswith("tied with a (within u_num 0.096, mostly the "
                                       "continuum's spread over the meshes)")
+    # a quantity whose own continuum values agree still carries the spread the same
+    # reference shows on another of its values
+    agree = [dict(r, w_rel_err=0.1, w_mm=1.0, w_fem_mm=2.0) for r in runs]
+    assert rankings.uncertainty(agree, "w_rel_err") == (pytest.approx(0.01), False)
+    assert rankings.uncertainty(agree, "w_rel_err", spread_keys=("q_fem_mm",)) == (
+        pytest.approx(np.hypot(0.01, 0.1 / 1.05)), True)
     per = rankings.uncertainty(runs, "q_rel_err", per_mesh=True)
     assert per == (pytest.approx(0.01), False)       # each mesh its own problem: no spread
     (own,) = rankings.ranking(runs, "q_rel_err", "error", per_mesh=("clamped",))
