@@ -151,6 +151,22 @@ def conclusion(pops, models, quick):
     return out
 
 
+# the run keys of the phases every ranking already counts; any other '<check>_failed' key is a
+# case's own check (a homogeneous compression, say) whose failure no population shows
+RANKED_FAILURES = ("failed", "static_failed", "finite_failed")
+
+
+def failed_checks(data):
+    """'Failed checks ...: MODEL on CASE/MESH/BC (CHECK), ...' over the runs of every case in
+    ``data`` ({case: metrics}): the failures of a case's own checks, which no ranking
+    counts, named so that none is passed unread; or that none failed."""
+    bad = [f"{r['model']} on {case}/{r['mesh']}/{r['bc']} ({k[:-len('_failed')]})"
+           for case, d in data.items() for r in d["runs"] for k in sorted(r)
+           if k.endswith("_failed") and k not in RANKED_FAILURES and r[k]]
+    return ("Failed checks outside the rankings (each a case's own check, named in its "
+            "report): " + (", ".join(bad) if bad else "none") + ".")
+
+
 def index_documents(root, cases, studies=(), missing=()):
     """The Markdown and HTML of reports/index: the answers (``cases.answers``) and their
     table first, then the studies, the scorecard and its conclusion; ``missing``, the
@@ -207,7 +223,7 @@ def index_documents(root, cases, studies=(), missing=()):
                         + [Cell(cells[m][0], BANDS[cells[m][1]][1]) if m in cells else ""
                            for m in models])
     doc.table(["case/bc", "error", "FEM P1 vs continuum", "u_val"] + models, rows, keys=4)
-    for line in conclusion(pops, models, quick):
+    for line in conclusion(pops, models, quick) + [failed_checks(data)]:
         doc.p(line)
     doc.p("Each case folder holds metrics.json, report.md, report.html and the figures; "
           "regenerate with `pbcm report`.")

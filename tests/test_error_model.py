@@ -773,3 +773,16 @@ def test_the_scorecard_names_failures_against_the_continuum_too():
                                  {"modes": set()}, {"modes": "est"})
     last = conclusion(pops, ["fem-linear", "a"], False)[-1]
     assert last.endswith("against the continuum (the total): a in modes/free (1 of 1).")
+
+
+def test_a_failed_check_outside_the_rankings_is_named_in_the_index():
+    """A case's own check that failed (a '<check>_failed' run key no population counts) is
+    named in the index with its model, case, mesh and bc; the ranked phases' failures are
+    left to the rankings; with none failed the line says none."""
+    from cases.index import failed_checks
+    runs = [{"model": "msm", "mesh": "bcc", "bc": "clamped", "homogeneous_failed": "no root",
+             "static_failed": "x", "failed": None},
+            {"model": "a", "mesh": "six", "bc": "clamped", "homogeneous_failed": None}]
+    line = failed_checks({"large-compression": {"runs": runs}})
+    assert line.endswith("report): msm on large-compression/bcc/clamped (homogeneous).")
+    assert failed_checks({"c": {"runs": runs[1:]}}).endswith(": none.")
