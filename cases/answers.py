@@ -655,10 +655,12 @@ def _discretisation(pops, finite):
 def u_vals(truth, strain, floor):
     """The Truth Cube's u_val (ASME V&V 20) of each model at ``strain`` (and of the neo-Hookean
     continuum, read as the models are), with its parts: u_D the beads' noise ``floor``, u_input
-    the model's own bead RMS over the study's variants of the inputs nobody measured (plate
-    friction, travel, nu; on the mesh they ran on; the continuum's over its references'
-    variants), each input's half range combined in quadrature (``input_spread``), u_num the
-    neo-Hookean reference's change over its last refinement.
+    the neo-Hookean continuum's bead RMS over its references' variants of the inputs nobody
+    measured (plate friction, travel, nu), each input's half range combined in quadrature
+    (``input_spread``): the inputs' own effect, the same for every model (a model's response
+    beyond it, a P1 mesh locking near incompressibility, is its error, never uncertainty);
+    where the continuum has no variants, each model's own spread over them (on the mesh they
+    ran on); u_num the neo-Hookean reference's change over its last refinement.
     Returns ({model: u_val}, u_num, {model: u_input}, the variants' mesh)."""
     from .error_model import u_val
     nh = truth["headline"].get("continuum")
@@ -676,8 +678,8 @@ def u_vals(truth, strain, floor):
         u_input[m] = input_spread({r["variant"]: r["bead_rms_mm"] for r in rows
                                    if r["model"] == m and r["mesh"] == mesh}, variants)
     cont = {r["variant"]: r["bead_rms_mm"] for r in at if r.get("bead_rms_mm") is not None}
-    if nh and cont:
-        u_input[nh] = input_spread(cont, variants)
+    if nh and len(cont) > 1:
+        u_input = dict.fromkeys([*u_input, nh], input_spread(cont, variants))
     for m, ui in u_input.items():
         u[m] = u_val(u_num, ui, floor)
     return u, u_num, u_input, mesh

@@ -294,7 +294,7 @@ def test_the_quick_study_holds_its_gold_and_its_controls(quick_truthcube, capsys
     gap = [r["bead_vs_continuum_mm"] for r in lin]
     assert gap == sorted(gap) and gap[0] < doc["data"]["states"][0]["floor_mm"]["total"]
     md = (quick_truthcube / "report.md").read_text()
-    assert "Kerdok" in md and "floor" in md
+    assert "Kerdok" in md and "noise" in md
     assert (quick_truthcube / "beads_by_layer.png").is_file()
 
 

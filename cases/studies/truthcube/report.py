@@ -1,5 +1,5 @@
 """The Truth Cube study's files: metrics.json (every row, the references, the data's numbers, the
-rows the gate reads), report.md/.html (the answer, the data and its floor, the errors per
+rows the gate reads), report.md/.html (the answer, the data and its noise, the errors per
 strain and model, the sensitivity to the plates, the travel and nu, figures by layer). Every
 sentence is computed from the rows it is written with."""
 from pathlib import Path
@@ -195,8 +195,9 @@ def conclusion(doc):
             "plates prescribe displacement, so the beads test the deformed shape, not the "
             f"stiffness): at {percent(last)}, read against each model's u_val "
             f"(sqrt(u_num^2 + u_input^2 + u_D^2): the beads' noise {fmt(val['u_d'], 2)} mm, the "
-            f"model's own spread over the unmeasured friction, travel and nu on the "
-            f"{val['mesh']} mesh, the neo-Hookean reference's change over its last refinement "
+            f"neo-Hookean continuum's spread over the unmeasured friction, travel and nu (the "
+            "inputs' own effect; a model's response beyond it, a P1 mesh locking near "
+            "incompressibility, is its error, not uncertainty), the neo-Hookean reference's change over its last refinement "
             f"{fmt(val['u_num'], 2)} mm), "
             + (f"{', '.join(within)} agree with the measurement" if within else
                "no model agrees with the measurement")
@@ -284,17 +285,17 @@ def build(out, study, s, doc):
 
 def _data(d, doc):
     data = doc["data"]
-    d.h(2, "The measurement and its floor")
-    d.p("The floor is the noise of a measured displacement component: the RMS residual of a "
+    d.h(2, "The measurement and its noise")
+    d.p("The noise of a measured displacement component is: the RMS residual of a "
         "degree-4 polynomial of the rest positions fitted to each state's displacement (the "
         "compressed cube's field is smooth; the beads' scatter about it is not), combined as "
-        "each error is. A model's error beyond the noise is sqrt(rms^2 - floor^2) (the '*' "
-        "of the tables: beyond one floor in total, axially or laterally). A model reproduces "
-        "a state when its total RMS error is within its u_val there: the floor, its own "
-        "spread over the inputs nobody measured and the neo-Hookean reference's change over "
+        "each error is. A model's error beyond the noise is sqrt(rms^2 - noise^2) (the '*' "
+        "of the tables: beyond the noise in total, axially or laterally). A model reproduces "
+        "a state when its total RMS error is within its u_val there: the noise, the "
+        "neo-Hookean continuum's spread over the inputs nobody measured and the neo-Hookean reference's change over "
         "its last refinement combined (sqrt(u_num^2 + u_input^2 + u_D^2)).")
     d.table(["strain", "nominal travel [mm]", "RMS displacement [mm]", "axial", "lateral",
-             "floor total [mm]", "axial", "lateral", "quantisation x, y, z [mm]",
+             "noise total [mm]", "axial", "lateral", "quantisation x, y, z [mm]",
              "rigid motion removed x, y [mm], z-rotation [deg]"],
             [[percent(st["strain"]), fmt(t), fmt(st["scale_mm"]["total"]),
               fmt(st["scale_mm"]["axial"]), fmt(st["scale_mm"]["lateral"]),
@@ -324,7 +325,7 @@ def _state_table(d, rows, data, title):
     for st in data["states"]:
         p = percent(st["strain"])
         header += [f"{p} RMS [mm]", f"{p} axial", f"{p} lateral", f"{p} max", f"{p} raw"]
-    body = [["floor"] + [x for st in data["states"] for x in (
+    body = [["noise"] + [x for st in data["states"] for x in (
         fmt(fl[st["state"]]["total"]), fmt(fl[st["state"]]["axial"]),
         fmt(fl[st["state"]]["lateral"]), "", "")]]
     for m in models:
@@ -347,7 +348,7 @@ def _errors(d, doc):
     d.h(2, "Bead errors per strain and model")
     d.p("RMS over the 343 beads of the error vector's length, its axial (z) and lateral (x, y) "
         "parts and the largest, in mm, against the measurement with its rigid in-plane motion "
-        "removed; raw: the RMS against the measurement as scanned. '*': beyond the floor (the "
+        "removed; raw: the RMS against the measurement as scanned. '*': beyond the noise (the "
         "error beyond the noise exceeds it in total, axially or laterally). Relative errors "
         "(over the RMS measured displacement) are in metrics.json.")
     meshes = sorted({r["mesh"] for r in doc["rows"] if r["variant"] == DEFAULT},
@@ -357,7 +358,7 @@ def _errors(d, doc):
                      f"Bonded plates, nominal travel, {mesh} mesh")
     d.h(3, "Where each departs")
     d.p(f"On the {doc['finest_mesh']} mesh: from the measurement (its error beyond the noise "
-        "above the floor) and from the neo-Hookean continuum under the same assumptions (the "
+        "above the noise) and from the neo-Hookean continuum under the same assumptions (the "
         "RMS distance of their bead displacements beyond the model's u_val there, the beads' "
         "noise left out of it: no measurement enters that comparison).")
     vs = doc["against_continuum"]
@@ -375,7 +376,7 @@ def _sensitivity(d, doc, s):
     floor = floors(doc["data"])[len(doc["data"]["states"])]["total"]
     d.h(2, "How the answer moves with the plates, the travel and nu")
     d.p(f"Bead RMS error [mm] at {percent(last)} on the {mesh} mesh, each assumption changed "
-        f"alone (floor {fmt(floor)} mm; '*': beyond it). The continuum's row says how far the "
+        f"alone (noise {fmt(floor)} mm; '*': beyond it). The continuum's row says how far the "
         "assumption itself moves the answer.")
     by = {(r["model"], r["variant"]): r for r in doc["rows"] + doc["references"]
           if r["strain"] == last and r["mesh"] in (mesh, "reference")}
@@ -451,15 +452,16 @@ def _figures(d, out, doc):
 
 def definitions():
     return [
-        "measurement floor: the noise of a measured bead displacement component, the RMS "
+        "measurement noise: the scatter of a measured bead displacement component, the RMS "
         "residual of a degree-4 polynomial of the rest positions fitted to the measured "
         "displacement of each state; combined over components as each error is.",
         "within measurement: a run whose total RMS error is at most its u_val at that state "
-        "(the floor, the model's spread over the unmeasured plate friction, travel and nu, "
+        "(the noise, the neo-Hookean continuum's spread over the unmeasured plate friction, "
+        "travel and nu, "
         "and the neo-Hookean reference's change over its last refinement, combined in "
         "quadrature); two runs whose RMS errors differ by less than the larger u_val are not "
-        "ranked. '*' in the tables: the error beyond the noise, sqrt(rms^2 - floor^2), "
-        f"exceeds {WITHIN:g} floor in total, axially or laterally.",
+        "ranked. '*' in the tables: the error beyond the noise, sqrt(rms^2 - noise^2), "
+        f"exceeds {WITHIN:g} times the noise in total, axially or laterally.",
         "rigid in-plane motion: the translation in x, y and rotation about z best carrying "
         "the rest beads to a measured state (2-D Procrustes); removed from each state before "
         "comparing.",
