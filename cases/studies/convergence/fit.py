@@ -191,14 +191,23 @@ def fit(h, e, nested=True, u=0.0):
         return Fit(None, e[-1], max(e), "exact",
                    f"every error is below {EXACT:g}: the reference's own to within its "
                    "solver and the load's remaining nonlinearity", n)
-    if e[-1] > GROWTH * e[0]:
-        return Fit(None, e[-1], abs(e[-1] - e[-2]), "diverges",
-                   f"the error grows from {e[0]:.3g} to {e[-1]:.3g} as h falls", n)
+    # growth beyond the finest change's band (and the values' own): a sequence that went
+    # down and came back up within it has not shown a trend
+    band = math.hypot(FS_THREE * abs(e[-1] - e[-2]), u) if n >= 3 else 0.0
+    if e[-1] > GROWTH * e[0] and e[-1] - e[0] > band:
+        return Fit(None, None, None, "diverges",
+                   f"the error grows from {e[0]:.3g} to {e[-1]:.3g} as h falls (beyond the "
+                   f"finest change's band {band:.2g}): no limit", n)
     if not nested:
         return Fit(None, None, None, "not asymptotic",
                    "the meshes are not self-similar (no asymptotic expansion in h holds), so "
                    f"no limit is extrapolated; the finest error is {e[-1]:.3g}", n)
     falling, q = still_falling(h, e, u)
+    if n >= 3 and e[-1] > GROWTH * e[-2] and e[-1] - e[-2] > u:
+        # the finest refinement raises the error: neither a limit nor a level it stays at
+        return Fit(None, None, None, "not asymptotic",
+                   f"the finest refinement raises the error from {e[-2]:.3g} to {e[-1]:.3g}: "
+                   "no level it stays at, no limit", n)
     if n >= 3 and not falling:
         # stopped within its uncertainty: the level it stopped at, +- its last changes
         e_inf = e[-1]
@@ -215,7 +224,8 @@ def fit(h, e, nested=True, u=0.0):
         if bounds_nothing(err, e[-1], u):
             return _undecided(n, e_inf, err, e[-1], stopped)
         return Fit(p_obs, e_inf, err, "converges",
-                   f"{stopped} at {e_inf:.2g} +- {err:.2g}, not distinguishable from zero", n)
+                   f"fell to {e_inf:.2g} +- {err:.2g}, not distinguishable from zero, and "
+                   f"{stopped[0].lower()}{stopped[1:]}", n)
     e_inf, err, p = extrapolate(h, e)
     err = math.hypot(err, u)
     r = h[-2] / h[-1]
