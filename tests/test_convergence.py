@@ -46,6 +46,12 @@ def test_verdicts_of_the_shapes_a_model_shows():
     assert fit([8, 4, 2], [0.2, 0.1, 0.05]).verdict == "converges"
     assert fit([8, 4, 2], [0.2, 0.19, 0.185]).verdict == "floor"
     assert fit([8, 4, 2], [0.2, 0.4, 0.8]).verdict == "diverges"
+    assert fit([8, 4, 2], [0.2, 0.4, 0.8]).e_inf is None        # no limit to print
+    # growth within the finest change's band (down, then back up) shows no trend
+    assert fit([8, 4, 2, 4 / 3], [0.20, 0.21, 0.12, 0.225]).verdict != "diverges"
+    # a finest refinement that raises the error by half is no floor
+    rising = fit([8, 4, 2, 4 / 3], [0.30, 0.25, 0.23, 0.345])
+    assert rising.verdict == "not asymptotic" and rising.e_inf is None
     assert fit([8, 4, 2], [3e-10, 1e-10, 2e-10]).verdict == "exact"
     assert fit([8, 4], [EXACT * 2, EXACT * 1.5]).verdict != "exact"
     # two levels: first order assumed, Roache's factor 3
