@@ -259,7 +259,11 @@ def cell(rank, failure, model, v):
     """The text of a value: a convergence failure's is the candidate's fit verdict."""
     if failure["kind"] == "floor":
         fit = rank["floors"].get(model, {}).get("by_fit", {}).get(failure["key"])
-        return "no fit" if fit is None else f"{fit[0]}, e_inf {fmt(fit[1])} +- {fmt(fit[2])}"
+        if fit is None:
+            return "no fit"
+        # a fit without a limit (diverging, not asymptotic) has no e_inf to print
+        return fit[0] + (f", e_inf {fmt(fit[1])} +- {fmt(fit[2])}" if fit[1] is not None
+                         else "")
     return fmt(v)
 
 
