@@ -73,3 +73,25 @@ def test_script_writes_timings_and_differences(tmp_path, capsys):
     assert "fem-linear" in capsys.readouterr().out
     assert warp_forces.main(["--device", "nonsense", "--sizes", "100"]) == 2
     assert "nonsense" in capsys.readouterr().err
+
+
+def test_bench_times_the_warp_kernels_on_a_device(tmp_path):
+    """`pbcm bench --device cpu` adds, for each covered model timed, a row per dtype with its
+    ns per tetrahedron on that device and its forces' difference from pbcm's numba forces,
+    and bench.md shows them in a table naming the device; a model without Warp kernels has
+    no such row."""
+    import json
+    from cases.cli import main
+    out = tmp_path / "bench"
+    assert main(["bench", "--device", "cpu", "--sizes", "100", "--rounds", "1", "--models",
+                 "fem-linear", "pbcm-corner", "fem-corotated", "--out", str(out)]) == 0
+    data = json.loads((out / "bench.json").read_text())
+    rows = data["device_rows"]
+    assert {(r["model"], r["dtype"]) for r in rows} == {
+        (m, d) for m in ("fem-linear", "pbcm-corner") for d in ("float32", "float64")}
+    for r in rows:
+        assert r["device"] == "cpu" and r["ns_per_tet"] > 0 and r["force_vs_numba"] > 0
+        assert r["max_rel_diff_vs_numba"] < (1e-11 if r["dtype"] == "float64" else 1e-4)
+    md = (out / "bench.md").read_text()
+    assert f"Warp kernels on device {data['device']}" in md
+    assert "| pbcm-corner | 135 | cpu (CPU) | float32 |" in md
