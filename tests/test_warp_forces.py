@@ -59,9 +59,12 @@ def test_a_flattened_tetrahedron_is_an_error_as_in_pbcm():
 
 
 def test_script_writes_timings_and_differences(tmp_path, capsys):
-    """The script entry times the covered presets on a device and writes, per preset and
-    dtype, ns per tetrahedron and the max relative difference from pbcm's numba forces."""
+    """The script entry times the covered presets on a device, on the bench's meshes, and
+    writes, per preset and dtype, ns per tetrahedron and the max relative difference from
+    pbcm's numba forces."""
     import json
+    from cases.tools.bench import bench_mesh
+    assert all(warp_forces.bench_mesh(n).n_tets == bench_mesh(n).n_tets for n in (1e2, 1e4))
     assert warp_forces.main(["--device", "cpu", "--sizes", "100", "--models", "fem-linear",
                              "msm", "--min-seconds", "0.001", "--out", str(tmp_path)]) == 0
     data = json.loads((tmp_path / "warp_forces.json").read_text())

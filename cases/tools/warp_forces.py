@@ -33,7 +33,10 @@ from types import SimpleNamespace
 
 import numpy as np
 import warp as wp
+from numba import njit
 
+from model.integrate import total_forces
+from model.mesh import cube
 from model.terms.volume import FLAT
 
 wp.config.quiet = True
@@ -409,9 +412,14 @@ def seconds_per_evaluation(wf, min_s=0.2, max_reps=10000):
     return (time.perf_counter() - t0) / reps
 
 
+@njit   # not cached: it takes the kernels (as cases.tools.bench's loop)
+def _force_loop(kernels, x, out, reps):
+    for _ in range(reps):
+        total_forces(kernels, x, out)
+
+
 def numba_seconds_per_evaluation(pm, x, min_s=0.2):
     """Wall-clock seconds per force evaluation of pbcm's serial numba kernels on the CPU."""
-    from .bench import _force_loop
     kern, out = pm.kernels(), np.zeros_like(x)
     _force_loop(kern, x, out, 1)
     t0 = time.perf_counter()
@@ -420,6 +428,13 @@ def numba_seconds_per_evaluation(pm, x, min_s=0.2):
     t0 = time.perf_counter()
     _force_loop(kern, x, out, reps)
     return (time.perf_counter() - t0) / reps
+
+
+def bench_mesh(target):
+    """The bench's mesh (cases.tools.bench.bench_mesh, which imports this module): the 'five'
+    cube of side 32 mm whose tetrahedron count is closest to ``target``."""
+    k = max(1, round((target / 5.0) ** (1.0 / 3.0)))
+    return cube(k + 1, 0.032, "five")
 
 
 def time_model(pm, device, dtypes=DTYPES, seed=0, min_s=0.2):
@@ -471,7 +486,6 @@ def main(argv=None):
               f"{', '.join(COVERED)}", file=sys.stderr)
         return 2
     from model import Material, build
-    from .bench import bench_mesh
     mat = Material(10e3, 0.45, 1000.0)
     rows = []
     head = f"{'model':26s} {'tets':>9s} {'dtype':8s} {'ns/tet':>9s} {'numba ns/tet':>13s} " \
@@ -496,9 +510,10 @@ def main(argv=None):
     if args.out:
         out = Path(args.out)
         out.mkdir(parents=True, exist_ok=True)
-        from .bench import _machine
+        import platform
         data = {"device": device_name(args.device), "warp": wp.config.version,
-                "machine": _machine(), "not_covered": list(NOT_COVERED),
+                "machine": {"cpu": platform.processor() or platform.machine(),
+                            "cores": os.cpu_count(), "python": platform.python_version()}, "not_covered": list(NOT_COVERED),
                 "timing": "wall clock per force evaluation after a warm-up launch, device "
                           "synchronised around the timed launches; numba: pbcm's serial "
                           "kernels on the CPU, wall clock",
