@@ -298,7 +298,6 @@ class WarpForces:
         self.np_dtype, scalar, vec, mat = _types(dtype)
         self.dtype, self.pm, self.n_tets = dtype, pm, pm.mesh.n_tets
         k = kernels(dtype)
-        self._vec, self._scalar = vec, scalar
         tets = self._array(pm.mesh.tets.astype(np.int32), wp.int32)
         self.x = self._array(np.asarray(x, dtype=self.np_dtype), vec)
         self.f = wp.zeros(pm.mesh.n_nodes, dtype=vec, device=self.device)
@@ -313,7 +312,7 @@ class WarpForces:
                 self._add(k.springs, term, self._array(term.edge.astype(np.int32), wp.int32),
                           self._array(term.rest, scalar), self._array(term.k, scalar))
             elif term.name == "shear":
-                tets_, vol0, gamma0, factor = term.reference_kernel()[1]
+                _, vol0, gamma0, factor = term.reference_kernel()[1]
                 fn = getattr(k.shear, f"shear_{term.p['reading']}")
                 self._add(fn, term, tets, self._array(vol0, scalar),
                           self._array(gamma0, scalar), scalar(factor))
