@@ -142,3 +142,15 @@ def test_own_stable_step_is_rk4s_limit_of_the_highest_frequency():
     m = np.repeat(pm.mass, 3)
     w2 = np.linalg.eigvals(K / m[:, None]).real.max()
     assert own_stable_step(pm) == pytest.approx(2 * np.sqrt(2) / np.sqrt(w2), rel=1e-6)
+
+
+def test_bench_refuses_a_device_it_cannot_time_on_before_timing(tmp_path, capsys):
+    """`pbcm bench --device` with a device Warp does not have (or without warp-lang) is a
+    usage error naming the option and the device, given before anything is timed or
+    written."""
+    out = tmp_path / "bench"
+    assert main(["bench", "--device", "nonsense", "--sizes", "100", "--rounds", "1",
+                 "--models", "msm", "--out", str(out)]) == 2
+    err = capsys.readouterr().err
+    assert "--device nonsense" in err and "bench:" not in capsys.readouterr().out
+    assert not out.exists()

@@ -26,8 +26,24 @@ def add(sub):
     bn.add_argument("--merge", action="store_true",
                     help="add the rows of --models to the bench.json in --out (timed against "
                          "the baselines in this process) and keep every other row")
+    bn.add_argument("--device", help="also time the Warp kernels of the covered presets on this "
+                                      "Warp device (cpu, cuda, cuda:0 ...), float32 and "
+                                      "float64; needs warp-lang (default: not timed)")
     add_term_files(bn)
     bn.set_defaults(func=run)
+
+
+def check_device(device):
+    """A UsageError unless warp-lang is installed and has the device ``device``."""
+    import importlib.util
+    if importlib.util.find_spec("warp") is None:
+        raise UsageError(f"--device {device} times Warp kernels: install warp-lang "
+                         "(pip install warp-lang) or drop --device")
+    from ..tools.warp_forces import check_device as warp_device
+    try:
+        warp_device(device)
+    except ValueError as exc:
+        raise UsageError(f"--device {device}: {exc}") from None
 
 
 def run(args):
@@ -36,6 +52,8 @@ def run(args):
     models = chosen_models(args.models, list(model.PRESETS))
     sizes = args.sizes or (bench.QUICK_SIZES if args.quick else bench.SIZES)
     # checked before any timing starts
+    if args.device is not None:
+        check_device(args.device)
     old = None
     if args.merge:
         if not models:
@@ -49,7 +67,7 @@ def run(args):
         models = tuple(m for m in models if m not in bench.BASELINES)
     with StagedFolder(Path(args.out), mark=costs.FILE) as out:
         data = bench.run(sizes=sizes, models=models, rounds=3 if args.quick else args.rounds,
-                         with_engines=old is None)
+                         with_engines=old is None, device=args.device)
         bench.write(bench.merge(old, data) if old else data, out.path)
         path = out.commit()
     print(f"bench written to {path}")

@@ -7,6 +7,8 @@ times, so another process on the machine slows a sample less than a wall clock w
 presets are timed round-robin, one sample of each per round, and a ratio (to msm, to
 fem-linear) is taken within each round, then the median over rounds: drift of the machine
 between rounds cancels. Every cost sentence of the reports comes from these ratios.
+With ``--device`` the covered presets' forces are also timed as Warp kernels on that device
+(cases.tools.warp_forces), in a table of their own.
 """
 import json
 import time
@@ -172,10 +174,30 @@ def _engine_timers(mesh, timed, progress):
     return timers, status
 
 
-def run(sizes=SIZES, models=None, rounds=7, progress=print, with_engines=True):
+def _device_rows(timed, models, rows, device, progress):
+    """The Warp kernels of the covered models among ``models`` timed on ``device`` in float32
+    and float64 (cases.tools.warp_forces), with their ratio to the numba row of the same model
+    and size."""
+    from . import warp_forces
+    out = []
+    for name in models:
+        pm = timed[name].pm
+        if not warp_forces.covered(pm):
+            continue
+        cpu = next(r for r in rows if r["model"] == name and r["tets"] == pm.mesh.n_tets)
+        for r in warp_forces.time_model(pm, device, min_s=10 * SAMPLE_S):
+            r["force_vs_numba"] = r["ns_per_tet"] / cpu["ns_per_tet"]
+            out.append(r)
+            progress(f"bench: {name} on {r['device']} {r['dtype']}: "
+                     f"{fmt(r['ns_per_tet'])} ns/tet")
+    return out
+
+
+def run(sizes=SIZES, models=None, rounds=7, progress=print, with_engines=True, device=None):
     """Measure every model at every size; returns the bench document (plain data). The
     baselines (msm, fem-linear) are always timed, for the ratios; the other engines only with
-    ``with_engines``."""
+    ``with_engines``. With a Warp ``device`` (``cpu``, ``cuda``, ``cuda:1`` ...) the Warp
+    kernels of the covered models are timed there too (``device_rows``)."""
     if not models:      # every preset and the normal-stress candidates of `pbcm run extensions`
         models = [*PRESETS, *CANDIDATES]
     models = list(models)
@@ -186,7 +208,7 @@ def run(sizes=SIZES, models=None, rounds=7, progress=print, with_engines=True):
     mat = Material(10e3, 0.45, 1000.0)
     for name in timed_models:   # load every module once, so that memory counts the model only
         build(name, bench_mesh(1), mat)
-    rows, engine_rows, engines = [], [], {}
+    rows, engine_rows, engines, device_rows = [], [], {}, []
     for target in sizes:
         mesh = bench_mesh(target)
         progress(f"bench: {mesh.n_tets} tetrahedra, {len(timed_models)} models")
@@ -232,10 +254,16 @@ def run(sizes=SIZES, models=None, rounds=7, progress=print, with_engines=True):
                 row[f"step_vs_{base}_range"] = [float(np.min(own[:, 1] / ref[:, 1])),
                                                 float(np.max(own[:, 1] / ref[:, 1]))]
             rows.append(row)
+        if device is not None:
+            device_rows += _device_rows(timed, models, rows, device, progress)
         del timed, timers
-    return {"machine": _machine(), "sizes": [int(s) for s in sizes], "rows": rows,
+    data = {"machine": _machine(), "sizes": [int(s) for s in sizes], "rows": rows,
             "engines": {k: "; ".join(v) for k, v in engines.items()},
             "engine_rows": engine_rows}
+    if device is not None:
+        from . import warp_forces
+        data.update(device=warp_forces.device_name(device), device_rows=device_rows)
+    return data
 
 
 def merge(old, new):
@@ -308,6 +336,19 @@ def write(data, out):
         doc.table(["engine", "tets", "ns/tet (force)", f"force vs pbcm {ENGINE_REFERENCE}"],
                   [[r["engine"], r["tets"], fmt(r["ns_per_tet"]),
                     fmt(r[f"force_vs_{ENGINE_REFERENCE}"])] for r in data["engine_rows"]])
+    if data.get("device_rows"):
+        doc.p(f"Warp kernels on device {data['device']} (`pbcm bench --device`): each covered "
+              "model's internal forces (the sum of its terms) as Warp kernels, wall-clock time "
+              "per force evaluation after a warm-up launch, the device synchronised around "
+              "the timed launches; 'vs numba' is that time over the model's serial numba "
+              "force evaluation above (thread CPU time), and the last column the largest "
+              "force difference from pbcm's numba forces at a perturbed state, relative to "
+              "the largest force.")
+        doc.table(["model", "tets", "device", "dtype", "ns/tet (force)", "vs numba",
+                   "max rel. diff. from numba"],
+                  [[r["model"], r["tets"], r["device_name"], r["dtype"], fmt(r["ns_per_tet"]),
+                    fmt(r["force_vs_numba"]), f"{r['max_rel_diff_vs_numba']:.1e}"]
+                   for r in data["device_rows"]])
     doc.img("step_time.png", "RK4 step time against tetrahedra, every model")
     doc.write(out, stem="bench")
 
