@@ -125,6 +125,14 @@ TWO_LEVELS = ("two levels observe no order: a floor, a slow convergence and a ri
               "asymptotic range look alike there")
 
 
+def _floor_range(fits):
+    """'lowest-highest' of the floors, each its e_inf -+ its fit's uncertainty: how far the
+    median's fits reach."""
+    lo = min(f["e_inf"] - (f.get("e_inf_err") or 0.0) for f in fits)
+    hi = max(f["e_inf"] + (f.get("e_inf_err") or 0.0) for f in fits)
+    return f"{max(lo, 0.0):.2g}-{hi:.2g} with each fit's +-"
+
+
 def decided(f):
     """Whether a fit's verdict is decided: 'exact' on any levels; 'converges', 'floor' and
     'diverges' on three levels or more (two levels observe no order, and the finer levels
@@ -179,7 +187,8 @@ def conclusion(s, data):
             "stopping at a floor that no refinement removes: " + ("; ".join(
                 f"{m} in {len(floors[m])} of {total} ({len(by[m])} with a limit or a trend; "
                 "median floor "
-                f"{np.median([f['e_inf'] for f in floors[m]]):.2g})" for m in floored)
+                f"{np.median([f['e_inf'] for f in floors[m]]):.2g} [{_floor_range(floors[m])}])"
+                for m in floored)
                 or "none"))
         if loose:
             head += (f"; not resolved (the reference's estimate more than a "
