@@ -59,11 +59,16 @@ def _pm(v):
     return f"{rel(v[0], 2)} +- {rel(v[1], 1)}"
 
 
+def _shown(verdict):
+    """A fit's verdict as said beside a limit: 'exact' with the level it means."""
+    return "exact (every error at the reference's own level)" if verdict == "exact" else verdict
+
+
 def worst(values):
     """'largest +- its fit's (lattice)' over the entries with a limit, and the lattices
     without one."""
     nums = {k: v for k, v in values.items() if isinstance(v, tuple)}
-    other = [f"{v} on {k}" for k, v in values.items() if not isinstance(v, tuple)]
+    other = [f"{_shown(v)} on {k}" for k, v in values.items() if not isinstance(v, tuple)]
     if not nums:
         return ", ".join(other) or "n/a"
     k = max(nums, key=lambda k: nums[k][0])
@@ -292,7 +297,7 @@ def _limit_ties(limits_, said="tied within their +-"):
 def _no_limit(values):
     """' (diverges on x; not asymptotic on y)': the families without a limit, with the fit's
     verdict there ('' where every family has one)."""
-    other = [f"{v} on {k}" for k, v in values.items() if not isinstance(v, tuple)]
+    other = [f"{_shown(v)} on {k}" for k, v in values.items() if not isinstance(v, tuple)]
     return f" ({'; '.join(other)})" if other else ""
 
 

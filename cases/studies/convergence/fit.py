@@ -78,7 +78,7 @@ class Fit:
         if self.verdict == "converges":
             return ("converges" if self.order is None else f"converges (order {self.order:.2g})")
         if self.verdict == "exact":
-            return "exact"
+            return f"exact (every error below {EXACT:g})"
         if self.verdict == "floor":
             return f"floor {self.e_inf:.2g} +- {self.e_inf_err:.1g}"
         if self.verdict == UNDECIDED:
