@@ -214,7 +214,8 @@ def best_and_worst(runs, metric, what, exact=False, estimate_key="p2_error_estim
                     f"({rel(JUDGES * u, 2)}): " + ", ".join(f"{s.model} ({rel(s.score)})"
                                                           for s in blind)
                     + (f"; above it, from {above[0].model} ({_cell(above[0])}) to "
-                       f"{worst.model} ({_cell(worst)})." if above else "."))
+                       f"{worst.model} ({_cell(worst)})." if len(above) > 1 else
+                       f"; above it, {worst.model} ({_cell(worst)})." if above else "."))
         else:
             line = (f"{what}{AGAINST}: from {best.model} ({_cell(best)}) to "
                     f"{worst.model} ({_cell(worst)}).")
