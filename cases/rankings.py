@@ -77,14 +77,16 @@ def uncertainty(runs, metric, estimate_key="p2_error_estimate", per_mesh=False,
     """(u_num, the spread exceeds the estimate) of a comparison of ``metric`` over ``runs`` (one
     continuum problem on several meshes): the reference's largest estimate combined in
     quadrature with the spread of the continuum's value across the meshes
-    (``error_model.u_num``); ``spread_keys``: the run keys of the same reference's other
-    values, whose largest spread over the meshes counts too (one reference that disagrees
-    with itself on one quantity is that uncertain on every quantity it gives); ``per_mesh``:
+    (``error_model.u_num``); ``spread_keys``: for a field (a metric without one continuum
+    value), the run keys of the same reference's scalar values, whose largest spread over the
+    meshes it takes (a reference that disagrees with itself on a quantity is that uncertain
+    on the field it gives; a scalar reads its own spread); ``per_mesh``:
     each mesh poses its own continuum problem, so the values' spread is no uncertainty and
     u_num is the estimate alone."""
     if per_mesh:
         return u_num(estimate(runs, estimate_key), [])
-    keys = [k for k in (_continuum_key(runs, metric), *spread_keys) if k]
+    own = _continuum_key(runs, metric)
+    keys = [own] if own else list(spread_keys)
     est = estimate(runs, estimate_key)
     found = [u_num(est, _last_values(runs, k)) for k in dict.fromkeys(keys)]
     return max(found) if found else u_num(est, [])
@@ -109,7 +111,8 @@ def _standings(runs, metric, u, lost_key=None):
     for r in runs:
         by.setdefault(r["model"], []).append(
             None if lost_key and r.get(lost_key) else r.get(metric))
-    return standings(by, u)
+    # ordered by the parts lost first, as the error model's tables are
+    return standings(by, u, _lost(runs, lost_key))
 
 
 def _lost(runs, lost_key):
@@ -130,7 +133,7 @@ def _u_text(u, defect, field=False, per_mesh=False):
             "the mesh's own nodes)" if per_mesh else
             " (the reference's estimate: a field has no one value to spread over the meshes)"
             if field else ", mostly the continuum's spread over the meshes" if defect else "")
-    return f"u_num {rel(u, 2)}{held}"
+    return f"u_val {rel(u, 2)}, which is u_num here{held}"
 
 
 def ranking(runs, metric, label, estimate_key="p2_error_estimate", lost_key=None,
@@ -161,7 +164,7 @@ def ranking(runs, metric, label, estimate_key="p2_error_estimate", lost_key=None
                                bc in per_mesh)
                 note.append(f"tied with {', '.join(tie.tied)} (within {held})")
             if tie.unresolved:
-                note.append(f"not resolved from {', '.join(tie.unresolved)} (beyond u_num, "
+                note.append(f"not resolved from {', '.join(tie.unresolved)} (beyond u_val, "
                             "within both medians' spread over the meshes)")
             if s.failed:
                 note.append(f"{s.failed} failed, counted against it")
@@ -216,6 +219,8 @@ def best_and_worst(runs, metric, what, exact=False, estimate_key="p2_error_estim
                     + (f"; above it, from {above[0].model} ({_cell(above[0])}) to "
                        f"{worst.model} ({_cell(worst)})." if len(above) > 1 else
                        f"; above it, {worst.model} ({_cell(worst)})." if above else "."))
+        elif best is worst:
+            line = f"{what}{AGAINST}: {best.model} alone ({_cell(best)})."
         else:
             line = (f"{what}{AGAINST}: from {best.model} ({_cell(best)}) to "
                     f"{worst.model} ({_cell(worst)}).")
@@ -237,12 +242,9 @@ def best_and_worst(runs, metric, what, exact=False, estimate_key="p2_error_estim
                      f"{', '.join(st[0][2].tied)}.")
         if st[0][2].unresolved:
             line += (f" {best.model} is not resolved from {', '.join(st[0][2].unresolved)}: "
-                     "beyond u_num, within both medians' spread over the meshes.")
-        smallest = min(min(s.values) for _, s, _ in st if s.values)
-        if u > smallest / 5:
-            line += (f" The reference's u_num ({rel(u, 2)}) exceeds a fifth of the smallest "
-                     f"error ranked ({rel(smallest, 2)}): the reference cannot judge "
-                     "differences below it.")
+                     "beyond u_val, within both medians' spread over the meshes.")
+        # the medians are what is ranked (judged, above five times u_num: nothing to add)
+        return line
         return line
     return " ".join(_labelled(runs, line_of))
 

@@ -411,7 +411,14 @@ def case_findings(name, quantities, runs, patch_tests=(), estimate_key="p2_error
                         f"{IDENTITY_TOL:g}: {', '.join(same)}" if same else
                         f"; none within the linear regime's nonlinearity {IDENTITY_TOL:g}")
                      + ")" + ("; " if ok else ""))
-        if ok:
+        lin = linearisation(p) if p.finite else None
+        nearly = lin is not None and lin < NEARLY_LINEAR
+        if nearly:
+            # one observation is not counted twice: the linear regime's population ranks it
+            line += (f"nearly linear at this load (fem-linear {rel(lin)} from neo-Hookean P1 "
+                     f"on this quantity, below {NEARLY_LINEAR:g}): the linear regime's "
+                     "observation again, shown in the table, not ranked a second time")
+        elif ok:
             first = "first (fewest unpaired modes, then the error)" if p.lost and any(
                 p.unpaired.values()) else "nearest the locked twin" if p.locking else "closest"
             # the farthest is the last of every model, a failed one included
@@ -440,14 +447,21 @@ def case_findings(name, quantities, runs, patch_tests=(), estimate_key="p2_error
                      + ("(exact to round-off: no discretisation error here)"
                         if max(disc) <= E.ROUND_OFF else
                         f"(beyond round-off, {rel(E.ROUND_OFF)}: P1 fails its own patch test)"))
+        elif disc and nearly:
+            line += (f". FEM P1 itself is {rel(np.median(disc))} "
+                     f"[{rel_range(min(disc), max(disc))}] from the continuum on these meshes "
+                     "(discretisation error)")
+        elif disc and p.u_continuum > np.median(disc) / 5:
+            # the continuum's u_num exceeds a fifth of P1's own error: nothing is judged closer
+            line += (f". FEM P1 itself is {rel(np.median(disc))} "
+                     f"[{rel_range(min(disc), max(disc))}] from the continuum on these meshes "
+                     f"(discretisation error); the continuum's own u_num, "
+                     f"{rel(p.u_continuum, 2)}, exceeds a fifth of it, so no model is judged "
+                     "closer to the continuum than P1 or as far")
         elif disc:
             line += (f". FEM P1 itself is {rel(np.median(disc))} "
                      f"[{rel_range(min(disc), max(disc))}] from the continuum on these meshes "
-                     "(discretisation error"
-                     + (f"; beyond what the reference judges: the continuum's own u_num, "
-                        f"{rel(p.u_continuum, 2)}, "
-                        "exceeds a fifth of it" if p.u_continuum > np.median(disc) / 5 else "")
-                     + ")")
+                     "(discretisation error)")
             # |total| < |P1's| with a model-form error: its error opposes P1's; a model that
             # leaves more continuum modes unpaired than P1 is not closer, whatever its rest
             lost = p.unpaired_total

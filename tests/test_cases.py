@@ -201,7 +201,7 @@ def test_rankings_tie_models_within_u_num_of_a_groups_first():
     (table,) = common.ranking(runs, "err", "error")
     assert [r[2] for r in table.rows] == ["a", "b", "c", "d"]
     alone = " (the reference's estimate: a field has no one value to spread over the meshes)"
-    within = f"u_num 0.01{alone}"
+    within = f"u_val 0.01, which is u_num here{alone}"
     assert [r[-1] for r in table.rows] == [f"tied with b (within {within})",
                                            f"tied with a (within {within})", "", ""]
     assert [r[1] for r in table.rows] == [1, 1, 3, 4]
@@ -233,14 +233,17 @@ def test_ties_widen_to_the_continuums_spread_over_the_meshes():
     u, defect = rankings.uncertainty(runs, "q_rel_err")
     assert u == pytest.approx(np.hypot(0.01, 0.1 / 1.05)) and defect
     (table,) = rankings.ranking(runs, "q_rel_err", "error")
-    assert table.rows[1][-1].endswith("tied with a (within u_num 0.096, mostly the "
-                                      "continuum's spread over the meshes)")
-    # a quantity whose own continuum values agree still carries the spread the same
-    # reference shows on another of its values
-    agree = [dict(r, w_rel_err=0.1, w_mm=1.0, w_fem_mm=2.0) for r in runs]
-    assert rankings.uncertainty(agree, "w_rel_err") == (pytest.approx(0.01), False)
-    assert rankings.uncertainty(agree, "w_rel_err", spread_keys=("q_fem_mm",)) == (
+    assert table.rows[1][-1].endswith("tied with a (within u_val 0.096, which is u_num here, "
+                                      "mostly the continuum's spread over the meshes)")
+    # a field (no continuum value of its own) carries the spread the same reference shows
+    # on its scalar values; a scalar whose own values agree reads its own
+    field = [dict(r, w_l2=0.1) for r in runs]
+    assert rankings.uncertainty(field, "w_l2") == (pytest.approx(0.01), False)
+    assert rankings.uncertainty(field, "w_l2", spread_keys=("q_fem_mm",)) == (
         pytest.approx(np.hypot(0.01, 0.1 / 1.05)), True)
+    agree = [dict(r, w_rel_err=0.1, w_mm=1.0, w_fem_mm=2.0) for r in runs]
+    assert rankings.uncertainty(agree, "w_rel_err", spread_keys=("q_fem_mm",)) == (
+        pytest.approx(0.01), False)
     per = rankings.uncertainty(runs, "q_rel_err", per_mesh=True)
     assert per == (pytest.approx(0.01), False)       # each mesh its own problem: no spread
     (own,) = rankings.ranking(runs, "q_rel_err", "error", per_mesh=("clamped",))
@@ -270,7 +273,7 @@ def test_rankings_keep_populations_apart_and_count_failed_runs():
     assert "[clamped] Error against its reference (total error" in line
     assert "from b (" in line and "to c (" in line
     assert "Failed runs, counted against their model: c (1 of 2)" in line
-    assert line.index("[sliding]") < line.index("from a (") < line.index("[clamped]")
+    assert line.index("[sliding]") < line.index("a alone (") < line.index("[clamped]")
 
 
 def test_failures_name_every_phase_that_found_no_equilibrium():

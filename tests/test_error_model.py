@@ -786,3 +786,36 @@ def test_a_failed_check_outside_the_rankings_is_named_in_the_index():
     line = failed_checks({"large-compression": {"runs": runs}})
     assert line.endswith("report): msm on large-compression/bcc/clamped (homogeneous).")
     assert failed_checks({"c": {"runs": runs[1:]}}).endswith(": none.")
+
+
+def test_a_model_shares_the_rank_of_the_first_group_it_is_not_ordered_from():
+    """Ranks are shared pair by pair with each group's first: a model not ordered from the
+    first group's first shares rank 1 even when a model between them began a group of its
+    own; models that all failed their median are ordered by how many runs failed."""
+    rows = E.standings({"a": [0.10, 0.10, 0.10], "b": [0.20, 0.20, 0.20],
+                        "c": [0.0, 0.22, 0.6]}, u=0.0)
+    assert [(r, s.model) for r, s, _ in rows] == [(1, "a"), (2, "b"), (1, "c")]
+    failed = E.standings({"x": [0.1, None, None], "y": [None, None, None]}, u=0.0)
+    assert [s.model for _, s, _ in failed] == ["x", "y"]
+
+
+def test_a_nearly_linear_load_is_shown_in_a_case_not_ranked_a_second_time():
+    """At a load the linear law meets within NEARLY_LINEAR on the case's quantity, the case's
+    opening says the population is the linear regime's observation again and names no
+    closest model; at a load where it does not, the closest is named."""
+    def runs(lin_at_load):
+        out = []
+        for mesh in ("five", "six"):
+            for m, q in (("fem-neohookean", 1.1), ("fem-linear", 1.1 + lin_at_load),
+                         ("a", 1.3), ("b", 1.5)):
+                out.append({"mesh": mesh, "bc": "clamped", "model": m,
+                            "torque_at_load_nm": q, "torque_at_load_fem_nm": 1.0,
+                            "nh_error_estimate": 0.001})
+        return out
+    q = E.Scalar("torque_at_load_nm", "torque_at_load_fem_nm", "torque at the load",
+                 p1=E.P1_FINITE, posed="nh_error_estimate")
+    near, _ = scorecard.case_findings("torsion", [q], runs(0.01),
+                                      estimate_key="nh_error_estimate")
+    assert "nearly linear at this load (fem-linear 0.01" in near[0] and "closest" not in near[0]
+    far, _ = scorecard.case_findings("torsion", [q], runs(0.2), estimate_key="nh_error_estimate")
+    assert "nearly linear" not in far[0] and "closest" in far[0]
