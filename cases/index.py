@@ -263,8 +263,10 @@ TERMS = {
     "input of it is unknown; the Truth Cube's plate friction, travel and nu), u_D the "
     "measurement's noise (0 where nothing is measured). Two errors closer than u_val are "
     "tied. On "
-    "the Truth Cube, u_input is each unmeasured input's half range of the model's bead RMS "
-    "(plate friction, plate travel, nu), in quadrature, and u_D the beads' noise.",
+    "the Truth Cube, u_input is each unmeasured input's half range of the neo-Hookean "
+    "continuum's bead RMS (plate friction, plate travel, nu), in quadrature, the same for "
+    "every model (a model's own response beyond it, a P1 mesh locking, is its error), and "
+    "u_D the beads' noise.",
     "mean rank": "a model's overall standing in one regime: the mean over the cases of its "
     "rank in each case (the mean over that case's populations, one per boundary condition: "
     "each case weighs one), each population ranking its models first by the parts they "

@@ -47,8 +47,11 @@ def test_verdicts_of_the_shapes_a_model_shows():
     assert fit([8, 4, 2], [0.2, 0.19, 0.185]).verdict == "floor"
     assert fit([8, 4, 2], [0.2, 0.4, 0.8]).verdict == "diverges"
     assert fit([8, 4, 2], [0.2, 0.4, 0.8]).e_inf is None        # no limit to print
-    # growth within the finest change's band (down, then back up) shows no trend
-    assert fit([8, 4, 2, 4 / 3], [0.20, 0.21, 0.12, 0.225]).verdict != "diverges"
+    # a dip then a rise shows no trend: not asymptotic, never diverging
+    assert fit([8, 4, 2, 4 / 3], [0.20, 0.21, 0.12, 0.225]).verdict == "not asymptotic"
+    # a rise at the finest level three times the fall before it is no floor
+    assert fit([8, 4, 2, 4 / 3], [0.70, 0.666, 0.649, 0.698], u=3e-5).verdict == \
+        "not asymptotic"
     # a finest refinement that raises the error by half is no floor
     rising = fit([8, 4, 2, 4 / 3], [0.30, 0.25, 0.23, 0.345])
     assert rising.verdict == "not asymptotic" and rising.e_inf is None

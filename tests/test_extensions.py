@@ -66,7 +66,7 @@ def test_rankings_failures_and_verdicts_worked_by_hand():
     text = " ".join(R.conclusion(doc))
     # leaving one population out: m1 is 0.25 (cantilever left) or 1 (paper cube left), m2
     # 0.5 or 2: the ranges overlap, so no best is named
-    assert "among the normal-stress extensions not decided between m1, m2" in text
+    assert "among the normal-stress extensions not resolved between m1, m2" in text
     assert "m1 0.5 [0.25-1], m2 1 [0.5-2]; m1 not resolved from the paper model" in text
     assert "m1 fixes 2 of them: paper-cube/clamped model-form error" in text \
         and "0.2 -> 0.05" in text
@@ -90,7 +90,7 @@ def test_headline_says_when_no_candidate_beats_the_paper_model():
     # one population: no range leaving one out, so no best is named
     assert R.conclusion(doc)[0].startswith(
         "Over the 1 pooled populations of the library, among the normal-stress extensions "
-        "not decided between m1, m2 (their ranges leaving one population out overlap): ")
+        "not resolved between m1, m2 (their ranges leaving one population out overlap): ")
     assert "m1 2, m2 4; m1 farther from FEM P1 than the paper model whichever population" in \
         R.conclusion(doc)[0]
 

@@ -36,6 +36,7 @@ from ...error_model import ROUND_OFF
 FS_THREE, FS_TWO = 1.25, 3.0   # Roache's safety factors for 3+ and for 2 levels
 ASSUMED_ORDER = 1.0            # the order assumed with two levels
 GROWTH = 1.1                   # error at the finest level above this x the coarsest: diverges
+RISE = 0.02                    # a finest rise below this share of the level is a floor's noise
 # errors all below this are the reference itself: the static solver's tolerance (1e-12 of
 # E h^2) and the nonlinearity left at the study's scaled load (strains about 5e-5)
 EXACT = 1e-4
@@ -191,19 +192,22 @@ def fit(h, e, nested=True, u=0.0):
         return Fit(None, e[-1], max(e), "exact",
                    f"every error is below {EXACT:g}: the reference's own to within its "
                    "solver and the load's remaining nonlinearity", n)
-    # growth beyond the finest change's band (and the values' own): a sequence that went
-    # down and came back up within it has not shown a trend
-    band = math.hypot(FS_THREE * abs(e[-1] - e[-2]), u) if n >= 3 else 0.0
-    if e[-1] > GROWTH * e[0] and e[-1] - e[0] > band:
+    # growth beyond the values' own uncertainty, still rising over the finest levels (a dip
+    # then a rise is no trend: not asymptotic below); a diverging sequence has no limit
+    if e[-1] > GROWTH * e[0] and e[-1] - e[0] > u and (n < 3 or e[-1] > e[-2] > e[-3]):
         return Fit(None, None, None, "diverges",
-                   f"the error grows from {e[0]:.3g} to {e[-1]:.3g} as h falls (beyond the "
-                   f"finest change's band {band:.2g}): no limit", n)
+                   f"the error grows from {e[0]:.3g} to {e[-1]:.3g} as h falls: no limit", n)
     if not nested:
         return Fit(None, None, None, "not asymptotic",
                    "the meshes are not self-similar (no asymptotic expansion in h holds), so "
                    f"no limit is extrapolated; the finest error is {e[-1]:.3g}", n)
     falling, q = still_falling(h, e, u)
-    if n >= 3 and e[-1] > GROWTH * e[-2] and e[-1] - e[-2] > u:
+    rise = e[-1] - e[-2] if n >= 3 else 0.0
+    # a rise at the finest level beyond the values' own uncertainty and either beyond
+    # GROWTH's share of the level, or beyond the change before it and RISE of the level: the
+    # sequence has not settled
+    if n >= 3 and rise > u and (rise > (GROWTH - 1) * abs(e[-2]) or rise > max(
+            FS_THREE * abs(e[-2] - e[-3]), RISE * abs(e[-2]))):
         # the finest refinement raises the error: neither a limit nor a level it stays at
         return Fit(None, None, None, "not asymptotic",
                    f"the finest refinement raises the error from {e[-2]:.3g} to {e[-1]:.3g}: "
@@ -242,7 +246,7 @@ def fit(h, e, nested=True, u=0.0):
             f" at order {p:.2g}" if p is not None else ", without an observed order"))
     if n >= 3 and p is None:
         # still falling, but its changes do not shrink as a power of h: no limit, no floor
-        return Fit(None, e_inf, err, "converges",
+        return Fit(None, None, None, "converges",
                    f"still falling (order {q:.2g} over the finest levels), not yet in the "
                    f"asymptotic range: no limit extrapolated, at most the finest error "
                    f"{e[-1]:.2g}", n)

@@ -166,7 +166,9 @@ def floors(data, models):
         fs = [f for f in data["fits"] if f["model"] == m]
         out[m] = {"floor": sum(f["verdict"] == "floor" for f in fs),
                   "diverges": sum(f["verdict"] == "diverges" for f in fs),
-                  "fits": len(fs), "e_inf": _median(f["e_inf"] for f in fs),
+                  # over the floors alone: a limit of another verdict is no floor
+                  "fits": len(fs), "e_inf": _median(f["e_inf"] for f in fs
+                                                    if f["verdict"] == "floor"),
                   "by_fit": {f"{f['case']}/{f['bc']} on {f['mesh']}":
                              [f["verdict"], f["e_inf"], f.get("e_inf_err")] for f in fs}}
     return out
@@ -352,7 +354,7 @@ def _lead(rank, cands):
               if r[1] < 1 else
               "farther from FEM P1 than the paper model whichever population is left out"
               if r[0] > 1 else "not resolved from the paper model (its range reaches 1)")
-    lead = (f"not decided between {', '.join(short(m) for m in [b] + level)} (their ranges "
+    lead = (f"not resolved between {', '.join(short(m) for m in [b] + level)} (their ranges "
             "leaving one population out overlap)" if level else f"the best is {short(b)}")
     same = [" = ".join(short(m) for m in g) for g in rank.get("identical", [])
             if set(g) <= set(cands)]
