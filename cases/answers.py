@@ -727,9 +727,9 @@ def _measured_line(truth, models):
             f"{fmt(100 * h['strain'], 4)} % compression (bonded plates, {h['mesh']} mesh), each "
             f"model read against its u_val = sqrt(u_D^2 + u_input^2 + u_num^2), "
             f"{_span(val['u_val'].values())} mm (u_D the beads' noise "
-            f"{fmt(val['u_d'], 2)}; u_input each unmeasured input's half range of the model's "
-            f"bead RMS (plate friction, travel, nu; locking included) in quadrature, on the "
-            f"{val['mesh']} mesh, {_span(val['u_input'].values())}; u_num the reference's "
+            f"{fmt(val['u_d'], 2)}; u_input each unmeasured input's half range of the "
+            f"neo-Hookean continuum's bead RMS (plate friction, travel, nu) in quadrature, the "
+            f"same for every model, {_span(val['u_input'].values())}; u_num the reference's "
             f"last refinement, {fmt(val['u_num'], 2)}): ")
     if NH in v:
         u_nh = val.get("continuum_u_val")

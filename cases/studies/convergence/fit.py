@@ -194,7 +194,7 @@ def fit(h, e, nested=True, u=0.0):
                    "solver and the load's remaining nonlinearity", n)
     # growth beyond the values' own uncertainty, still rising over the finest levels (a dip
     # then a rise is no trend: not asymptotic below); a diverging sequence has no limit
-    if e[-1] > GROWTH * e[0] and e[-1] - e[0] > u and (n < 3 or e[-1] > e[-2] > e[-3]):
+    if e[-1] > GROWTH * e[0] and (n < 3 or (e[-1] - e[0] > u and e[-1] > e[-2] > e[-3])):
         return Fit(None, None, None, "diverges",
                    f"the error grows from {e[0]:.3g} to {e[-1]:.3g} as h falls: no limit", n)
     if not nested:
