@@ -352,6 +352,8 @@ def test_fits_that_cannot_lie():
     assert f.verdict == "not decided"     # +- 0.56 bounds more than the finest error 0.2
     assert fit([8.0, 4.0, 2.0], [0.1, 0.05, 0.025], nested=False).verdict == "not asymptotic"
     assert fit([8.0, 4.0, 2.0], [0.1, 0.05, 0.025], nested=False).e_inf is None
+    below = fit(H4, [0.6, 0.4, 0.2, 0.1])     # extrapolates to -2.8 +- 2.3: no limit printed
+    assert below.verdict == "not asymptotic" and below.e_inf is None and "below zero" in below.why
     # a ratio 2.46, 1.24, 0.835, 0.747 (pbcm-variational's cantilever on six) crosses 1
     assert cancellation([0.3, 0.2, 0.1, 0.15]) == "the error is not monotone in h"
     assert cancellation([1.46, 0.24, 0.165, 0.253], [2.46, 1.24, 0.835, 0.747]) \

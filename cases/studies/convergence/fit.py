@@ -237,7 +237,8 @@ def fit(h, e, nested=True, u=0.0):
         math.log(e[-2] / e[-1]) / math.log(r) if n == 2 and e[-1] > 0 and e[-2] > e[-1]
         else None)
     if e_inf + err < 0:     # an error cannot tend below zero: the levels are not asymptotic
-        return Fit(p_obs, 0.0, err, "not asymptotic",
+        # and no limit is printed (a zero there would read as a limit the levels never gave)
+        return Fit(p_obs, None, None, "not asymptotic",
                    f"the extrapolated limit {e_inf:.3g} +- {err:.2g} is below zero: the levels "
                    "are not in the asymptotic range", n)
     e_inf = max(e_inf, 0.0)
