@@ -115,6 +115,12 @@ def _standings(runs, metric, u, lost_key=None):
     return standings(by, u, _lost(runs, lost_key))
 
 
+def _not_judged(standings, u):
+    """The standings whose finite median is below JUDGES times the reference's u_num: errors
+    the reference cannot order."""
+    return [s for _, s, _ in standings if math.isfinite(s.score) and s.score < JUDGES * u]
+
+
 def _lost(runs, lost_key):
     """{model: parts lost over its runs} (unpaired modes), the models that lost none left
     out."""
@@ -150,7 +156,7 @@ def ranking(runs, metric, label, estimate_key="p2_error_estimate", lost_key=None
         u, defect = uncertainty(rs, metric, estimate_key, bc in per_mesh, spread_keys)
         lost = _lost(rs, lost_key)
         st = _standings(rs, metric, u, lost_key)
-        blind = [s.model for _, s, _ in st if math.isfinite(s.score) and s.score < JUDGES * u]
+        blind = [s.model for s in _not_judged(st, u)]
         for rank, s, tie in st:
             note = []
             if s.model in blind:
@@ -209,8 +215,7 @@ def best_and_worst(runs, metric, what, exact=False, estimate_key="p2_error_estim
         if not st or not any(s.values for _, s, _ in st):
             return f"No model gave {what}."
         best, worst = st[0][1], st[-1][1]
-        judged = [s for _, s, _ in st if math.isfinite(s.score)]
-        blind = [s for s in judged if not exact and s.score < JUDGES * u]
+        blind = [] if exact else _not_judged(st, u)
         if blind:    # a reference orders no error below five times its own u_num
             above = [s for _, s, _ in st if s not in blind]
             line = (f"{what}{AGAINST}: not judged below {JUDGES} times the reference's u_num "
