@@ -32,23 +32,25 @@ LIMITED = ("exact", "converges", "floor")   # fit verdicts whose e_inf is a limi
 REGULAR = ("five", "six", "bcc")     # the lattices as generated; the rest is irregular
 
 
-def consistency(conv, model):
-    """{lattice: the converged limit e_inf of the sliding-cube patch test in the linear
-    regime, or the fit's verdict where it has no limit (diverging, not asymptotic)}."""
-    return {k: v[0] if isinstance(v, tuple) else v for k, v in limits(conv, model).items()}
-
-
 def limits(conv, model):
-    """{lattice: (e_inf, its fit's +-) of the sliding-cube patch test, or the fit's verdict
-    where it has no limit}."""
+    """{lattice: (limit, its fit's +-, 'displacement' or 'stiffness') of the sliding-cube
+    patch test, the larger of its two limits, or the fit's verdict where the displacement has
+    no limit}. The top face's displacement is prescribed, so the displacement error alone is
+    blind to the stiffness: a model half as stiff as the continuum can match its shape; the
+    stiffness error, the reaction ratio's limit's distance from 1, reads what it misses."""
     out = {}
     for f in (conv or {}).get("fits", []):
         if (f["case"], f["bc"]) == CONSISTENCY and f["model"] == model:
             # an irregular family is never extrapolated: its verdict, not a limit
             limited = (f["verdict"] in LIMITED and f.get("e_inf") is not None
                        and f["mesh"] in REGULAR)
-            out[f["mesh"]] = (f["e_inf"], f.get("e_inf_err") or 0.0) if limited \
-                else f["verdict"]
+            if not limited:
+                out[f["mesh"]] = f["verdict"]
+                continue
+            disp = (f["e_inf"], f.get("e_inf_err") or 0.0, "displacement")
+            stiff = ((abs(f["ratio_inf"] - 1.0), f.get("ratio_inf_err") or 0.0, "stiffness")
+                     if f.get("ratio_inf") is not None else None)
+            out[f["mesh"]] = stiff if stiff and stiff[0] > disp[0] else disp
     return out
 
 
@@ -72,7 +74,7 @@ def worst(values):
     if not nums:
         return ", ".join(other) or "n/a"
     k = max(nums, key=lambda k: nums[k][0])
-    return f"{_pm(nums[k])} ({k})" + (f"; {', '.join(other)}" if other else "")
+    return f"{_pm(nums[k])} ({nums[k][2]}, {k})" + (f"; {', '.join(other)}" if other else "")
 
 
 def _median(rows, key):
@@ -199,11 +201,14 @@ def lines(root, models, pops=(), quick=False):
         else:
             out.append("**How far from the continuum?** "
                        + "The consistency limit, the sliding cube's error as the mesh is "
-                       "refined (a patch test; the largest over the lattices, +- the "
+                       "refined (a patch test; on each lattice the larger of its displacement "
+                       "error and its stiffness error, the reaction ratio's distance from 1: "
+                       "the top face's displacement is prescribed, so the displacement alone "
+                       "is blind to the stiffness; the largest over the lattices, +- the "
                        "extrapolation's "
                        "uncertainty; beside it each family where the model has no limit, and "
                        "what its fit found there): "
-                       + ", ".join(f"{m} {_pm(_worst_limit(lim[m]))}" + _no_limit(lim[m])
+                       + ", ".join(f"{m} {_limit_text(_worst_limit(lim[m]))}" + _no_limit(lim[m])
                                    for m in rest if _worst_limit(lim[m]))
                        + _limit_ties(sorted(((m, _worst_limit(lim[m])) for m in rest
                                              if _worst_limit(lim[m])), key=lambda x: x[1][0]),
@@ -281,7 +286,7 @@ def _limit_ties(limits_, said="tied within their +-"):
     (sqrt(u_a^2 + u_b^2)); a model may share a group with each of two models that are resolved
     from each other (ties are not transitive)."""
     def tied(i, j):
-        (_, (a, ua)), (_, (b, ub)) = limits_[i], limits_[j]
+        (_, (a, ua, *_)), (_, (b, ub, *_)) = limits_[i], limits_[j]
         return abs(a - b) < (ua ** 2 + ub ** 2) ** 0.5
     groups = []
     for i in range(len(limits_)):
@@ -354,8 +359,14 @@ def _finest(conv, lims, lattices):
 
 
 def _worst_limit(lim):
-    nums = [v for v in lim.values() if isinstance(v, tuple)]
+    """(limit, +-, which, lattice): the largest of a model's limits over the lattices."""
+    nums = [(*v, k) for k, v in lim.items() if isinstance(v, tuple)]
     return max(nums, key=lambda v: v[0]) if nums else None
+
+
+def _limit_text(w):
+    """'0.7 +- 0.02 (stiffness, six)': a limit with what it measures and where."""
+    return f"{_pm(w)} ({w[2]}, {w[3]})"
 
 
 def _cost_of_replacing(pops, models, quick):
@@ -498,7 +509,7 @@ def recommendation(root, models, pops, quick, bench_rows):
                    if rng else "") + f"){cost(b)}")
         limit = _worst_limit(limits(conv, b)) if conv else None
         if limit and limit[0] >= PATCH_TOL:
-            said += f", consistency limit {_pm(limit)}"
+            said += f", consistency limit {_limit_text(limit)}"
         if others:
             said += (f", not resolved from {', '.join(others)} (tied, or level with it or "
                      "before it when one mesh family or one case is left out)")

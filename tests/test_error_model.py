@@ -355,6 +355,28 @@ def test_consistency_limits_closer_than_their_uncertainty_are_tied():
     assert _limit_ties(chain) == " (tied within their +-: v, b; b, n)"   # v, n: 0.13 > 0.042
 
 
+def test_consistency_limit_reads_the_stiffness_the_displacement_is_blind_to():
+    """On the sliding cube the top displacement is prescribed, so a model can match the shape
+    while half as stiff: its consistency limit on a lattice is the larger of its displacement
+    limit and its stiffness limit |ratio_inf - 1|, each with its fit's +-, and says which."""
+    from cases.answers import _limit_text, _worst_limit, limits, worst
+    fit = {"case": "paper-cube", "bc": "sliding", "model": "m", "verdict": "floor"}
+    conv = {"fits": [
+        {**fit, "mesh": "five", "e_inf": 0.03, "e_inf_err": 0.002, "ratio_inf": 0.45,
+         "ratio_inf_err": 0.001},
+        {**fit, "mesh": "six", "e_inf": 0.19, "e_inf_err": 0.004, "ratio_inf": 0.9,
+         "ratio_inf_err": 0.02},
+        {**fit, "mesh": "bcc", "e_inf": 0.2, "e_inf_err": 0.01, "ratio_inf": None},
+        {**fit, "mesh": "unstructured", "verdict": "diverges", "e_inf": None}]}
+    lim = limits(conv, "m")
+    assert lim["five"] == pytest.approx((0.55, 0.001, "stiffness"))
+    assert lim["six"] == pytest.approx((0.19, 0.004, "displacement"))
+    assert lim["bcc"] == pytest.approx((0.2, 0.01, "displacement"))
+    assert lim["unstructured"] == "diverges"
+    assert _limit_text(_worst_limit(lim)) == "0.55 +- 0.001 (stiffness, five)"
+    assert worst(lim) == "0.55 +- 0.001 (stiffness, five); diverges on unstructured"
+
+
 def test_what_to_pick_is_computed_and_names_what_is_not_decided(tmp_path, monkeypatch):
     """The recommendation names FEM P1 as an identity check with the discretisation error every
     model pays, the closest approximation in the linear regime, and 'not decided' at finite

@@ -177,6 +177,25 @@ def test_rewrite_draws_the_same_report_from_the_recorded_runs(small_study, tmp_p
     assert main(["run", "cantilever", "--rewrite", "--out", str(copy)]) == 2
 
 
+def test_its_fits_are_the_convergence_studys_rule_on_its_recorded_runs(small_study, tmp_path):
+    """The extensions study's convergence fits are derived from its recorded runs by the
+    convergence study's own rule, at writing and at --rewrite, so that the two reports give
+    the same verdict on the same runs and a rewrite after a change of the rule follows it."""
+    import shutil
+    from cases.studies.convergence.study import fits
+    doc = json.loads((small_study / "metrics.json").read_text())
+    assert doc["conv_runs"] and doc["fits"] == json.loads(json.dumps(
+        fits(doc["conv_runs"], doc["conv_references"])))
+    copy = tmp_path / "copy"
+    shutil.copytree(small_study, copy)
+    doc["fits"] = [{**f, "verdict": "stale"} for f in doc["fits"]]   # a record of old rules
+    (copy / "metrics.json").write_text(json.dumps(doc))
+    assert main(["run", "extensions", "--rewrite", "--out", str(copy)]) == 0
+    again = json.loads((copy / "metrics.json").read_text())
+    assert "stale" not in {f["verdict"] for f in again["fits"]}
+    assert again["fits"] == json.loads((small_study / "metrics.json").read_text())["fits"]
+
+
 def test_fit_recovers_the_closed_form_stiffness_scale(tmp_path):
     """A single-term model under prescribed displacement: positions do not depend on the
     stiffness scale k and the reaction is k times, so the least-squares k is 1 / the reaction

@@ -102,7 +102,10 @@ def definitions():
         "consistency limit.",
         "floor e_inf: a fit's limit, the displacement error that no refinement removes in one "
         "problem; on the sliding cube (uniaxial stress with traction-free sides, no node of "
-        "the sides prescribed) it is the consistency limit, on the other problems it is not.",
+        "the sides prescribed) it is the displacement part of the consistency limit, whose "
+        "other part is the stiffness error |ratio_inf - 1| (the top displacement is prescribed, "
+        "so the displacement alone is blind to the stiffness; the index reads the larger); on "
+        "the other problems it is neither.",
         "reaching a target only by cancellation (accuracy per cost): a run's error at or below "
         "the target on a mesh where FEM P1's is above it: the discretisation error, shared by "
         "every model on the mesh, exceeds the target, and the model's model-form error (at "

@@ -10,7 +10,7 @@ from ...document import Document, fmt
 from ... import figures
 from ...report import environment, write_study
 from ...runner import jsonable
-from .study import BASE, COST_TETS, TWIN, YARDSTICK, CANDIDATES, short
+from .study import BASE, COST_TETS, TWIN, YARDSTICK, CANDIDATES, conv_fits, short
 
 GATED = catalogue.gated("error", "alternation_max_rel", "e_inf", "moduli_rel_err")
 FEM_FACTOR = 1.5      # a model-form error this many times FEM P1's discretisation error fails
@@ -423,7 +423,9 @@ def gate_rows(data, rank):
 
 
 def write(out, study, s, data):
-    """Write metrics.json, run.json, report.md/.html and the PNG figures into ``out``."""
+    """Write metrics.json, run.json, report.md/.html and the PNG figures into ``out``; the
+    convergence fits derived from the recorded runs by the convergence study's rule."""
+    data = {**data, "fits": conv_fits(data)}
     rank = rankings(data, list(s.models))
     doc = jsonable({"case": study.name, "study": True, "parameters": s.describe(),
                     "problem": s.problem(), "gated": GATED, "environment": environment(),

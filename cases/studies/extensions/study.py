@@ -108,8 +108,20 @@ def costs(bench, models):
     return out
 
 
-# what a run computes (the rest of metrics.json is derived from it by the report)
-RUN_KEYS = ("case_runs", "fits", "elasticity", "cost_vs_fem_linear", "cost_same_terms")
+# what a run computes (the rest of metrics.json is derived from it by the report); the fits
+# are derived from the convergence runs and references by the convergence study's own rule
+RUN_KEYS = ("case_runs", "conv_runs", "conv_references", "elasticity", "cost_vs_fem_linear",
+            "cost_same_terms")
+# what the convergence fits read of a run and of a reference
+CONV_RUN_KEYS = ("case", "mesh", "bc", "h_mm", "model", "disp_rel_l2", "reaction_ratio")
+CONV_REFERENCE_KEYS = ("case", "bc", "error_estimate")
+
+
+def conv_fits(data):
+    """The convergence fits of the recorded runs, by the convergence study's rule (the same
+    runs give the same verdicts in both reports)."""
+    from ..convergence.study import fits
+    return fits(data["conv_runs"], data["conv_references"])
 
 
 def run(s, workers=None, log=True, bench=None, store=OFF):
@@ -126,7 +138,11 @@ def run(s, workers=None, log=True, bench=None, store=OFF):
         rows += case_rows(case, runs)
     conv = studies()["convergence"].run(s.convergence_settings(), workers=workers, log=log,
                                         bench=None, store=store)
-    return jsonable({"case_runs": rows, "fits": conv["fits"], "elasticity": [
+    return jsonable({"case_runs": rows,
+                     "conv_runs": [{k: r.get(k) for k in CONV_RUN_KEYS} for r in conv["runs"]],
+                     "conv_references": [{k: r.get(k) for k in CONV_REFERENCE_KEYS}
+                                         for r in conv["references"]],
+                     "elasticity": [
         {k: e.get(k) for k in ("model", "mesh", "moduli_rel_err", "anisotropy_AU", "E_x", "nu_xy",
                                "G_xy", "failed")} for e in conv["elasticity"]],
         "cost_vs_fem_linear": costs(bench, s.models),
