@@ -161,7 +161,12 @@ def _overall_cell(means, model, pops, finite, spread):
         return "FEM P1 itself"
     if any(model in p.identity and p.finite == finite for p in pops):
         return "identity check (P1's law in this regime)"
-    return scorecard.describe(means[model], spread.get(model)) if model in means else "n/a"
+    said = scorecard.describe(means[model], spread.get(model)) if model in means else "n/a"
+    # a failure in a population the ranking leaves out is the model's all the same
+    out = [f"{st.failed} of {st.runs} in {p.label}" for p in pops
+           if p.finite == finite and not p.ranked and not p.patch_test
+           for _, st, _ in p.standings() if st.model == model and st.failed]
+    return said + (f"; failed outside the ranking: {', '.join(out)}" if out else "")
 
 
 def _bead(measured, model):
@@ -201,10 +206,9 @@ def lines(root, models, pops=(), quick=False):
         else:
             out.append("**How far from the continuum?** "
                        + "The consistency limit, the sliding cube's error as the mesh is "
-                       "refined (a patch test; on each lattice the larger of its displacement "
-                       "error and its stiffness error, the reaction ratio's distance from 1: "
-                       "the top face's displacement is prescribed, so the displacement alone "
-                       "is blind to the stiffness; the largest over the lattices, +- the "
+                       "refined (a patch test; per lattice the larger of its displacement "
+                       "error and its stiffness error |reaction ratio - 1|, which the "
+                       "prescribed top displacement hides; the largest over the lattices, +- the "
                        "extrapolation's "
                        "uncertainty; beside it each family where the model has no limit, and "
                        "what its fit found there): "
@@ -233,7 +237,9 @@ def lines(root, models, pops=(), quick=False):
         out.append(f"**At what cost?** One simulated second at about "
                    f"{fmt(rows['fem-linear']['tets'])} "
                    "tetrahedra, at each model's own stable RK4 step, over fem-linear's "
-                   "(the in-round ratio [its range over the bench's rounds]): "
+                   "(the median over rounds of the in-round step-time ratio, times the "
+                   "stable-step ratio [its range over the rounds]; not a ratio of median "
+                   "times): "
                    + ", ".join(f"{m} {ratio_text(r, fl)}"
                                for m, r in rows.items() if r and m != "fem-linear")
                    + " ([bench](bench/bench.md)).")
@@ -329,7 +335,8 @@ def _single_runs_u(values, u, what):
             groups.append(", ".join(m for m, _ in vals[i:j + 1]))
         i = j + 1 if j > i else i + 1
     return (f"one run each, so no spread over meshes (n = 1): an order among them holds for "
-            f"this mesh only; u_num {rel(u)} ({what}): "
+            f"this mesh only; u_val {rel(u)}, which is u_num here ({what}; a computed "
+            "comparison has no unmeasured input or data): "
             + (f"tied: {'; '.join(groups)}" if groups else "no two within it"))
 
 
@@ -400,12 +407,12 @@ def _cost_of_replacing(pops, models, quick):
                    else "")
                 + (f" ({e[2]} failed runs)" if e[2] else "")
                 + (f" (the same mean rank as {tie})" if tie else "")
-                # its neighbour below, and for the first each model that reaches it when a
-                # unit is left out
-                + ("" if not (names := [b for (a, b) in loose if a == m]
-                              + (first_loose if k == 0 else []))
-                   else f" (not resolved from {', '.join(names)})")
-                for k, (_, m, e, tie) in enumerate(ranked)))
+                for _, m, e, tie in ranked)
+                # the order where it holds: neighbours a unit left out reverses or levels, and
+                # each model that reaches the first when a unit is left out, share a group
+                + _resolved_groups([m for _, m, _, _ in ranked],
+                                   set(loose) | {(ranked[0][1], b) for b in first_loose}
+                                   | {(m, tie) for _, m, _, tie in ranked if tie}))
     if not said:
         return "**What does replacing FEM cost?** No case has a decomposed quantity."
     return ("**What does replacing FEM cost?** The model-form error, each model against FEM P1 "
@@ -416,6 +423,31 @@ def _cost_of_replacing(pops, models, quick):
             "the load, no converged solve) counts against its model once, as infinitely wrong "
             "in its population's rank: "
             + "; ".join(said) + _left_out(pops) + " (the scorecard below).")
+
+
+def _resolved_groups(order, loose):
+    """' (resolved: {a, b} before {c}; within a group not resolved)': the order broken where
+    it holds, ``loose`` the pairs (either way round) a unit left out reverses, levels or ties;
+    a group runs on while any of its models is not resolved from a model further down (never
+    chained past a resolved gap). One group: 'no order resolved'."""
+    apart = {frozenset(p) for p in loose}
+    groups, i = [], 0
+    while i < len(order):
+        j = i
+        k = i
+        while k <= j:
+            j = max([j] + [x for x in range(j + 1, len(order))
+                           if frozenset((order[k], order[x])) in apart])
+            k += 1
+        groups.append(order[i:j + 1])
+        i = j + 1
+    if len(order) < 2:
+        return ""
+    if len(groups) == 1:
+        return (" (no order resolved among them: each gap reverses, levels or ties when one "
+                "mesh family or one case is left out)")
+    return (" (resolved: " + " before ".join("{" + ", ".join(g) + "}" for g in groups)
+            + "; within a group not resolved)")
 
 
 def _left_out(pops):

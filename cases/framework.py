@@ -488,6 +488,9 @@ class Study(abc.ABC):
     # the command line's selections the study honours; `pbcm run NAME` refuses the others
     # (`pbcm report` passes them to the studies that take them)
     selections: ClassVar[tuple] = ("models", "meshes")
+    # the keys of its metrics.json that hold its runs (dicts with 'model', 'mesh' and, for a
+    # run that gave no number, 'failed'): what the index reads so that no failure is unread
+    runs_recorded: ClassVar[tuple] = ()
 
     @abc.abstractmethod
     def settings(self, quick=False, **kw):

@@ -407,6 +407,15 @@ def test_a_failed_control_fails_the_models_observation_and_names_the_cause():
     assert b["kind"].startswith("failed control (six (Kuhn): failed (inverted element: "
                                 "tetrahedron 3")
     assert analysis.classes(u)["failed"] == ["b"]
+    # a failed model has no signature: the signatures the cause rests on leave it out
+    ans = analysis.answer(world)
+    dec = [v for v in ans["hypotheses"]["mirror"]["units"] if v["decides"]]
+    rows = [r for v in dec for r in v["rows"] if r["same_as"] is None]
+    lost = sum(r["kind"].startswith("failed") for r in rows)
+    assert u in dec and lost >= 1
+    assert (f"{len(rows) - lost} distinct model signatures there ({lost} more distinct models "
+            "failed there, no signature)") in analysis.how_sure(ans, {"decided": True,
+                                                                       "sure": "x"})
 
 
 def test_normal_stress_is_tested_only_where_the_term_is_active(nine_decides):

@@ -84,13 +84,14 @@ def test_a_power_law_falling_sequence_is_never_a_floor(p, u):
 def test_the_referees_sequence_still_falls_so_it_is_no_floor():
     """FEM P1's torsion error on 'six' (0.0101, 0.0059, 0.0040, 0.0028) falls at every level
     by far more than its reference's estimate (2.7e-5): its finest changes do not shrink as a
-    power of h, but a sequence still falling is not a floor."""
+    power of h: a sequence still falling is not a floor, and without an observed order it has
+    neither a limit nor a rate: 'not asymptotic', never 'converges'."""
     from cases.studies.convergence.fit import still_falling
     e = [0.0101, 0.0059, 0.0040, 0.0028]
     falling, q = still_falling(H4, e, 2.7e-5)
     assert falling and q == pytest.approx(math.log(0.0059 / 0.0028) / math.log(3.0))
     f = fit(H4, e, u=2.7e-5)
-    assert f.verdict == "converges" and "still falling" in f.why
+    assert f.verdict == "not asymptotic" and "still falling" in f.why and f.e_inf is None
 
 
 @pytest.mark.parametrize("c, C, p", [(0.1, 0.02, 1.0), (0.1, 0.01, 2.0), (0.05, 0.002, 1.5)])

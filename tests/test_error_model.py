@@ -271,14 +271,16 @@ def test_an_order_that_one_mesh_reverses_is_not_resolved(tmp_path):
 
 def test_single_runs_are_read_against_their_uncertainty():
     """Errors from one run each say they have no spread over meshes (n = 1), and are read
-    against u_num: differences below it are named tied (pair by pair along the order, never
-    chained)."""
+    against u_val, which for a computed comparison is u_num: differences below it are named
+    tied (pair by pair along the order, never chained)."""
     from cases.answers import _single_runs_u
     assert _single_runs_u([("a", 0.10), ("b", 0.20)], 0.01, "x") == \
         "one run each, so no spread over meshes (n = 1): an order among them holds for this " \
-        "mesh only; u_num 0.01 (x): no two within it"
+        "mesh only; u_val 0.01, which is u_num here (x; a computed comparison has no " \
+        "unmeasured input or data): no two within it"
     said = _single_runs_u([("c", 0.3), ("a", 0.10), ("b", 0.104), ("d", 0.108)], 0.005, "x")
-    assert said.endswith("u_num 0.005 (x): tied: a, b")
+    assert said.endswith("(x; a computed comparison has no unmeasured input or data): tied: "
+                         "a, b") and "u_val 0.005" in said
     assert "1e-08" in _single_runs_u([("a", 1e-12), ("b", 2e-12)], 0.0, "x")
 
 
@@ -426,6 +428,11 @@ def test_what_to_pick_is_computed_and_names_what_is_not_decided(tmp_path, monkey
     # its failure is said all the same
     assert ("failed runs in the populations left out (failures all the same): b 1 of 2 in "
             "large-compression/clamped") in said
+    # and in b's cell of the summary table, beside its standing
+    from cases.answers import _overall_cell
+    from cases import scorecard
+    cell = _overall_cell(scorecard.overall(locked, ["a", "b"], True), "b", locked, True, {})
+    assert cell.endswith("failed outside the ranking: 1 of 2 in large-compression/clamped")
 
 
 def test_no_equilibrium_at_a_linear_cases_load_is_a_failed_run_of_its_load_population(tmp_path):
@@ -810,6 +817,21 @@ def test_a_failed_check_outside_the_rankings_is_named_in_the_index():
     assert failed_checks({"c": {"runs": runs[1:]}}).endswith(": none.")
 
 
+def test_a_studys_failed_run_is_named_in_the_index():
+    """A study's run that gave no number (a control of the artefact study, say) is named in
+    the index's failure line with its study, mesh, bc and the failure's first clause; a study
+    without failures says none."""
+    from cases.index import failed_checks
+    cells = [{"model": "pbcm-balanced", "mesh": "six-17", "bc": "sliding",
+              "failed": "tetrahedron 3 is inverted; reduce the load step"},
+             {"model": "msm", "mesh": "six-17", "bc": "sliding", "failed": None}]
+    line = failed_checks({}, {"artefact": ({"cells": cells}, ("cells",))})
+    assert line.endswith("studies (no number; each named in its report): pbcm-balanced on "
+                         "artefact/six-17/sliding (tetrahedron 3 is inverted).")
+    assert failed_checks({}, {"artefact": ({"cells": cells[1:]}, ("cells",))}).endswith(
+        "report): none.")
+
+
 def test_a_model_shares_the_rank_of_the_first_group_it_is_not_ordered_from():
     """Ranks are shared pair by pair with each group's first: a model not ordered from the
     first group's first shares rank 1 even when a model between them began a group of its
@@ -841,3 +863,20 @@ def test_a_nearly_linear_load_is_shown_in_a_case_not_ranked_a_second_time():
     assert "nearly linear at this load (fem-linear 0.01" in near[0] and "closest" not in near[0]
     far, _ = scorecard.case_findings("torsion", [q], runs(0.2), estimate_key="nh_error_estimate")
     assert "nearly linear" not in far[0] and "closest" in far[0]
+
+
+def test_an_order_is_broken_into_the_groups_it_resolves():
+    """The ranked order is said as groups split only at gaps no unit left out reverses: a
+    group runs on while any member is not resolved from a model further down (a, c loose
+    puts b between them in the group), a resolved gap splits it, and an order with no
+    resolved gap says so."""
+    from cases.answers import _resolved_groups
+    order = ["a", "b", "c", "d", "e"]
+    assert _resolved_groups(order, {("a", "c"), ("d", "e")}) == (
+        " (resolved: {a, b, c} before {d, e}; within a group not resolved)")
+    assert _resolved_groups(order, set()) == (
+        " (resolved: {a} before {b} before {c} before {d} before {e}; within a group not "
+        "resolved)")
+    assert _resolved_groups(order, {("a", "b"), ("c", "b"), ("d", "c"), ("e", "a")}
+                            ).startswith(" (no order resolved among them")
+    assert _resolved_groups(["a"], set()) == ""

@@ -13,6 +13,7 @@ from .study import ArtefactSettings, bench_costs, run
 
 class Artefact(Study):
     name = "artefact"
+    runs_recorded = ("cells",)
     selections = ()           # its meshes and models are the controlled factors
     title = ("the bulge/neck pattern of the paper's cube over mesh, reading, normal stress, "
              "base and load")

@@ -1200,14 +1200,20 @@ def how_sure(ans, verdict):
              else r.get("mirror_why") or "")
           + ")" for u in dec for r in u["rows"]
           if r["same_as"] is None and (r["kind"].startswith("at the") or r["clear"] == "at")]
-    distinct = sum(u["distinct"] for u in dec)
     failed = [f"{r['name']} ({u['n']} {u['bc']})" for u in us for r in u["rows"]
               if r["kind"].startswith("failed")]
+    # a failed run has no signature: counted apart from the signatures the cause rests on
+    distinct = sum(r["same_as"] is None and not r["kind"].startswith("failed")
+                   for u in dec for r in u["rows"])
+    failed_there = sum(r["same_as"] is None and r["kind"].startswith("failed")
+                       for u in dec for r in u["rows"])
     return ("**How sure.** " + (
         f"The cause rests on {len(dec)} of {len(us)} configurations (size, base) (those whose "
         "smooth "
         f"test fields leak below {DECIDING_LEAK:g}, {LEAK_SHARE:g} of the clear level), "
-        f"{distinct} distinct model signatures there, one "
+        f"{distinct} distinct model signatures there"
+        + (f" ({failed_there} more distinct models failed there, no signature)"
+           if failed_there else "") + ", one "
         "mesh per split and size (no spread over meshes of one continuum problem), "
         "uncertainties that bound the leak of smooth fields by the worst test field's"
         + (", orders from two sizes only; " if any(

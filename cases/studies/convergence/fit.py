@@ -21,7 +21,8 @@ it; a sequence that is still falling is never one because its fit is poor:
 - still falling with an observed order (e = e_inf + C h^p): a floor at the extrapolated e_inf
   where e_inf - u_val > 0 (a constant plus a decaying part), else converges;
 - still falling without an observed order (the finest changes do not shrink as a power of h):
-  converges, its limit not extrapolated (at most the finest error);
+  not asymptotic, no limit extrapolated (at most the finest error): neither a floor nor an
+  order the word "converges" would promise;
 - two levels observe no order: first order assumed (a floor where e_inf - u_val > 0), which
   decides nothing the finer levels cannot overturn (the report says "not decided").
 """
@@ -247,7 +248,7 @@ def fit(h, e, nested=True, u=0.0):
             f" at order {p:.2g}" if p is not None else ", without an observed order"))
     if n >= 3 and p is None:
         # still falling, but its changes do not shrink as a power of h: no limit, no floor
-        return Fit(None, None, None, "converges",
+        return Fit(None, None, None, "not asymptotic",
                    f"still falling (order {q:.2g} over the finest levels), not yet in the "
                    f"asymptotic range: no limit extrapolated, at most the finest error "
                    f"{e[-1]:.2g}", n)

@@ -14,6 +14,7 @@ from .study import RUN_KEYS, ExtensionSettings, run
 
 class Extensions(Study):
     name = "extensions"
+    runs_recorded = ("case_runs",)
     selections = ("models",)  # it runs every case on its own meshes
     title = ("normal-stress extensions of the paper's model ranked over the case library and "
              "the convergence study")

@@ -13,6 +13,7 @@ from .study import TruthCubeSettings, run
 
 class TruthCube(Study):
     name = "truth-cube"
+    runs_recorded = ("rows",)
     selections = ("models",)  # its meshes are the cube's spacings
     title = ("the Truth Cube: every model against 343 measured beads of a silicone cube "
              "compressed 5, 12.5 and 18.25 %")
