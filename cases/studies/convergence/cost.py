@@ -10,13 +10,14 @@ from .fit import blind_levels
 FEM_P1 = "FEM P1"              # the yardstick's name in the runs (the study's)
 
 
-def pareto(points):
+def pareto(points, tol=0.0):
     """The indices of the points (cost, error) no other point beats in both (lower cost and
-    lower error, one of them strictly), in increasing cost."""
+    lower error, one of them strictly), in increasing cost; an error that improves on a cheaper
+    point's by ``tol`` or less (what the reference resolves) does not beat it."""
     order = sorted(range(len(points)), key=lambda i: (points[i][0], points[i][1]))
     front, best = [], np.inf
     for i in order:
-        if points[i][1] < best:
+        if points[i][1] < best - tol:
             front.append(i)
             best = points[i][1]
     return front
@@ -52,7 +53,8 @@ def judge(cost, runs, exact=0.0, cancelling=(), u_ref=None):
     {(case, bc): estimate}) is marked ``below_p1``: its lead over the discretisation error
     every model on that mesh shares is its model-form error offsetting it; a run at a level
     that tests nothing (``blind_levels``) is marked ``blind``. None of these is ever on the
-    front."""
+    front, and a run joins it only by an error below the cheaper ones' by more than the
+    reference's estimate (a smaller gain is not resolved)."""
     u_ref = u_ref or {}
     p1 = {(r["case"], r["bc"], r["mesh"], r["h_mm"]): r["disp_rel_l2"] for r in runs
           if r["model"] == FEM_P1 and r.get("disp_rel_l2") is not None}
@@ -72,7 +74,7 @@ def judge(cost, runs, exact=0.0, cancelling=(), u_ref=None):
                     and not p["below_p1"] and not p["blind"]]
         g["front"] = [eligible[i] for i in pareto([(pts[i]["cost_us"],
                                                     max(pts[i]["disp_rel_l2"], exact))
-                                                   for i in eligible])]
+                                                   for i in eligible], tol=u)]
         for i in g["front"]:
             counts[pts[i]["model"]] = counts.get(pts[i]["model"], 0) + 1
     cost["front_counts"] = dict(sorted(counts.items(), key=lambda kv: -kv[1]))
@@ -89,10 +91,13 @@ def by_cancellation(p, target):
     return p["disp_rel_l2"] <= target and e1 is not None and e1 > target
 
 
-def cheapest(points, target):
+def cheapest(points, target, u=0.0, margin=5.0):
     """(the cheapest point reaching ``target`` that is neither cancelling, below FEM P1, at a
     level that tests nothing nor there only by cancellation, or None; the points that reach
-    it only by cancellation)."""
+    it only by cancellation); (None, None) where the target is below ``margin`` times the
+    reference's estimate ``u``: that reference cannot judge which run reaches it."""
+    if target < margin * u:
+        return None, None
     by_c = [p for p in points if by_cancellation(p, target)]
     ok = [p for p in points if p["disp_rel_l2"] <= target and not p.get("cancellation")
           and not p.get("below_p1") and not p.get("blind") and not by_cancellation(p, target)]

@@ -212,8 +212,9 @@ def conclusion(s, data):
                "is the model's consistency limit, not geometric nonlinearity).")
     odd = [f for f in data["fits"] if f.get("verdict") == "not asymptotic"]
     if odd:
-        out.append(f"Not asymptotic ({len(odd)} fits, not extrapolated or with a limit below "
-                   "zero): " + ", ".join(sorted({f"{f['model']} on {f['mesh']}" for f in odd}))
+        out.append(f"Not asymptotic ({len(odd)} fits: not self-similar, so not "
+                   "extrapolated; a limit below zero; or still falling without an observed "
+                   "order, no limit): " + ", ".join(sorted({f"{f['model']} on {f['mesh']}" for f in odd}))
                    + ".")
     div = sorted({f["model"] for f in data["fits"] if f.get("verdict") == "diverges"
                   and decided(f)})
@@ -577,8 +578,15 @@ def _cost_section(doc, out, s, data):
         return (f"{p['model']} ({p['mesh']}, h {p['h_mm']:.3g}: {p['cost_us']:.3g} us, "
                 f"e {p['disp_rel_l2']:.2g})")
 
+    u_ref = {(r["case"], r["bc"]): r.get("error_estimate") or 0.0
+             for r in data.get("references", [])}
+
     def pick(g, target):
-        best, by_c = cheapest_run(g["points"], target)
+        u = u_ref.get((g["case"], g["bc"]), 0.0)
+        best, by_c = cheapest_run(g["points"], target, u, REF_MARGIN)
+        if by_c is None:
+            return (f"not judged (the reference's estimate {u:.2g} is above a fifth of the "
+                    "target)")
         return (point(best) if best else "none") + ("; reaching it only by cancellation, not "
                                                    "picked: " + "; ".join(
             f"{point(p)}, FEM P1 {p['p1_error']:.2g} there" for p in by_c) if by_c else "")
@@ -587,8 +595,10 @@ def _cost_section(doc, out, s, data):
                      "; ".join(point(g["points"][i]) for i in g["front"]),
                      pick(g, BUDGETS[0]), pick(g, BUDGETS[1])])
     doc.p("The Pareto front of each problem: the runs no other run beats in both step cost "
-          "and displacement error, cheapest first; and the cheapest run that reaches an error "
-          "target. A run whose series may cancel rather than converge (its error not monotone "
+          "and displacement error (a gain within the reference's estimate beats nothing), "
+          "cheapest first; and the cheapest run that reaches an error "
+          f"target, not judged where the reference's estimate exceeds 1/{REF_MARGIN:g} of "
+          "the target. A run whose series may cancel rather than converge (its error not monotone "
           "in h, or its stiffness ratio crossing 1; round-off never counts) is never on the "
           "front nor the cheapest, nor is a run whose error is below FEM P1's on the same mesh "
           "and level by more than the reference's estimate (its lead is its model-form error "
