@@ -132,8 +132,7 @@ TWO_LEVELS = ("two levels observe no order: a floor, a slow convergence and a ri
 
 
 def _floor_range(fits):
-    """'lowest-highest' of the floors, each its e_inf -+ its fit's uncertainty: how far the
-    median's fits reach."""
+    """'lowest-highest' of the floors, each its e_inf -+ its fit's uncertainty."""
     lo = min(f["e_inf"] - (f.get("e_inf_err") or 0.0) for f in fits)
     hi = max(f["e_inf"] + (f.get("e_inf_err") or 0.0) for f in fits)
     return f"{max(lo, 0.0):.2g}-{hi:.2g} with each fit's +-"
@@ -191,9 +190,10 @@ def conclusion(s, data):
             "converging on every fit where a limit is decided: " + (_converging(
                 conv, data["fits"], loose, total) or "none") + "; "
             "stopping at a floor that no refinement removes: " + ("; ".join(
+                # floors of different problems are different quantities: their range, never
+                # a median pooled over them
                 f"{m} in {len(floors[m])} of {total} ({len(by[m])} with a limit or a trend; "
-                "median floor "
-                f"{np.median([f['e_inf'] for f in floors[m]]):.2g} [{_floor_range(floors[m])}])"
+                f"floors {_floor_range(floors[m])}, per problem in the tables below)"
                 for m in floored)
                 or "none"))
         if loose:

@@ -159,16 +159,22 @@ STOPS = ("floor", "diverges")
 
 
 def floors(data, models):
-    """Per model: the convergence verdicts over the (problem, family) fits, the median
-    extrapolated error e_inf, and each fit's verdict and e_inf by 'problem/bc on family'."""
+    """Per model: the convergence verdicts over the (problem, family) fits, the range of its
+    floors (each e_inf -+ its fit's +-; floors of different problems are different quantities,
+    so never a median over them) and the largest, and each fit's verdict and e_inf by
+    'problem/bc on family'."""
     out = {}
     for m in models:
         fs = [f for f in data["fits"] if f["model"] == m]
+        # over the floors alone: a limit of another verdict is no floor
+        fl = [f for f in fs if f["verdict"] == "floor" and f.get("e_inf") is not None]
         out[m] = {"floor": sum(f["verdict"] == "floor" for f in fs),
                   "diverges": sum(f["verdict"] == "diverges" for f in fs),
-                  # over the floors alone: a limit of another verdict is no floor
-                  "fits": len(fs), "e_inf": _median(f["e_inf"] for f in fs
-                                                    if f["verdict"] == "floor"),
+                  "fits": len(fs),
+                  "e_inf": max((f["e_inf"] for f in fl), default=None),
+                  "range": [max(0.0, min(f["e_inf"] - (f.get("e_inf_err") or 0.0) for f in fl)),
+                            max(f["e_inf"] + (f.get("e_inf_err") or 0.0) for f in fl)]
+                  if fl else None,
                   "by_fit": {f"{f['case']}/{f['bc']} on {f['mesh']}":
                              [f["verdict"], f["e_inf"], f.get("e_inf_err")] for f in fs}}
     return out
@@ -477,7 +483,8 @@ def build(out, study, s, doc):
           "the model's meshes and bases; the 5-layer view decides nothing (the artefact "
           "study's finer meshes do).",
           "convergence floor: fits (of the convergence study) whose verdict is floor or "
-          "diverges, and the median extrapolated error e_inf.",
+          "diverges, and the range of the floors, each e_inf with its fit's +- (floors of "
+          "different problems are different quantities: never pooled into a median).",
           "C_eff: the largest relative error of its bulk modulus and five deviatoric Kelvin "
           f"moduli against the target's on each lattice; a failure above {ISOTROPIC_TOL:g}.",
           f"cost: RK4 step time over fem-linear's at {COST_TETS:.0e} tetrahedra, from the "
@@ -518,9 +525,11 @@ def build(out, study, s, doc):
     lattices = sorted({e["mesh"] for e in doc["elasticity"]})
     fl = rank["floors"]
     d.table(["model", "step / fem-linear", "alternation (5-layer view)", "floor + diverges",
-             "median e_inf"] + [f"C_eff {lat}" for lat in lattices],
+             "floors (each with its +-)"] + [f"C_eff {lat}" for lat in lattices],
             [[short(m), fmt(rank["cost"].get(m)), fmt(rank["alternation"].get(m)),
-              f"{fl[m]['floor'] + fl[m]['diverges']} of {fl[m]['fits']}", fmt(fl[m]["e_inf"])]
+              f"{fl[m]['floor'] + fl[m]['diverges']} of {fl[m]['fits']}",
+              f"{fmt(fl[m]['range'][0])}-{fmt(fl[m]['range'][1])}" if fl[m].get("range")
+              else "none"]
              + [fmt(rank["tensors"][m].get(lat)) for lat in lattices] for m in models])
     d.p("By cost: "
         + ", ".join(short(m) for m in order(rank["cost"])) + "; by floors: "
