@@ -305,3 +305,26 @@ def test_a_floor_within_both_limits_uncertainty_is_no_change():
                        "w": {"by_fit": {"p/clamped on six": ["floor", 0.2, 0.0245]}}}}
     assert R.judge(rank, failure, "m") == (0.107, "no change")
     assert R.judge(rank, failure, "w") == (0.2, "worsens")
+
+
+def test_the_sliding_cubes_stiffness_is_a_criterion_its_displacement_cannot_see():
+    """The sliding cube's top displacement is prescribed, so a model can match its shape while
+    soft: the paper model fails on a lattice where |ratio_inf - 1| exceeds the C_eff tolerance
+    beyond its fit's +-, and a candidate whose stiffness limit comes within it fixes that."""
+    fit = {"case": "paper-cube", "bc": "sliding", "mesh": "six", "verdict": "floor",
+           "e_inf": 0.19, "e_inf_err": 0.03}
+    data = {"fits": [{**fit, "model": BASE, "ratio_inf": 0.658, "ratio_inf_err": 1e-6},
+                     {**fit, "model": "m", "ratio_inf": 0.995, "ratio_inf_err": 1e-3},
+                     {**fit, "model": "w", "ratio_inf": 0.5, "ratio_inf_err": 1e-3},
+                     {**fit, "model": "n", "ratio_inf": 1.02, "ratio_inf_err": 0.02,
+                      "mesh": "five"}]}
+    fl = R.floors(data, [BASE, "m", "w", "n"])
+    assert fl[BASE]["stiffness"]["paper-cube/sliding on six"] == pytest.approx([0.342, 1e-6])
+    rank = {"case_errors": {}, "floors": fl, "tensors": {}}
+    (stiff,) = [f for f in R.failures(rank) if f["kind"] == "stiffness"]
+    assert stiff["what"] == "stiffness of paper-cube/sliding on six"
+    assert R.judge(rank, stiff, "m") == (pytest.approx(0.005), "fixes")
+    assert R.judge(rank, stiff, "w") == (pytest.approx(0.5), "worsens")
+    # within its +- of the tolerance: no failure (n's 0.02 +- 0.02 on five)
+    assert not [f for f in R.failures({**rank, "floors": {BASE: fl["n"]}})
+                if f["kind"] == "stiffness"]

@@ -123,10 +123,11 @@ def _rewrite_study(study, folder):
     except (OSError, ValueError) as exc:
         raise UsageError(f"--rewrite reads the {study.name} study's {path}: {exc}; run the "
                          "study first") from None
-    got = study.recorded(metrics)
-    if got is None:
-        raise UsageError(f"the {study.name} study cannot be rewritten from its metrics; rerun it")
     try:
+        got = study.recorded(metrics)
+        if got is None:
+            raise UsageError(f"the {study.name} study cannot be rewritten from its metrics; "
+                             "rerun it")
         cfg, data = got
     except (KeyError, TypeError) as exc:
         raise UsageError(f"{path} lacks {exc}: it was written by another version; rerun the "

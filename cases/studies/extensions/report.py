@@ -158,6 +158,9 @@ def alternations(data, models):
 STOPS = ("floor", "diverges")
 
 
+SLIDING = ("paper-cube", "sliding")     # the convergence study's patch test (the consistency)
+
+
 def floors(data, models):
     """Per model: the convergence verdicts over the (problem, family) fits, the range of its
     floors (each e_inf -+ its fit's +-; floors of different problems are different quantities,
@@ -176,7 +179,13 @@ def floors(data, models):
                             max(f["e_inf"] + (f.get("e_inf_err") or 0.0) for f in fl)]
                   if fl else None,
                   "by_fit": {f"{f['case']}/{f['bc']} on {f['mesh']}":
-                             [f["verdict"], f["e_inf"], f.get("e_inf_err")] for f in fs}}
+                             [f["verdict"], f["e_inf"], f.get("e_inf_err")] for f in fs},
+                  # the sliding cube's stiffness limit, which its displacement (the top
+                  # prescribed) is blind to: |ratio_inf - 1| and its fit's +-
+                  "stiffness": {f"{f['case']}/{f['bc']} on {f['mesh']}":
+                                [abs(f["ratio_inf"] - 1.0), f.get("ratio_inf_err") or 0.0]
+                                for f in fs if (f["case"], f["bc"]) == SLIDING
+                                and f.get("ratio_inf") is not None}}
     return out
 
 
@@ -228,6 +237,11 @@ def failures(rank):
         if v in STOPS:
             out.append({"what": f"convergence of {key}", "note": v, "kind": "floor",
                         "key": key, "base": e_inf, "base_err": err, "limit": None})
+    for key, (d, err) in rank["floors"].get(BASE, {}).get("stiffness", {}).items():
+        if d - err > ISOTROPIC_TOL:
+            out.append({"what": f"stiffness of {key}", "kind": "stiffness", "key": key,
+                        "note": f"|reaction ratio limit - 1|, +- {fmt(err)}", "base": d,
+                        "limit": ISOTROPIC_TOL})
     for lattice, d in rank["tensors"].get(BASE, {}).items():
         if d is not None and d > ISOTROPIC_TOL:
             out.append({"what": f"C_eff on {lattice}", "kind": "tensor", "key": lattice,
@@ -244,6 +258,9 @@ def value(rank, failure, model):
     if k == "floor":
         fit = rank["floors"].get(model, {}).get("by_fit", {}).get(failure["key"])
         return None if fit is None else fit[1]
+    if k == "stiffness":
+        st = rank["floors"].get(model, {}).get("stiffness", {}).get(failure["key"])
+        return None if st is None else st[0]
     return rank["tensors"].get(model, {}).get(failure["key"])
 
 
@@ -485,6 +502,11 @@ def build(out, study, s, doc):
           "convergence floor: fits (of the convergence study) whose verdict is floor or "
           "diverges, and the range of the floors, each e_inf with its fit's +- (floors of "
           "different problems are different quantities: never pooled into a median).",
+          "stiffness: on the sliding cube (its top displacement prescribed, so its "
+          "displacement error is blind to the stiffness), the reaction ratio's limit's "
+          "distance from 1, |ratio_inf - 1|, per lattice; a failure where it exceeds "
+          f"{ISOTROPIC_TOL:g} beyond its fit's +- (the tolerance of C_eff, whose uniaxial "
+          "modulus it measures).",
           "C_eff: the largest relative error of its bulk modulus and five deviatoric Kelvin "
           f"moduli against the target's on each lattice; a failure above {ISOTROPIC_TOL:g}.",
           f"cost: RK4 step time over fem-linear's at {COST_TETS:.0e} tetrahedra, from the "
