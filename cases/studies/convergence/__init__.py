@@ -44,6 +44,11 @@ class Convergence(Study):
     def definitions(self):
         return report.definitions()
 
+    def fits(self, runs, references=()):
+        """The fits of recorded runs by this study's rule (another study's runs included), so
+        that one rule gives one verdict wherever the same runs are read."""
+        return fits(runs, references)
+
     def recorded(self, metrics):
         """The settings and data a run recorded, for ``pbcm run convergence --rewrite``."""
         p = metrics["parameters"]

@@ -120,8 +120,7 @@ CONV_REFERENCE_KEYS = ("case", "bc", "error_estimate")
 def conv_fits(data):
     """The convergence fits of the recorded runs, by the convergence study's rule (the same
     runs give the same verdicts in both reports)."""
-    from ..convergence.study import fits
-    return fits(data["conv_runs"], data["conv_references"])
+    return studies()["convergence"].fits(data["conv_runs"], data["conv_references"])
 
 
 def run(s, workers=None, log=True, bench=None, store=OFF):
