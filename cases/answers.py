@@ -44,12 +44,22 @@ def limits(conv, model):
             # an irregular family is never extrapolated: its verdict, not a limit
             limited = (f["verdict"] in LIMITED and f.get("e_inf") is not None
                        and f["mesh"] in REGULAR)
+            stiff = ((abs(f["ratio_inf"] - 1.0), f.get("ratio_inf_err") or 0.0, "stiffness")
+                     if f.get("ratio_inf") is not None and f["mesh"] in REGULAR else None)
+            if f["mesh"] in REGULAR and f.get("ratio_inf") is None and \
+                    (f.get("ratio_why") or "").startswith("not asymptotic"):
+                # a stiffness that has not settled gives the lattice no limit, whatever the
+                # displacement's
+                out[f["mesh"]] = "not asymptotic (stiffness)"
+                continue
             if not limited:
-                out[f["mesh"]] = f["verdict"]
+                # a stiffness error resolved from 0 bounds the limit from below: said, with
+                # the displacement's verdict beside it
+                out[f["mesh"]] = ((*stiff[:2], f"stiffness; displacement {f['verdict']}")
+                                  if stiff and stiff[0] - stiff[1] > PATCH_TOL
+                                  else f["verdict"])
                 continue
             disp = (f["e_inf"], f.get("e_inf_err") or 0.0, "displacement")
-            stiff = ((abs(f["ratio_inf"] - 1.0), f.get("ratio_inf_err") or 0.0, "stiffness")
-                     if f.get("ratio_inf") is not None else None)
             out[f["mesh"]] = stiff if stiff and stiff[0] > disp[0] else disp
     return out
 
@@ -216,7 +226,8 @@ def lines(root, models, pops=(), quick=False):
                                    for m in rest if _worst_limit(lim[m]))
                        + _limit_ties(sorted(((m, _worst_limit(lim[m])) for m in rest
                                              if _worst_limit(lim[m])), key=lambda x: x[1][0]),
-                                     "tied within their +- on the lattices, whatever each does "
+                                     "tied within their +- on the lattices (limits of one "
+                                     "quantity only), whatever each does "
                                      "on the families where it has no limit")
                        + (f"; below {PATCH_TOL:g}: {', '.join(passed)}" if passed else "")
                        + (f"; no limit on {', '.join(nolimit)}" if nolimit else "")
@@ -292,8 +303,10 @@ def _limit_ties(limits_, said="tied within their +-"):
     (sqrt(u_a^2 + u_b^2)); a model may share a group with each of two models that are resolved
     from each other (ties are not transitive)."""
     def tied(i, j):
-        (_, (a, ua, *_)), (_, (b, ub, *_)) = limits_[i], limits_[j]
-        return abs(a - b) < (ua ** 2 + ub ** 2) ** 0.5
+        (_, (a, ua, *wa)), (_, (b, ub, *wb)) = limits_[i], limits_[j]
+        # a displacement limit and a stiffness limit are two quantities: never tied
+        same = [w.split(";")[0] for w in wa[:1]] == [w.split(";")[0] for w in wb[:1]]
+        return same and abs(a - b) < (ua ** 2 + ub ** 2) ** 0.5
     groups = []
     for i in range(len(limits_)):
         j = i
@@ -355,14 +368,23 @@ def _finest(conv, lims, lattices):
                   and r.get("disp_rel_l2") is not None]
             if rs:
                 r = min(rs, key=lambda r: r["h_mm"])
-                said.append(f"{m} {fmt(r['disp_rel_l2'], 2)} at {fmt(r['h_mm'], 3)} mm")
-                values.append((m, r["disp_rel_l2"]))
+                e, which = finest_error(r)
+                said.append(f"{m} {fmt(e, 2)} ({which}) at {fmt(r['h_mm'], 3)} mm")
+                values.append((m, e))
         if said:
             per.append(f"on {lattice}: {', '.join(said)} ("
                        + _single_runs_u(values, max(est, default=0.0),
                                         "the reference's estimate") + ")")
     return ("; there, the error at the finest level (no limit: not a consistency limit): "
             + "; ".join(per)) if per else ""
+
+
+def finest_error(run):
+    """(error, 'displacement' or 'stiffness'): a sliding-cube run's error as its limit is
+    read, the larger of its displacement error and |reaction ratio - 1|."""
+    e = run["disp_rel_l2"]
+    s = abs(run["reaction_ratio"] - 1.0) if run.get("reaction_ratio") is not None else -1.0
+    return (s, "stiffness") if s > e else (e, "displacement")
 
 
 def _worst_limit(lim):
@@ -411,8 +433,8 @@ def _cost_of_replacing(pops, models, quick):
                 # the order where it holds: neighbours a unit left out reverses or levels, and
                 # each model that reaches the first when a unit is left out, share a group
                 + _resolved_groups([m for _, m, _, _ in ranked],
-                                   set(loose) | {(ranked[0][1], b) for b in first_loose}
-                                   | {(m, tie) for _, m, _, tie in ranked if tie}))
+                                   scorecard.unresolved_pairs(pops, models, finite)
+                                   | {(ranked[0][1], b) for b in first_loose}))
     if not said:
         return "**What does replacing FEM cost?** No case has a decomposed quantity."
     return ("**What does replacing FEM cost?** The model-form error, each model against FEM P1 "
@@ -426,10 +448,10 @@ def _cost_of_replacing(pops, models, quick):
 
 
 def _resolved_groups(order, loose):
-    """' (resolved: {a, b} before {c}; within a group not resolved)': the order broken where
-    it holds, ``loose`` the pairs (either way round) a unit left out reverses, levels or ties;
-    a group runs on while any of its models is not resolved from a model further down (never
-    chained past a resolved gap). One group: 'no order resolved'."""
+    """' (resolved: {a, b} before {c}; within a group, not every pair resolved)': the order
+    broken only where every model before the break is resolved from every model after it,
+    ``loose`` every pair (either way round) a unit left out reverses, levels or ties. One
+    group: 'no order resolved'."""
     apart = {frozenset(p) for p in loose}
     groups, i = [], 0
     while i < len(order):
@@ -447,7 +469,7 @@ def _resolved_groups(order, loose):
         return (" (no order resolved among them: each gap reverses, levels or ties when one "
                 "mesh family or one case is left out)")
     return (" (resolved: " + " before ".join("{" + ", ".join(g) + "}" for g in groups)
-            + "; within a group not resolved)")
+            + "; within a group, not every pair resolved)")
 
 
 def _left_out(pops):
@@ -820,10 +842,11 @@ def _irregular(conv, models):
     """'; on irregular patches ...': each model's worst patch-test error over the families
     whose patch is irregular (perturbed lattices, unstructured), where the study ran it, read
     against FEM P1's error on the same patches (the exact answer's numerical floor)."""
-    worst_of, floor, where = {}, 0.0, {}
+    worst_of, floor, where, ran = {}, 0.0, {}, set()
     for r in conv.get("patch", []):
         if r["mesh"] in REGULAR or r.get("patch_error") is None:
             continue
+        ran.add(r["mesh"])
         if r["model"] == "FEM P1":
             floor = max(floor, r["patch_error"])
         if r["model"] in models and r["patch_error"] >= worst_of.get(r["model"], 0.0):
@@ -832,7 +855,7 @@ def _irregular(conv, models):
         return ""
     ordered = sorted(worst_of.items(), key=lambda kv: kv[1])
     return ("; the patch test with every boundary node prescribed, on irregular patches "
-            f"({', '.join(sorted(set(where.values())))}; each model's worst, on the patch "
+            f"({', '.join(sorted(ran))}; each model's worst, on the patch "
             "named, against the exact linear field; "
             + _single_runs_u(ordered, floor, "FEM P1's own error there").replace(
                 "this mesh only", "these patches only") + "): "

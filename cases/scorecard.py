@@ -238,6 +238,22 @@ def unresolved(pops, models, finite=False):
     return out
 
 
+def unresolved_pairs(pops, models, finite=False):
+    """{(upper, lower)} over every pair of ``ranked(overall(...))``, not its neighbours alone,
+    whose order reverses or levels when one mesh family or one case is left out, or whose
+    mean ranks are equal: what no group boundary may separate."""
+    base = ranked(overall(pops, models, finite))
+    order = [m for _, m, _, _ in base]
+    out = {(m, t) for _, m, _, t in base if t}
+    for _, subset in _subsets(pops, finite):
+        alt = overall(subset, models, finite)
+        for i, a in enumerate(order):
+            for b in order[i + 1:]:
+                if a in alt and b in alt and _order(alt[a], a)[:1] >= _order(alt[b], b)[:1]:
+                    out.add((a, b))
+    return out
+
+
 def not_resolved_from(pops, models, first, finite=False):
     """{model: what was left out}: the models ranked after ``first`` that come level with it
     or before it when one mesh family or one case is left out, pair by pair with ``first``

@@ -579,3 +579,13 @@ def test_patch_test_and_consistency_limit_have_distinct_names():
     said = _sliding({"runs": [_run("six", "m", 2.0, 0.21, 1.0, "paper-cube", "sliding")]},
                     ["m"])
     assert "is not this test" in said and "consistency limit of the sliding cube" in said
+
+
+def test_a_stiffness_ratio_whose_changes_grow_has_no_limit():
+    """A stiffness ratio whose finest change exceeds the one before (0.318, 0.3125, 0.298) is
+    not settling: no limit, 'not asymptotic'; one whose changes shrink is extrapolated."""
+    from cases.studies.convergence.fit import ratio_limit
+    limit, why = ratio_limit([8.0, 4.0, 2.0], [0.318, 0.3125, 0.298])
+    assert limit is None and why.startswith("not asymptotic: its finest changes grow")
+    limit, err = ratio_limit([8.0, 4.0, 2.0], [0.7, 0.6, 0.55])
+    assert limit == pytest.approx(0.5) and err >= 0

@@ -706,8 +706,16 @@ def test_the_finest_level_is_said_per_lattice_with_its_own_ties():
     assert "c " not in bcc            # c has a limit on bcc: no finest level said there
     assert bcc.startswith("; there, the error at the finest level") and "on bcc: a 0.09" in bcc
     assert "tied: a, b" in bcc
-    assert unstructured.startswith("unstructured: a 0.09 at 2 mm, b 0.5 at 2 mm")
+    assert unstructured.startswith("unstructured: a 0.09 (displacement) at 2 mm, b 0.5 "
+                                   "(displacement) at 2 mm")
     assert "no two within it" in unstructured
+    # the finest error is read as the limit is: the larger of the displacement error and
+    # |reaction ratio - 1|
+    for r in runs:
+        r["reaction_ratio"] = 1.6 if r["model"] == "a" else 1.0
+    said = _finest({"runs": runs, "references": []}, {"a": {"unstructured": "diverges"}},
+                   ["unstructured"])
+    assert "on unstructured: a 0.6 (stiffness) at 2 mm" in said
 
 
 def test_a_quick_index_table_decides_no_verdict(tmp_path):
@@ -866,17 +874,16 @@ def test_a_nearly_linear_load_is_shown_in_a_case_not_ranked_a_second_time():
 
 
 def test_an_order_is_broken_into_the_groups_it_resolves():
-    """The ranked order is said as groups split only at gaps no unit left out reverses: a
-    group runs on while any member is not resolved from a model further down (a, c loose
-    puts b between them in the group), a resolved gap splits it, and an order with no
-    resolved gap says so."""
+    """The ranked order is said as groups split only where every model before the split is
+    resolved from every model after it (a, c loose puts b between them in the group), and
+    an order with no such split says so."""
     from cases.answers import _resolved_groups
     order = ["a", "b", "c", "d", "e"]
     assert _resolved_groups(order, {("a", "c"), ("d", "e")}) == (
-        " (resolved: {a, b, c} before {d, e}; within a group not resolved)")
+        " (resolved: {a, b, c} before {d, e}; within a group, not every pair resolved)")
     assert _resolved_groups(order, set()) == (
-        " (resolved: {a} before {b} before {c} before {d} before {e}; within a group not "
-        "resolved)")
+        " (resolved: {a} before {b} before {c} before {d} before {e}; within a group, not "
+        "every pair resolved)")
     assert _resolved_groups(order, {("a", "b"), ("c", "b"), ("d", "c"), ("e", "a")}
                             ).startswith(" (no order resolved among them")
     assert _resolved_groups(["a"], set()) == ""

@@ -22,7 +22,7 @@ RECORDED = ("runs", "fits", "references", "elasticity", "cost", "manufactured", 
 
 class Convergence(Study):
     name = "convergence"
-    runs_recorded = ("runs",)
+    runs_recorded = ("runs", "steps", "patch", "elasticity")
     title = ("h-convergence of every model on the paper cube, cantilever and torsion bar; "
              "effective elasticity of every lattice; accuracy per cost")
     # --quick: two levels on the two mesh families the paper cube's quick mode keeps, against

@@ -267,6 +267,11 @@ def ratio_limit(h, ratios, nested=True):
     below zero."""
     if not nested:
         return None, "not self-similar: no extrapolation"
+    r = [float(x) for x in ratios]
+    if len(r) >= 3 and abs(r[-1] - r[-2]) > max(abs(r[-2] - r[-3]), ROUND_LEVEL):
+        # changes that grow under refinement are not a sequence settling on a limit
+        return None, (f"not asymptotic: its finest changes grow ({r[-2] - r[-3]:+.2g}, "
+                      f"{r[-1] - r[-2]:+.2g})")
     limit, err, _ = extrapolate(h, ratios)
     if not limit > 0:
         return None, f"extrapolated to {limit:.3g}: not asymptotic"
