@@ -328,3 +328,24 @@ def test_the_sliding_cubes_stiffness_is_a_criterion_its_displacement_cannot_see(
     # within its +- of the tolerance: no failure (n's 0.02 +- 0.02 on five)
     assert not [f for f in R.failures({**rank, "floors": {BASE: fl["n"]}})
                 if f["kind"] == "stiffness"]
+
+
+def test_a_candidate_failing_where_the_paper_model_passes_is_named():
+    """A criterion the paper's model meets and a candidate fails (a stiffness beyond the
+    tolerance past its +-, a floor where the paper's model converges, a C_eff beyond the
+    tolerance) is named as the candidate's own failure; one within its +- is not."""
+    fit = {"case": "paper-cube", "bc": "sliding", "mesh": "bcc", "e_inf": 0.01,
+           "e_inf_err": 0.001}
+    data = {"fits": [{**fit, "model": BASE, "verdict": "converges", "ratio_inf": 0.994,
+                      "ratio_inf_err": 0.031},
+                     {**fit, "model": "e", "verdict": "floor", "ratio_inf": 1.0497,
+                      "ratio_inf_err": 0.0265},
+                     {**fit, "model": "k", "verdict": "converges", "ratio_inf": 1.03,
+                      "ratio_inf_err": 0.025}]}
+    rank = {"floors": R.floors(data, [BASE, "e", "k"]),
+            "tensors": {BASE: {"five": 0.005}, "e": {"five": 0.02}, "k": {"five": 0.004}}}
+    assert R.new_failures(rank, "e") == [
+        "stiffness of paper-cube/sliding on bcc 0.0497 +- 0.0265",
+        "convergence of paper-cube/sliding on bcc (floor, e_inf 0.01 +- 0.001)",
+        "C_eff on five 0.02"]
+    assert R.new_failures(rank, "k") == []
