@@ -582,6 +582,7 @@ def recommendation(root, models, pops, quick, bench_rows):
                    + ": 0 model-form error by construction, an identity check)"
                    + _discretisation(pops, False)
                    + (f"; the closest approximation is {named(lin, b, others)}" if b else "")
+                   + (_cheaper_contender(b, others, bench_rows, p1_lin, conv) if b else "")
                    + ".")
     if fin and p1_fin:
         b, others = best(fin, True)
@@ -664,6 +665,29 @@ def recommendation(root, models, pops, quick, bench_rows):
                         "unpaired)" if lin[cheapest][2] else ""))
         out.append(line + ".")
     return out[:5] if len(out) > 1 else []
+
+
+def _cheaper_contender(best, others, bench_rows, base, conv=None):
+    """'; of those not resolved from it, X costs ... : the pick at the accuracy the data
+    resolve': among the first and the models it is not resolved from, one whose cost per
+    simulated second (its range over the bench's rounds) lies wholly below the first's."""
+    fl = bench_rows.get(base)
+    if not others or not fl or not bench_rows.get(best):
+        return ""
+    def span(m):
+        r, rng = sim_ratio(bench_rows[m], fl)
+        return rng or [r, r]
+    hi_best = span(best)[0]
+    cheaper = [m for m in others if bench_rows.get(m) and span(m)[1] < hi_best]
+    if not cheaper:
+        return ""
+    m = min(cheaper, key=lambda m: span(m)[1])
+    limit = _worst_limit(limits(conv, m)) if conv else None
+    return (f"; {m}, not resolved from it in model-form error, costs "
+            f"{ratio_text(bench_rows[m], fl)} times {base}'s, wholly below {best}'s range"
+            + (f" (its consistency limit {_limit_text(limit)})"
+               if limit and limit[0] >= PATCH_TOL else "")
+            + f": at the model-form accuracy the data resolve, {m} is the cheaper pick")
 
 
 def _how_finite(pops, linear_law):

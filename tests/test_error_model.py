@@ -887,3 +887,20 @@ def test_an_order_is_broken_into_the_groups_it_resolves():
     assert _resolved_groups(order, {("a", "b"), ("c", "b"), ("d", "c"), ("e", "a")}
                             ).startswith(" (no order resolved among them")
     assert _resolved_groups(["a"], set()) == ""
+
+
+def test_a_contender_whose_cost_range_lies_below_the_firsts_is_the_cheaper_pick():
+    """Among the first and the models it is not resolved from, one whose cost per simulated
+    second (its range over the bench's rounds) lies wholly below the first's is named the
+    cheaper pick; overlapping ranges name none."""
+    from cases.answers import _cheaper_contender
+    def row(m, r, lo, hi):
+        return {"model": m, "stable_dt_us": 1.0, "cpu_s_per_simulated_s": r,
+                "step_vs_fl": r, "step_vs_fl_range": [lo, hi]}
+    rows = {"fl": {"model": "fl", "stable_dt_us": 1.0, "cpu_s_per_simulated_s": 1.0},
+            "a": row("a", 12, 7.6, 12), "b": row("b", 4.7, 4.4, 4.9), "c": row("c", 8, 7, 9)}
+    said = _cheaper_contender("a", ["b", "c"], rows, "fl")
+    assert said.startswith("; b, not resolved from it in model-form error, costs 4.7 "
+                           "[4.4-4.9] times fl's") and said.endswith("b is the cheaper pick")
+    assert _cheaper_contender("a", ["c"], rows, "fl") == ""
+    assert _cheaper_contender("a", [], rows, "fl") == ""
