@@ -353,11 +353,6 @@ def _overlap(a, b):
     return a is None or b is None or (a[0] <= b[1] and b[0] <= a[1])
 
 
-def _smallest(errors):
-    """The approximation with the smallest error of one population (the yardstick left out)."""
-    return order({m: e for m, e in errors.items() if m != YARDSTICK})[0]
-
-
 def shared_ranks(by, rank):
     """{model: its rank as text}: in the order ``by``, a model whose range leaving one
     population out overlaps its group head's shares the head's rank (the data cannot order
@@ -559,10 +554,11 @@ def build(out, study, s, doc):
                          and f"{r['mesh']}/{r['bc']}" == ks[0]) for c, ks in gone.items()}
         d.p("Left out of every comparison, because no model (FEM included) has a result there: "
             + "; ".join(f"{c} on {', '.join(ks)} ({first[c]})" for c, ks in gone.items()) + ".")
-    d.p(f"Smallest median per case among the approximations ({YARDSTICK}, FEM P1 itself, is "
-        "the yardstick, not ranked; an order of medians over the meshes, resolved against no "
-        "uncertainty): " + "; ".join(f"{c} {short(_smallest(rank['case_errors'][c]))}"
-                                     for c in cases) + ".")
+    # no per-case winner is named: an order of medians resolved against no uncertainty is
+    # not a finding (the index's scorecard reads each case against its u_val)
+    d.p("Per case, the medians over the meshes are in the table above; which model is "
+        "closest in each case, read against its uncertainty, is in the index's "
+        "[scorecard](../index.md).")
     dropped = {}
     for r in doc["case_runs"]:
         for t in r.get("dropped") or []:
