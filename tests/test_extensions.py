@@ -90,7 +90,8 @@ def test_headline_says_when_no_candidate_beats_the_paper_model():
     # one population: no range leaving one out, so no best is named
     assert R.conclusion(doc)[0].startswith(
         "Over the 1 pooled populations of the library, among the normal-stress extensions "
-        "not resolved between m1, m2 (their ranges leaving one population out overlap): ")
+        "not resolved between m1, m2 (their ranges leaving one population or one mesh "
+        "family out overlap): ")
     assert "m1 2, m2 4; m1 farther from FEM P1 than the paper model whichever population" in \
         R.conclusion(doc)[0]
 
@@ -349,3 +350,22 @@ def test_a_candidate_failing_where_the_paper_model_passes_is_named():
         "convergence of paper-cube/sliding on bcc (floor, e_inf 0.01 +- 0.001)",
         "C_eff on five 0.02"]
     assert R.new_failures(rank, "k") == []
+
+
+def test_the_overall_range_also_leaves_one_mesh_family_out():
+    """The range of a candidate's geometric mean covers leaving one mesh family out of every
+    population (the mesh is the unit of analysis), not only one population: a candidate far
+    ahead on one mesh family moves the median when another family is left out."""
+    runs = []
+    for pop in ("a", "b"):
+        for mesh, (base, cand) in {"five": (0.1, 0.01), "six": (0.1, 0.2),
+                                   "bcc": (0.1, 0.2)}.items():
+            for m, e in ((BASE, base), ("c", cand)):
+                runs.append({"case": pop, "bc": "clamped", "mesh": mesh, "model": m,
+                             "error": e, "failed": None})
+    data = {"case_runs": runs}
+    errors = R.case_errors(data, [BASE, "c"])
+    assert R.overall(errors, [BASE, "c"])["c"] == pytest.approx(2.0)
+    assert R.overall_range(errors, [BASE, "c"])["c"] == pytest.approx([2.0, 2.0])
+    lo, hi = R.overall_range(errors, [BASE, "c"], data)["c"]
+    assert lo == pytest.approx(1.05) and hi == pytest.approx(2.0)   # six, or five, left out
