@@ -130,7 +130,10 @@ def table(root, models, pops=(), quick=False):
     conv = _load(root, "convergence", "metrics.json")
     cube = _load(root, "paper-cube", "metrics.json")
     bench = _load(root, BENCH_FOLDER, BENCH_FILE)
-    measured = (_load(root, MEASURED, "metrics.json") or {}).get("headline")
+    truth = _load(root, MEASURED, "metrics.json")
+    measured = (truth or {}).get("headline")
+    truth_u = validation(truth)["u_val"] if measured and not truth["parameters"]["quick"] \
+        else None
     linear, finite = scorecard.overall(pops, models), scorecard.overall(pops, models, True)
     spread = {f: scorecard.spread(pops, models, f) for f in (False, True)}
     header = ["model", "model-form error, linear regime", "model-form error, finite load",
@@ -161,7 +164,7 @@ def table(root, models, pops=(), quick=False):
                      (f"{fmt(b['cpu_s_per_simulated_s'])} ({ratio_text(b, fl)} x fem-linear)"
                       if b and fl and b is not fl else
                       fmt(b["cpu_s_per_simulated_s"]) if b else "n/a"),
-                     _bead(measured, m)])
+                     _bead(measured, m, truth_u)])
     return header, rows
 
 
@@ -179,9 +182,15 @@ def _overall_cell(means, model, pops, finite, spread):
     return said + (f"; failed outside the ranking: {', '.join(out)}" if out else "")
 
 
-def _bead(measured, model):
+def _bead(measured, model, u_val=None):
+    """'rms at strain % (u_val u)': a model's bead RMS at the headline state with the
+    uncertainty it is read against."""
     v = (measured or {}).get("models", {}).get(model)
-    return f"{fmt(v['bead_rms_mm'])} at {fmt(100 * measured['strain'], 4)} %" if v else "n/a"
+    if not v:
+        return "n/a"
+    u = (u_val or {}).get(model)
+    return (f"{fmt(v['bead_rms_mm'])} at {fmt(100 * measured['strain'], 4)} %"
+            + (f" (u_val {fmt(u, 2)})" if u is not None else ""))
 
 
 def lines(root, models, pops=(), quick=False):
