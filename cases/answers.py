@@ -574,8 +574,9 @@ def recommendation(root, models, pops, quick, bench_rows):
         if limit and limit[0] >= PATCH_TOL:
             said += f", consistency limit {_limit_text(limit)}"
         if others:
-            said += (f", not resolved from {', '.join(others)} (tied, or level with it or "
-                     "before it when one mesh family or one case is left out)")
+            said += (f", not resolved from {', '.join(others)} (level with it or before it "
+                     "when one mesh family or one case is left out, and not below it paired "
+                     "under every leave-out)")
         return said
 
     def cost(m):

@@ -299,7 +299,9 @@ TERMS = {
     "naming which: an order of two models that reverses, or levels, when one mesh (a "
     "population's two medians within both medians' spread over the meshes), one mesh family "
     "(every population's runs on it) or one case is left out (the data cannot order them, "
-    "whatever their mean ranks say; judged pair by pair, never chained through a third); or a "
+    "whatever their mean ranks say; judged pair by pair, never chained through a third), "
+    "unless the two compared directly (the geometric mean over the cases of their paired "
+    "population errors' ratio) keep that order whatever is left out; or a "
     "value below what its uncertainty resolves (a convergence fit whose finest error is below "
     "five times its reference's estimate; an artefact part within its u of 0). A reference "
     "too coarse to judge a case's differences is said as such, not with this word.",

@@ -235,7 +235,8 @@ def unresolved(pops, models, finite=False):
             if (a, b) not in out and a in alt and b in alt and \
                     _order(alt[a], a)[:1] >= _order(alt[b], b)[:1]:
                 out[(a, b)] = left_out
-    return out
+    # a pair the direct comparison orders the same way under every leave-out is resolved
+    return {k: v for k, v in out.items() if not paired_ahead(pops, *k, finite)}
 
 
 def unresolved_pairs(pops, models, finite=False):
@@ -251,7 +252,36 @@ def unresolved_pairs(pops, models, finite=False):
             for b in order[i + 1:]:
                 if a in alt and b in alt and _order(alt[a], a)[:1] >= _order(alt[b], b)[:1]:
                     out.add((a, b))
-    return out
+    return {(a, b) for a, b in out if not paired_ahead(pops, a, b, finite)}
+
+
+def _paired_ratio(subset, a, b, finite):
+    """The geometric mean over the cases (a case's boundary conditions averaged first) of
+    a's population score over b's, on the populations of one regime both ran in; None where
+    either failed in one (a failed run has no ratio) or none is shared."""
+    by_case = {}
+    for p in subset:
+        if p.finite != finite or not p.ranked:
+            continue
+        score = {st.model: st.score for _, st, _ in p.standings()}
+        if a not in score or b not in score:
+            continue
+        if not (math.isfinite(score[a]) and math.isfinite(score[b])) or \
+                score[a] <= 0 or score[b] <= 0:
+            return None
+        by_case.setdefault(p.case, []).append(math.log(score[a] / score[b]))
+    if not by_case:
+        return None
+    return math.exp(float(np.mean([np.mean(v) for v in by_case.values()])))
+
+
+def paired_ahead(pops, a, b, finite=False):
+    """Whether a's model-form error is below b's paired, population by population: the
+    geometric mean of their ratios below 1 on every population and whatever mesh family or
+    case is left out (the two compared directly, not through their ranks among the others)."""
+    ratios = [_paired_ratio(pops, a, b, finite)] + [
+        _paired_ratio(subset, a, b, finite) for _, subset in _subsets(pops, finite)]
+    return all(r is not None and r < 1.0 for r in ratios)
 
 
 def not_resolved_from(pops, models, first, finite=False):
@@ -269,7 +299,7 @@ def not_resolved_from(pops, models, first, finite=False):
             if m in alt and m not in out and \
                     _order(alt[m], m)[:1] <= _order(alt[first], first)[:1]:
                 out[m] = left_out
-    return out
+    return {m: v for m, v in out.items() if not paired_ahead(pops, first, m, finite)}
 
 
 def _subsets(pops, finite):

@@ -904,3 +904,33 @@ def test_a_contender_whose_cost_range_lies_below_the_firsts_is_the_cheaper_pick(
                            "[4.4-4.9] times fl's") and said.endswith("b is the cheaper pick")
     assert _cheaper_contender("a", ["c"], rows, "fl") == ""
     assert _cheaper_contender("a", [], rows, "fl") == ""
+
+
+class _Pop:
+    """A population stub: its case and each model's score (what the paired comparison reads)."""
+
+    def __init__(self, case, scores, finite=False):
+        self.case, self.scores, self.finite, self.ranked = case, scores, finite, True
+        self.meshes = {}
+
+    def standings(self):
+        from types import SimpleNamespace
+        return [(0, SimpleNamespace(model=m, score=s), None) for m, s in self.scores.items()]
+
+    def without(self, mesh):
+        return self
+
+
+def test_a_pair_kept_in_order_when_compared_directly_is_resolved():
+    """Two models compared directly (the geometric mean over the cases of their paired
+    errors' ratio) are resolved when that ratio stays below 1 whatever case is left out, even
+    where their mean ranks level on a subset; one case reversing the ratio leaves them not
+    resolved, and a failed population gives no ratio."""
+    ahead = [_Pop("p", {"a": 0.1, "b": 0.5}), _Pop("q", {"a": 0.1, "b": 0.5}),
+             _Pop("r", {"a": 0.31, "b": 0.3})]
+    assert scorecard.paired_ahead(ahead, "a", "b")
+    assert not scorecard.paired_ahead(ahead, "b", "a")
+    flips = [_Pop("p", {"a": 0.1, "b": 0.5}), _Pop("r", {"a": 0.31, "b": 0.3})]
+    assert not scorecard.paired_ahead(flips, "a", "b")      # without p, b is ahead
+    failed = ahead + [_Pop("s", {"a": float("inf"), "b": 0.3})]
+    assert not scorecard.paired_ahead(failed, "a", "b")
