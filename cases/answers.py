@@ -46,11 +46,14 @@ def limits(conv, model):
                        and f["mesh"] in REGULAR)
             stiff = ((abs(f["ratio_inf"] - 1.0), f.get("ratio_inf_err") or 0.0, "stiffness")
                      if f.get("ratio_inf") is not None and f["mesh"] in REGULAR else None)
+            if f["verdict"] == "exact" and stiff and stiff[0] < PATCH_TOL:
+                # the reference's own level (the nonlinearity left at the scaled load): FEM
+                stiff = None
             if f["mesh"] in REGULAR and f.get("ratio_inf") is None and \
                     (f.get("ratio_why") or "").startswith("not asymptotic"):
-                # a stiffness that has not settled gives the lattice no limit, whatever the
-                # displacement's
-                out[f["mesh"]] = "not asymptotic (stiffness)"
+                # a stiffness error growing under refinement: at least its finest value (the
+                # floor rule's +-, 1.25 x its last change); one that moves otherwise, no limit
+                out[f["mesh"]] = _growing_stiffness(conv, f) or "not asymptotic (stiffness)"
                 continue
             if not limited:
                 # a stiffness error resolved from 0 bounds the limit from below: said, with
@@ -62,6 +65,25 @@ def limits(conv, model):
             disp = (f["e_inf"], f.get("e_inf_err") or 0.0, "displacement")
             out[f["mesh"]] = stiff if stiff and stiff[0] > disp[0] else disp
     return out
+
+
+def _whole(v):
+    """Whether a lattice's entry is a limit of both quantities (not a verdict, nor a
+    stiffness bound beside a displacement with no limit)."""
+    return isinstance(v, tuple) and "; " not in v[2]
+
+
+def _growing_stiffness(conv, fit):
+    """(finest |ratio - 1|, 1.25 x its last change, 'stiffness, growing: at least') of a fit
+    whose stiffness error grows at every refinement, or None."""
+    rs = sorted((r for r in conv.get("runs", [])
+                 if (r["case"], r["bc"], r["mesh"], r["model"])
+                 == (fit["case"], fit["bc"], fit["mesh"], fit["model"])
+                 and r.get("reaction_ratio") is not None), key=lambda r: -r["h_mm"])
+    d = [abs(r["reaction_ratio"] - 1.0) for r in rs]
+    if len(d) < 3 or not all(b > a for a, b in zip(d, d[1:])):
+        return None
+    return (d[-1], 1.25 * (d[-1] - d[-2]), "stiffness, growing: at least")
 
 
 def _pm(v):
@@ -215,8 +237,7 @@ def lines(root, models, pops=(), quick=False):
             x[0] + x[1] < PATCH_TOL if isinstance(x, tuple) else x in LIMITED
             for x in v.values())]
         rest = sorted((m for m in models if m not in passed), key=lambda m: _largest(lim[m]))
-        nolimit = sorted({k for m in rest for k, v in lim[m].items()
-                          if not isinstance(v, tuple)})
+        nolimit = sorted({k for m in rest for k, v in lim[m].items() if not _whole(v)})
         if conv["parameters"]["quick"]:     # the patches are the full run's: said
             out.append("**How far from the continuum?** Quick: not decided (`pbcm run "
                        "convergence` decides, on its finer levels); on the same patches as "
@@ -331,6 +352,8 @@ def _no_limit(values):
     """' (diverges on x; not asymptotic on y)': the families without a limit, with the fit's
     verdict there ('' where every family has one)."""
     other = [f"{_shown(v)} on {k}" for k, v in values.items() if not isinstance(v, tuple)]
+    other += [f"{v[2].split('; ', 1)[1]} on {k} (its stiffness {_pm(v)} there)"
+              for k, v in values.items() if isinstance(v, tuple) and "; " in v[2]]
     return f" ({'; '.join(other)})" if other else ""
 
 
@@ -371,7 +394,7 @@ def _finest(conv, lims, lattices):
     per = []
     for lattice in lattices:
         said, values = [], []
-        for m in [m for m, v in lims.items() if not isinstance(v.get(lattice), tuple)]:
+        for m in [m for m, v in lims.items() if not _whole(v.get(lattice))]:
             rs = [r for r in conv.get("runs", []) if (r["case"], r["bc"]) == CONSISTENCY
                   and r["mesh"] == lattice and r["model"] == m
                   and r.get("disp_rel_l2") is not None]

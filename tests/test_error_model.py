@@ -934,3 +934,27 @@ def test_a_pair_kept_in_order_when_compared_directly_is_resolved():
     assert not scorecard.paired_ahead(flips, "a", "b")      # without p, b is ahead
     failed = ahead + [_Pop("s", {"a": float("inf"), "b": 0.3})]
     assert not scorecard.paired_ahead(failed, "a", "b")
+
+
+def test_a_growing_stiffness_error_bounds_the_limit_and_fems_nonlinearity_is_no_limit():
+    """A stiffness error that grows at every refinement (0.682, 0.687, 0.702) has no
+    extrapolated limit but bounds the lattice's from below: at least its finest value, +-
+    1.25 x its last change; FEM's stiffness at the reference's own level is no limit; a
+    stiffness bound beside a displacement with no limit names the displacement's verdict."""
+    from cases.answers import _no_limit, limits
+    fit = {"case": "paper-cube", "bc": "sliding", "model": "m"}
+    conv = {"fits": [
+        {**fit, "mesh": "six", "verdict": "floor", "e_inf": 0.19, "e_inf_err": 0.004,
+         "ratio_inf": None, "ratio_why": "not asymptotic: its finest changes grow"},
+        {**fit, "mesh": "five", "verdict": "exact", "e_inf": 2e-10, "e_inf_err": 2e-10,
+         "ratio_inf": 1.00005, "ratio_inf_err": 1e-9},
+        {**fit, "mesh": "bcc", "verdict": "not decided", "e_inf": 0.0, "e_inf_err": 0.18,
+         "ratio_inf": 1.04, "ratio_inf_err": 0.013}],
+        "runs": [{**fit, "mesh": "six", "h_mm": h, "reaction_ratio": r, "disp_rel_l2": 0.2}
+                 for h, r in ((8.0, 0.318), (4.0, 0.3125), (2.0, 0.298))]}
+    lim = limits(conv, "m")
+    assert lim["six"][0] == pytest.approx(0.702) and lim["six"][2].startswith("stiffness, grow")
+    assert lim["six"][1] == pytest.approx(1.25 * (0.702 - 0.6875))
+    assert lim["five"] == pytest.approx((2e-10, 2e-10, "displacement"))
+    assert lim["bcc"][2] == "stiffness; displacement not decided"
+    assert "displacement not decided on bcc (its stiffness 0.04 +- 0.01 there)" in _no_limit(lim)
