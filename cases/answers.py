@@ -70,7 +70,7 @@ def limits(conv, model):
 def _whole(v):
     """Whether a lattice's entry is a limit of both quantities (not a verdict, nor a
     stiffness bound beside a displacement with no limit)."""
-    return isinstance(v, tuple) and "; " not in v[2]
+    return isinstance(v, tuple) and "; " not in (v[2] if len(v) > 2 else "")
 
 
 def _growing_stiffness(conv, fit):
