@@ -14,6 +14,7 @@ from typing import ClassVar
 
 import numpy as np
 
+from model.units import MM  # noqa: F401 (the cases' millimetre)
 from model import PRESETS, Material, PbcmError, build
 from model.errors import ConvergenceError, ModelError
 from model import static
@@ -29,7 +30,6 @@ AT_LOAD = "the decomposed quantity at the load"
 # what a run may fail with and still be a finding: the suite's own errors and numerical ones
 FINDINGS = (PbcmError, ArithmeticError, np.linalg.LinAlgError)
 
-MM = 1e-3
 MESH_FAMILIES = SCHEMES          # five, six, bcc, unstructured
 # the linear regime: the case's loads scaled so that the largest strain of the converged linear
 # reference (its tetrahedron averages) is this; every model then answers as its linearisation

@@ -20,10 +20,10 @@ from pathlib import Path
 import numpy as np
 
 from model.errors import ModelError
+from model.units import MM
 
 DATA = Path(__file__).parent / "data" / "truthcube" / "uniaxial_positions.csv"
 HEADER_LINES = 7
-MM = 1e-3
 SIDE = 80 * MM                                 # the specimen's edge [m]
 STRAINS = (0.0, 0.05, 0.125, 0.1825)           # the four states' nominal compression
 BEADS_PER_SIDE = 7

@@ -156,7 +156,7 @@ def test_no_study_imports_another_studys_modules():
 def test_reference_takes_the_mesh_from_model_never_its_physics():
     g = graph()
     allowed = {"model", "model.mesh", "model.geometry", "model.bc", "model.errors",
-               "model.material"}
+               "model.material", "model.units"}
     used = {b for a, bs in g.items() if layer(a) == "reference" for b in bs
             if layer(b) == "model"}
     assert used <= allowed, used - allowed

@@ -9,9 +9,9 @@ from cases.runner import reaction_along
 from reference import linear
 from reference.linear import dof_component
 from reference.discretisation import Region
+from model.units import MM
 
 SPACING = 8.0     # coarse: the face is one lattice cell, resolved by the refinements
-MM = 1e-3
 
 
 def punch_force(family, dirichlet_fn):

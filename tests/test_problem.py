@@ -20,10 +20,10 @@ from cases.library.problem.case import on_triangles
 from cases.library.problem.spec import KEYS
 from model.loads import boundary_facets
 from model.mesh import cube, read_with_sets
+from model.units import MM
 
 ROOT = Path(__file__).resolve().parents[1]
 EXAMPLE = ROOT / "examples" / "cylinder" / "cylinder.toml"
-MM = 1e-3
 
 
 def example_spec():

@@ -18,7 +18,7 @@ from . import common
 
 SIZE_MM, NODES = 32.0, 5
 PUSH_MM, STEPS = 9.6, 6
-LAYERS_MM = (0.0, 8.0, 16.0, 24.0, 32.0)
+LAYERS_MM = tuple(np.linspace(0.0, SIZE_MM, NODES).tolist())   # the lattice's node planes
 ENERGY_STEP = 1e-3     # the energy's central difference: this fraction of the push
 
 

@@ -14,7 +14,7 @@ from model.mesh import cube
 from .. import metrics as M
 from . import transient
 from ..error_model import Scalar
-from ..framework import Case, Knob, MESH_FAMILIES, Settings, regimes
+from ..framework import MM, Case, Knob, MESH_FAMILIES, Settings, regimes
 from . import common
 from . import paper_cube_report as report
 
@@ -22,10 +22,8 @@ SIZE_MM = 32.0
 NODES_PER_SIDE = 5
 PUSH_MM = 1.7
 SPEED_MM_S = 1.7
-LAYERS_MM = (0.0, 8.0, 16.0, 24.0, 32.0)
 BCS = common.CUBE_BCS
 
-MM = 1e-3
 REPEAT_DT4 = ("every", "blew up")   # which dynamic runs are repeated at a quarter of the step
 
 
@@ -83,6 +81,9 @@ def layers_mm(nodes_per_side):
     """The y-layers of the layer profile: the lattice's node planes (the paper's five at 0, 8,
     16, 24, 32 mm on its 5 x 5 x 5 lattice)."""
     return np.linspace(0.0, SIZE_MM, nodes_per_side).tolist()
+
+
+LAYERS_MM = tuple(layers_mm(NODES_PER_SIDE))     # the paper's own five layers
 
 
 def apparent_poisson(profile, push_mm):

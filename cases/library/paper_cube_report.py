@@ -10,7 +10,6 @@ from .. import figures, rankings
 from ..metrics import ALTERNATION_CLEAR, PATCH_TOL, PATTERN_TOL
 from ..document import Table, fmt
 
-SIZE_MM = 32.0
 SPEED_MM_S = 1.7
 PAPER_TETS = 374     # the paper's mesh (section 4), unpublished
 CAUCHY_TOL = 0.02    # an apparent Poisson ratio this close to 1/4 does not show anisotropy
@@ -61,12 +60,13 @@ def _bracket(counts, paper):
 
 
 def what_was_run(cfg, runs):
+    size = cfg.problem()["size_mm"]     # the case's geometry, declared once by the case
     return [
-        f"Cube of side {SIZE_MM:g} mm, {cfg.nodes_per_side} x {cfg.nodes_per_side} x "
+        f"Cube of side {size:g} mm, {cfg.nodes_per_side} x {cfg.nodes_per_side} x "
         f"{cfg.nodes_per_side} lattice nodes. The paper's own "
         "374-tetrahedron mesh is not published, so it cannot be reproduced: the meshes here "
         f"{_bracket([r['tets'] for r in runs if 'tets' in r], PAPER_TETS)}.",
-        f"Top nodes (y = {SIZE_MM:g} mm) pushed down {cfg.push_mm:g} mm; boundary conditions "
+        f"Top nodes (y = {size:g} mm) pushed down {cfg.push_mm:g} mm; boundary conditions "
         f"{', '.join(cfg.bcs)} (clamped: bottom fixed, top fully prescribed; sliding: only y "
         "prescribed at top and bottom, rigid motions pinned). The paper does not say which.",
         f"Static equilibrium at {cfg.push_mm:g} mm and the paper's dynamic run: classical RK4, "

@@ -8,8 +8,8 @@ import numpy as np
 
 from model.errors import ModelError
 from reference import truthcube as T
+from model.units import MM
 
-MM = 1e-3
 # a model reproduces the measurement when its error beyond the noise,
 # sqrt(max(rms^2 - floor^2, 0)), is at most this many floors (its misfit no larger than the
 # scatter of the beads themselves)

@@ -23,8 +23,8 @@ from ...workers import dearest_first
 from .problem import (FAMILY, STEP_OF_SPACING, dirichlet as plate_dirichlet,
                       mesh as spacing_mesh, nominal_travels, schedule, step_strain)
 from .beads import Measured, errors, layer_axial, layer_lateral
+from model.units import MM
 
-MM = 1e-3
 NU = 0.499                       # RTV 6166: nearly incompressible; the range's middle
 NU_RANGE = (0.49, 0.4999)        # the silicone's range, shown as a sensitivity
 E = 15e3                         # under displacement control the bead field does not depend
