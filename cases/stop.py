@@ -21,8 +21,28 @@ _EXCEPTIONS = {signal.SIGINT: KeyboardInterrupt, signal.SIGTERM: Terminated}
 _received = []
 
 
+# the libraries in whose Python frames an exception can leave native objects half-freed
+# (llvmlite disposes LLVM objects from finalisers while numba compiles): there the signal is
+# only recorded, and ``checkpoint()`` raises it at the next point the suite owns
+NATIVE = ("llvmlite", "numba")
+NATIVE_DEPTH = 8     # the innermost frames looked at
+
+
+def _in_native(frame):
+    """Whether one of the innermost frames runs code of a NATIVE library."""
+    for _ in range(NATIVE_DEPTH):
+        if frame is None:
+            return False
+        if str(frame.f_globals.get("__name__", "")).split(".")[0] in NATIVE:
+            return True
+        frame = frame.f_back
+    return False
+
+
 def _handler(signum, frame):
     _received.append(signum)
+    if _in_native(frame):
+        return
     raise _EXCEPTIONS[signum]()
 
 

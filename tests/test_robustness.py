@@ -471,3 +471,20 @@ def test_a_stress_panels_scale_is_robust_to_one_slivers_spike(tmp_path, monkeypa
     figures.stress_panels(tmp_path / "s.png", [("a", mesh, np.zeros((mesh.n_nodes, 3)), tau)],
                           "max |tau|", 1.0)
     assert labels[0].startswith("max |tau| / 1000 Pa, the 99th percentile")
+
+
+def test_a_signal_inside_numba_or_llvmlite_is_recorded_and_raised_at_the_next_checkpoint():
+    """A signal whose handler runs in numba's or llvmlite's Python code (where an exception
+    can leave LLVM objects half-freed) is recorded, not raised there; the next checkpoint
+    raises it. Elsewhere it raises at once."""
+    import types
+    from cases import stop
+    native = types.SimpleNamespace(f_globals={"__name__": "llvmlite.binding.ffi"}, f_back=None)
+    own = types.SimpleNamespace(f_globals={"__name__": "cases.runner"}, f_back=None)
+    with stop.handling():
+        stop._handler(signal.SIGINT, native)            # recorded only
+        with pytest.raises(KeyboardInterrupt):
+            stop.checkpoint()
+    with stop.handling():
+        with pytest.raises(KeyboardInterrupt):
+            stop._handler(signal.SIGINT, own)
