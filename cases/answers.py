@@ -439,12 +439,8 @@ def _cost_of_replacing(pops, models, quick):
     said = []
     for finite, regime in ((False, "linear regime"), (True, "finite load")):
         ranked = scorecard.ranked(scorecard.overall(pops, models, finite))
-        loose = scorecard.unresolved(pops, models, finite)
         rng = scorecard.spread(pops, models, finite)
         if ranked:
-            first_loose = [b for b in scorecard.not_resolved_from(pops, models, ranked[0][1],
-                                                                   finite)
-                           if (ranked[0][1], b) not in loose]
             used = [p for p in pops if p.finite == finite and p.ranked]
             n, c = len(used), len({p.case for p in used})
             us = [p.u_model_form for p in used]
@@ -462,11 +458,9 @@ def _cost_of_replacing(pops, models, quick):
                 + (f" ({e[2]} failed runs)" if e[2] else "")
                 + (f" (the same mean rank as {tie})" if tie else "")
                 for _, m, e, tie in ranked)
-                # the order where it holds: neighbours a unit left out reverses or levels, and
-                # each model that reaches the first when a unit is left out, share a group
+                # the order where it holds: every pair a unit left out reverses or levels
                 + _resolved_groups([m for _, m, _, _ in ranked],
-                                   scorecard.unresolved_pairs(pops, models, finite)
-                                   | {(ranked[0][1], b) for b in first_loose}))
+                                   scorecard.unresolved_pairs(pops, models, finite)))
     if not said:
         return "**What does replacing FEM cost?** No case has a decomposed quantity."
     return ("**What does replacing FEM cost?** The model-form error, each model against FEM P1 "
