@@ -91,16 +91,16 @@ class Settings:
 LOAD_SPLITS = (1, 2, 4, 8)
 
 
-def solve_split(pm, dirichlet, f_ext=None, **kw):
+def solve_split(pm, dirichlet, f_ext=None, splits=LOAD_SPLITS, **kw):
     """``(static result, load steps)``: the model's equilibrium under ``dirichlet`` (and
-    ``f_ext``), in the fewest of LOAD_SPLITS equal steps that converges; the last split's
+    ``f_ext``), in the fewest of ``splits`` equal steps that converges; the last split's
     error where none does."""
     extra = {} if f_ext is None else {"f_ext": f_ext}
-    for steps in LOAD_SPLITS:
+    for steps in splits:
         try:
             return pm.solve_static(dirichlet, load_steps=steps, **extra, **kw), steps
         except ConvergenceError:
-            if steps == LOAD_SPLITS[-1]:
+            if steps == splits[-1]:
                 raise
 
 

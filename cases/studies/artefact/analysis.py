@@ -34,8 +34,8 @@ from scipy.stats import spearmanr
 from ...document import fmt, rel
 from ...library import paper_cube as P
 from ...metrics import ALTERNATION_CLEAR, nyquist_weights
-from .study import (DECISIVE, LINEAR_SCALE, SPLITS, YARDSTICK as YARDSTICK_MODEL,
-                    _free_layers, short)
+from .study import (DECISIVE, LINEAR_SCALE, SPLITS, SPLITS_TRIED,
+                    YARDSTICK as YARDSTICK_MODEL, _free_layers, short)
 
 PAPER_COST = 10.0      # the paper (its Figure 2): the time of one step over msm's, more than 10
 RUN_S = P.PUSH_MM / P.SPEED_MM_S   # the paper's run: the push, 1.7 mm at 1.7 mm/s
@@ -55,6 +55,7 @@ COARSE = 1e-2          # the coarser clustering (2 significant figures) (c) is a
 ACTIVE = 1e-6          # a term changes a signature beyond round-off from this (relative)
 WIDTHS = (2, 4)        # the test Gaussians' standard deviations, in layer spacings
 DECAYS = (2, 1, 0.5)   # the test boundary layers' decay lengths, in layer spacings
+MIN_RESOLVED = 4       # (c) correlates over at least this many resolved signatures
 END_LAYERS = 3         # the end-localised alternation: this many free layers at each end
 Z95 = 1.96             # the two-sided 95 % normal quantile
 MIRRORED, UNMIRRORED = SPLITS["five"], SPLITS["five-unmirrored"]
@@ -361,32 +362,18 @@ def _index(cells):
             for c in cells}
 
 
-def finite_strain(cells, n, bc):
-    """The continuum's own finite-strain change at (n, bc): its mean |lateral displacement|
-    at the paper's push (neo-Hookean) over its mean at the linear load scaled to the push
-    (linear), minus 1, in magnitude; None where the linear load was not run at that size.
-    FEM P1 is linear, so its signature in mm scales exactly with the load: this is what a
-    neo-Hookean P1 control (not run) could differ by, estimated from the continuum's."""
-    p, q = _arr(_profile(cells, n, bc)), _arr(_profile(cells, n, bc, "linear"))
-    if p is None or q is None or not np.abs(q).mean():
-        return None
-    return float(abs(np.abs(p).mean() / (np.abs(q).mean() / LINEAR_SCALE) - 1.0))
-
-
-def _part(c, fem, ref, free, leak, fs):
+def _part(c, fem, ref, free, leak):
     """(part, u) of a model's cell against FEM P1's on the same tetrahedra: the difference of
-    their signatures (over the reference's mean) and its uncertainty, the configuration's ``leak``
-    times the smooth amplitude of (model - FEM P1), and the finite-strain term ``fs`` times
-    FEM P1's signature, with round-off, in quadrature; (None, None) where either is missing."""
+    their signatures (over the reference's mean) and its uncertainty, the configuration's
+    ``leak`` times the smooth amplitude of (model - FEM P1), with round-off, in quadrature;
+    (None, None) where either is missing."""
     if c is None or fem is None or c.get("alternation_rel") is None \
             or fem.get("alternation_rel") is None:
         return None, None
     d = c["alternation_rel"] - fem["alternation_rel"]
     a = smooth_amplitude(np.asarray(c["bulge_profile_mm"]) - np.asarray(fem["bulge_profile_mm"]),
                          ref, free)
-    u = float(np.sqrt((leak * a) ** 2 + (fs * fem["alternation_rel"]) ** 2
-                      + ROUND_OFF_FLOOR ** 2))
-    return d, u
+    return d, float(np.hypot(leak * a, ROUND_OFF_FLOOR))
 
 
 def _mirror_call(d, u, parts):
@@ -416,22 +403,24 @@ def units(cells, models=None):
     for every model), each with its own uncertainty, and its class.
 
     The leak of a configuration is its worst smooth test field's score (``metric_check``). u of a
-    model's part: sqrt((leak x A)^2 + (fs x FEM P1's signature)^2 + round-off^2), A the smooth
-    amplitude of (model - FEM P1), fs the continuum's finite-strain change (``finite_strain``:
-    the control is linear P1, not a neo-Hookean P1; 0 on the sliding base, where every P1 is
-    exact); a control's part the same on its split. u of a signature (FEM P1's or a model's):
-    leak x the smooth amplitude of (cell - reference), with the floor (FEM P1's largest
-    signature on any conforming split run at that size: the reference's own period-2 error
-    is bounded by it) and FEM P1's finite-strain term. On the sliding base FEM P1 is exact (a
-    homogeneous field), an identity check, not a measured error.
+    model's part: sqrt((leak x A)^2 + round-off^2), A the smooth amplitude of (model - FEM P1)
+    (FEM P1 with the continuum's neo-Hookean law); a control's part the same on its split
+    (the conforming splits the model and FEM P1 ran on at that size). u of a signature (FEM
+    P1's or a model's): leak x the smooth amplitude of (cell - reference), with the floor (FEM
+    P1's largest signature on any conforming split run at that size: the reference's own
+    period-2 error is bounded by it). On the sliding base FEM P1 is exact (a homogeneous
+    field), an identity check, not a measured error.
 
-    A model's class: 'failed (...)' where its mirrored cell or a control failed; 'not decided
-    (the configuration's check)'; 'at the threshold (part / u)' where |part| / u is within NEAR of
-    RATIO; 'not resolved' below it (its part cannot be told from 0); else 'own +' / 'own -'
-    (the paper's sign or reversed) with where it comes from: 'the mirror's' where the mirror
-    ratio's interval (``_mirror_call``) is RATIO or more, 'on every split' where it is below,
-    else 'mirror not decided' with the reason. A model whose cells agree with one counted
-    before it (``one_observation``) is one observation with it."""
+    A configuration reads own parts from DECISIVE layers ('reads': the leak enters every u);
+    its clear-level calls decide only where the leak is below DECIDING_LEAK ('decides'). A
+    model's class: 'failed (...)' where its mirrored cell or a control failed; 'not decided'
+    on a configuration that does not read; 'at the threshold (part / u)' where |part| / u is
+    within NEAR of RATIO; 'not resolved' below it (its part cannot be told from 0); else
+    'own +' / 'own -' (the paper's sign or reversed) with where it comes from: 'the mirror's'
+    where the mirror ratio's interval (``_mirror_call``) is RATIO or more, 'on every split'
+    where it is below, else 'mirror not decided' with the reason. Whether it is clear (large
+    enough to see) is apart. A model whose cells agree with one counted before it
+    (``one_observation``) is one observation with it."""
     check = metric_check(cells)
     at = _index(cells)
     order = list(models or dict.fromkeys(c["model"] for c in cells))
@@ -440,6 +429,9 @@ def units(cells, models=None):
                          if c["split"] == MIRRORED}):
         chk = check.get((n, bc), {})
         leak = chk.get("worst", 0.0)
+        # a configuration reads own parts from DECISIVE layers (the leak is in every u); its
+        # clear-level calls decide only where the leak is below DECIDING_LEAK ("decides")
+        reads = n >= DECISIVE and chk.get("worst") is not None
         fem = at.get((YARDSTICK_MODEL, MIRRORED, n, bc, "paper"))
         ref = _arr(fem and fem.get("bulge_profile_fem_mm"))
         free = _free_layers(bc, n)
@@ -455,15 +447,9 @@ def units(cells, models=None):
         floor = max([ROUND_OFF_FLOOR] + [abs(v) for v in fem_all.values() if v is not None])
         identity = all(v is not None and abs(v) < ROUND_OFF_FLOOR for v in fem_all.values()) \
             and fem_five is not None and abs(fem_five) < ROUND_OFF_FLOOR
-        fs, fs_from = (0.0, None) if identity else (finite_strain(cells, n, bc), n)
-        if fs is None:      # the linear load is not run on the finest meshes: the base's largest
-            got = [(x, k) for k in range(n) for x in [finite_strain(cells, k, bc)]
-                   if x is not None]
-            fs, fs_from = max(got, default=(0.0, None))
         u_fem = None
         if fem_five is not None and fem is not None:
-            u_fem = float(np.sqrt(signature_u(fem, leak, floor) ** 2
-                                  + (fs * fem_five) ** 2))
+            u_fem = signature_u(fem, leak, floor)
         fem_vs = None if u_fem is None else against(abs(fem_five) / u_fem, RATIO)
         fem_clear = None if u_fem is None else clear_call(fem_five, u_fem, own_factor(fem))[0]
         rows, seen = [], []
@@ -477,16 +463,18 @@ def units(cells, models=None):
                    "unmirrored": (at.get((m, UNMIRRORED, n, bc, "paper")) or {}).get(
                        "alternation_rel"), "same_as": None, "sign": None}
             row["u_sig"] = signature_u(c, leak, floor) if not c.get("failed") else None
-            if row["u_sig"] is not None and fem_five is not None:
-                row["u_sig"] = float(np.hypot(row["u_sig"], fs * fem_five))
             row["clear"], row["clear_by"] = clear_call(row["five"], row["u_sig"] or 0.0,
                                                        row["own_factor"])
             for x in CONFORMING_CONTROLS:
                 y = at.get((m, x, n, bc, "paper"))
                 row["controls"][x] = ("not run" if y is None else failure(y)
                                       if y.get("failed") else y.get("alternation_rel"))
+            # the model's controls: each conforming split it and FEM P1 ran on at this size
+            own_ctrls = [x for x in CONFORMING_CONTROLS if (m, x, n, bc, "paper") in at
+                         and (YARDSTICK_MODEL, x, n, bc, "paper") in at]
+            row["ctrls"] = own_ctrls
             bad = [f"{x}: {v}" for x, v in row["controls"].items()
-                   if x in ctrls and isinstance(v, str)]
+                   if x in own_ctrls and isinstance(v, str)]
             if c.get("failed") or bad:
                 row["kind"] = failure(c) if c.get("failed") else "failed control (" + \
                     "; ".join(bad) + ")"
@@ -502,11 +490,11 @@ def units(cells, models=None):
                 row["kind"] = f"same as {dup['name']}"
                 rows.append(row)
                 continue
-            d, u = _part(c, fem, ref, free, leak, fs)
+            d, u = _part(c, fem, ref, free, leak)
             parts = []
-            for x in ctrls:
+            for x in own_ctrls:
                 cp, uc = _part(at[(m, x, n, bc, "paper")], at[(YARDSTICK_MODEL, x, n, bc,
-                                                                "paper")], ref, free, leak, fs)
+                                                                "paper")], ref, free, leak)
                 row["control_parts"][x] = {"part": cp, "u": uc,
                                            "resolved": against(abs(cp) / uc, RATIO)}
                 parts.append((cp, uc))
@@ -518,12 +506,9 @@ def units(cells, models=None):
                 lo, hi, call, why = _mirror_call(d, u, parts)
                 row.update({"mirror_lo": lo, "mirror_hi": hi, "mirror_vs": call,
                             "mirror_why": why})
-            if not chk.get("decides"):
-                kind = "not decided (the configuration's check)"
-            elif row["clear"] == "below":
-                kind = "no clear signature"
-            elif row["clear"] == "at":
-                kind = "at the clear level: not decided"
+            if not reads:
+                kind = ("not decided (the paper's 5-layer view)" if n < DECISIVE
+                        else f"not decided ({chk.get('why')})")
             elif row["part_vs_u"] == "at":
                 kind = "at the threshold (part / u)"
             elif row["part_vs_u"] == "below":
@@ -540,13 +525,14 @@ def units(cells, models=None):
             rows.append(row)
         distinct = [r for r in rows if r["same_as"] is None]
         out.append({"n": n, "bc": bc, "check": chk, "decides": bool(chk.get("decides")),
+                    "reads": reads,
                     "leak": leak, "controls": ctrls, "missing_controls": missing,
                     "fem_five": fem_five, "fem_mm": None if fem is None else
                     fem.get("alternation_mm"), "u_fem": u_fem, "fem_vs": fem_vs,
                     "fem_clear": fem_clear,
                     "fem_controls": fem_all, "floor": floor, "identity": identity,
                     "fem_ratio": None if fem_five is None else abs(fem_five) / floor,
-                    "finite_strain": fs, "finite_strain_from": fs_from, "rows": rows,
+                    "rows": rows,
                     "distinct": len(distinct), "run": len(rows)})
     return out
 
@@ -573,20 +559,20 @@ def two_point_order(coarse, u_coarse, fine, u_fine):
 
 def orders(us):
     """Per base: each distinct model's order in h of its own part from the smallest to the
-    next size (h halved) where both configurations decide and the part is resolved at both with one
-    sign: log2 of the ratio, with its uncertainty (``two_point_order``); with how many of the
-    models at both sizes it covers."""
+    next size (h halved) where both configurations read and the part is resolved at both with
+    one sign: log2 of the ratio, with its uncertainty (``two_point_order``); with how many of
+    the models at both sizes it covers."""
     by = {(u["n"], u["bc"]): u for u in us}
     out = {}
     for (n, bc), u in by.items():
         fine = by.get((2 * n - 1, bc))
         if fine is None:
             continue
-        if not (u["decides"] and fine["decides"]):
+        if not (u["reads"] and fine["reads"]):
             out[bc] = {"orders": {}, "of": 0, "sizes": (n, fine["n"]),
-                       "why": f"the {n}-node {bc} configuration does not decide"
-                       if not u["decides"] else
-                       f"the {fine['n']}-node configuration does not decide"}
+                       "why": f"the {n}-node {bc} configuration does not read own parts"
+                       if not u["reads"] else
+                       f"the {fine['n']}-node configuration does not read own parts"}
             continue
         fr = {r["model"]: r for r in fine["rows"] if r["same_as"] is None}
         both = [r for r in u["rows"] if r["same_as"] is None and r["model"] in fr]
@@ -606,11 +592,11 @@ def orders(us):
 
 def mirror(cells, models=None):
     """Hypothesis (a), the mirror symmetry: the decomposition (``units``), the orders, and the
-    configurations where FEM P1's own signature (clear and resolved) or a model's own part
-    (its signature clear, its part resolved) is the mirror's."""
+    configurations that read where FEM P1's own signature or a model's own part is resolved
+    and the mirror's."""
     us = units(cells, models)
-    dec = [u for u in us if u["decides"] and u["n"] >= DECISIVE]
-    mesh = [u for u in dec if u["fem_vs"] == "above" and u.get("fem_clear") == "above"]
+    dec = [u for u in us if u["reads"]]
+    mesh = [u for u in dec if u["fem_vs"] == "above" and not u["identity"]]
     own = [u for u in dec if any(r.get("mirror_vs") == "above" and r["sign"]
                                  for r in u["rows"] if r["same_as"] is None)]
     return {"units": us, "orders": orders(us), "deciding": [(u["n"], u["bc"]) for u in dec],
@@ -619,15 +605,13 @@ def mirror(cells, models=None):
 
 
 def normal_stress(cells, us):
-    """Hypothesis (b), the missing normal stress: pairs (a deciding configuration of the
-    mirrored split, a calibrated reading whose signature is clear there (the standard of all
-    three hypotheses) and whose own part is resolved, a normal-stress term) where the
-    term changes the signature beyond round-off (ACTIVE); each pair's part without and with
-    the term, and whether the term reduces the model's own part RATIO-fold (the interval of
-    the ratio from both parts' u). The rest are listed as not tested, with why (the term
-    changes nothing; no clear signature; no resolved own part; the configuration does not
-    decide; failed), and which signs
-    of the own part the tested pairs cover."""
+    """Hypothesis (b), the missing normal stress: pairs (a configuration of the mirrored
+    split that reads own parts, a calibrated reading whose own part is resolved there, a
+    normal-stress term) where the term changes the signature beyond round-off (ACTIVE); each
+    pair's part without and with the term, and whether the term reduces the model's own part
+    RATIO-fold (the interval of the ratio from both parts' u). The rest are listed as not
+    tested, with why (the term changes nothing; no resolved own part; the configuration does
+    not read; failed), and which signs of the own part the tested pairs cover."""
     at = {(c["nodes_per_side"], c["bc"], c["reading"], c["normal"]): c for c in cells
           if c["family"] == "particle" and c["constant"] == "calibrated"
           and c["split"] == MIRRORED and c["load"] == "paper"}
@@ -646,8 +630,8 @@ def normal_stress(cells, us):
         def skip(why):
             untested.append({"n": n, "bc": bc, "name": name, "base": short(base["model"]),
                              "sign": r.get("sign"), "why": why})
-        if not dec[(n, bc)]["decides"] or n < DECISIVE:
-            skip("the configuration does not decide")
+        if not dec[(n, bc)]["reads"]:
+            skip("the configuration does not read own parts")
             continue
         if base.get("failed") or w.get("failed"):
             skip("failed")
@@ -656,9 +640,6 @@ def normal_stress(cells, us):
         if same(a, b, ACTIVE):
             skip("the term changes nothing here (to 1e-6; the fitted constants are not "
                  "stored, so whether the fit set it to 0 is not known)")
-            continue
-        if r.get("clear") != "above":
-            skip(f"{short(base['model'])} has no clear signature")
             continue
         if r.get("part_vs_u") != "above":
             skip(f"{short(base['model'])} has no resolved own part")
@@ -727,9 +708,9 @@ def consistency(cells):
     signature at the push on the sliding base and the sliding cube's linear-load error, signed
     and on |signature|, with models agreeing to SAME (3 significant figures) and to COARSE (2)
     counted once, each with its 95 % interval; the verdict where all four agree, else 'not
-    decided'; not testable on a mesh whose configuration does not decide or where no model's
-    signature is clear (on both normalisations, against its uncertainty): the standard of all
-    three hypotheses."""
+    decided'; not testable on a mesh where fewer than MIN_RESOLVED models' signatures are
+    resolved (|signature| at least RATIO times its u, the configuration's leak in it): a
+    correlation over signatures that cannot be told from 0 ranks the leak."""
     check = metric_check(cells)
     leak = {k: v.get("worst", 0.0) for k, v in check.items()}
     per, size = {}, {}
@@ -741,7 +722,7 @@ def consistency(cells):
         size[c["mesh"]] = c["nodes_per_side"]
     rows = []
     for mesh, by_model in per.items():
-        pts, clear, at_, failed = [], [], [], []
+        pts, clear, at_, failed = [], [], [], []     # clear: resolved; at_: at the threshold
         for model, v in by_model.items():
             if "paper" not in v or "linear" not in v:
                 continue
@@ -752,8 +733,9 @@ def consistency(cells):
             if s is None or e is None:
                 continue
             pts.append((s, e))
-            call, _ = cell_clear(v["paper"], leak.get((v["paper"]["nodes_per_side"],
-                                                       "sliding"), 0.0))
+            u = signature_u(v["paper"], leak.get((v["paper"]["nodes_per_side"], "sliding"),
+                                                 0.0))
+            call = against(abs(s) / u, RATIO)
             (clear if call == "above" else at_ if call == "at" else []).append(short(model))
         if len(pts) < 3:
             continue
@@ -770,12 +752,13 @@ def consistency(cells):
                                            "verdict": _track(rho, ci)}
         verdicts = {v["verdict"] for v in variants.values()}
         chk = check.get((size[mesh], "sliding"), {})
-        if not chk.get("decides"):
-            verdict = (f"not testable: the configuration ({size[mesh]}, sliding) does not "
-                       f"decide ({chk.get('why')})")
-        elif not clear:
-            verdict = "not testable: no signature clear on both normalisations" + (
-                f" ({', '.join(at_)} not decided)" if at_ else "")
+        if chk.get("worst") is None:
+            verdict = (f"not testable: the configuration ({size[mesh]}, sliding) has no "
+                       f"signature ({chk.get('why')})")
+        elif len(clear) < MIN_RESOLVED:
+            verdict = (f"not testable: {len(clear)} of {len(pts)} signatures resolved, fewer "
+                       f"than {MIN_RESOLVED}") + (f" ({', '.join(at_)} at the threshold)" if at_
+                                            else "")
         elif len(verdicts) == 1:
             verdict = verdicts.pop()
         else:
@@ -797,8 +780,8 @@ def linear_check(cells):
     (same mesh; the signature at the push beyond round-off; models whose two signatures agree
     to SAME with one counted before are one observation): median [min-max], n of N, the cells
     that change by more than NEAR with the load (part of their signature is finite strain),
-    and FEM P1's ratios (1 to round-off: it is linear). Near 1 the pattern is a property of
-    the linear regime."""
+    and FEM P1's ratios (neo-Hookean P1: its change is the law's own finite strain). Near 1
+    the pattern is a property of the linear regime."""
     at = _index(cells)
     out = {}
     for bc in sorted({c["bc"] for c in cells}):
@@ -886,14 +869,13 @@ def _resolve(unit, row):
 
 
 def by_reading(us):
-    """{model name: summary} over the deciding configurations: per configuration its class (a
-    duplicate takes
-    its observation's; 'not run' where it has no cell), the configurations where its own part is
+    """{model name: summary} over the configurations that read own parts: per configuration its
+    class (a duplicate takes its observation's; 'not run' where it has no cell), the configurations where its own part is
     resolved and their sign, where the mirror's, on every split or not decided, and a label:
     '+' / '-' with 'n of N configurations' where every resolved part has one sign, '+-' where both
     occur, 'not decided (U only: not run at ...)' where the model ran on one deciding configuration,
     'not resolved' or 'failed' where no part is resolved."""
-    dec = [u for u in us if u["decides"]]
+    dec = [u for u in us if u["reads"]]
     out = {}
     for name in dict.fromkeys(r["name"] for u in dec for r in u["rows"]):
         got, dup = {}, set()
@@ -914,9 +896,10 @@ def by_reading(us):
             tag = "same"
             label = (f"one observation with {_names(sorted(dup))} on every configuration it ran ("
                      + ", ".join(ran) + ")")
-        elif len(ran) == 1 and len(dec) > 1:
+        elif len({k.split(" ")[0] for k in ran}) == 1 and \
+                len({u["n"] for u in dec}) > 1:     # one size only: no check under refinement
             tag = "not decided"
-            label = (f"not decided ({ran[0]} only: not run at "
+            label = (f"not decided ({', '.join(ran)} only: not run at "
                      + ", ".join(k for k in kinds if k not in ran) + ")")
         elif len(signs) == 2:
             tag, label = "+-", f"both signs over the configurations ({len(resolved)} of {len(dec)})"
@@ -925,9 +908,6 @@ def by_reading(us):
             label = f"{tag} on {len(resolved)} of {len(dec)} configurations"
         elif all(v.startswith("failed") or v == "not run" for v in kinds.values()):
             tag, label = "failed", "failed"
-        elif all(v == "no clear signature" or v.startswith("failed") or v == "not run"
-                 for v in kinds.values()):
-            tag, label = "no clear", "no clear signature on any configuration"
         else:
             tag, label = "not resolved", "not resolved on any configuration"
         out[name] = {"tag": tag, "label": label, "units": kinds, "resolved": len(resolved),
@@ -1022,13 +1002,14 @@ def _below_text(dec):
     not_below = [f"{r['name']} ({_where((u['n'], u['bc']))}: {_clear_word(r['clear'])})"
                  for u, r in rows if r["clear"] != "below"]
     ends = ", ".join(f"{fmt(u['check']['ends'], 2)} ({u['bc']})" for u in fine)
-    head = (f"at {top} nodes every model's signature is below the clear level {CLEAR:g} on "
+    where = ", ".join(_where((u["n"], u["bc"])) for u in fine)
+    head = (f"on {where} every model's signature is below the clear level {CLEAR:g} on "
             "both normalisations" if not not_below else
-            f"at {top} nodes not every model's signature is below the clear level {CLEAR:g}: "
+            f"on {where} not every model's signature is below the clear level {CLEAR:g}: "
             + ", ".join(not_below))
     return {"text": head + f" (an alternation confined to the {END_LAYERS} end layers at each "
             f"end reads {ends} of its amplitude there: such a pattern is not excluded)",
-            "all_below": not not_below, "n": top}
+            "head": head, "all_below": not not_below, "n": top}
 
 
 def order_text(bc, o):
@@ -1062,168 +1043,172 @@ def resolved_counts(dec):
     return out
 
 
+def mirror_counts(u):
+    """Per configuration that reads: the distinct models by what their own part is: the
+    mirror's (with its sign), on every split, mirror not decided, not resolved or at the
+    threshold, failed."""
+    rows = [r for r in u["rows"] if r["same_as"] is None and not r["kind"].startswith("n/a")]
+    out = {"of": len(rows), "+": [], "-": [], "every": [], "open": [], "unresolved": [],
+           "failed": []}
+    for r in rows:
+        k = r["kind"]
+        key = ("failed" if k.startswith("failed") else
+               r["sign"] if r["sign"] and r.get("mirror_vs") == "above" else
+               "every" if r["sign"] and r.get("mirror_vs") == "below" else
+               "open" if r["sign"] else "unresolved")
+        out[key].append(r["name"])
+    return out
+
+
+def _mirror_text(u):
+    c = mirror_counts(u)
+    mirror = len(c["+"]) + len(c["-"])
+    bits = [f"the mirror's for {mirror} of {c['of']} distinct models"
+            + (f" (the paper's sign + in {_compress(c['+'])}; reversed - in "
+               f"{_compress(c['-'])})" if mirror else "")]
+    for key, word in (("every", "on every split"), ("open", "mirror not decided"),
+                      ("unresolved", "not resolved"), ("failed", "failed")):
+        if c[key]:
+            bits.append(f"{word} {len(c[key])}")
+    return f"on {_where((u['n'], u['bc']))} " + ", ".join(bits)
+
+
 def answer(cells, models=None):
-    """The paper's question answered from the configurations that decide: the metric's check, each
-    model's own part and FEM P1's signature against their uncertainties, where a resolved part
-    is the mirror's, the three hypotheses, and the cause per reading; 'not decided' for the
-    paper's 5-node cube and wherever no configuration decides."""
+    """The paper's question answered hypothesis by hypothesis from the configurations that
+    read own parts (DECISIVE or more layers): (a) where a resolved own part is the mirror's,
+    with its order in h; (b) whether a normal-stress term reduces it; (c) whether it tracks
+    the patch-test error; then whether it is large enough to see (the clear level, on the
+    configurations that decide it); 'not decided' for the paper's 5-node cube."""
     m = mirror(cells, models)
     us = m["units"]
     ns, cs = normal_stress(cells, us), consistency(cells)
     view, lin = paper_view(us), linear_check(cells)
-    dec = [u for u in us if u["decides"]]
+    dec = [u for u in us if u["reads"]]
     paper = _five_text(us)
     hyp = {"mirror": m, "normal_stress": ns, "consistency": cs}
     base = {"hypotheses": hyp, "paper_view": view, "linear": lin, "ratio": RATIO,
             "decisive": DECISIVE, "clear_level": CLEAR, "near": NEAR,
             "deciding": m["deciding"], "asymmetry": reference_asymmetry(cells),
             "inward": inward(cells)}
-    big = [u for u in us if u["n"] >= DECISIVE]
     if not dec:
-        text = "Not decided: " + paper + ". " + (
-            f"No configuration of {DECISIVE} or more layers passes the metric's check ("
-            + "; ".join(f"{u['n']} {u['bc']}: {u['check'].get('why')}" for u in big) + ")."
-            if big else f"No mesh with {DECISIVE} or more layers was run.")
+        text = "Not decided: " + paper + f". No mesh with {DECISIVE} or more layers was run."
         return {**base, "decided": False, "cause": "not decided", "text": text,
-                "numbers": text, "clear": False, "largest": {}, "by_reading": {}}
+                "numbers": text, "clear": False, "largest": {}, "by_reading": {},
+                "causes": []}
     tags = by_reading(us)
-    groups = _cause_groups(tags)
-    where = ", ".join(_where(x) for x in m["deciding"])
-    skipped = "; ".join(f"{u['n']} {u['bc']} ({u['check'].get('why')})"
-                        for u in big if not u["decides"])
-    undecided = {n: t["label"] for n, t in tags.items() if t["tag"] == "not decided"}
-    unresolved = [n for n, t in tags.items() if t["tag"] == "not resolved"]
-    unclear = [n for n, t in tags.items() if t["tag"] == "no clear"]
-    failed = [n for n, t in tags.items() if t["tag"] == "failed"]
-    order = m["orders"]
-    slopes = [(bc, sorted(o["orders"].values()), o) for bc, o in order.items() if o["orders"]]
-    decay = "; ".join(order_text(bc, o) for bc, _, o in slopes)
-    below = _below_text(dec)
-    dup_at = {}
-    for u in dec:
-        for r in u["rows"]:
-            if r["same_as"]:
-                dup_at.setdefault(f"{r['name']} = {r['same_as']}", []).append(
-                    _where((u["n"], u["bc"])))
-    merged = {}
-    for k, v in dup_at.items():
-        name, _, other = k.partition(" = ")
-        merged.setdefault((other, tuple(v)), []).append(name)
-    dups = [f"{_compress(v)} = {other} ({', '.join(w)})" for (other, w), v in merged.items()]
-    any_clear = any(r["clear"] == "above" for u in dec for r in u["rows"]
-                    if r["same_as"] is None)
-    word = {"+": "the paper's sign", "-": "the reversed sign"}
-    normal = (f"the normal-stress terms reduce the model's own part {RATIO:g}-fold in "
-              f"{ns['removed']} of {ns['tested']} pairs where a term is active"
+    counts = {_where((u["n"], u["bc"])): mirror_counts(u) for u in dec}
+    mirrored = sum(len(c["+"]) + len(c["-"]) for c in counts.values())
+    against_ = sum(len(c["every"]) for c in counts.values())
+    fem_units = [_where(x) for x in m["mesh_units"]]
+    a_holds = (mirrored > 0 or bool(fem_units)) and not against_
+    slopes = [order_text(bc, o) for bc, o in m["orders"].items() if o["orders"]]
+    a_text = ("; ".join(_mirror_text(u) for u in dec if mirror_counts(u)["of"])
+              + (f"; FEM P1's own signature is resolved and the mirror's on "
+                 f"{', '.join(fem_units)}" if fem_units else "")
+              + (f"; the own part {'; '.join(slopes)}" if slopes else ""))
+    b_text = (f"{ns['removed']} of {ns['tested']} pairs (a calibrated reading's resolved own "
+              "part with and without an active term, the split held fixed) reduced "
+              f"{RATIO:g}-fold"
               + (f" ({ns['at_threshold']} at the threshold)" if ns["at_threshold"] else "")
-              + (f", all beside readings of {word[ns['signs'][0]]} "
-                 f"({_names(ns['readings'])}); for "
-                 f"{word['+' if ns['signs'] == ['-'] else '-']} (b) is not tested"
-                 + (f" (beside {_names(ns['inactive_other_sign'])} every term changes "
-                    "nothing)" if ns["inactive_other_sign"] else "")
-                 if len(ns["signs"]) == 1 else "")
-              if ns["decided"] else "the normal-stress terms: not tested (no term active "
-              "beside a clear signature)")
-    cons = ("not testable (" + "; ".join(
+              + (f"; |with| / |without| {fmt(min(p['ratio'] for p in ns['pairs']), 2)}-"
+                 f"{fmt(max(p['ratio'] for p in ns['pairs']), 2)}" if ns["pairs"] else "")
+              if ns["decided"] else "not tested (no term active beside a resolved own part)")
+    c_text = ("not testable (" + "; ".join(
         f"{', '.join(meshes)}: {why}" for why, meshes in _by_value(
             {r["mesh"]: r["verdict"][len("not testable: "):] for r in cs["rows"]}).items())
-        + ")"
-            if not cs["testable"] else "supported" if cs["holds"] else "not supported ("
-            + "; ".join(f"{r['mesh']} {r['verdict']}" for r in cs["rows"]) + ")")
-    fem_units = [_where((u["n"], u["bc"])) for u in dec if u["fem_vs"] == "above"
-                 and u.get("fem_clear") == "above"]
-    own_any = bool(groups["+"] or groups["-"])
-    counts = resolved_counts(dec)
-    owns = ("the model's own part (model - FEM P1 on the same tetrahedra) is resolved (|part| "
-            f"at least {RATIO:g} times its u) for " + ", ".join(
-                f"{k} of {n} distinct models on {w}" + (" (" + ", ".join(
-                    f"{v} {c}" for c, v in rest.items()) + ")" if rest else "")
-                for w, k, n, rest in counts))
-    fem_said = "FEM P1's own signature on the mirrored split (the mesh's error): " + \
-        _fem_text(dec)
-    below_clear = (f"{owns}; {fem_said}; " + (f"the models' own part {decay}; " if decay
-                                              else "") + below["text"])
-    standard = (f"each hypothesis is judged on clear signatures alone (above the clear level "
-                f"{CLEAR:g} on both normalisations, against their u)")
-    if own_any or fem_units:
-        word = "Resolved in part" if not all(k == n for _, k, n, _ in counts) else "Resolved"
-        mirror_text = ((f"FEM P1's own signature is clear and resolved on "
-                        f"{', '.join(fem_units)}; " if fem_units else "")
-                       + "its sign depends on the reading (n of N: the configurations where "
-                       f"the signature is clear and the own part resolved; 'the mirror's': "
-                       f"at least {RATIO:g} times the conforming splits' part there, within "
-                       "both uncertainties): the paper's (+) in "
-                       + ("; ".join(groups["+"]) or "none")
-                       + "; reversed (-) in " + ("; ".join(groups["-"]) or "none"))
-        head = (f"{standard}: (a) mirror symmetry: {mirror_text}; (b) {normal}; (c) the "
-                f"consistency hypothesis is {cons}. Below the clear level: {below_clear}.")
-    else:
-        word = "Not resolved"
-        head = (f"no model's signature (nor FEM P1's) is clear on any of them, and "
-                f"{standard}: (a) mirror symmetry: not testable (no clear signature); (b) "
-                f"{normal}; (c) the consistency hypothesis is {cons}. Below the clear level, "
-                f"what the runs show: {below_clear}.")
-    open_ = ([paper] + ([skipped] if skipped else [])
-             + ([f"{_names(unresolved)} (not resolved on any configuration)"]
-                if unresolved else [])
-             + ([f"{_names(failed)} (failed on every configuration that decides)"]
-                if failed else [])
-             + ([f"{_compress(unclear)} (no clear signature on any configuration)"]
-                if unclear and (own_any or fem_units) else [])
-             + [f"{_compress(ns_)} ({v[len('not decided ('):-1]})"
-                for v, ns_ in _by_value(undecided).items()])
-    text = (f"{word} (on the configurations (size, base) that decide: {where}; one mesh per "
-            "split each, n = 1, the uncertainty from the leak of smooth fields alone): "
-            f"{head} Not decided: {'; '.join(open_)}."
-            + (f" One observation (identical cells): {'; '.join(dups)}." if dups else ""))
-    cause = text
-    numbers = text
+        + ")" if not cs["testable"] else _tracks_word(cs["rows"]) + " (" + "; ".join(
+            f"{r['mesh']}: {r['verdict']}, signed rho {fmt(r['rho'], 2)}"
+            + (f" [{r['interval'][0]:.2f}, {r['interval'][1]:.2f}]" if r["interval"] else "")
+            for r in cs["rows"]) + ")")
+    causes = (["the mirror symmetry (a)"] if a_holds else []) + (
+        ["the missing normal stress (b)"] if ns["holds"] else []) + (
+        ["the model's inconsistency (c)"] if cs["holds"] else [])
+    said = (["the period-2 part these runs resolve is the mirror's (a)"] if a_holds else []) + (
+        ["a normal-stress term removes it (b)"] if ns["holds"] else []) + (
+        ["it tracks the patch-test error (c)"] if cs["holds"] else [])
+    seen_at = [u for u in us if u["decides"] and u["n"] >= DECISIVE]
+    below = _below_text(seen_at) if seen_at else None
+    lead = ("; ".join(said)[0].upper() + "; ".join(said)[1:] if said else
+            "Not resolved (no hypothesis holds on the configurations that read own parts)")
+    text = (f"{lead}, on {', '.join(_where((u['n'], u['bc'])) for u in dec)} (the configurations "
+            f"of {DECISIVE} and more layers; one mesh per split each, n = 1; a part is "
+            f"resolved where it is {RATIO:g} times its u, the metric's leak of smooth fields; "
+            f"the mirror's where it is {RATIO:g} times the conforming splits' part within "
+            f"both u). (a) Mirror symmetry: {a_text}. (b) Normal stress: {b_text}. (c) "
+            f"Consistency: {c_text}. "
+            + (f"Large enough to see? {below['text'][0].upper()}{below['text'][1:]}: the "
+               "pattern these runs resolve is not a visible one there. "
+               if below and below["all_below"] else
+               f"Large enough to see? {below['head'][0].upper()}{below['head'][1:]}. "
+               if below else
+               f"Large enough to see: not decided (no configuration's leak is below "
+               f"{DECIDING_LEAK:g}). ")
+            + f"Not decided: {paper}."
+            + (f" One observation (identical cells): {'; '.join(_duplicates(dec))}."
+               if _duplicates(dec) else ""))
     largest = {}
     for u in dec:
         rows = [r for r in u["rows"] if r["same_as"] is None and r.get("own") is not None]
         top = max(rows, key=lambda r: abs(r["own"]), default=None)
         largest[_where((u["n"], u["bc"]))] = None if top is None else [top["name"],
                                                                       top["own"]]
-    return {**base, "decided": bool(m["own_units"] or any(t["tag"] in ("+", "-")
-                                                          for t in tags.values())),
-            "cause": cause, "text": text, "numbers": numbers, "clear": any_clear,
-            "all_below": below["all_below"], "by_reading": tags, "largest": largest}
+    return {**base, "decided": bool(causes), "cause": lead, "text": text, "numbers": text,
+            "clear": any(r["clear"] == "above" for u in seen_at for r in u["rows"]
+                         if r["same_as"] is None),
+            "all_below": bool(below and below["all_below"]), "by_reading": tags,
+            "largest": largest, "causes": causes, "counts": counts}
+
+
+def _duplicates(units_):
+    """'b+n = b (9 sliding, 17 sliding)': the models that are one observation with another,
+    with the configurations where they are."""
+    where = {}
+    for u in units_:
+        for r in u["rows"]:
+            if r["same_as"]:
+                where.setdefault((r["same_as"], r["name"]), []).append(_where((u["n"], u["bc"])))
+    merged = {}
+    for (other, name), w in where.items():
+        merged.setdefault((other, tuple(w)), []).append(name)
+    return [f"{_compress(v)} = {other} ({', '.join(w)})" for (other, w), v in merged.items()]
+
+
+def _tracks_word(rows):
+    """(c) over the meshes where it is testable: 'tracks' or 'does not track' where every one
+    says so, else 'not decided'."""
+    said = {r["verdict"] for r in rows if not r["verdict"].startswith("not testable")}
+    return said.pop() if len(said) == 1 and said <= {"tracks", "does not track"} else \
+        "not decided"
 
 
 def how_sure(ans, verdict):
     """The report's 'how sure' line: what the answers rest on and what is at a threshold."""
     us = ans["hypotheses"]["mirror"]["units"]
-    dec = [u for u in us if u["decides"]]
+    dec = [u for u in us if u["reads"]]
     at = [f"{r['name']} ({u['n']} {u['bc']}: "
-          + ("the clear level" if r["clear"] == "at" and not r["kind"].startswith("at the")
-             else r["kind"][len("at the threshold ("):-1] if r["kind"].startswith("at the")
+          + (r["kind"][len("at the threshold ("):-1] if r["kind"].startswith("at the")
              else r.get("mirror_why") or "")
           + ")" for u in dec for r in u["rows"]
-          if r["same_as"] is None and (r["kind"].startswith("at the") or r["clear"] == "at")]
+          if r["same_as"] is None and (r["kind"].startswith("at the")
+                                       or r.get("mirror_why") == "the ratio at the threshold")]
     failed = [f"{r['name']} ({u['n']} {u['bc']})" for u in us for r in u["rows"]
               if r["kind"].startswith("failed")]
-    # a failed run has no signature: counted apart from the signatures the cause rests on
-    distinct = sum(r["same_as"] is None and not r["kind"].startswith("failed")
+    # a failed run has no signature: counted apart from the parts the cause rests on
+    distinct = sum(r["same_as"] is None and not r["kind"].startswith(("failed", "n/a"))
                    for u in dec for r in u["rows"])
-    failed_there = sum(r["same_as"] is None and r["kind"].startswith("failed")
-                       for u in dec for r in u["rows"])
     return ("**How sure.** " + (
-        f"The cause rests on {len(dec)} of {len(us)} configurations (size, base) (those whose "
-        "smooth "
-        f"test fields leak below {DECIDING_LEAK:g}, {LEAK_SHARE:g} of the clear level), "
-        f"{distinct} distinct model signatures there"
-        + (f" ({failed_there} more distinct models failed there, no signature)"
-           if failed_there else "") + ", one "
-        "mesh per split and size (no spread over meshes of one continuum problem), "
+        f"The cause rests on {len(dec)} of {len(us)} configurations (size, base) (those of "
+        f"{DECISIVE} and more layers), {distinct} distinct model parts there"
+        + (f" ({len(failed)} failed, no part: {', '.join(failed)}; the study's static solve "
+           f"splits the push into up to {SPLITS_TRIED[-1]} steps before it calls a cell "
+           "failed)" if failed else "")
+        + ", one mesh per split and size (no spread over meshes of one continuum problem), "
         "uncertainties that bound the leak of smooth fields by the worst test field's"
         + (", orders from two sizes only; " if any(
             o["orders"] for o in ans["hypotheses"]["mirror"]["orders"].values()) else "; ")
-        + (f"not decided at a threshold (within {NEAR:.0%}) or between the two "
-           f"normalisations: {', '.join(at)}; " if at
+        + (f"at a threshold (within {NEAR:.0%}): {', '.join(at)}; " if at
            else f"none within {NEAR:.0%} of a threshold; ")
-        + (f"failed (no finer load stepping run, so not diagnosed): {', '.join(failed)}; "
-           if failed else "")
-        if dec else "No configuration decides; ")
+        if dec else "No configuration reads own parts; ")
         + "the reading: " + (verdict["sure"] if verdict["decided"] else _reading_sure(verdict))
         + ".")
 

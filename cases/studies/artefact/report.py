@@ -12,11 +12,11 @@ from ...document import GLOSSARY, Document, fmt, rel
 from ...report import environment, write_study
 from ...runner import jsonable
 from .analysis import (CLEAR, COARSE, DECAYS, DECIDING_LEAK, END_LAYERS, GROWS, LEAK_SHARE,
-                       NEAR, PAPER_BULGES_MM, PAPER_COST, PAPER_NECKS_MM, RATIO,
+                       MIN_RESOLVED, NEAR, PAPER_BULGES_MM, PAPER_COST, PAPER_NECKS_MM, RATIO,
                        SAME, WIDTHS, _compress, answer, classes, failure, how_sure,
                        paper_figure, paper_figure_text,
                        reading_table, reading_verdict, signature_own, times)
-from .study import (DECISIVE, FINEST_NORMAL_READING, LINEAR_SCALE, READINGS, SPLITS,
+from .study import (DECISIVE, LINEAR_SCALE, READINGS, SPLITS, SPLITS_TRIED,
                     YARDSTICK, short)
 
 GATED = catalogue.gated("alternation_rel", "disp_rel_l2")
@@ -154,10 +154,10 @@ def _what_was_run(d, s, doc):
         "calibrated reading is the paper's equations with another constant), each calibrated "
         "one with each normal-stress term (not in the paper's equations; its constant fitted "
         "per mesh; the fitted constants are not stored), msm, msm with the variational shear "
-        f"at c = 1, and {YARDSTICK} (FEM P1: constant-strain, small-strain linear FEM on the "
-        "same tetrahedra; no neo-Hookean P1 was run). On the finest meshes each "
-        f"normal-stress term beside the {FINEST_NORMAL_READING} reading only, and on the "
-        "finest bcc the calibrated readings and FEM P1 only (the cost of 9009 nodes). The "
+        f"at c = 1, and {YARDSTICK} (FEM P1: constant-strain FEM with the continuum's own "
+        "neo-Hookean law on the same tetrahedra, the control). On the finest bcc (9009 nodes) "
+        "the calibrated readings and the control only (the cost of its Newton matrices): "
+        "the other models' mirror is read against the six split alone. The "
         "literal readings and msm are not calibrated: their lateral displacement error is "
         "shown beside every signature"
         + (" (patch-test displacement errors " + ", ".join(
@@ -278,62 +278,53 @@ def _mirror(d, doc):
     us = m["units"]
     est = _estimates(doc)
     d.h(2, "(a) Mirror symmetry: FEM P1's signature and the model's own part")
-    d.p("Per (size, base) of the mirrored five split: the leak (the metric's check); the "
-        "controls (the conforming splits run for every model at that size: the same for "
-        "every model); FEM P1's signature there (the mesh's own period-2 error) +- u (leak "
-        "times its smooth amplitude, the floor and the finite-strain term, in quadrature) "
-        f"and whether it is resolved ({RATIO:g} times u); the floor (FEM P1's largest "
-        "signature on any conforming split run at that size; on the sliding base FEM P1 is "
-        "exact, an identity check); the finite-strain term fs (the continuum's own change "
-        "from the linear regime to the push, neo-Hookean mean lateral displacement over the "
-        "linear one scaled to the push, minus 1: FEM P1 is linear, so its signature in mm "
-        "scales exactly with the load and the control at the push is linear P1, not the "
-        "neo-Hookean P1 the glossary's model-form error at finite load uses, which was not "
-        "run; fs times FEM P1's signature estimates what a neo-Hookean P1 control could "
-        "change, and enters every part's u; 0 on the sliding base, where every P1 is "
-        "exact); and the distinct models by class, n of N.")
+    d.p("Per (size, base) of the mirrored five split: whether it reads own parts "
+        f"({DECISIVE} or more layers: the leak enters every u) and whether its clear-level "
+        "calls decide (the metric's check); the leak; the controls (the conforming splits run "
+        "for every model at that size; a model run on more reads its mirror against each it "
+        "ran on); FEM P1's signature there (neo-Hookean P1: the mesh's own period-2 error) "
+        "+- u (leak times its smooth amplitude and the floor, in quadrature) and whether it "
+        f"is resolved ({RATIO:g} times u); the floor (FEM P1's largest signature on any "
+        "conforming split run at that size; on the sliding base FEM P1 is exact, an identity "
+        "check); and the distinct models by class, n of N.")
     rows = []
     for u in us:
         k = classes(u)
         n = sum(len(v) for v in k.values())
-        rows.append([_unit(u), "yes" if u["decides"] else "no",
+        rows.append([_unit(u), "yes" if u["reads"] else "no", "yes" if u["decides"] else "no",
                      fmt(u["check"].get("worst"), 2),
                      ", ".join(x.split(" ")[0] for x in u["controls"]) + "".join(
-                         f"; {x.split(' ')[0]} run for {u['run'] - len(v)} of {u['run']} "
-                         "(not used)" for x, v in u["missing_controls"].items() if v),
+                         f"; {x.split(' ')[0]} for the {u['run'] - len(v)} of {u['run']} "
+                         "run on it" for x, v in u["missing_controls"].items() if v),
                      _pm(u["fem_five"], u.get("u_fem")),
                      {"above": "yes", "below": "no", "at": "at the threshold"}.get(
                          u.get("fem_vs"), "n/a") if not u["identity"] else "exact",
                      ("n/a" if u["fem_five"] is None else "identity check (exact)"
                       if u["identity"] else _sig(u["floor"])),
                      times(u["fem_ratio"]) if not u["identity"] else "n/a",
-                     "0 (P1 exact)" if u["identity"] else
-                     fmt(u["finite_strain"], 2) + (
-                         "" if u["finite_strain_from"] in (None, u["n"])
-                         else f" (from {u['finite_strain_from']})"),
                      f"{u['distinct']} of {u['run']}",
                      "; ".join(f"{c} {len(v)} of {n}" for c, v in sorted(k.items()))])
-    d.table(["configuration", "decides", "leak", "controls", "FEM P1, mirrored +- u", "resolved",
-             "floor", "FEM P1 / floor", "fs", "distinct models", "classes"], rows)
+    d.table(["configuration", "reads parts", "clear calls decide", "leak", "controls",
+             "FEM P1, mirrored +- u", "resolved", "floor", "FEM P1 / floor", "distinct models",
+             "classes"], rows)
     d.p("Every distinct model on the mirrored split: its signature (over the reference's "
-        "mean) +- u (leak times the smooth amplitude of model - reference, the floor and "
-        "the finite-strain term), over its own mean, whether it is clear (on both "
+        "mean) +- u (leak times the smooth amplitude of model - reference and the floor), "
+        "over its own mean, whether it is clear (on both "
         "normalisations; where not decided each one's call), its lateral displacement error "
         "(its mean lateral displacement over the free layers over the continuum's, minus 1: "
         "positive moves out more, softer laterally), its own part (model - FEM P1 on the "
-        "same tetrahedra) +- u (leak times the smooth amplitude of model - FEM P1 and the "
-        "finite-strain term), its part on each control +- its own u, the mirror ratio (|part| "
+        "same tetrahedra) +- u (leak times the smooth amplitude of model - FEM P1), its part "
+        "on each control +- its own u, the mirror ratio (|part| "
         "over the largest |control part|) and its interval from both uncertainties "
         "((|part| - u) / max(|control| + u_c) to (|part| + u) / max(|control| - u_c), "
         "unbounded where every control's part is unresolved), the unmirrored five split (not "
-        "conforming, not a control) and the class: 'no clear signature' where the "
-        "signature is below the clear level on both normalisations ('at the clear level: not "
-        "decided' where not both; the standard of all three hypotheses: such a part is "
-        "shown, never a cause); 'not resolved' where |part| is below "
+        "conforming, not a control) and the class: 'not resolved' where |part| is below "
         f"{RATIO:g} u (it cannot be told from 0); 'own +' / 'own -' where resolved, with "
         f"'the mirror's' where the whole ratio interval is {RATIO:g} or more, 'on every "
         "split' where it is all below, else 'mirror not decided' with the reason; 'not "
-        "decided' on a configuration whose check fails.")
+        f"decided' below {DECISIVE} layers (the paper's view). Whether a signature is clear "
+        "(large enough to see) is a column apart: it decides only where the configuration's "
+        "leak is below the deciding level.")
     rows = []
     for u in us:
         for r in u["rows"]:
@@ -359,14 +350,14 @@ def _mirror(d, doc):
     if failed:
         d.p("Failed observations (a hole, counted against the model): " + "; ".join(
             f"{r['name']} at {_unit(u)}: {r['kind']}" for u, r in failed) + ". The study's "
-            "static solve splits the load into up to 8 steps before it reports a failure; no "
-            "finer stepping was run, so whether the inversion is a load-path problem or the "
-            "model's own is not diagnosed, and these cells have no number.")
+            f"static solve splits the push into up to {SPLITS_TRIED[-1]} equal steps before "
+            "it reports a failure: an inversion that survives that is the model's own on this "
+            "load path, and these cells have no number.")
     tags = a.get("by_reading") or {}
     if tags:
-        dec = [u for u in us if u["decides"]]
+        dec = [u for u in us if u["reads"]]
         d.p("The cause, conditional on the reading: each model's class on the configurations that "
-            "decide (a model that is one observation with another takes its class), and "
+            "read own parts (a model that is one observation with another takes its class), and "
             "what its own part rests on: its sign with the number of configurations where it is "
             "resolved, n of N, and where it is the mirror's.")
         d.table(["model"] + [_unit(u) for u in dec] + ["own part", "the mirror's on"],
@@ -400,7 +391,8 @@ def _mirror(d, doc):
             "signature at both loads (the rest below 1e-05 at the push, or one observation "
             "with another)"
             + (", FEM P1 " + ", ".join(f"{fmt(r, 6)} at {n}" for n, r in x["fem"])
-               + " (linear: it scales exactly)" if x["fem"] else "")
+               + " (neo-Hookean: what it changes is the law's own finite strain)"
+               if x["fem"] else "")
             + ". " + (f"Changing by more than {NEAR:.0%} with the load (part of the signature "
                       "is finite strain): " + ", ".join(f"{nm} at {n} ({fmt(r, 2)})"
                                                        for nm, n, r in x["changed"])
@@ -412,9 +404,9 @@ def _normal(d, ns):
     d.h(2, "(b) Missing normal stress")
     word = {"+": "the paper's sign", "-": "the reversed sign"}
     d.p("Tested only on pairs where a normal-stress term changes the signature beyond "
-        "round-off (relative 1e-6), on a configuration that decides, beside a calibrated "
-        "reading whose signature is clear (the standard of all three hypotheses) and whose "
-        "own part (model - FEM P1) is resolved there; the part without and with the term, and "
+        "round-off (relative 1e-6), on a configuration that reads own parts, beside a "
+        "calibrated reading whose own part (model - FEM P1) is resolved there, the split "
+        "held fixed; the part without and with the term, and "
         f"whether the term reduces it {RATIO:g}-fold (the ratio's interval from both parts' "
         "u): " + (f"{ns['removed']} of {ns['tested']} pairs reduced {RATIO:g}-fold or more"
                   + (f". Every tested pair is beside a reading of {word[ns['signs'][0]]} ("
@@ -453,21 +445,22 @@ def _consistency(d, cs, us=()):
         "observation), each with its 95 % interval (Fisher z, variance 1.06 / (n - 3)); "
         f"'tracks' where the interval lies above 0 and the correlation is 0.7 or more, 'does "
         "not track' where the interval lies below 0.7; the verdict only where all four "
-        "agree; 'not testable' where no model's signature is clear on both normalisations "
-        "(nothing to explain)."
+        f"agree; 'not testable' where fewer than {MIN_RESOLVED} models' signatures are "
+        f"resolved ({RATIO:g} times their u: a correlation over signatures that cannot be told "
+        "from 0 ranks the leak)."
         + "".join(f" On {u['n']} sliding layers the metric reads an alternation confined to "
                   f"the {END_LAYERS} end layers at each end at {fmt(u['check']['ends'], 2)} of "
-                  "its amplitude: 'no clear signature' does not exclude one there."
+                  "its amplitude: an alternation of the end layers alone is read weakly there."
                   for u in us if u["bc"] == "sliding" and u["n"] >= DECISIVE
                   and u["check"].get("ends") is not None and u["n"] in {
                       int(r["mesh"].rsplit("-", 1)[-1]) for r in cs["rows"]
                       if r["mesh"].rsplit("-", 1)[-1].isdigit()}))
     d.table(["mesh", "clustered at", "distinct models", "signed: rho [95 %]",
-             "unsigned: rho [95 %]", "clear signatures", "verdict"],
+             "unsigned: rho [95 %]", "resolved signatures", "verdict"],
             [[r["mesh"], fmt(v["tol"]), f"{v['n']} of {r['of']}",
               _rho(v), _rho(next(w for w in r["variants"] if w["tol"] == v["tol"]
                                  and not w["signed"])),
-              f"{r['clear']}" + (f" ({len(r['at'])} not decided)" if r["at"] else ""),
+              f"{r['clear']}" + (f" ({len(r['at'])} at the threshold)" if r["at"] else ""),
               r["verdict"]]
              for r in cs["rows"] for v in r["variants"] if v["signed"]])
 
