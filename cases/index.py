@@ -167,12 +167,14 @@ def failed_checks(data, studies=None):
     out = ("Failed checks outside the rankings (each a case's own check, named in its "
            "report): " + (", ".join(bad) if bad else "none") + ".")
     if studies:
-        runs = [(name, r) for name, (d, keys) in studies.items() for k in keys
+        # a study may name its models for display ("names"), as its own report does
+        runs = [(name, d, r) for name, (d, keys) in studies.items() for k in keys
                 for r in d.get(k) or [] if r.get("failed")]
         out += (" Failed runs of the studies (no number; each named in its report): "
-                + ("; ".join(f"{r['model']} on {name}/{r['mesh']}"
+                + ("; ".join(f"{d.get('names', {}).get(r['model'], r['model'])} on "
+                             f"{name}/{r['mesh']}"
                              + (f"/{r['bc']}" if r.get("bc") else "")
-                             + f" ({str(r['failed']).split(';')[0]})" for name, r in runs)
+                             + f" ({str(r['failed']).split(';')[0]})" for name, d, r in runs)
                    if runs else "none") + ".")
     return out
 

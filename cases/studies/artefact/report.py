@@ -53,6 +53,7 @@ def write(out, study, s, data):
     found = analyse(data, list(s.models), s.damping)
     doc = jsonable({"case": study.name, "study": True, "parameters": s.describe(),
                     "problem": s.problem(), "gated": GATED, "environment": environment(),
+                    "names": {m: short(m) for m in s.models},
                     **data, **found, "gate_runs": gate_rows(data["cells"])})
     return write_study(out, doc, lambda folder: build(folder, study, s, doc))
 
