@@ -50,6 +50,18 @@ def test_a_pure_alternation_reads_as_its_amplitude(n):
             beta, rel = M.alternation(1.1 * ref + amp * alt, ref, free)
             assert beta == pytest.approx(amp, rel=1e-9)
             assert rel == pytest.approx(amp / np.abs(ref).mean(), rel=1e-9)
+    # added to any smooth field it reads its amplitude within that field's leak: exactly
+    # beside a polynomial the layers absorb, to the Gaussian's own score beside a bump
+    if n == 17:
+        ref, y = np.full(n, 0.3825), np.linspace(-1, 1, n)
+        poly = np.polynomial.legendre.legval(y, np.linspace(0.3, -0.2, n - 1))
+        bump = 0.05 * np.exp(-0.5 * ((k - 8) / 4) ** 2)
+        leak = abs(M.alternation(ref + bump, ref)[0])
+        for amp in (0.02, -0.03):
+            assert M.alternation(ref + 0.01 * poly + amp * alt, ref)[0] == \
+                pytest.approx(amp, rel=1e-9)
+            assert abs(M.alternation(ref + bump + amp * alt, ref)[0] - amp) <= leak + 1e-15
+            assert leak < 1e-7 * 0.05
     # the paper's sliding five-split msm profile: even layers 0.1452, odd 0.1233 mm
     msm = np.array([0.1452, 0.1233, 0.1452, 0.1233, 0.1452])
     assert M.alternation(msm, np.full(5, 0.3825))[0] == pytest.approx(0.01095, rel=1e-9)

@@ -244,12 +244,13 @@ def test_the_mirror_holds_where_only_the_mirrored_split_alternates(nine_decides)
     tags = a["by_reading"]
     assert {k: v["tag"] for k, v in tags.items()} == {"b": "+", "msm": "+", "b+n": "same"}
     assert tags["b"]["label"] == "+ on 4 of 4 configurations" and len(tags["b"]["mirror"]) == 4
-    assert a["text"].startswith("The period-2 part these runs resolve is the mirror's (a), on "
-                                "9 clamped, 9 sliding, 17 clamped, 17 sliding (the "
-                                "configurations of 9 and more layers; one mesh per split "
-                                "each, n = 1")
-    assert "on 17 sliding the mirror's for 2 of 2 distinct models (the paper's sign + in b, " \
-        "msm; reversed - in none)" in a["text"]
+    assert a["text"].startswith("The period-2 part is the mirror's (a) wherever its source is "
+                                "decided (9 clamped, 9 sliding, 17 clamped, 17 sliding: 8 of 8 "
+                                "resolved parts, none on every split), with the sign of the "
+                                "model: the paper's sign (+) for b, msm")
+    assert "17 sliding: 2 distinct models, 2 resolved, the mirror's 2 (+ 2: b, msm)" \
+        in a["text"]
+    assert "one mesh per split each, n = 1" in a["text"]
     assert a["text"].index("mirror's (a)") < a["text"].index("Not decided: the paper's own "
                                                               "5-node cube")
     assert "b+n = b (9 clamped, 9 sliding, 17 clamped, 17 sliding)" in a["text"]
@@ -328,8 +329,8 @@ def _boundary_world(height, fem_smooth=0.0, alt=0.002):
 def test_a_control_whose_part_is_leakage_leaves_the_mirror_not_decided(nine_decides):
     """The conforming splits' parts carry their own u (leak times their smooth amplitude): a
     sharp end boundary layer there, whose score is leakage, not an alternation, is not
-    resolved, so the mirror ratio's interval is unbounded above and reaches below 3 (a
-    control's part unresolved): the mirror is not decided, and never 'on every split'.
+    resolved, so the mirror ratio's interval is unbounded above and reaches below 3 (its lower
+    bound named): the mirror is not decided, and never 'on every split'.
     Without the boundary layer the same mirrored part is the mirror's."""
     a = analysis.answer(_boundary_world(3.0, alt=0.02))
     u = _unit(a, 9, "sliding")
@@ -337,7 +338,8 @@ def test_a_control_whose_part_is_leakage_leaves_the_mirror_not_decided(nine_deci
     six = b["control_parts"][SIX]
     assert six["resolved"] != "above" and abs(six["part"]) > 0
     assert b["mirror_hi"] is None and b["mirror_lo"] < analysis.RATIO
-    assert b["kind"] == "own +, mirror not decided (a control's part unresolved)"
+    assert b["kind"].startswith("own +, mirror not decided (the ratio's lower bound ")
+    assert b["kind"].endswith(", below 3)")
     clean = _unit(analysis.answer(_boundary_world(0.0, alt=0.02)), 9, "sliding")
     assert next(r for r in clean["rows"] if r["name"] == "b")["kind"] == "own +, the mirror's"
 
@@ -370,29 +372,34 @@ def test_a_part_on_every_split_is_not_the_mirrors():
     assert set(analysis.classes(_unit(a, 17, "sliding"))) == {"own +, on every split"}
 
 
-def test_a_failed_control_fails_the_models_observation_and_names_the_cause():
-    """A control cell that failed (an inverted element) makes the model's observation at that
-    unit 'failed control (...)' with the cause, never 'same as another model'."""
+def test_a_failed_control_is_a_hole_in_that_control_and_every_failed_cell_is_named():
+    """A control cell that failed (an inverted element) is a hole counted against the model:
+    the model keeps its own part, read against the controls that ran, with the failed
+    control named; a failed mirrored cell fails the model's observation there; the answer
+    lists every failed cell of the study and 'how sure' names each."""
     world = _world(_mirror_world)
     for c in world:
         if c["model"] == "b" and c["split"] == SIX and c["nodes_per_side"] == 17:
             c.update(failed="tetrahedron 3 (nodes [0, 1, 2, 3]) is inverted or flattened in "
                      "term 'shear'; reduce the load step", alternation_rel=None,
                      alternation_mm=None)
-    u = _unit(analysis.answer(world), 17, "sliding")
-    b = next(r for r in u["rows"] if r["name"] == "b")
-    assert b["kind"].startswith("failed control (six (Kuhn): failed (inverted element: "
-                                "tetrahedron 3")
-    assert analysis.classes(u)["failed"] == ["b"]
-    # a failed model has no signature: the signatures the cause rests on leave it out
+        if c["model"] == "msm" and c["split"] == FIVE and c["nodes_per_side"] == 17 \
+                and c["bc"] == "clamped":
+            c.update(failed="tetrahedron 5 (nodes [0, 1, 2, 4]) is inverted or flattened in "
+                     "term 'springs'", alternation_rel=None, alternation_mm=None)
     ans = analysis.answer(world)
-    dec = [v for v in ans["hypotheses"]["mirror"]["units"] if v["reads"]]
-    rows = [r for v in dec for r in v["rows"] if r["same_as"] is None]
-    lost = sum(r["kind"].startswith("failed") for r in rows)
-    assert u in dec and lost >= 1
+    u = _unit(ans, 17, "sliding")
+    b = next(r for r in u["rows"] if r["name"] == "b")
+    assert b["kind"] == "own +, the mirror's" and b["ctrls"] == [BCC]
+    assert b["failed_controls"][0].startswith("six (Kuhn): failed (inverted element: "
+                                              "tetrahedron 3")
+    clamped = _unit(ans, 17, "clamped")
+    assert analysis.classes(clamped)["failed"] == ["msm"]
+    assert ("msm", "five-17", "clamped", "paper") in {f[:4] for f in ans["failed"]}
+    assert ("b", "six-17", "sliding", "paper") in {f[:4] for f in ans["failed"]}
     said = analysis.how_sure(ans, {"decided": True, "sure": "x"})
-    assert f"{len(rows) - lost} distinct model parts there" in said
-    assert "failed, no part: " in said and "b (17 sliding)" in said
+    assert "1 failed on the mirrored split" in said
+    assert "b on six-17 sliding, six-17 clamped" in said and "msm on five-17 clamped" in said
 
 
 def test_normal_stress_is_tested_only_where_the_term_is_active(nine_decides):
@@ -411,7 +418,7 @@ def test_normal_stress_is_tested_only_where_the_term_is_active(nine_decides):
     ns = a["hypotheses"]["normal_stress"]
     assert ns["decided"] and ns["holds"] and ns["removed"] == ns["tested"] == 4
     assert all(p["reduced"] == "above" for p in ns["pairs"])
-    assert ns["signs"] == ["+"] and "4 of 4 pairs" in a["text"]
+    assert ns["signs"] == ["+"] and "4 of 4 distinct pairs" in a["text"]
     assert "a normal-stress term removes it (b)" in a["text"]
 
 
@@ -651,9 +658,10 @@ def test_the_cause_says_for_how_many_models_the_own_part_is_resolved_on_each_uni
             return 0.0
         return (0.04 if model == "b" else 0.06) if n == 9 else 0.0
     a = analysis.answer(_world(one))
-    assert a["text"].startswith("The period-2 part these runs resolve is the mirror's (a)")
-    assert "on 9 sliding the mirror's for 2 of 2 distinct models" in a["text"]
-    assert "on 17 sliding the mirror's for 0 of 1 distinct models, not resolved 1" in a["text"]
+    assert a["text"].startswith("The period-2 part is the mirror's (a) wherever its source is "
+                                "decided (9 clamped, 9 sliding: 4 of 4 resolved parts")
+    assert "9 sliding: 2 distinct models, 2 resolved, the mirror's 2" in a["text"]
+    assert "17 sliding: 1 distinct models, 0 resolved, not resolved 1" in a["text"]
 
 
 def _art(cells, table, verdict):
@@ -854,7 +862,8 @@ def test_a_resolved_part_below_the_clear_level_answers_the_mirror_and_says_it_is
     u = _unit(a, 17, "sliding")
     assert set(analysis.classes(u)) == {"own +, the mirror's"}
     assert all(r["clear"] == "below" for r in u["rows"] if r["same_as"] is None)
-    assert a["text"].startswith("The period-2 part these runs resolve is the mirror's (a)")
+    assert a["text"].startswith("The period-2 part is the mirror's (a) wherever its source is "
+                                "decided")
     assert "Large enough to see? On 17 clamped, 17 sliding every model's signature is below " \
         "the clear level 0.01" in a["text"]
     assert "the pattern these runs resolve is not a visible one there" in a["text"]

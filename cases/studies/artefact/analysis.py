@@ -390,8 +390,8 @@ def _mirror_call(d, u, parts):
     hi = (abs(d) + u) / floor_ if floor_ > 0 else None
     call = bounded(lo, hi, RATIO)
     why = None if call != "at" else (
-        "a control's part unresolved" if unresolved and hi is None or
-        unresolved and lo < RATIO * (1 - NEAR) else "the ratio at the threshold")
+        "the ratio at the threshold" if lo >= RATIO * (1 - NEAR) else
+        f"the ratio's lower bound {lo:.2g}, below {RATIO:g}")
     return lo, hi, call, why
 
 
@@ -473,11 +473,14 @@ def units(cells, models=None):
             own_ctrls = [x for x in CONFORMING_CONTROLS if (m, x, n, bc, "paper") in at
                          and (YARDSTICK_MODEL, x, n, bc, "paper") in at]
             row["ctrls"] = own_ctrls
-            bad = [f"{x}: {v}" for x, v in row["controls"].items()
-                   if x in own_ctrls and isinstance(v, str)]
-            if c.get("failed") or bad:
-                row["kind"] = failure(c) if c.get("failed") else "failed control (" + \
-                    "; ".join(bad) + ")"
+            # a failed control is a hole in that control, counted against the model, never its
+            # whole observation: its part is read against the controls that ran
+            row["failed_controls"] = [f"{x}: {v}" for x, v in row["controls"].items()
+                                      if x in own_ctrls and isinstance(v, str)]
+            own_ctrls = [x for x in own_ctrls if not isinstance(row["controls"][x], str)]
+            row["ctrls"] = own_ctrls
+            if c.get("failed"):
+                row["kind"] = failure(c)
                 rows.append(row)
                 continue
             if row["five"] is None or fem_five is None or ref is None:
@@ -516,7 +519,7 @@ def units(cells, models=None):
             else:
                 row["sign"] = "+" if d > 0 else "-"
                 kind = f"own {row['sign']}, " + (
-                    "mirror not decided (no control run)" if not parts else
+                    "mirror not decided (no control ran)" if not parts else
                     "the mirror's" if row["mirror_vs"] == "above" else
                     "on every split" if row["mirror_vs"] == "below" else
                     f"mirror not decided ({row['mirror_why']})")
@@ -646,6 +649,9 @@ def normal_stress(cells, us):
             continue
         rw = rows[(n, bc)].get(w["model"], {})
         if rw.get("same_as"):
+            if rw["same_as"] != r.get("name"):      # one observation with another term's
+                skip(f"one observation with {rw['same_as']}")
+                continue
             rw = next(x for x in rows[(n, bc)].values() if x["name"] == rw["same_as"])
         without, uw = r["part"], r["u"]
         with_, uv = rw.get("part"), rw.get("u")
@@ -661,9 +667,13 @@ def normal_stress(cells, us):
     removed = sum(p["reduced"] == "above" for p in pairs)
     at_ = sum(p["reduced"] == "at" for p in pairs)
     signs = sorted({p["sign"] for p in pairs})
-    inactive = sorted({f"{x['base']} ({x['n']} {x['bc']})" for x in untested
-                       if x["sign"] and x["sign"] not in signs
-                       and x["why"].startswith("the term changes nothing")})
+    where = {}
+    for x in untested:
+        if x["sign"] and x["sign"] not in signs and x["why"].startswith("the term changes "
+                                                                          "nothing"):
+            where.setdefault(x["base"], set()).add((x["n"], x["bc"]))
+    inactive = [f"{b} ({', '.join(f'{n} {bc}' for n, bc in sorted(v))})"
+                for b, v in where.items()]
     return {"pairs": pairs, "untested": untested, "tested": len(pairs), "removed": removed,
             "at_threshold": at_, "decided": bool(pairs), "signs": signs,
             "readings": sorted({p["base"] for p in pairs}), "inactive_other_sign": inactive,
@@ -705,7 +715,8 @@ def consistency(cells):
     """Hypothesis (c), the model's consistency: per conforming mesh with the linear regime
     (the sliding cube at 1e-3 of the push is a patch test) from DECISIVE layers, the rank
     correlation over the distinct approximations (the control left out) between the
-    signature at the push on the sliding base and the sliding cube's linear-load error, signed
+    signature at the linear load on the sliding base and the sliding cube's linear-load
+    error (one regime), signed
     and on |signature|, with models agreeing to SAME (3 significant figures) and to COARSE (2)
     counted once, each with its 95 % interval; the verdict where all four agree, else 'not
     decided'; not testable on a mesh where fewer than MIN_RESOLVED models' signatures are
@@ -729,12 +740,13 @@ def consistency(cells):
             if v["paper"].get("failed") or v["linear"].get("failed"):
                 failed.append(short(model))
                 continue
-            s, e = v["paper"].get("alternation_rel"), v["linear"].get("disp_rel_l2")
+            # one regime: the signature and the patch-test error both at the linear load
+            s, e = v["linear"].get("alternation_rel"), v["linear"].get("disp_rel_l2")
             if s is None or e is None:
                 continue
             pts.append((s, e))
-            u = signature_u(v["paper"], leak.get((v["paper"]["nodes_per_side"], "sliding"),
-                                                 0.0))
+            u = signature_u(v["linear"], leak.get((v["linear"]["nodes_per_side"], "sliding"),
+                                                  0.0))
             call = against(abs(s) / u, RATIO)
             (clear if call == "above" else at_ if call == "at" else []).append(short(model))
         if len(pts) < 3:
@@ -1045,40 +1057,54 @@ def resolved_counts(dec):
 
 def mirror_counts(u):
     """Per configuration that reads: the distinct models by what their own part is: the
-    mirror's (with its sign), on every split, mirror not decided, not resolved or at the
-    threshold, failed."""
+    mirror's (by sign), on every split, mirror not decided, at the threshold, not resolved,
+    failed (its mirrored cell); and the models one of whose controls failed."""
     rows = [r for r in u["rows"] if r["same_as"] is None and not r["kind"].startswith("n/a")]
-    out = {"of": len(rows), "+": [], "-": [], "every": [], "open": [], "unresolved": [],
-           "failed": []}
+    out = {"of": len(rows), "+": [], "-": [], "every": [], "open": [], "at": [],
+           "unresolved": [], "failed": [],
+           "control_failed": [r["name"] for r in rows if r.get("failed_controls")]}
     for r in rows:
         k = r["kind"]
         key = ("failed" if k.startswith("failed") else
                r["sign"] if r["sign"] and r.get("mirror_vs") == "above" else
                "every" if r["sign"] and r.get("mirror_vs") == "below" else
-               "open" if r["sign"] else "unresolved")
+               "open" if r["sign"] else "at" if k.startswith("at the") else "unresolved")
         out[key].append(r["name"])
+    out["resolved"] = len(out["+"]) + len(out["-"]) + len(out["every"]) + len(out["open"])
     return out
 
 
 def _mirror_text(u):
     c = mirror_counts(u)
     mirror = len(c["+"]) + len(c["-"])
-    bits = [f"the mirror's for {mirror} of {c['of']} distinct models"
-            + (f" (the paper's sign + in {_compress(c['+'])}; reversed - in "
-               f"{_compress(c['-'])})" if mirror else "")]
+    bits = [f"{c['of']} distinct models, {c['resolved']} resolved"]
+    if mirror:
+        bits.append(f"the mirror's {mirror} ("
+                    + "; ".join(f"{s} {len(c[s])}: {_compress(c[s])}" for s in ("+", "-")
+                                if c[s]) + ")")
     for key, word in (("every", "on every split"), ("open", "mirror not decided"),
-                      ("unresolved", "not resolved"), ("failed", "failed")):
+                      ("at", "at the threshold"), ("unresolved", "not resolved"),
+                      ("failed", "failed")):
         if c[key]:
             bits.append(f"{word} {len(c[key])}")
-    return f"on {_where((u['n'], u['bc']))} " + ", ".join(bits)
+    if c["control_failed"]:
+        bits.append(f"a control failed for {len(c['control_failed'])} (read on the others)")
+    return f"{_where((u['n'], u['bc']))}: " + ", ".join(bits)
+
+
+def failed_cells(cells):
+    """Every failed cell of the study (any split, base, load): (model, mesh, bc, load, why)."""
+    return [(short(c["model"]), c["mesh"], c["bc"], c["load"], failure(c)) for c in cells
+            if c.get("failed")]
 
 
 def answer(cells, models=None):
     """The paper's question answered hypothesis by hypothesis from the configurations that
     read own parts (DECISIVE or more layers): (a) where a resolved own part is the mirror's,
-    with its order in h; (b) whether a normal-stress term reduces it; (c) whether it tracks
-    the patch-test error; then whether it is large enough to see (the clear level, on the
-    configurations that decide it); 'not decided' for the paper's 5-node cube."""
+    by sign, with its order in h; (b) whether a normal-stress term reduces it, and for which
+    sign that was tested; (c) whether it tracks the patch-test error, in the linear regime;
+    then whether it is large enough to see (the clear level, on the configurations that
+    decide it); 'not decided' for the paper's 5-node cube."""
     m = mirror(cells, models)
     us = m["units"]
     ns, cs = normal_stress(cells, us), consistency(cells)
@@ -1089,7 +1115,7 @@ def answer(cells, models=None):
     base = {"hypotheses": hyp, "paper_view": view, "linear": lin, "ratio": RATIO,
             "decisive": DECISIVE, "clear_level": CLEAR, "near": NEAR,
             "deciding": m["deciding"], "asymmetry": reference_asymmetry(cells),
-            "inward": inward(cells)}
+            "inward": inward(cells), "failed": failed_cells(cells)}
     if not dec:
         text = "Not decided: " + paper + f". No mesh with {DECISIVE} or more layers was run."
         return {**base, "decided": False, "cause": "not decided", "text": text,
@@ -1097,21 +1123,38 @@ def answer(cells, models=None):
                 "causes": []}
     tags = by_reading(us)
     counts = {_where((u["n"], u["bc"])): mirror_counts(u) for u in dec}
+    by_sign = {s: list(dict.fromkeys(n for c in counts.values() for n in c[s]))
+               for s in ("+", "-")}
     mirrored = sum(len(c["+"]) + len(c["-"]) for c in counts.values())
+    resolved = sum(c["resolved"] for c in counts.values())
     against_ = sum(len(c["every"]) for c in counts.values())
+    where_mirror = [w for w, c in counts.items() if c["+"] or c["-"]]
     fem_units = [_where(x) for x in m["mesh_units"]]
     a_holds = (mirrored > 0 or bool(fem_units)) and not against_
     slopes = [order_text(bc, o) for bc, o in m["orders"].items() if o["orders"]]
+    sliding = [u for u in dec if u["bc"] == "sliding" and u["identity"]]
     a_text = ("; ".join(_mirror_text(u) for u in dec if mirror_counts(u)["of"])
               + (f"; FEM P1's own signature is resolved and the mirror's on "
                  f"{', '.join(fem_units)}" if fem_units else "")
-              + (f"; the own part {'; '.join(slopes)}" if slopes else ""))
-    b_text = (f"{ns['removed']} of {ns['tested']} pairs (a calibrated reading's resolved own "
-              "part with and without an active term, the split held fixed) reduced "
-              f"{RATIO:g}-fold"
-              + (f" ({ns['at_threshold']} at the threshold)" if ns["at_threshold"] else "")
-              + (f"; |with| / |without| {fmt(min(p['ratio'] for p in ns['pairs']), 2)}-"
-                 f"{fmt(max(p['ratio'] for p in ns['pairs']), 2)}" if ns["pairs"] else "")
+              + (". On the sliding base the continuum is homogeneous (FEM P1 exact): there "
+                 "every own part is the model's patch-test failure, and only the mirrored "
+                 "split repeats with a two-cell period, so the mirror sets the period and the "
+                 "model's inconsistency its amplitude" if sliding else "")
+              + (f". The own part {'; '.join(slopes)}" if slopes else ""))
+    word = {"+": "the paper's sign", "-": "the reversed sign"}
+    b_text = ((f"{ns['removed']} of {ns['tested']} distinct pairs (a calibrated reading's "
+               "resolved own part with and without an active term, the split held fixed) "
+               f"reduced {RATIO:g}-fold"
+               + (f" ({ns['at_threshold']} at the threshold)" if ns["at_threshold"] else "")
+               + (f"; |with| / |without| {fmt(min(p['ratio'] for p in ns['pairs']), 2)}-"
+                  f"{fmt(max(p['ratio'] for p in ns['pairs']), 2)}" if ns["pairs"] else "")
+               + (f"; every tested pair is beside a reading of {word[ns['signs'][0]]} ("
+                  f"{_names(ns['readings'])}): for {word['+' if ns['signs'] == ['-'] else '-']}"
+                  " (b) is not tested"
+                  + (f" (beside {_names(ns['inactive_other_sign'])} every term changes "
+                     "nothing: its fitted constant is not stored, so whether the fit set it "
+                     "to 0 is not known)" if ns["inactive_other_sign"] else "")
+                  if len(ns["signs"]) == 1 else ""))
               if ns["decided"] else "not tested (no term active beside a resolved own part)")
     c_text = ("not testable (" + "; ".join(
         f"{', '.join(meshes)}: {why}" for why, meshes in _by_value(
@@ -1123,19 +1166,26 @@ def answer(cells, models=None):
     causes = (["the mirror symmetry (a)"] if a_holds else []) + (
         ["the missing normal stress (b)"] if ns["holds"] else []) + (
         ["the model's inconsistency (c)"] if cs["holds"] else [])
-    said = (["the period-2 part these runs resolve is the mirror's (a)"] if a_holds else []) + (
+    signs = "; ".join(f"{word[s]} ({s}) for {_compress(by_sign[s])}" for s in ("+", "-")
+                      if by_sign[s])
+    said = ([f"The period-2 part is the mirror's (a) wherever its source is decided "
+             f"({', '.join(where_mirror)}: {mirrored} of {resolved} resolved parts, none on "
+             f"every split), with the sign of the model: {signs}"] if a_holds else []) + (
         ["a normal-stress term removes it (b)"] if ns["holds"] else []) + (
         ["it tracks the patch-test error (c)"] if cs["holds"] else [])
     seen_at = [u for u in us if u["decides"] and u["n"] >= DECISIVE]
     below = _below_text(seen_at) if seen_at else None
-    lead = ("; ".join(said)[0].upper() + "; ".join(said)[1:] if said else
+    lead = ("; ".join(said) if said else
             "Not resolved (no hypothesis holds on the configurations that read own parts)")
-    text = (f"{lead}, on {', '.join(_where((u['n'], u['bc'])) for u in dec)} (the configurations "
-            f"of {DECISIVE} and more layers; one mesh per split each, n = 1; a part is "
-            f"resolved where it is {RATIO:g} times its u, the metric's leak of smooth fields; "
-            f"the mirror's where it is {RATIO:g} times the conforming splits' part within "
-            f"both u). (a) Mirror symmetry: {a_text}. (b) Normal stress: {b_text}. (c) "
-            f"Consistency: {c_text}. "
+    fem_said = _fem_text(dec)
+    text = (f"{lead}. (a) Mirror symmetry, per configuration (size, base) of {DECISIVE} and "
+            "more layers (one mesh per split each, n = 1; a part is resolved where it is "
+            f"{RATIO:g} times its u, the metric's leak of smooth fields; the mirror's where it "
+            f"is also {RATIO:g} times the model's part on each conforming split without the "
+            f"mirror, within both u): {a_text}. FEM P1's own signature on the mirrored split "
+            f"(the mesh's error): {fem_said}. (b) Normal stress: {b_text}. (c) Consistency "
+            f"(the linear regime: the signature at the linear load against the patch-test "
+            f"error): {c_text}. "
             + (f"Large enough to see? {below['text'][0].upper()}{below['text'][1:]}: the "
                "pattern these runs resolve is not a visible one there. "
                if below and below["all_below"] else
@@ -1182,7 +1232,8 @@ def _tracks_word(rows):
 
 
 def how_sure(ans, verdict):
-    """The report's 'how sure' line: what the answers rest on and what is at a threshold."""
+    """The report's 'how sure' line: what the answers rest on, what the uncertainty holds and
+    leaves out, what is at a threshold, and every failed cell."""
     us = ans["hypotheses"]["mirror"]["units"]
     dec = [u for u in us if u["reads"]]
     at = [f"{r['name']} ({u['n']} {u['bc']}: "
@@ -1191,24 +1242,34 @@ def how_sure(ans, verdict):
           + ")" for u in dec for r in u["rows"]
           if r["same_as"] is None and (r["kind"].startswith("at the")
                                        or r.get("mirror_why") == "the ratio at the threshold")]
-    failed = [f"{r['name']} ({u['n']} {u['bc']})" for u in us for r in u["rows"]
-              if r["kind"].startswith("failed")]
-    # a failed run has no signature: counted apart from the parts the cause rests on
-    distinct = sum(r["same_as"] is None and not r["kind"].startswith(("failed", "n/a"))
-                   for u in dec for r in u["rows"])
+    rows = [r for u in dec for r in u["rows"] if r["same_as"] is None
+            and not r["kind"].startswith("n/a")]
+    lost = sum(r["kind"].startswith("failed") for r in rows)
+    failed = ans.get("failed") or []
+    by_model = {}
+    for model, mesh, bc, load, _ in failed:
+        by_model.setdefault(model, []).append(f"{mesh} {bc}" + (
+            f" ({load} load)" if load != "paper" else ""))
     return ("**How sure.** " + (
         f"The cause rests on {len(dec)} of {len(us)} configurations (size, base) (those of "
-        f"{DECISIVE} and more layers), {distinct} distinct model parts there"
-        + (f" ({len(failed)} failed, no part: {', '.join(failed)}; the study's static solve "
-           f"splits the push into up to {SPLITS_TRIED[-1]} steps before it calls a cell "
-           "failed)" if failed else "")
-        + ", one mesh per split and size (no spread over meshes of one continuum problem), "
-        "uncertainties that bound the leak of smooth fields by the worst test field's"
-        + (", orders from two sizes only; " if any(
+        f"{DECISIVE} and more layers): {len(rows)} distinct models there, {len(rows) - lost} "
+        f"with an own part"
+        + (f", {lost} failed on the mirrored split" if lost else "")
+        + "; one mesh per split and size (no spread over meshes of one continuum problem); "
+        "each u holds the leak of smooth fields (the worst test field's) and the solver's "
+        f"tolerance ({ROUND_OFF_FLOOR:g}), not the sensitivity to the fitted constants (fitted "
+        "per mesh, not stored) nor a spread over meshes: the verdicts are provisional on "
+        "those"
+        + ("; orders from two sizes only; " if any(
             o["orders"] for o in ans["hypotheses"]["mirror"]["orders"].values()) else "; ")
         + (f"at a threshold (within {NEAR:.0%}): {', '.join(at)}; " if at
            else f"none within {NEAR:.0%} of a threshold; ")
         if dec else "No configuration reads own parts; ")
+        + (f"failed cells ({len(failed)}, each a hole counted against its model; the static "
+           f"solve splits the push into up to {SPLITS_TRIED[-1]} equal steps first; not "
+           "diagnosed further): " + "; ".join(f"{k} on {', '.join(v)}"
+                                             for k, v in by_model.items()) + "; "
+           if failed else "")
         + "the reading: " + (verdict["sure"] if verdict["decided"] else _reading_sure(verdict))
         + ".")
 
@@ -1297,8 +1358,11 @@ def paper_figure_text(fig, bc="clamped"):
     return ("The paper's Figure 1 (bulges at y = " + _ys(PAPER_BULGES_MM) + " mm, necks at "
             + _ys(PAPER_NECKS_MM) + " mm) on the paper's setting (mirrored five, 5 nodes per "
             "side, the paper's push), each layer a bulge where it is out further than every "
-            "neighbouring layer and a neck where it is in further: "
-            + " ".join([one(bc) + "."] + [f"Beside it, the {one(b)}." for b in others]))
+            "neighbouring layer and a neck where it is in further (read on the raw profile of "
+            "5 layers, the paper's own view, without an uncertainty: it decides nothing): "
+            + " ".join([one(bc) + "."] + [f"Beside it, the {one(b)}." for b in others])
+            + " On the clamped base the top and bottom layers are held laterally, so the "
+            "figure's end bulges cannot appear there.")
 
 
 # ---------------------------------------------------------------------------- the reading
@@ -1459,14 +1523,16 @@ def _span(r):
     return f"{fmt(r['step_vs_msm'], 3)} [{fmt(lo, 3)}-{fmt(hi, 3)}]"
 
 
-def reading_verdict(table, damping, spread=None):
+def reading_verdict(table, damping, spread=None, figure=None):
     """Which reading of the paper's equations its decidable observables point to: a reading
     is decided only where its matches (True) exceed every other reading's possible matches
     (True or not decided); else 'not decided', with why. Whether no reading reproduces all
     the observables (each has a measured mismatch), or no timed one does. Stability is said
     per mesh: a reading stable on one mesh and growing on another is not stable. The
     readings with a normal-stress term are said apart: their cost is not decided (this
-    implementation's term). ``spread`` the bench's sizes and rounds the cost ranges cover."""
+    implementation's term). ``spread`` the bench's sizes and rounds the cost ranges cover;
+    ``figure`` (``paper_figure``) the paper's Figure 1 on its 5 layers, said beside the
+    verdict, never scored."""
     readings = [r for r in table if r["in_paper"]]
     extra = [r for r in table if not r["in_paper"]]
     total = len(OBSERVABLES)
@@ -1536,7 +1602,18 @@ def reading_verdict(table, damping, spread=None):
                f"{_names([r['name'] for r in timed if not r['step_range']])}"
                if any(not r["step_range"] for r in timed) else "")
             + (f"; not timed: {_names(untimed)}" if untimed else "") + ". ")
+    per = "; ".join(f"{r['name']}: cost {MATCH_WORDS[r['matches']['cost']]}, stability "
+                    f"{MATCH_WORDS[r['matches']['stable']]}" for r in readings)
+    fig = ""
+    if figure:
+        names = {r["name"] for r in readings}
+        fig = (" Figure 1 (the pattern on the paper's 5 layers, its own view: shown, never "
+               "scored): " + "; ".join(
+                   f"on the {b} base reproduced by "
+                   + _names([n for n, ok, _, _ in figure[b] if ok and n in names])
+                   for b in figure) + ".")
     text = ((f"Not decided: {why}. " if not decided else f"{why}. ")
+            + (f"Each reading, observable by observable: {per}." if per else "") + fig + " "
             + ("No reading reproduces all the paper's observables. " if none_all else
                f"No timed reading reproduces all the paper's observables ({_names(cost_miss)} "
                "each miss the cost); the literal readings were not timed, so whether they do "

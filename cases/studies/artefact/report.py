@@ -44,7 +44,8 @@ def analyse(data, models, damping):
     table = reading_table(data["cells"], data["step_vs_msm"], readings(models), damping,
                           with_normal(models), data.get("step_vs_msm_range"))
     found = {"answer": answer(data["cells"], models), "readings": table,
-             "verdict": reading_verdict(table, damping, data.get("bench_spread"))}
+             "verdict": reading_verdict(table, damping, data.get("bench_spread"),
+                                        paper_figure(data["cells"], readings(models)))}
     found["how_sure"] = how_sure(found["answer"], found["verdict"])
     return found
 
@@ -146,7 +147,9 @@ def _what_was_run(d, s, doc):
         + ", ".join(SPLITS[k] for k in dict.fromkeys(spec[0] for spec in s.meshes.values()))
         + f") at {', '.join(map(str, sizes))} nodes per side. The unmirrored five split "
         "splits every cell alike, so its faces' diagonals cross: it is not conforming and is "
-        "shown apart, never a control."
+        "shown apart, never a control (a split of a cube into five tetrahedra conforms only "
+        "where each cell is the mirror image of its neighbours, so no conforming unmirrored "
+        "five split exists; the conforming splits without the mirror are six and bcc)."
         + (f" The paper reports {PAPER_TETS} tetrahedra on its 5-node cube; the mirrored five "
            f"split of the same lattice has {five['tets']}: the paper's own mesh is not among "
            "these meshes." if five else ""),
@@ -246,11 +249,11 @@ def _metric_check(d, doc):
                     + [fmt(lk.get(f"Gaussian, sd {w} layers"), 2) for w in WIDTHS]
                     + [fmt(lk.get(f"end layer, decay {x:g}"), 2) for x in DECAYS]
                     + [fmt(c.get("worst"), 2), fmt(c.get("ends"), 2),
-                       "yes" if u["decides"] else f"no: {c.get('why')}"])
+                       "yes" if u["decides"] else f"no: {c.get('why')}"])     # clear calls
     d.table(["configuration (nodes, base)", "free layers", "degree absorbed", "sum |w|", "||w||_2",
              "(-1)^k reads", "barrel"] + [f"Gaussian sd {w}" for w in WIDTHS]
             + [f"end layer, decay {x:g}" for x in DECAYS]
-            + ["leak (worst)", "end alternation reads", "decides"], rows)
+            + ["leak (worst)", "end alternation reads", "clear calls decide"], rows)
     view = doc["answer"]["paper_view"]
     msm = next((c for c in doc["cells"] if c["model"] == "msm" and c["mesh"] == "five"
                 and c["bc"] == "sliding" and c["load"] == "paper"
@@ -347,13 +350,17 @@ def _mirror(d, doc):
     d.table(["model", "configuration", "signature +- u", "over own mean: clear?",
              "lateral displacement error", "part (model - FEM P1) +- u", "control parts +- u",
              "mirror ratio [interval]", "unmirrored five", "class"], rows, keys=2)
-    failed = [(u, r) for u in us for r in u["rows"] if r["kind"].startswith("failed")]
+    failed = a.get("failed") or []
     if failed:
-        d.p("Failed observations (a hole, counted against the model): " + "; ".join(
-            f"{r['name']} at {_unit(u)}: {r['kind']}" for u, r in failed) + ". The study's "
-            f"static solve splits the push into up to {SPLITS_TRIED[-1]} equal steps before "
-            "it reports a failure: an inversion that survives that is the model's own on this "
-            "load path, and these cells have no number.")
+        d.p(f"Failed cells ({len(failed)}: each a hole counted against its model; a failed "
+            "control removes that control from the model's mirror ratio, never the model's "
+            "own part): " + "; ".join(f"{m} on {mesh} {bc}" + (
+                f" ({load} load)" if load != "paper" else "") + f": {why}"
+                for m, mesh, bc, load, why in failed)
+            + f". The study's static solve splits the push into up to {SPLITS_TRIED[-1]} equal "
+            "steps before it reports a failure; whether an inversion that survives that is the "
+            "model's own or its constraints' (several fail on the same corner tetrahedron of "
+            "the sliding base) is not diagnosed, and these cells have no number.")
     tags = a.get("by_reading") or {}
     if tags:
         dec = [u for u in us if u["reads"]]
@@ -374,8 +381,10 @@ def _mirror(d, doc):
                "distinct models resolved at both sizes"
                + (f" ({', '.join(f'{k} {x:.2f}' for k, x in o['orders'].items())})"
                   if v else "")
-               + ". From two sizes: one order each, no check that the sizes are in the "
-               "asymptotic range and no uncertainty"
+               + ". From two sizes: one order each, its uncertainty the parts' u propagated "
+               "through the slope (at most "
+               + fmt(max((o.get("u") or {0: 0.0}).values()), 2) + "), no check that the "
+               "sizes are in the asymptotic range"
                + ("; the orders of unrelated models agree within "
                   f"{max(v) - min(v):.3f}: one common order, not a per-model property (its "
                   "cause is not identified by these runs)" if len(v) > 2
@@ -437,9 +446,9 @@ def _normal(d, ns):
 def _consistency(d, cs, us=()):
     d.h(2, "(c) The model's consistency")
     d.p("Per conforming mesh with the linear load (from 9 nodes per side: 17 has no linear "
-        "load): the rank correlation over the distinct models (FEM P1 left out) between the "
-        "signature at the push and the sliding cube's linear-load error (the displacement "
-        "error at "
+        "load), in one regime: the rank correlation over the distinct models (FEM P1 left "
+        "out) between the signature at the linear load and the sliding cube's linear-load "
+        "error (the displacement error at "
         f"{LINEAR_SCALE:g} of the push), both on the sliding base, signed and on |signature|, "
         f"with models whose signature and that error agree to {SAME:g} (3 significant "
         f"figures) and to {COARSE:g} (2) counted once (near-duplicate variants are one "
