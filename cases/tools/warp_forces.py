@@ -45,7 +45,7 @@ if hasattr(wp.config, "log_level"):      # newer Warp logs its start-up and modu
 
 DTYPES = ("float32", "float64")
 # the terms written as Warp kernels; a model of these terms alone is covered
-TERMS = ("fem_linear", "volume", "springs", "shear", "normal_edge")
+TERMS = ("fem_linear", "volume", "springs", "shear", "normal", "normal_edge")
 COVERED = ("fem-linear", "msm", "msm+volume", "pbcm-corner", "pbcm-balanced",
            "pbcm-variational", "pbcm-variational+normal")
 NOT_COVERED = ("fem-corotated", "fem-neohookean")
@@ -316,7 +316,7 @@ class WarpForces:
                 fn = getattr(k.shear, f"shear_{term.p['reading']}")
                 self._add(fn, term, tets, self._array(vol0, scalar),
                           self._array(gamma0, scalar), scalar(factor))
-            else:       # normal_edge
+            else:       # normal, normal_edge
                 coef_G = term.kernel()[1][-1]
                 p = pm.mesh.points[pm.mesh.tets]
                 pairs = [(0, 1), (0, 2), (0, 3), (1, 2), (1, 3), (2, 3)]
