@@ -1,10 +1,10 @@
-"""The case contract: what a case declares, and what the shared runner (``cases.runner``) does
+"""The case contract: what a case declares, and what the shared runner (``cases.running.runner``) does
 with it.
 
 A case is a module that declares one :class:`Case` subclass: its geometry and mesh family,
 boundary conditions and loads, quantities of interest, closed form, quick and full settings and
 any case-specific metric, finding or figure. It does not loop, solve the FEM references, compute
-the standard metrics, write files or gate: the runner, ``cases.report`` and ``cases.gate``
+the standard metrics, write files or gate: the runner, ``cases.reporting.report`` and ``cases.running.gate``
 do that for every case alike. Millimetres stop at the case module's edge: everything a case
 hands the runner is in SI units, except the quantities it names ``*_mm`` for its report.
 """
@@ -21,8 +21,8 @@ from model import static
 from model.compose import parse
 from model.mesh import SCHEMES
 from model.loads import body_forces, traction_forces
-from . import catalogue
-from .error_model import at_load
+from .measuring import catalogue
+from .measuring.error_model import at_load
 
 # ``Case.decomposed_at_load``'s default: the case's ``decomposed`` quantity at its load
 AT_LOAD = "the decomposed quantity at the load"
@@ -249,7 +249,7 @@ class Case(abc.ABC):
     locking_prone : the boundary conditions where FEM P1, the model-form twin, locks (constant-
         strain tetrahedra near incompressibility): its model-form error ranks closeness to a
         locked mesh, so the population is shown and said, never pooled in the overall ranking.
-    decomposed : what the error model (``cases.error_model``) splits into model-form error
+    decomposed : what the error model (``cases.measuring.error_model``) splits into model-form error
         (against FEM P1 with the same law on the same tetrahedra) and discretisation error
         (FEM P1 against the continuum): a ``Scalar`` quantity or a ``Norm``; None: the case
         has no continuum reference to decompose against.
@@ -500,7 +500,7 @@ class Study(abc.ABC):
     @abc.abstractmethod
     def run(self, s, workers=None, log=True, bench=None, store=None):
         """Compute everything; return the data its ``write`` takes. ``bench`` is the
-        `pbcm bench` document (cost), or None; ``store`` a ``cases.store.RunStore`` to take
+        `pbcm bench` document (cost), or None; ``store`` a ``cases.running.store.RunStore`` to take
         stored results from and keep computed ones in (None: none)."""
 
     @abc.abstractmethod

@@ -15,7 +15,7 @@ from pathlib import Path
 
 from filelock import FileLock
 
-from cases import store as S
+from cases.running import store as S
 
 # The commands' run store keeps the FEM references only, in a folder of this test session
 # (shared by its xdist workers): every model run is computed by the test that checks it (a

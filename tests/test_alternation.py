@@ -6,7 +6,7 @@ from math import comb
 import numpy as np
 import pytest
 
-from cases import metrics as M
+from cases.measuring import metrics as M
 
 CLEAR = M.ALTERNATION_CLEAR
 

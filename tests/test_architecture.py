@@ -107,10 +107,10 @@ def test_the_circle_finder_finds_a_circle():
 
 def test_the_graph_sees_deferred_and_relative_imports():
     g = graph()
-    # cases.registry imports nothing of the package statically; cases.report imports costs
-    assert "cases.costs" in g["cases.report"]
+    # cases.registry imports nothing of the package statically; cases.reporting.report imports costs
+    assert "cases.reporting.costs" in g["cases.reporting.report"]
     # `from ...costs import SOURCE` three levels up, in a subpackage
-    assert "cases.costs" in g["cases.studies.convergence.cost"]
+    assert "cases.reporting.costs" in g["cases.studies.convergence.cost"]
     assert "cases.library.common" in g["cases.library.paper_cube"]
 
 
@@ -170,3 +170,65 @@ def test_nothing_points_outside_the_repository():
     bad = [str(p.relative_to(ROOT)) for p in texts if p.is_file()
            and any(s in p.read_text() for s in ("../shared", "MODEL.md", "VERDICTS.md"))]
     assert bad == []
+
+
+DOC = ROOT / "docs" / "architecture.md"
+
+
+def _rooms_table():
+    """{folder: its row's text} of docs/architecture.md's rooms table."""
+    out = {}
+    for line in DOC.read_text().splitlines():
+        cells = [c.strip() for c in line.split("|")]
+        if len(cells) > 3 and cells[1].startswith("`") and cells[1].endswith("/`"):
+            out[cells[1].strip("`").rstrip("/")] = cells[2]
+    return out
+
+
+def test_the_rooms_table_names_every_folder_of_the_harness_and_every_module_in_it():
+    """docs/architecture.md's picture of the rooms is the package's: every package folder of
+    cases/ has its row, every row of cases/ is a folder, and the harness's rows (cases/ itself
+    and its measuring, running and reporting rooms) name every module in them."""
+    rows = _rooms_table()
+    folders = {str(p.parent.relative_to(ROOT)) for p in (ROOT / "cases").glob("*/__init__.py")}
+    assert {f for f in rows if f.startswith("cases/")} == folders
+    for folder in ("cases", "cases/measuring", "cases/running", "cases/reporting"):
+        names = {p.stem for p in (ROOT / folder).glob("*.py") if p.stem != "__init__"}
+        missing = sorted(n for n in names if f"`{n}`" not in rows[folder]
+                         and f"`{n}.py`" not in rows[folder])
+        assert missing == [], (folder, missing)
+
+
+def _stated_rules():
+    """[(room, [rooms it must not import])] from the doc's bullets of the form
+    "`A/` imports neither `B/` nor `C/`" or "`A/` imports no `B/`"."""
+    import re
+    out = []
+    for line in DOC.read_text().splitlines():
+        m = re.match(r"- `(cases/\w+)/` imports (?:neither|no) (.*);$", line.strip())
+        if m:
+            out.append((m.group(1), re.findall(r"`(cases/\w+)/`", m.group(2))))
+    return out
+
+
+def test_the_rooms_import_as_the_doc_says():
+    """Each direction the doc states between the harness's rooms holds on the import graph:
+    measuring imports neither running nor reporting, running imports no reporting."""
+    rules = _stated_rules()
+    assert ("cases/measuring", ["cases/running", "cases/reporting"]) in rules
+    assert ("cases/running", ["cases/reporting"]) in rules
+    g = graph()
+    for room, banned in rules:
+        src, bans = room.replace("/", "."), [b.replace("/", ".") for b in banned]
+        bad = sorted((a, b) for a, bs in g.items() if a.startswith(src + ".") for b in bs
+                     if any(b == x or b.startswith(x + ".") for x in bans))
+        assert bad == [], (room, bad)
+
+
+def test_model_and_reference_never_import_each_others_physics():
+    """model never imports reference; reference takes from model only its mesh, geometry,
+    boundary conditions, material, errors and units (checked above): neither imports the
+    other's physics."""
+    g = graph()
+    assert sorted((a, b) for a, bs in g.items() if layer(a) == "model" for b in bs
+                  if layer(b) == "reference") == []

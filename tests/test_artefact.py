@@ -8,7 +8,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from cases import metrics as M
+from cases.measuring import metrics as M
 from cases.studies.artefact import analysis
 from cases.studies.artefact.study import SPLITS, _free_layers
 
@@ -244,15 +244,15 @@ def test_the_mirror_holds_where_only_the_mirrored_split_alternates(nine_decides)
     tags = a["by_reading"]
     assert {k: v["tag"] for k, v in tags.items()} == {"b": "+", "msm": "+", "b+n": "same"}
     assert tags["b"]["label"] == "+ on 4 of 4 configurations" and len(tags["b"]["mirror"]) == 4
-    assert a["text"].startswith("The period-2 part is the mirror's (a) wherever its source is "
-                                "decided (9 clamped, 9 sliding, 17 clamped, 17 sliding: 8 of 8 "
-                                "resolved parts, none on every split), with the sign of the "
-                                "model: the paper's sign (+) for b, msm")
-    assert "17 sliding: 2 distinct models, 2 resolved, the mirror's 2 (+ 2: b, msm)" \
-        in a["text"]
+    assert a["text"].startswith("Not decided for the paper's own 5-node cube (")
+    assert "Under refinement, a resolved period-2 part is the mirror's wherever its source is " \
+        "decided, and none is on every split (a); provisional" in a["text"]
+    assert "the paper's sign (+): the mirror's in 8 of 8 resolved parts (b, msm; on 9 " \
+        "clamped, 9 sliding, 17 clamped, 17 sliding); the reversed sign (-): no resolved " \
+        "part" in a["text"]
     assert "one mesh per split each, n = 1" in a["text"]
-    assert a["text"].index("mirror's (a)") < a["text"].index("Not decided: the paper's own "
-                                                              "5-node cube")
+    assert a["text"].index("Not decided for the paper's own 5-node cube") < \
+        a["text"].index("mirror's wherever")
     assert "b+n = b (9 clamped, 9 sliding, 17 clamped, 17 sliding)" in a["text"]
 
 
@@ -390,7 +390,8 @@ def test_a_failed_control_is_a_hole_in_that_control_and_every_failed_cell_is_nam
     ans = analysis.answer(world)
     u = _unit(ans, 17, "sliding")
     b = next(r for r in u["rows"] if r["name"] == "b")
-    assert b["kind"] == "own +, the mirror's" and b["ctrls"] == [BCC]
+    assert b["kind"] == "own +, the mirror's (six (Kuhn) failed: read on bcc)"
+    assert b["ctrls"] == [BCC]
     assert b["failed_controls"][0].startswith("six (Kuhn): failed (inverted element: "
                                               "tetrahedron 3")
     clamped = _unit(ans, 17, "clamped")
@@ -658,10 +659,11 @@ def test_the_cause_says_for_how_many_models_the_own_part_is_resolved_on_each_uni
             return 0.0
         return (0.04 if model == "b" else 0.06) if n == 9 else 0.0
     a = analysis.answer(_world(one))
-    assert a["text"].startswith("The period-2 part is the mirror's (a) wherever its source is "
-                                "decided (9 clamped, 9 sliding: 4 of 4 resolved parts")
-    assert "9 sliding: 2 distinct models, 2 resolved, the mirror's 2" in a["text"]
-    assert "17 sliding: 1 distinct models, 0 resolved, not resolved 1" in a["text"]
+    assert "the paper's sign (+): the mirror's in 4 of 4 resolved parts (b, b+n; on 9 " \
+        "clamped, 9 sliding)" in a["text"]
+    assert analysis.mirror_counts(_unit(a, 9, "sliding"))["+"] == ["b", "b+n"]
+    counts = analysis.mirror_counts(_unit(a, 17, "sliding"))
+    assert (counts["of"], counts["resolved"], counts["unresolved"]) == (1, 0, ["b"])
 
 
 def _art(cells, table, verdict):
@@ -675,7 +677,7 @@ def test_the_index_line_is_the_studys_table_and_a_run_without_the_fine_meshes_de
     table (never 'stable matched' where the table says the stability depends on the mesh),
     and its cause line says 'Quick: not decided' where the run lacks the 9- and 17-node
     meshes."""
-    from cases.answers import _cause_numbers, _decisive
+    from cases.reporting.answers import _cause_numbers, _decisive
     rates = {"a": 0.27, "b": 0.0}
     cells = _reading_cells(rates) + [cell("six", SIX, "a", 0.0, bc="clamped",
                                           growth_rate_1_s=8.0)]
@@ -862,8 +864,7 @@ def test_a_resolved_part_below_the_clear_level_answers_the_mirror_and_says_it_is
     u = _unit(a, 17, "sliding")
     assert set(analysis.classes(u)) == {"own +, the mirror's"}
     assert all(r["clear"] == "below" for r in u["rows"] if r["same_as"] is None)
-    assert a["text"].startswith("The period-2 part is the mirror's (a) wherever its source is "
-                                "decided")
+    assert "Under refinement, a resolved period-2 part is the mirror's" in a["text"]
     assert "Large enough to see? On 17 clamped, 17 sliding every model's signature is below " \
         "the clear level 0.01" in a["text"]
     assert "the pattern these runs resolve is not a visible one there" in a["text"]

@@ -6,7 +6,7 @@ import numba
 import pytest
 import numpy as np
 
-from cases import costs
+from cases.reporting import costs
 from cases.tools import bench
 from cases.cli import main
 

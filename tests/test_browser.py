@@ -58,7 +58,7 @@ def _target(url):
 def reports(library, quick_artefact, quick_truthcube, tmp_path_factory):
     """A reports folder as `pbcm report --quick` writes it: the quick cases, the quick
     artefact and truth-cube studies, the index and the glossary."""
-    from cases.index import write_index
+    from cases.reporting.index import write_index
     from cases.registry import CASES
     root = tmp_path_factory.mktemp("reports")
     for name in CASES:

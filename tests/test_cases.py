@@ -7,10 +7,10 @@ import pytest
 
 from conftest import floats_in
 
-from cases import metrics as M
+from cases.measuring import metrics as M
 from cases.cli import main
 from cases.library.paper_cube import LAYERS_MM, SIZE_MM, make_mesh, static_bc
-from cases.report import TIMING_KEYS
+from cases.reporting.report import TIMING_KEYS
 from model import PRESETS, ModelError
 from reference import linear
 
@@ -62,7 +62,7 @@ def test_the_full_setting_repeats_every_dynamic_run_at_a_quarter_of_the_step():
     """repeat_dt4 = "every" (the full run's): a run that comes to rest at dt is run again at
     dt/4, which does not change its verdict; the report says every run was repeated."""
     from cases.library.paper_cube import CASE
-    from cases.runner import run
+    from cases.running.runner import run
     s = CASE.settings(quick=True, repeat_dt4="every", meshes=("five",), bcs=("clamped",),
                       models=("msm",))
     (r,), _ = run(CASE, s, log=False)
@@ -226,7 +226,7 @@ def test_ties_widen_to_the_continuums_spread_over_the_meshes():
     two meshes whose references give 1.0 and 1.1 (spread 0.095 > estimate 0.01) tie errors
     0.10 and 0.15, and the note says the spread set it; where each mesh poses its own
     continuum problem the spread is no uncertainty and the two are not tied."""
-    from cases import rankings
+    from cases.reporting import rankings
     runs = [{"model": m, "mesh": mesh, "bc": "clamped", "q_rel_err": e, "q_mm": 1.0,
              "q_fem_mm": ref, "p2_error_estimate": 0.01}
             for mesh, ref in (("five", 1.0), ("six", 1.1)) for m, e in (("a", 0.10), ("b", 0.15))]
@@ -255,7 +255,7 @@ def test_rankings_keep_populations_apart_and_count_failed_runs():
     ranked on its own, each cell 'median [min-max], n of N runs'; a run that gave no value
     counts against its model as infinitely wrong (ranked, never left out), so a model that
     failed half its runs is never named closest, however small its values."""
-    from cases import rankings
+    from cases.reporting import rankings
     runs = []
     for mesh, (a, b, c) in (("five", (1e-10, 0.02, 0.01)), ("six", (1e-10, 0.04, None))):
         runs += [{"model": "a", "mesh": mesh, "bc": "sliding", "err": a},
@@ -280,7 +280,7 @@ def test_failures_name_every_phase_that_found_no_equilibrium():
     """The failures line says which runs found no equilibrium in the linear regime and which
     at the case's load (where a reference of it exists), and claims 'every model found its
     equilibrium' only of the phases where none failed."""
-    from cases import rankings
+    from cases.reporting import rankings
     ok = {"mesh": "five", "bc": "clamped", "static_failed": None, "finite_failed": None,
           "nh_error_estimate": 0.01}
     runs = [dict(ok, model="a"), dict(ok, model="b", finite_failed="no convergence")]
@@ -330,7 +330,7 @@ def test_energy_norm_of_a_homogeneous_strain_and_of_rigid_motions():
 def test_stiffer_than_fem_is_said_run_by_run():
     """'msm stiffer in torsion' was said of a median though msm was softer on six: a
     statement of direction is made per run."""
-    from cases import rankings
+    from cases.reporting import rankings
     runs = [{"model": "msm", "mesh": "five", "bc": "clamped", "ratio": 1.2},
             {"model": "msm", "mesh": "six", "bc": "clamped", "ratio": 0.63},
             {"model": "fem", "mesh": "five", "bc": "clamped", "ratio": 1.01},
@@ -358,7 +358,7 @@ def test_the_sliding_cube_is_a_patch_test_passed_by_fem_alone(quick):
     nonlinear baselines are off only by the linear regime's own nonlinearity (strains of
     1e-4: about 5e-5), well below the tolerance, and the particle readings' consistency
     errors are above it; the report says which pass."""
-    from cases.metrics import PATCH_TOL
+    from cases.measuring.metrics import PATCH_TOL
     runs = {(r["mesh"], r["model"]): r for r in
             json.loads((quick / "metrics.json").read_text())["runs"] if r["bc"] == "sliding"}
     for mesh in ("five", "six"):
@@ -370,7 +370,7 @@ def test_the_sliding_cube_is_a_patch_test_passed_by_fem_alone(quick):
 
 
 def test_a_wide_table_is_split_and_each_part_keeps_the_row_names():
-    from cases.document import MAX_COLUMNS, Document, _inline_html
+    from cases.reporting.document import MAX_COLUMNS, Document, _inline_html
     d = Document("t")
     d.table(["model"] + [f"m{k}" for k in range(20)], [["a"] + list(range(20))])
     parts = [b for b in d.blocks if b[0] == "table"]
@@ -390,7 +390,7 @@ def test_linearisation_error_is_fem_linear_against_neohookean_p1_per_base():
     neo-Hookean P1 on the same mesh (its model-form error there), one boundary condition at
     a time, beside its total against the reference (which holds P1's discretisation error
     too), never the difference of two norms."""
-    from cases.rankings import _linearisation
+    from cases.reporting.rankings import _linearisation
     runs = [{"mesh": m, "bc": bc, "model": model, "disp_rel_l2_nh": v, "disp_rel_l2_nh_p1": p}
             for m, bc, model, v, p in (("five", "clamped", "fem-linear", 0.1565, 0.01),
                                        ("five", "clamped", "fem-neohookean", 0.1563, 0.0),
@@ -433,7 +433,7 @@ def test_a_profiles_shape_is_read_from_its_second_differences():
 def test_a_line_says_failed_at_the_median_with_the_runs_that_gave_a_number():
     """Where more of a model's runs failed than gave a number, its line gives no median: it
     says 'failed at the median' and lists the numbers the other runs gave."""
-    from cases import rankings
+    from cases.reporting import rankings
     runs = [{"model": m, "mesh": mesh, "bc": "clamped", "err": e, "p2_error_estimate": 0.01}
             for mesh, (a, b) in (("five", (0.1, 0.226)), ("six", (0.1, None)),
                                  ("bcc", (0.1, None)), ("unstructured", (0.1, None)))

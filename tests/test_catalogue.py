@@ -6,8 +6,8 @@ from pathlib import Path
 
 import pytest
 
-from cases import catalogue
-from cases.catalogue import CATALOGUE, DESCRIPTORS, err_name, metric, ref_name
+from cases.measuring import catalogue
+from cases.measuring.catalogue import CATALOGUE, DESCRIPTORS, err_name, metric, ref_name
 from cases.registry import CASES, studies
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -43,7 +43,7 @@ def test_an_undeclared_key_is_caught():
     data = {"runs": [{"mesh": "five", "model": "x", "disp_rel_l2_p2": 0.1,
                       "wobble_index": 3.0}], "gated": {"disp_rel_l2_p2": "max"}}
     assert undeclared(data) == ["wobble_index"]
-    with pytest.raises(KeyError, match="declare it in cases/catalogue.py"):
+    with pytest.raises(KeyError, match="declare it in cases/measuring/catalogue.py"):
         metric("wobble_index")
 
 

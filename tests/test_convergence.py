@@ -11,9 +11,9 @@ import pytest
 from conftest import floats_in
 
 from cases.cli import main
-from cases.costs import step_cost_us
+from cases.reporting.costs import step_cost_us
 from cases.studies.convergence.cost import pareto
-from cases.studies.convergence.fit import EXACT, extrapolate, fit, observed_order
+from cases.studies.convergence.extrapolation import EXACT, extrapolate, fit, observed_order
 from model.mesh import cube
 from reference import linear
 
@@ -86,7 +86,7 @@ def test_the_referees_sequence_still_falls_so_it_is_no_floor():
     by far more than its reference's estimate (2.7e-5): its finest changes do not shrink as a
     power of h: a sequence still falling is not a floor, and without an observed order it has
     neither a limit nor a rate: 'not asymptotic', never 'converges'."""
-    from cases.studies.convergence.fit import still_falling
+    from cases.studies.convergence.extrapolation import still_falling
     e = [0.0101, 0.0059, 0.0040, 0.0028]
     falling, q = still_falling(H4, e, 2.7e-5)
     assert falling and q == pytest.approx(math.log(0.0059 / 0.0028) / math.log(3.0))
@@ -271,7 +271,7 @@ def test_quick_study_passes_the_committed_bounds(study, capsys):
 def test_progress_says_the_time_left_on_a_log(capsys):
     """The one progress display (every command's): a log (not a terminal) gets a line at
     every tenth of the work with the time left, and nothing when told not to log."""
-    from cases.progress import Progress
+    from cases.running.progress import Progress
     with Progress("convergence", 10.0) as t:
         t.advance(4.0, "paper-cube clamped")
         t.advance(0.5, "cantilever clamped")       # within the same tenth: no new line
@@ -362,7 +362,7 @@ def test_fits_that_cannot_lie():
     beyond its uncertainty is 'not asymptotic'), a family that is not self-similar is never
     extrapolated, a stiffness ratio's limit is never at or below zero, and a series whose
     error is not monotone or whose ratio crosses 1 is flagged 'cancellation'."""
-    from cases.studies.convergence.fit import cancellation, fit, ratio_limit
+    from cases.studies.convergence.extrapolation import cancellation, fit, ratio_limit
     # order 0.74 from 1, 0.5, 0.2: Richardson's correction 0.45 overshoots to -0.25 +- 0.56
     f = fit([8.0, 4.0, 2.0], [1.0, 0.5, 0.2])
     assert f.e_inf == 0.0 and f.e_inf_err == pytest.approx(1.25 * 0.45, rel=1e-2)
@@ -425,7 +425,7 @@ def test_round_off_is_never_cancellation():
     place on the cost front (the sliding cube: fem-linear at 2.8e-10 beats a dearer run at
     2.5e-5)."""
     from cases.studies.convergence.cost import judge
-    from cases.studies.convergence.fit import ROUND_LEVEL, cancellation
+    from cases.studies.convergence.extrapolation import ROUND_LEVEL, cancellation
     from cases.studies.convergence.study import fits
     assert ROUND_LEVEL >= EXACT
     assert cancellation([2.83e-10, 2.64e-10, 1.73e-10, 3e-10],
@@ -464,7 +464,7 @@ def test_a_limit_wider_than_the_finest_error_is_not_decided():
     """A limit whose +- exceeds the finest error (times Roache's factor: the band of a clean
     extrapolation to zero) decides nothing: 'not decided', never 'converges' with a number.
     The torsion bar on 'five' with its 8 mm level extrapolated to 0 +- 3."""
-    from cases.studies.convergence.fit import FS_THREE, bounds_nothing
+    from cases.studies.convergence.extrapolation import FS_THREE, bounds_nothing
     from cases.studies.convergence.report import verdict_cell
     f = fit([8.0, 4.0, 2.0, 4.0 / 3.0], [0.00465, 0.00649, 0.00228, 0.00139], u=2.7e-5)
     assert f.verdict == "not decided", f
@@ -482,7 +482,7 @@ def test_a_level_every_model_shares_tests_nothing():
     """A level where every model's error is the same (within SAME_ERROR) while their stiffness
     ratios spread ten times as much tests nothing: it is left out of the fits and the report
     says why; a level where the models differ stays."""
-    from cases.studies.convergence.fit import blind_levels
+    from cases.studies.convergence.extrapolation import blind_levels
     from cases.studies.convergence.report import blind_text
     from cases.studies.convergence.study import fits
     ratios = {"FEM P1": 2.07, "a": 0.98, "b": 2.29, "c": 1.71}
@@ -512,7 +512,7 @@ def test_torsion_at_8_mm_on_five_is_every_models_rigid_turn():
     across and the equilibrium is each section's rigid turn without warping, FEM P1's to
     round-off and msm's (the softest in Poisson's ratio) within 1e-3."""
     from model import build
-    from cases.runner import free_components
+    from cases.running.runner import free_components
     from cases.studies.convergence.problems import PROBLEMS
     from cases.studies.convergence.study import ConvergenceSettings
     s = ConvergenceSettings()
@@ -561,13 +561,13 @@ def test_patch_test_and_consistency_limit_have_distinct_names():
     limit' (the sliding cube's floor) are two numbers with two names: no heading or sentence
     calls one by the other's name; the study defines a fit's floor, the glossary the
     consistency limit, once."""
-    from cases.document import Document
+    from cases.reporting.document import Document
     from cases.studies.convergence.report import definitions
     from cases.studies.convergence.verification_report import _sliding, patch_section
     terms = [d.split(":")[0] for d in definitions()]
     assert "patch test with every boundary node prescribed (patch error)" in terms
     assert "floor e_inf" in terms and "consistency limit" not in terms
-    from cases.index import TERMS
+    from cases.reporting.index import TERMS
     assert "consistency limit" in TERMS
     assert not any("consistency error" in d for d in definitions())
     doc = Document("t")
@@ -584,7 +584,7 @@ def test_patch_test_and_consistency_limit_have_distinct_names():
 def test_a_stiffness_ratio_whose_changes_grow_has_no_limit():
     """A stiffness ratio whose finest change exceeds the one before (0.318, 0.3125, 0.298) is
     not settling: no limit, 'not asymptotic'; one whose changes shrink is extrapolated."""
-    from cases.studies.convergence.fit import ratio_limit
+    from cases.studies.convergence.extrapolation import ratio_limit
     limit, why = ratio_limit([8.0, 4.0, 2.0], [0.318, 0.3125, 0.298])
     assert limit is None and why.startswith("not asymptotic: its finest changes grow")
     limit, err = ratio_limit([8.0, 4.0, 2.0], [0.7, 0.6, 0.55])

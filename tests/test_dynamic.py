@@ -226,7 +226,7 @@ def test_modal_method_names_what_it_needs():
 
 
 def test_mac_of_shapes_and_spaces_worked_by_hand():
-    from cases.metrics import mac
+    from cases.measuring.metrics import mac
     e = np.eye(5)
     assert mac(e[0], e[:1].T) == pytest.approx(1.0)
     assert mac(e[0], e[1:2].T) == pytest.approx(0.0)
@@ -237,7 +237,7 @@ def test_mac_of_shapes_and_spaces_worked_by_hand():
 
 
 def test_pairing_by_shape_skips_a_spurious_mode_and_spans_degenerate_pairs():
-    from cases.metrics import pair_modes
+    from cases.measuring.metrics import pair_modes
     e = np.eye(6)
     f_ref, v_ref = [1.0, 1.0, 2.0, 3.0], e[[0, 1, 2, 3]]
     rot = np.array([e[0] + e[1], e[0] - e[1]]) / np.sqrt(2)   # the pair's space, rotated
@@ -257,7 +257,7 @@ def _orthonormal(n, k, seed=0):
 
 
 def test_a_model_equal_to_the_reference_pairs_every_mode_with_itself():
-    from cases.metrics import pair_modes
+    from cases.measuring.metrics import pair_modes
     f, v = [1.0, 1.0, 1.3, 2.0, 2.0, 2.0, 2.5], _orthonormal(30, 7)
     mass = np.random.default_rng(1).uniform(0.5, 2.0, 10)
     pairs, unpaired = pair_modes(f, v, f, v, mass=mass)
@@ -271,7 +271,7 @@ def test_a_model_equal_to_the_reference_pairs_every_mode_with_itself():
 
 
 def test_a_spurious_mode_stays_unpaired_and_does_not_shift_the_later_pairs():
-    from cases.metrics import pair_modes
+    from cases.measuring.metrics import pair_modes
     e = _orthonormal(30, 7)
     f_ref, v_ref = [1.0, 1.2, 1.5, 2.0, 2.4, 3.0], e[:6]
     f_model = [1.0, 1.2, 1.3, 1.5, 2.0, 2.4, 3.0]           # 1.3: a shape no reference has
@@ -283,7 +283,7 @@ def test_a_spurious_mode_stays_unpaired_and_does_not_shift_the_later_pairs():
 def test_two_mixed_modes_pair_as_one_space_though_their_frequencies_differ():
     """A model's error mixes reference modes a few % apart (FEM P1 those 15 % apart): each
     model mode then matches neither alone (MAC 0.5) but the two together."""
-    from cases.metrics import pair_modes
+    from cases.measuring.metrics import pair_modes
     e = _orthonormal(30, 4)
     f_ref, v_ref = [1.0, 1.05, 1.5, 2.0], e
     mixed = np.array([e[0] + e[1], e[0] - e[1]]) / np.sqrt(2)
@@ -301,10 +301,10 @@ def test_fem_p1_pairs_all_its_modes_with_fem_p2_and_with_itself(family, bc):
     """The modes case's cube: FEM P1 (lumped mass) differs from FEM P2 only by
     discretisation, so every one of its first 10 modes must pair (mesh P2: the old pairing
     left 1 to 3 unpaired on six and bcc clamped and on unstructured)."""
-    from cases.error_model import P1_LINEAR
+    from cases.measuring.error_model import P1_LINEAR
     from cases.library import transient
     from cases.library.modes import CASE, ModesSettings
-    from cases.metrics import pair_modes
+    from cases.measuring.metrics import pair_modes
     s = ModesSettings(fem_refine=0)
     mesh = CASE.mesh(family, s)
     ref = CASE.solve_reference(mesh, bc, s, None)

@@ -5,8 +5,8 @@ import math
 
 import pytest
 
-from cases import error_model as E
-from cases import scorecard
+from cases.measuring import error_model as E
+from cases.reporting import scorecard
 
 
 def test_p1_against_itself_has_no_model_form_error():
@@ -109,7 +109,7 @@ def test_scorecard_decomposes_counts_failures_and_names_identity(tmp_path):
     (never ranked); a model equal to P1 has model-form error 0 and its total is P1's
     discretisation error; a model's failed run
     counts against it while the population stays; a model with a failed median is last."""
-    from cases.index import conclusion, index_documents, populations
+    from cases.reporting.index import conclusion, index_documents, populations
 
     def run(mesh, model, q):
         return {"mesh": mesh, "bc": "clamped", "model": model, "torque_nm": q,
@@ -144,7 +144,7 @@ def test_scorecard_decomposes_counts_failures_and_names_identity(tmp_path):
 
 def test_quick_scorecard_decides_nothing(tmp_path):
     """A quick run's overall ranking says it is not decided and names the command."""
-    from cases.index import conclusion, populations
+    from cases.reporting.index import conclusion, populations
     runs = [{"mesh": "five", "bc": "clamped", "model": m, "torque_nm": q,
              "torque_fem_nm": 1.0} for m, q in (("fem-linear", 1.2), ("a", 1.0))]
     _case_folder(tmp_path, "torsion", runs, quick=True)
@@ -206,7 +206,7 @@ def test_the_quantity_at_the_load_is_the_linear_regimes_on_the_finite_solve():
     run key, against neo-Hookean P1 and the neo-Hookean continuum, posed where that reference
     exists; a quantity already at the load, or a set of modes, has none; the catalogue
     declares both derived keys."""
-    from cases import catalogue
+    from cases.measuring import catalogue
     q = E.at_load(E.Scalar("torque_nm", "torque_fem_nm", "torque"))
     assert (q.key, q.continuum, q.p1, q.posed) == (
         "torque_at_load_nm", "torque_at_load_fem_nm", E.P1_FINITE, "nh_error_estimate")
@@ -249,7 +249,7 @@ def _torsion_runs(values):
 def _three_models(tmp_path, torques):
     """The populations of a synthetic torsion case: fem-linear at 1 and models a, b, c at
     ``torques`` {mesh: (a, b, c)} against a continuum of 1; and the models."""
-    from cases.index import populations
+    from cases.reporting.index import populations
     v = {}
     for mesh, (a, b, c) in torques.items():
         v.update({(mesh, "fem-linear"): 1.0, (mesh, "a"): a, (mesh, "b"): b, (mesh, "c"): c})
@@ -273,7 +273,7 @@ def test_single_runs_are_read_against_their_uncertainty():
     """Errors from one run each say they have no spread over meshes (n = 1), and are read
     against u_val, which for a computed comparison is u_num: differences below it are named
     tied (pair by pair along the order, never chained)."""
-    from cases.answers import _single_runs_u
+    from cases.reporting.answers import _single_runs_u
     assert _single_runs_u([("a", 0.10), ("b", 0.20)], 0.01, "x") == \
         "one run each, so no spread over meshes (n = 1): an order among them holds for this " \
         "mesh only; u_val 0.01, which is u_num here (x; a computed comparison has no " \
@@ -328,7 +328,7 @@ def test_truth_cube_u_val_is_per_model_by_hand():
     the linear reference's), its own half-range over the unmeasured-input variants and the
     beads' noise; a model within it is named, and models
     closer than the larger u_val are tied."""
-    from cases.answers import validation
+    from cases.reporting.answers import validation
     rows = [{"mesh": "10mm", "variant": var, "model": m, "strain": 0.2, "bead_rms_mm": v}
             for m, vals in {"a": (1.0, 1.6), "b": (0.3, 0.3)}.items()
             for var, v in zip(("bonded", "nu=0.49"), vals)]
@@ -349,7 +349,7 @@ def test_truth_cube_u_val_is_per_model_by_hand():
 def test_consistency_limits_closer_than_their_uncertainty_are_tied():
     """Limits are tied when they differ by less than sqrt(u_a^2 + u_b^2), pair by pair: a
     model tied with each of two models resolved from each other shares a group with each."""
-    from cases.answers import _limit_ties
+    from cases.reporting.answers import _limit_ties
     lims = [("a", (0.19, 0.03)), ("b", (0.192, 0.004)), ("c", (0.59, 0.08)), ("d", (0.9, 0.01))]
     assert _limit_ties(lims) == " (tied within their +-: a, b)"
     assert _limit_ties(lims[2:]) == ""
@@ -361,7 +361,7 @@ def test_consistency_limit_reads_the_stiffness_the_displacement_is_blind_to():
     """On the sliding cube the top displacement is prescribed, so a model can match the shape
     while half as stiff: its consistency limit on a lattice is the larger of its displacement
     limit and its stiffness limit |ratio_inf - 1|, each with its fit's +-, and says which."""
-    from cases.answers import _limit_text, _worst_limit, limits, worst
+    from cases.reporting.answers import _limit_text, _worst_limit, limits, worst
     fit = {"case": "paper-cube", "bc": "sliding", "model": "m", "verdict": "floor"}
     conv = {"fits": [
         {**fit, "mesh": "five", "e_inf": 0.03, "e_inf_err": 0.002, "ratio_inf": 0.45,
@@ -384,8 +384,8 @@ def test_what_to_pick_is_computed_and_names_what_is_not_decided(tmp_path, monkey
     model pays, the closest approximation in the linear regime, and 'not decided' at finite
     load where one mesh reverses the order, with the candidates' failures at a case's load;
     a locking-prone population is left out of the ranking and named."""
-    from cases.answers import _cost_of_replacing, recommendation
-    from cases.index import populations
+    from cases.reporting.answers import _cost_of_replacing, recommendation
+    from cases.reporting.index import populations
     from cases.library.large_compression import CASE as LARGE
     monkeypatch.setattr(type(LARGE), "locking_prone", ())
     lin = {}
@@ -429,8 +429,8 @@ def test_what_to_pick_is_computed_and_names_what_is_not_decided(tmp_path, monkey
     assert ("failed runs in the populations left out (failures all the same): b 1 of 2 in "
             "large-compression/clamped") in said
     # and in b's cell of the summary table, beside its standing
-    from cases.answers import _overall_cell
-    from cases import scorecard
+    from cases.reporting.answers import _overall_cell
+    from cases.reporting import scorecard
     cell = _overall_cell(scorecard.overall(locked, ["a", "b"], True), "b", locked, True, {})
     assert cell.endswith("failed outside the ranking: 1 of 2 in large-compression/clamped")
 
@@ -441,7 +441,7 @@ def test_no_equilibrium_at_a_linear_cases_load_is_a_failed_run_of_its_load_popul
     equilibrium there has a failed run in it, counted once as infinitely wrong in that
     population's rank (never moved again after the rest), and its entry counts the failures; a mesh where the reference failed poses no
     comparison and is no model's failure."""
-    from cases.index import populations
+    from cases.reporting.index import populations
 
     def at_load(r):
         ok = r["model"] != "a"
@@ -487,7 +487,7 @@ def test_each_case_weighs_one_in_the_overall_ranking(tmp_path):
     """Two boundary conditions of one case are averaged before the cases are: a model first
     on both bcs of one case and last on one other case has the mean rank (1 + 2) / 2, not
     (1 + 1 + 2) / 3, and its geometric mean is over the cases' geometric means."""
-    from cases.index import populations
+    from cases.reporting.index import populations
     runs = []
     for bc in ("clamped", "sliding"):
         runs += [dict(r, bc=bc) for r in _torsion_runs({("five", "fem-linear"): 1.0,
@@ -509,7 +509,7 @@ def test_geometric_mean_range_leaves_one_mesh_family_out(tmp_path):
     """The geometric mean's range is its smallest and largest value over the rankings that
     leave one mesh family out: a's model-form errors 0.1 (five), 0.3 (six), 0.2 (bcc) give
     the medians 0.25, 0.15, 0.2 without five, bcc, six."""
-    from cases.index import populations
+    from cases.reporting.index import populations
     v = {}
     for mesh, a in {"five": 1.1, "six": 1.3, "bcc": 1.2}.items():
         v.update({(mesh, "fem-linear"): 1.0, (mesh, "a"): a})
@@ -523,7 +523,7 @@ def test_geometric_mean_range_leaves_one_mesh_family_out(tmp_path):
 def test_cost_ratio_is_the_in_round_step_ratio_times_the_stable_steps_with_its_range():
     """A simulated second's cost over fem-linear's is the in-round step ratio (2, rounds 1.5
     to 3) times fem-linear's stable step over the model's (10 / 5 us): 4 [3-6]."""
-    from cases.answers import ratio_text, sim_ratio
+    from cases.reporting.answers import ratio_text, sim_ratio
     fl = {"model": "fem-linear", "stable_dt_us": 10.0, "cpu_s_per_simulated_s": 1.0}
     row = {"model": "a", "stable_dt_us": 5.0, "cpu_s_per_simulated_s": 3.9,
            "step_vs_fem-linear": 2.0, "step_vs_fem-linear_range": [1.5, 3.0]}
@@ -537,7 +537,7 @@ def test_a_total_with_unpaired_continuum_modes_ranks_after_one_without():
     """Against the continuum too an unpaired mode is a failed mode: a model whose paired
     frequencies are closest (0.03) but that left 9 continuum modes unpaired ranks after one
     that paired every mode (0.2), in the scorecard's total and in the case's own table."""
-    from cases import rankings
+    from cases.reporting import rankings
     q = E.Norm("mf", "tot", "modes", unpaired="lost", unpaired_total="lost_c", count=10)
     run = {"mesh": "six", "bc": "free"}
     runs = [dict(run, model="fem-linear", mf=0.0, tot=0.05, lost=0, lost_c=0),
@@ -566,7 +566,7 @@ def test_truth_cube_u_input_adds_each_unmeasured_inputs_half_range_in_quadrature
     """u_input combines the inputs apart: plate 1.6 vs 1.8 (half range 0.1), travel 1.6 vs
     1.6 (0) and nu 1.3 to 2.0 (0.35) give sqrt(0.1^2 + 0.35^2), not the half range 0.35 of
     every variant pooled."""
-    from cases.error_model import input_spread
+    from cases.measuring.error_model import input_spread
     variants = {"bonded": ("bonded", "nominal", 0.499), "frictionless": ("free", "nominal", 0.499),
                 "fitted": ("bonded", "fitted", 0.499), "nu-": ("bonded", "nominal", 0.49),
                 "nu+": ("bonded", "nominal", 0.4999)}
@@ -623,7 +623,7 @@ def test_the_index_names_a_model_whose_forces_do_not_balance(tmp_path):
     """A model whose net internal force or torque exceeds round-off (1e-8 of its forces'
     sum) in some run is named with its largest value and where, even a small 1e-6; models
     that balance both to round-off are not."""
-    from cases.answers import _imbalance
+    from cases.reporting.answers import _imbalance
     runs = [{"mesh": "five", "bc": "clamped", "model": "a", "net_force_rel": 0.2},
             {"mesh": "six", "bc": "clamped", "model": "a", "net_force_rel": 0.05},
             {"mesh": "five", "bc": "clamped", "model": "c", "net_force_rel": 1e-6},
@@ -665,7 +665,7 @@ def test_how_far_names_the_problems_beyond_the_patch_test_where_a_model_diverges
     model, the convergence fits of the other problems that diverge or stop at a floor (the
     sliding cube's own fits are not counted twice, nor a two-level fit, nor one the study
     calls not resolved)."""
-    from cases.answers import _beyond_the_patch
+    from cases.reporting.answers import _beyond_the_patch
     fits = [dict(f, levels=4) for f in (
             {"case": "cantilever", "bc": "clamped", "mesh": "six", "model": "a",
              "verdict": "diverges"},
@@ -690,7 +690,7 @@ def test_the_finest_level_is_said_per_lattice_with_its_own_ties():
     """Where no limit exists, each lattice's finest-level errors are listed under its name,
     only for the models without a limit there, and ties are read within one lattice, never
     across two."""
-    from cases.answers import _finest
+    from cases.reporting.answers import _finest
     runs = [{"case": "paper-cube", "bc": "sliding", "mesh": mesh, "model": m, "h_mm": h,
              "disp_rel_l2": e}
             for mesh, vals in (("bcc", {"a": 0.09, "b": 0.0900001, "c": 0.3}),
@@ -721,8 +721,8 @@ def test_the_finest_level_is_said_per_lattice_with_its_own_ties():
 def test_a_quick_index_table_decides_no_verdict(tmp_path):
     """A quick run's table says 'quick: not decided' for the model-form rankings and whether
     the runs come to rest, never a number the full run could contradict."""
-    from cases.answers import QUICK_CELL, table
-    from cases.index import populations
+    from cases.reporting.answers import QUICK_CELL, table
+    from cases.reporting.index import populations
     _case_folder(tmp_path, "torsion", _torsion_runs({(mesh, m): v for mesh in ("five", "six")
                                                      for m, v in (("fem-linear", 1.2),
                                                                   ("a", 1.1))}))
@@ -737,8 +737,8 @@ def test_how_finite_each_load_is_reads_the_linear_laws_error_at_the_load(tmp_pat
     """Each population at finite load is named with the linear law's model-form error there:
     within 0.05 a nearly linear response, the linear regime's observation again, which the
     finite-load ranking does not pool; beyond it a finite one, which it does."""
-    from cases.answers import _how_finite
-    from cases.index import populations
+    from cases.reporting.answers import _how_finite
+    from cases.reporting.index import populations
 
     def at_load(r, lin):
         mf = {"fem-neohookean": 0.0, "fem-linear": lin, "a": 0.2}[r["model"]]
@@ -796,7 +796,7 @@ def test_a_locking_prone_case_names_no_closest_model():
 def test_the_scorecard_names_failures_against_the_continuum_too():
     """A run that fails against the continuum alone (a continuum mode left unpaired, its
     model-form number intact) is named among the failed runs of the scorecard's conclusion."""
-    from cases.index import conclusion
+    from cases.reporting.index import conclusion
     q = E.Norm("mf", "tot", "modes", unpaired="lost", unpaired_total="lost_c", count=10)
     run = {"mesh": "six", "bc": "free"}
     runs = [dict(run, model="fem-linear", mf=0.0, tot=0.05, lost=0, lost_c=0),
@@ -816,7 +816,7 @@ def test_a_failed_check_outside_the_rankings_is_named_in_the_index():
     """A case's own check that failed (a '<check>_failed' run key no population counts) is
     named in the index with its model, case, mesh and bc; the ranked phases' failures are
     left to the rankings; with none failed the line says none."""
-    from cases.index import failed_checks
+    from cases.reporting.index import failed_checks
     runs = [{"model": "msm", "mesh": "bcc", "bc": "clamped", "homogeneous_failed": "no root",
              "static_failed": "x", "failed": None},
             {"model": "a", "mesh": "six", "bc": "clamped", "homogeneous_failed": None}]
@@ -829,7 +829,7 @@ def test_a_studys_failed_run_is_named_in_the_index():
     """A study's run that gave no number (a control of the artefact study, say) is named in
     the index's failure line with its study, mesh, bc and the failure's first clause; a study
     without failures says none."""
-    from cases.index import failed_checks
+    from cases.reporting.index import failed_checks
     cells = [{"model": "pbcm-balanced", "mesh": "six-17", "bc": "sliding",
               "failed": "tetrahedron 3 is inverted; reduce the load step"},
              {"model": "msm", "mesh": "six-17", "bc": "sliding", "failed": None}]
@@ -877,7 +877,7 @@ def test_an_order_is_broken_into_the_groups_it_resolves():
     """The ranked order is said as groups split only where every model before the split is
     resolved from every model after it (a, c loose puts b between them in the group), and
     an order with no such split says so."""
-    from cases.answers import _resolved_groups
+    from cases.reporting.answers import _resolved_groups
     order = ["a", "b", "c", "d", "e"]
     assert _resolved_groups(order, {("a", "c"), ("d", "e")}) == (
         " (resolved: {a, b, c} before {d, e}; within a group, not every pair resolved)")
@@ -893,7 +893,7 @@ def test_a_contender_whose_cost_range_lies_below_the_firsts_is_the_cheaper_pick(
     """Among the first and the models it is not resolved from, one whose cost per simulated
     second (its range over the bench's rounds) lies wholly below the first's is named the
     cheaper pick; overlapping ranges name none."""
-    from cases.answers import _cheaper_contender
+    from cases.reporting.answers import _cheaper_contender
     def row(m, r, lo, hi):
         return {"model": m, "stable_dt_us": 1.0, "cpu_s_per_simulated_s": r,
                 "step_vs_fl": r, "step_vs_fl_range": [lo, hi]}
@@ -941,7 +941,7 @@ def test_a_growing_stiffness_error_bounds_the_limit_and_fems_nonlinearity_is_no_
     extrapolated limit but bounds the lattice's from below: at least its finest value, +-
     1.25 x its last change; FEM's stiffness at the reference's own level is no limit; a
     stiffness bound beside a displacement with no limit names the displacement's verdict."""
-    from cases.answers import _no_limit, limits
+    from cases.reporting.answers import _no_limit, limits
     fit = {"case": "paper-cube", "bc": "sliding", "model": "m"}
     conv = {"fits": [
         {**fit, "mesh": "six", "verdict": "floor", "e_inf": 0.19, "e_inf_err": 0.004,

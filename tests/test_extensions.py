@@ -10,7 +10,7 @@ from cases.studies.extensions import STUDY
 from cases.studies.extensions import report as R
 from cases.studies.extensions.study import BASE, CANDIDATES, YARDSTICK, short
 from cases.registry import CASES
-from cases.runner import reaction_along, reference
+from cases.running.runner import reaction_along, reference
 from model import build
 from model.terms.shear import Shear
 
@@ -235,7 +235,7 @@ def test_fit_refuses_before_computing(args, said, tmp_path, capsys):
 def test_fit_reports_the_worst_change_on_the_cases_left_out():
     """An rms of 0.0325 -> 0.05 can hide one left-out problem going from 0.0325 to 0.186:
     the worst factor is named beside it; a problem that fails after the fit is the worst."""
-    from cases.studies.fit import worst_change
+    from cases.cli.fitting import worst_change
     rows = [{"problem": "a", "before": 0.0325, "after": 0.186},
             {"problem": "b", "before": 0.2, "after": 0.01}]
     w = worst_change(rows)

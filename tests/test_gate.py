@@ -201,7 +201,7 @@ def test_malformed_or_missing_gold_exits_2(blessed, tmp_path, name, text, word, 
 
 
 def test_the_band_is_two_sided_for_either_sign():
-    from cases.gate import Bound
+    from cases.running.gate import Bound
     for value in (-0.6, 0.6):
         for direction in ("min", "max"):
             b = Bound("c", "quick", "m", "b", "x", "alternation_rel", value, 0.1, 0.0, direction)
@@ -360,7 +360,7 @@ def test_only_a_dead_runs_staging_folder_is_stale(tmp_path):
     import socket
     import subprocess
     import sys
-    from cases.output import stale_staging, staging_prefix
+    from cases.running.output import stale_staging, staging_prefix
     target = tmp_path / "paper-cube"
     mine = tmp_path / (staging_prefix(target) + "abc")
     dead = subprocess.run([sys.executable, "-c", "import os; print(os.getpid())"],

@@ -5,7 +5,7 @@ import numpy as np
 
 from cases.library.indentation import (CASE, DEPTH_MM, PATCH_MM, RIM_MM, SIZE_MM, in_patch,
                                        punch)
-from cases.runner import reaction_along
+from cases.running.runner import reaction_along
 from reference import linear
 from reference.linear import dof_component
 from reference.discretisation import Region

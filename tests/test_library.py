@@ -12,10 +12,10 @@ import pytest
 from conftest import floats_in
 
 from cases.cli import main
-from cases import catalogue
+from cases.measuring import catalogue
 from cases.framework import Case, Settings
 from cases.registry import CASES
-from cases.report import TIMING_KEYS
+from cases.reporting.report import TIMING_KEYS
 from model.errors import MeshError
 from model.loads import body_forces, traction_forces
 from model.mesh import box, cube
@@ -201,7 +201,7 @@ def test_cantilever_metrics_carry_the_issue_fields(library):
 
 
 def test_scorecard_index(library):
-    from cases.index import index_documents
+    from cases.reporting.index import index_documents
     md, html = index_documents(library, list(CASES))
     assert md.split("\n\n")[1].startswith("**Which reading?**")
     answers = md.split("## Scorecard")[0]
@@ -237,8 +237,8 @@ class Broken(Case):
 
 
 def test_a_failed_mesh_is_recorded_and_the_case_goes_on(tmp_path):
-    from cases.report import write_case
-    from cases.runner import run
+    from cases.reporting.report import write_case
+    from cases.running.runner import run
     case = Broken()
     s = case.settings()
     runs, fields = run(case, s, log=False)

@@ -14,7 +14,7 @@ import numpy as np
 import pytest
 
 from cases.cli import main
-from cases.error_model import ROUND_OFF
+from cases.measuring.error_model import ROUND_OFF
 from cases.library.problem import EXAMPLE_MESH, ProblemError, case_of, load, template
 from cases.library.problem.case import on_triangles
 from cases.library.problem.spec import KEYS
@@ -236,11 +236,11 @@ def test_a_bad_spec_is_refused_before_computing_naming_the_key(old, new, key, tm
     is not a length, a mesh file that does not exist, a clashing name, free rigid motions...)
     is one line `pbcm: error: FILE: KEY: ...` with exit status 2, before any computing and
     without an output folder."""
-    import cases.runner
+    import cases.running.runner
 
     def computing(*args, **kw):
         raise AssertionError("the run started computing")
-    monkeypatch.setattr(cases.runner, "run", computing)
+    monkeypatch.setattr(cases.running.runner, "run", computing)
     text = EXAMPLE.read_text()
     assert old in text
     text = text.replace(old, new, 1).replace('file = "cylinder.msh"',

@@ -15,8 +15,8 @@ def test_readme_worked_example_case_runs_and_matches_uniaxial_stretch(tmp_path):
     module = types.ModuleType("plate")
     exec(compile(code, "README.md", "exec"), module.__dict__)
     case = module.CASE
-    from cases.report import write_case
-    from cases.runner import run
+    from cases.reporting.report import write_case
+    from cases.running.runner import run
     s = case.settings(quick=True, models=("pbcm-variational", "msm"))
     runs, fields = run(case, s, log=False)
     assert all(r["failed"] is None and r["static_failed"] is None for r in runs)

@@ -9,7 +9,7 @@ import pytest
 
 from cases.framework import LINEAR_STRAIN, linear_scale
 from cases.library.paper_cube import CASE, PUSH_MM, SIZE_MM
-from cases.runner import finite_metrics, linear_regime, reference, static_metrics
+from cases.running.runner import finite_metrics, linear_regime, reference, static_metrics
 from model import Material
 from model.bc import bc_arrays
 from model.errors import ModelError

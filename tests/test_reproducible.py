@@ -1,8 +1,8 @@
 """Reports that any machine reproduces: a value at round-off is printed as such and never
 decides a tie or a rank; a blow-up is said by its time, not by the step a processor's
 arithmetic reached the bound at."""
-from cases.document import rel
-from cases.error_model import ROUND_OFF, standings
+from cases.reporting.document import rel
+from cases.measuring.error_model import ROUND_OFF, standings
 
 
 def test_round_off_is_printed_as_such_and_ties():

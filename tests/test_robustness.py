@@ -12,9 +12,9 @@ import meshio
 import numpy as np
 import pytest
 
-from cases import runner
+from cases.running import runner
 from cases.cli import main
-from cases.output import StagedFolder, OutputError
+from cases.running.output import StagedFolder, OutputError
 from model.errors import ConvergenceError, MeshError
 from model.mesh import cube, read
 
@@ -345,7 +345,7 @@ def test_bless_refuses_a_bad_margin(margin, small_run, tmp_path, capsys):
 def test_bless_keeps_unseen_rows_and_the_policy_unless_told(small_run, tmp_path, capsys,
                                                            monkeypatch):
     import tempfile
-    from cases.gate import load
+    from cases.running.gate import load
     monkeypatch.setattr(tempfile, "tempdir", str(tmp_path / "tmp"))
     (tmp_path / "tmp").mkdir()
     g = tmp_path / "g"
@@ -426,7 +426,7 @@ def test_after_a_stop_a_finaliser_cut_off_half_way_is_not_reported(monkeypatch, 
     landed while numba compiled) prints nothing after the one-line message; other unraisable
     exceptions are still reported."""
     import gc
-    from cases import stop
+    from cases.running import stop
     seen = []
     monkeypatch.setattr(sys, "unraisablehook", seen.append)
     stop.quiet_finalisers()
@@ -447,7 +447,7 @@ def test_the_progress_bar_keeps_its_numbers_at_80_columns(monkeypatch):
     percentage, the time spent and the time left keep their room."""
     import io
     from rich.console import Console
-    from cases import progress
+    from cases.running import progress
     monkeypatch.setattr(progress, "Console", lambda stderr: Console(
         file=io.StringIO(), width=80, force_terminal=True))
     p = progress.Progress("paper-cube", 10, width=56)
@@ -460,7 +460,7 @@ def test_a_stress_panels_scale_is_robust_to_one_slivers_spike(tmp_path, monkeypa
     """The stress figure's colour scale is the 99th percentile of max |tau|, not its maximum:
     one tetrahedron with a spike 1000 times the rest leaves the scale near the rest's, and
     the colour bar says which percentile."""
-    from cases import figures
+    from cases.reporting import figures
     mesh = cube(4, 0.032, "five")
     tau = np.full(mesh.n_tets, 1e3)
     tau[0] = 1e6
@@ -478,9 +478,9 @@ def test_a_signal_inside_numba_or_llvmlite_is_recorded_and_raised_at_the_next_ch
     can leave LLVM objects half-freed) is recorded, not raised there; the next checkpoint
     raises it. Elsewhere it raises at once."""
     import types
-    from cases import stop
+    from cases.running import stop
     native = types.SimpleNamespace(f_globals={"__name__": "llvmlite.binding.ffi"}, f_back=None)
-    own = types.SimpleNamespace(f_globals={"__name__": "cases.runner"}, f_back=None)
+    own = types.SimpleNamespace(f_globals={"__name__": "cases.running.runner"}, f_back=None)
     with stop.handling():
         stop._handler(signal.SIGINT, native)            # recorded only
         with pytest.raises(KeyboardInterrupt):

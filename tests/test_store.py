@@ -14,7 +14,7 @@ from pathlib import Path
 
 import pytest
 
-from cases import runner, store as S
+from cases.running import runner, store as S
 from cases.cli import main
 from cases.registry import CASES
 
@@ -107,7 +107,7 @@ def _tree(tmp_path):
 
 
 @pytest.mark.parametrize("edited", ["model/terms/shear.py", "reference/linear.py",
-                                    "cases/runner.py", "cases/studies/sweeps/nu.toml"])
+                                    "cases/running/runner.py", "cases/cli/sweeps/nu.toml"])
 def test_a_change_to_any_source_file_misses_every_entry(tmp_path, edited):
     root = _tree(tmp_path)
     before = S.source_hash(root)
@@ -170,7 +170,7 @@ def test_keys_depend_on_what_determines_a_result():
 KILLED = textwrap.dedent("""
     import sys, time
     import diskcache.core
-    from cases.store import RunStore
+    from cases.running.store import RunStore
     real = diskcache.core.Disk.store
     def store_then_hang(self, value, read, key=diskcache.core.UNKNOWN):
         out = real(self, value, read, key)      # the value's file is on disk ...
@@ -324,7 +324,7 @@ def test_cache_info_counts_kinds_and_stale_entries_and_clear_stale_keeps_the_cur
     """`pbcm cache info` prints the store's size, cap and entries by kind, counting as stale
     the entries computed under another source; `clear --stale` removes those only, `clear`
     every entry; each entry expires KEEP_DAYS after it was stored or last found."""
-    from cases import store as S
+    from cases.running import store as S
     from cases.cli import main
     monkeypatch.setenv(S.ENV, str(tmp_path / "store"))
     monkeypatch.delenv(S.ENV_KINDS, raising=False)       # every kind kept
@@ -354,7 +354,7 @@ def test_the_store_cap_is_diskcaches_lru_eviction_and_a_bad_cap_is_refused(tmp_p
     """The store is capped by diskcache's own least-recently-used eviction at
     $PBCM_CACHE_SIZE_GB (default SIZE_GB); a cap that is not a number > 0 is refused with a
     message naming the variable, before anything runs."""
-    from cases import store as S
+    from cases.running import store as S
     from cases.cli import main
     assert S.settings() == {"size_limit": int(S.SIZE_GB * 2 ** 30),
                             "eviction_policy": "least-recently-used"}

@@ -13,7 +13,7 @@ import pytest
 
 from cases.cli import main
 from cases.registry import CASES
-from cases.studies.sweeps import engine, report, spec as specs, table
+from cases.cli.sweeps import engine, report, spec as specs, table
 
 SMALL = """
 title = "small"
@@ -361,7 +361,7 @@ def test_the_shipped_spec_parses_and_names_every_model(capsys):
     assert "nu (sweep, pbcm sweep nu): Every model on the paper cube over Poisson's ratio" \
         in listed
     assert "sweep axes: resolution: nodes per side (nodes_per_side); load: push [mm]" in listed
-    s = specs.load(Path(__file__).resolve().parents[1] / "cases" / "studies" / "sweeps"
+    s = specs.load(Path(__file__).resolve().parents[1] / "cases" / "cli" / "sweeps"
                    / "nu.toml", CASES)
     assert s.axes["nu"] == [0.0, 0.1, 0.2, 0.3, 0.4, 0.45, 0.49]
     assert s.axes["model"] == list(CASES["paper-cube"].models)
@@ -378,7 +378,7 @@ def test_case_knobs_name_settings_the_case_reads():
                 v = getattr(case.settings(), knob.field)
                 turned = case.settings(**{knob.field: 2 * v}).problem()
                 assert turned != case.settings().problem(), (case.name, knob.field)
-    from cases import runner
+    from cases.running import runner
     case = CASES["paper-cube"]
     force = []
     for push in (1.7, 3.4):
@@ -416,7 +416,7 @@ def test_a_task_no_worker_finishes_is_lost_for_this_sweep_only(serial, tmp_path)
 
 def test_the_gate_does_not_read_a_sweeps_runs(serial, tmp_path):
     """A sweep folder under reports/ holds runs/<key>/metrics.json: rows, not case metrics."""
-    from cases import gate
+    from cases.running import gate
     root = tmp_path / "reports"
     import shutil
     shutil.copytree(serial[1], root / "sweeps" / "small")

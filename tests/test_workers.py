@@ -11,7 +11,7 @@ import pytest
 
 from cases.cli import main
 from conftest import _run, shared
-from cases.workers import Cluster, Workers, WorkerLost, RETRIES
+from cases.running.workers import Cluster, Workers, WorkerLost, RETRIES
 
 # two units (a mesh each) of the case with the cheapest references, their static solves,
 # modal problems and figures: what an executor must hand out and collect in order
@@ -51,7 +51,7 @@ def test_scheduler_and_workers_together_are_refused_before_computing(capsys, tmp
 
 
 def test_an_unreachable_scheduler_is_one_line(capsys, tmp_path, monkeypatch):
-    from cases import workers
+    from cases.running import workers
     monkeypatch.setattr(workers, "CONNECT_TIMEOUT_S", 1)     # nothing answers port 9
     assert main(["run", "cantilever", "--quick", "--scheduler", "tcp://127.0.0.1:9",
                  "--out", str(tmp_path / "c")]) == 2
@@ -149,7 +149,7 @@ def test_a_stopped_run_leaves_no_worker_behind(sig, status, tmp_path):
 
 
 def _reports_twice(x):
-    from cases.workers import tick
+    from cases.running.workers import tick
     tick(x, "half")
     tick(x, "all")
     return x
@@ -158,7 +158,7 @@ def _reports_twice(x):
 def test_a_local_pool_passes_a_units_progress_to_the_parent_as_it_runs():
     """What a unit reports while it runs (``tick``) reaches ``on_tick`` in the parent, every
     report of every unit, before its result is handed out."""
-    from cases.workers import Workers
+    from cases.running.workers import Workers
     seen = []
     with Workers(2) as w:
         for x in w.unordered(_reports_twice, [1, 2, 3], lambda *news: seen.append(news)):

@@ -13,7 +13,7 @@ import sys
 import model
 import model.terms
 from model.errors import PbcmError
-from .. import stop
+from ..running import stop
 from . import (bench, bless, cache, check, fit, index, listing, mesh, problem, report, run,
                sweep)
 from .common import Parser, UsageError

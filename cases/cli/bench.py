@@ -1,7 +1,7 @@
 """`pbcm bench`: what every model costs."""
 from pathlib import Path
 
-from ..output import StagedFolder
+from ..running.output import StagedFolder
 from .common import UsageError, add_term_files, chosen_models, number
 import model
 
@@ -47,7 +47,7 @@ def check_device(device):
 
 
 def run(args):
-    from .. import costs
+    from ..reporting import costs
     from ..tools import bench
     models = chosen_models(args.models, list(model.PRESETS))
     sizes = args.sizes or (bench.QUICK_SIZES if args.quick else bench.SIZES)

@@ -2,7 +2,7 @@
 import sys
 from pathlib import Path
 
-from ..output import StagedFolder, writable_folder, write_atomic
+from ..running.output import StagedFolder, writable_folder, write_atomic
 from .common import add_selection, number
 from .pipeline import configs, run_everything
 
@@ -43,7 +43,8 @@ def run(args):
     policy keeps the full-mode gold. What it keeps: gold rows of runs it did not see (other
     modes, meshes, models...) unless ``--prune``."""
     import tempfile
-    from ..gate import COMPACT_MODES, POLICY, CheckError, Gold, Policy, bless, load, measured
+    from ..running.gate import (COMPACT_MODES, POLICY, CheckError, Gold, Policy, bless, load,
+                                measured)
     folder = Path(args.gold)
     if not args.metrics and not args.run:
         print("pbcm bless: error: nothing to bless: give --metrics DIR (metrics already "
@@ -92,7 +93,7 @@ def _write_gold(folder, old, new, values, changes, root):
     """Write the compact gold files (atomically, each), the policy when it changed, and
     install the case folders of full-mode metrics where the full-mode gold lives."""
     import shutil
-    from ..gate import COMPACT_MODES, POLICY, compact_files, policy_text
+    from ..running.gate import COMPACT_MODES, POLICY, compact_files, policy_text
     files = compact_files(new)
     for name, text in files.items():
         path = folder / name

@@ -21,7 +21,7 @@ def add(sub):
 
 
 def run(args):
-    from ..store import RunStore
+    from ..running.store import RunStore
     store = RunStore()
     if not store.enabled:
         raise UsageError("the run store is off (PBCM_NO_CACHE is set): unset it to see it")

@@ -1,4 +1,4 @@
-"""`pbcm check`: measured metrics against the gold values (cases.gate)."""
+"""`pbcm check`: measured metrics against the gold values (cases.running.gate)."""
 import sys
 from pathlib import Path
 
@@ -48,8 +48,8 @@ LEGEND = ("margin: how far inside its band a value is, as a fraction of the band
 
 
 def run(args):
-    from ..gate import NEW, CheckError, check, flip_message, load, measured
-    from ..output import OutputError, writable_folder
+    from ..running.gate import NEW, CheckError, check, flip_message, load, measured
+    from ..running.output import OutputError, writable_folder
     try:
         if args.junit:      # before comparing anything
             if Path(args.junit).is_dir():
@@ -104,7 +104,7 @@ def _write_junit(path, v, flip_message):
     """The verdict as JUnit XML: one test case per gated value (its class the run, its name
     the metric), a failure for each value out of its band or flipped to or from n/a."""
     import xml.etree.ElementTree as ET
-    from ..output import write_atomic
+    from ..running.output import write_atomic
     suite = ET.Element("testsuite", name="pbcm check", tests=str(len(v.rows) + len(v.flips)),
                        failures=str(sum(not ok for _, _, ok in v.rows) + len(v.flips)))
     for b, value, ok in v.rows:

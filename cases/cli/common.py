@@ -7,7 +7,7 @@ import re
 from pathlib import Path
 
 import model
-from ..output import StagedFolder  # noqa: F401 (the commands' staging)
+from ..running.output import StagedFolder  # noqa: F401 (the commands' staging)
 
 
 class Parser(argparse.ArgumentParser):
@@ -109,8 +109,8 @@ def study_config(study, args):
 def run_study_into(study, cfg, folder, workers=None, store=None):
     """Run ``study`` and write its files into ``folder``; the step costs come from the bench
     beside the folder (reports/bench), or the checkout's."""
-    from .. import costs
-    from ..store import OFF
+    from ..reporting import costs
+    from ..running.store import OFF
     data = costs.load(Path(folder).parent)
     study.write(folder, cfg, study.run(cfg, workers=workers, bench=data, store=store or OFF))
 
@@ -131,9 +131,9 @@ def run_case_into(name, cfg, folder, workers=None, store=None):
 
 def case_into(case, cfg, folder, workers=None, store=None):
     """Run ``case`` (a Case, of the library or a user's problem) as ``run_case_into``."""
-    from ..report import write_case
-    from ..runner import run
-    from ..store import OFF
+    from ..reporting.report import write_case
+    from ..running.runner import run
+    from ..running.store import OFF
     runs, fields = run(case, cfg, workers=workers, store=store or OFF)
     write_case(folder, case, cfg, runs, fields)
     return runs
@@ -144,7 +144,7 @@ def worker_pool(args, cfgs):
     ``--workers`` local processes; nothing to start for one worker or one unit in every case
     (a worker runs one mesh of a case with all its bcs, or one problem and bc of a study)."""
     from contextlib import nullcontext
-    from ..workers import executor
+    from ..running.workers import executor
     units = max(c.units for c in cfgs.values())
     return executor(getattr(args, "scheduler", None), args.workers, units) or nullcontext()
 
@@ -169,7 +169,7 @@ def check_executor(args):
 
 def run_store(args):
     """The run store a command reads and fills (``--no-cache``: none)."""
-    from ..store import RunStore, settings
+    from ..running.store import RunStore, settings
     store = RunStore(enabled=not getattr(args, "no_cache", False))
     if store.enabled:
         settings()          # its cap, checked before anything runs

@@ -1,7 +1,7 @@
 """`pbcm fit`: a model's constants fitted to the FEM references of chosen cases."""
 from pathlib import Path
 
-from ..output import StagedFolder
+from ..running.output import StagedFolder
 from .common import add_term_files, case_named, choose, number, poisson
 
 def add(sub):
@@ -32,7 +32,7 @@ def run(args):
     import json
     from model.compose import label, slug
     from ..registry import CASES
-    from ..studies import fit
+    from . import fitting as fit
     name = label(args.model)
     fit.fitted_terms(name)                       # a model with nothing to fit: refused now
     train = [case_named(c) for c in args.cases]

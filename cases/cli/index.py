@@ -16,7 +16,7 @@ def run(args):
     """reports/index.md and index.html from the case and study folders already written (after
     a `pbcm run` of one case or study, without running the others again)."""
     from ..registry import CASES, STUDY_MODULES
-    from ..index import write_index
+    from ..reporting.index import write_index
     root = Path(args.out)
     present = [name for name in CASES if (root / name / "metrics.json").is_file()]
     if not present:

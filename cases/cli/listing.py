@@ -28,8 +28,8 @@ def run(args):
     for name, study in studies().items():
         print(textwrap.fill(f"{name} (study): {_summary(study)}", width=96,
                             subsequent_indent="  "))
-    from ..studies.sweeps import SHIPPED
-    from ..studies.sweeps.spec import load
+    from .sweeps import SHIPPED
+    from .sweeps.spec import load
     from ..registry import CASES as cases
     for path in sorted(SHIPPED.glob("*.toml")):
         print(f"{path.stem} (sweep, pbcm sweep {path.stem}): {load(path, cases).title}")

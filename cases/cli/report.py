@@ -1,7 +1,7 @@
 """`pbcm report`: every case and study, written with the index."""
 from contextlib import ExitStack
 
-from ..output import StagedFolder, writable_folder
+from ..running.output import StagedFolder, writable_folder
 from .common import add_selection
 from .pipeline import configs, run_everything
 
@@ -14,7 +14,7 @@ def add(sub):
 
 
 def run(args):
-    from ..index import write_index
+    from ..reporting.index import write_index
     from ..registry import CASES
     cfgs = configs(args)
     root = writable_folder(args.out or "reports")

@@ -3,7 +3,7 @@ user's problem, declared in a TOML file, run as a case."""
 from pathlib import Path
 
 import model
-from ..output import StagedFolder
+from ..running.output import StagedFolder
 from .common import (UsageError, add_selection, case_configs, case_into, case_named,
                      check_executor, chosen_models, run_store, run_study_into, study_config,
                      worker_pool)
@@ -107,8 +107,8 @@ def _run_problem(args):
 
 def _write_glossary(folder):
     """The glossary beside a problem's report (its folder may live outside a reports root)."""
-    from ..index import glossary_documents
-    from ..output import write_atomic
+    from ..reporting.index import glossary_documents
+    from ..running.output import write_atomic
     md, html = glossary_documents()
     write_atomic(folder / "glossary.md", md)
     write_atomic(folder / "glossary.html", html)

@@ -6,7 +6,7 @@ def add(sub):
     sw = sub.add_parser(
         "sweep", help="run a parameter sweep (TOML spec): table, runs and report",
         description="Run every point of a sweep spec (cases, fixed settings, axes over E, nu, "
-                    "rho, resolution, load, mesh, bc and model; see cases/studies/sweeps/nu.toml) as "
+                    "rho, resolution, load, mesh, bc and model; see cases/cli/sweeps/nu.toml) as "
                     "tasks on --workers local processes, or on the Dask cluster at "
                     "--scheduler. Finished runs are kept (runs/<key>/metrics.json) "
                     "and skipped on a rerun; a failing run is a row with its error. Writes "
@@ -28,6 +28,6 @@ def add(sub):
 
 
 def run(args):
-    from ..studies.sweeps import command
+    from .sweeps import command
     return command.run(args)
 

@@ -5,7 +5,7 @@ from dataclasses import dataclass
 
 
 from reference import analytic
-from ..error_model import Scalar
+from ..measuring.error_model import Scalar
 from ..framework import Case, Knob, Loads, MM, Settings, Traction
 from . import common
 

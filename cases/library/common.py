@@ -1,5 +1,5 @@
 """What the library's cases share: bars meshed at a spacing, their end faces, and sentences
-that compare FEM with a closed form; the rankings (``cases.rankings``) are the harness's,
+that compare FEM with a closed form; the rankings (``cases.reporting.rankings``) are the harness's,
 named here for the cases."""
 import numpy as np
 
@@ -7,8 +7,8 @@ from model import ModelError
 from model.bc import merge
 from model.mesh import box
 from ..framework import MM
-from ..rankings import (best_and_worst, estimate, failures, finite_load, per_run,  # noqa: F401
-                        ranking)
+from ..reporting.rankings import (best_and_worst, estimate, failures,  # noqa: F401
+                                  finite_load, per_run, ranking)
 
 CUBE_BCS = ("clamped", "sliding")    # the compressed cube's bases
 

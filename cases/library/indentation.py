@@ -16,9 +16,9 @@ import numpy as np
 
 from model.mesh import cube
 from model.terms.shear import Shear
-from .. import metrics as M
+from ..measuring import metrics as M
 from reference.discretisation import Region
-from ..error_model import Scalar
+from ..measuring.error_model import Scalar
 from ..framework import Case, Knob, MM, Settings
 from . import common
 
@@ -194,7 +194,7 @@ class Indentation(Case):
 
 
     def sections(self, doc, s, runs, fields, out):
-        from .. import figures
+        from ..reporting import figures
         for mesh in s.meshes:
             rs = [r for r in runs if r["mesh"] == mesh and not r.get("failed")]
             if not rs:

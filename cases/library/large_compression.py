@@ -10,9 +10,9 @@ import numpy as np
 
 from model.mesh import cube
 from reference import hyperelastic, linear
-from .. import figures
-from .. import metrics as M
-from ..error_model import P1_FINITE, Scalar, u_num
+from ..reporting import figures
+from ..measuring import metrics as M
+from ..measuring.error_model import P1_FINITE, Scalar, u_num
 from ..framework import FINDINGS, Case, Knob, MM, Reference, Settings, linear_scale
 from . import common
 

@@ -6,8 +6,8 @@ import numpy as np
 
 from model.mesh import cube
 from . import transient
-from ..document import fmt
-from ..error_model import P1_LINEAR, Norm
+from ..reporting.document import fmt
+from ..measuring.error_model import P1_LINEAR, Norm
 from ..framework import MM, Case, Reference, Settings
 from . import common
 
@@ -133,7 +133,7 @@ class Modes(Case):
         return super().cell(metric, run)
 
     def sections(self, doc, s, runs, fields, out):
-        from .. import figures
+        from ..reporting import figures
         for bc in s.bcs:
             rs = [r for r in runs if r["bc"] == bc and r["mesh"] == s.meshes[0]
                   and not r.get("failed")]

@@ -11,9 +11,9 @@ import numpy as np
 from model import PRESETS, BlowUpError, ModelError
 from model.bc import Ramp, bc_arrays
 from model.mesh import cube
-from .. import metrics as M
+from ..measuring import metrics as M
 from . import transient
-from ..error_model import Scalar
+from ..measuring.error_model import Scalar
 from ..framework import MM, Case, Knob, MESH_FAMILIES, Settings, regimes
 from . import common
 from . import paper_cube_report as report

@@ -6,9 +6,9 @@ import re
 
 import numpy as np
 
-from .. import figures, rankings
-from ..metrics import ALTERNATION_CLEAR, PATCH_TOL, PATTERN_TOL
-from ..document import Table, fmt
+from ..reporting import figures, rankings
+from ..measuring.metrics import ALTERNATION_CLEAR, PATCH_TOL, PATTERN_TOL
+from ..reporting.document import Table, fmt
 
 SPEED_MM_S = 1.7
 PAPER_TETS = 374     # the paper's mesh (section 4), unpublished

@@ -7,8 +7,8 @@ import numpy as np
 from model.bc import merge
 from model.mesh import cube
 from reference import analytic
-from .. import metrics as M
-from ..error_model import Scalar
+from ..measuring import metrics as M
+from ..measuring.error_model import Scalar
 from ..framework import FINDINGS, Case, Knob, Loads, MM, Settings
 from . import common
 

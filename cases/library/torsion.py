@@ -5,7 +5,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..error_model import Scalar
+from ..measuring.error_model import Scalar
 from ..framework import Case, Knob, MM, Settings
 from . import common
 

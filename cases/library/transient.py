@@ -7,7 +7,7 @@ import numpy as np
 
 from model.bc import bc_arrays
 from reference import dynamic, modal
-from .. import metrics as M
+from ..measuring import metrics as M
 
 N_MODES = 10            # non-rigid frequencies compared
 # modes past them, to complete a group of mixed modes the tenth one cuts: FEM P1 mixes the

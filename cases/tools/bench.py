@@ -25,10 +25,11 @@ from model.integrate import STEP_BUFFERS, rk4_ramp, total_forces
 from model.candidates import CANDIDATES
 from model.mesh import cube
 
-from .. import figures, stop
+from ..reporting import figures
+from ..running import stop
 from .engines import ENGINES
-from ..costs import FILE
-from ..document import Document, fmt
+from ..reporting.costs import FILE
+from ..reporting.document import Document, fmt
 
 SIZES = (1e2, 3.2e2, 1e3, 1e4, 1e5, 1e6)   # 3.2e2: the paper's 125-node cube (five split)
 STABLE_STEP_TETS = 2e4      # the own stable step is measured up to this size (an eigenvalue)

@@ -16,12 +16,13 @@ from scipy.spatial import cKDTree
 
 from model.loads import body_forces
 from .. import common
-from ... import catalogue, figures
-from ... import metrics as M
-from ...catalogue import err_name, ref_name
-from ...error_model import Scalar
+from ...measuring import catalogue
+from ...reporting import figures
+from ...measuring import metrics as M
+from ...measuring.catalogue import err_name, ref_name
+from ...measuring.error_model import Scalar
 from ...framework import AT_LOAD, MM, Case, Loads, Settings
-from ...runner import reaction_along, reference
+from ...running.runner import reaction_along, reference
 from .spec import AXES, ProblemError, load, nodes_said
 
 BC = "declared"

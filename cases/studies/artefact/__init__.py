@@ -6,7 +6,7 @@ the base and the load, each cell's alternation against the continuum's; the fact
 switch the pattern on and off, and the answers computed from them.
 """
 from ...framework import Study
-from ...store import OFF
+from ...running.store import OFF
 from . import report
 from .study import ArtefactSettings, bench_costs, run
 
@@ -52,7 +52,7 @@ class Artefact(Study):
         data = {k: metrics[k] for k in ("cells", "references", "step_vs_msm")}
         # the cost is the checkout's bench at the paper's size, the number every other report
         # prints; the recorded one only where the checkout has no bench
-        from ...costs import load
+        from ...reporting.costs import load
         bench = load()
         if bench:
             data.update(bench_costs(bench, list(s.models)))

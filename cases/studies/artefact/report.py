@@ -6,11 +6,11 @@ from pathlib import Path
 
 import numpy as np
 
-from ... import catalogue
-from ... import figures  # noqa: F401  (selects matplotlib's file backend before pyplot)
-from ...document import GLOSSARY, Document, fmt, rel
-from ...report import environment, write_study
-from ...runner import jsonable
+from ...measuring import catalogue
+from ...reporting import figures  # noqa: F401  (selects matplotlib's file backend before pyplot)
+from ...reporting.document import GLOSSARY, Document, fmt, rel
+from ...reporting.report import environment, write_study
+from ...running.runner import jsonable
 from .analysis import (CLEAR, COARSE, DECAYS, DECIDING_LEAK, END_LAYERS, GROWS, LEAK_SHARE,
                        MIN_RESOLVED, NEAR, PAPER_BULGES_MM, PAPER_COST, PAPER_NECKS_MM, RATIO,
                        SAME, WIDTHS, _compress, answer, classes, failure, how_sure,

@@ -12,13 +12,13 @@ from model.compose import label
 from model.mesh import cube
 from model.paper_mesh import unmatched_faces
 from reference import hyperelastic, linear
-from ... import metrics as M
+from ...measuring import metrics as M
 from ...framework import FINDINGS, LOAD_SPLITS, solve_split
 from ...library import paper_cube as P
-from ...progress import Progress
-from ...runner import free_components, jsonable
-from ...store import OFF, key
-from ...workers import dearest_first
+from ...running.progress import Progress
+from ...running.runner import free_components, jsonable
+from ...running.store import OFF, key
+from ...running.workers import dearest_first
 
 READINGS = ("corner", "balanced", "variational")
 # constant-strain FEM with the continuum's own law (neo-Hookean) on the same tetrahedra: the

@@ -8,11 +8,11 @@ RK4 step, with the models on the Pareto front.
 from dataclasses import fields
 
 from ...framework import Study
-from ...store import OFF
+from ...running.store import OFF
 from . import report
 from .problems import PROBLEMS
 from .cost import judge
-from .fit import EXACT
+from .extrapolation import EXACT
 from .study import ConvergenceSettings, cancelling, fits, run
 
 # what metrics.json records of a run, all the report is drawn from

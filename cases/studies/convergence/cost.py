@@ -1,11 +1,11 @@
 """Accuracy per cost: each run's displacement error against what one RK4 step of its model
-costs on its mesh (``cases.costs``, from `pbcm bench`), and the Pareto front of the models: for
+costs on its mesh (``cases.reporting.costs``, from `pbcm bench`), and the Pareto front of the models: for
 a given cost budget, the least error any model reaches.
 """
 import numpy as np
 
-from ...costs import SOURCE, step_cost_us
-from .fit import blind_levels
+from ...reporting.costs import SOURCE, step_cost_us
+from .extrapolation import blind_levels
 
 FEM_P1 = "FEM P1"              # the yardstick's name in the runs (the study's)
 

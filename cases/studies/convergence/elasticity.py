@@ -8,9 +8,9 @@ from model.homogenize import (anisotropy_index, asymmetry, directional_young,
                               effective_stiffness, engineering_constants, kelvin_moduli,
                               moduli_errors)
 from model.mesh import cube
-from ... import stop
-from ...runner import FINDINGS
-from ...store import OFF, key
+from ...running import stop
+from ...running.runner import FINDINGS
+from ...running.store import OFF, key
 
 PATCH_MM = 32.0
 # directions of the directional Young's modulus figure: the x-y plane, every 5 degrees

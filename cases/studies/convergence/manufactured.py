@@ -6,8 +6,8 @@ import numpy as np
 
 from model.mesh import cube
 from reference import manufactured as mms
-from ... import stop
-from ...store import OFF, key
+from ...running import stop
+from ...running.store import OFF, key
 from .verification import spec
 
 def orders(cells, errors):

@@ -13,9 +13,9 @@ from model import Material, build
 from model.geometry import displacement_gradients
 from model.mesh import cube, perturbed
 from reference import linear
-from ... import stop
-from ...runner import FINDINGS
-from ...store import OFF, key
+from ...running import stop
+from ...running.runner import FINDINGS
+from ...running.store import OFF, key
 from .verification import spec as verification_spec
 
 PERTURBED = "-perturbed"

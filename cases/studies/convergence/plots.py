@@ -3,7 +3,7 @@ directional Young's modulus per lattice, error against step cost."""
 import numpy as np
 from matplotlib.ticker import NullLocator
 
-from ...figures import plt
+from ...reporting.figures import plt
 
 # drawn last, dashed: fem-linear (FEM P1's explicit twin) shows underneath
 P1_STYLE = {"color": "k", "lw": 2.0, "ls": "--", "marker": "o", "ms": 4, "zorder": 10}

@@ -15,7 +15,7 @@ import numpy as np
 from ...framework import MM, Loads, Traction
 from ...library import common
 from ...registry import CASES
-from ...runner import reaction_along
+from ...running.runner import reaction_along
 
 
 @dataclass(frozen=True)

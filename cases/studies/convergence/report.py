@@ -3,16 +3,16 @@ accuracy per cost, and the rows the gate reads), report.md/.html and the figures
 sentence is computed from the data it is written with."""
 import numpy as np
 
-from ... import catalogue
-from ...document import Document, fmt, rel
-from ...report import environment, write_study
-from ...runner import jsonable
+from ...measuring import catalogue
+from ...reporting.document import Document, fmt, rel
+from ...reporting.report import environment, write_study
+from ...running.runner import jsonable
 from .plots import directional_young, error_vs_h, pareto
 from .elasticity import ANGLES_DEG, PATCH_MM
 from .problems import PROBLEMS
 from .cost import cheapest as cheapest_run
-from .fit import EXACT, FS_THREE, ORDER_MIN, ROUND_LEVEL, UNDECIDED, UNDECIDED_WHY
-from .fit import SAME_ERROR, blind_levels
+from .extrapolation import EXACT, FS_THREE, ORDER_MIN, ROUND_LEVEL, UNDECIDED, UNDECIDED_WHY
+from .extrapolation import SAME_ERROR, blind_levels
 from .study import FEM_P1, MAX_NODES
 from .verification_report import (gate_rows as verification_gate_rows, manufactured_section,
                                   patch_section, steps_section)

@@ -9,10 +9,10 @@ import math
 import numpy as np
 
 from model import build
-from ... import stop
+from ...running import stop
 from ...framework import FINDINGS
 from ...library import paper_cube as pc
-from ...store import OFF, key
+from ...running.store import OFF, key
 
 DIVISORS = (1, 2)           # the case's step divided by these
 REFERENCE = 8               # the push at the case's step / 8 is the reference

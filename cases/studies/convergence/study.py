@@ -10,17 +10,17 @@ import numpy as np
 
 from model import PRESETS, Material, build
 from reference import linear
-from ... import metrics as M
-from ... import stop
-from ...progress import Progress
-from ...store import OFF, key
+from ...measuring import metrics as M
+from ...running import stop
+from ...running.progress import Progress
+from ...running.store import OFF, key
 from ...framework import MESH_FAMILIES
-from ...runner import FINDINGS, free_components, jsonable
-from ...workers import dearest_first, one_blas_thread
+from ...running.runner import FINDINGS, free_components, jsonable
+from ...running.workers import dearest_first, one_blas_thread
 from .cost import accuracy_per_cost
 from .elasticity import table as elasticity_table
-from .fit import (EXACT, SAME_ERROR, blind_levels, cancellation, fit, observed_order,
-                  ratio_limit)
+from .extrapolation import (EXACT, SAME_ERROR, blind_levels, cancellation, fit, observed_order,
+                            ratio_limit)
 from .problems import PROBLEMS
 from .manufactured import units as manufactured_units
 from .patch import units as patch_units
@@ -136,7 +136,7 @@ def solve_reference(problem, bc, s):
     """P2 on the 'five' mesh at each spacing of the problem's ladder (8, 4, 2 mm; the
     torsion bar adds 1.33 mm). The relative L2 changes of the displacement at the coarsest
     mesh's nodes between the three finest levels give the observed order p
-    (``cases.studies.convergence.fit.observed_order``) and the finest level's error, its last change
+    (``cases.studies.convergence.extrapolation.observed_order``) and the finest level's error, its last change
     times h_f^p / (h_c^p - h_f^p). Richardson's extrapolation of the field from the two finest
     levels, u_f + (u_f - u_c) h_f^p / (h_c^p - h_f^p), has as error estimate its distance to
     the same extrapolation one level coarser (an upper estimate: what is left when the error
@@ -396,7 +396,7 @@ def cancelling(fitted):
 def run(s, workers=None, log=True, bench=None, store=OFF):
     """Run the study with settings ``s``: the metrics document (runs, fits, references,
     effective elasticity, accuracy per cost from the ``bench`` document). ``workers`` (a
-    started cases.workers.Workers) runs the units side by side: first the reference of each
+    started cases.running.workers.Workers) runs the units side by side: first the reference of each
     (problem, bc), then the runs of each (problem, bc, family); the results do not depend on
     it (one BLAS thread everywhere). ``store`` gives the runs, reference values and the
     elasticity table it has, and keeps those computed."""

@@ -1,7 +1,7 @@
 """The convergence report's verification section: the references' manufactured-solution
 ladders and every model's patch test, each sentence computed from the rows it shows."""
-from ... import catalogue
-from ...document import fmt
+from ...measuring import catalogue
+from ...reporting.document import fmt
 from .steps import DIVISORS, REFERENCE, ROUNDOFF
 from .verification import spec
 

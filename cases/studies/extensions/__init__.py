@@ -7,7 +7,7 @@ of its effective elasticity are from the isotropic target's.
 from dataclasses import fields
 
 from ...framework import Study
-from ...store import OFF
+from ...running.store import OFF
 from . import report
 from .study import RUN_KEYS, ExtensionSettings, run
 

@@ -5,11 +5,11 @@ from pathlib import Path
 
 import numpy as np
 
-from ... import catalogue
-from ...document import Document, fmt
-from ... import figures
-from ...report import environment, write_study
-from ...runner import jsonable
+from ...measuring import catalogue
+from ...reporting.document import Document, fmt
+from ...reporting import figures
+from ...reporting.report import environment, write_study
+from ...running.runner import jsonable
 from .study import BASE, COST_TETS, TWIN, YARDSTICK, CANDIDATES, conv_fits, short
 
 GATED = catalogue.gated("error", "alternation_max_rel", "e_inf", "moduli_rel_err")

@@ -4,12 +4,12 @@ from dataclasses import dataclass, field, replace
 
 from model import Material
 from model.candidates import BASE, CANDIDATES, NORMAL_FORMS, short  # noqa: F401 (the study's names)
-from ...catalogue import STATIC, err_name
-from ...costs import step_cost_us
-from ...error_model import decomposed
-from ...store import OFF
+from ...measuring.catalogue import STATIC, err_name
+from ...reporting.costs import step_cost_us
+from ...measuring.error_model import decomposed
+from ...running.store import OFF
 from ...registry import studies
-from ...runner import jsonable, run as run_case
+from ...running.runner import jsonable, run as run_case
 
 YARDSTICK = "fem-linear"     # what the same tetrahedra give as constant-strain FEM
 COST_TETS = 1e4              # the mesh size at which costs are compared

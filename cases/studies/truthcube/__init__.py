@@ -6,7 +6,7 @@ measurement beside the neo-Hookean continuum and linear P2, against the measurem
 floor.
 """
 from ...framework import Study
-from ...store import OFF
+from ...running.store import OFF
 from . import report
 from .study import TruthCubeSettings, run
 

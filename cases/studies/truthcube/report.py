@@ -6,11 +6,12 @@ from pathlib import Path
 
 import numpy as np
 
-from ... import catalogue, figures
-from ...document import Document, fmt, rel
-from ...error_model import input_spread, u_val
-from ...report import environment, write_study
-from ...runner import jsonable
+from ...measuring import catalogue
+from ...reporting import figures
+from ...reporting.document import Document, fmt, rel
+from ...measuring.error_model import input_spread, u_val
+from ...reporting.report import environment, write_study
+from ...running.runner import jsonable
 from .beads import WITHIN, excess, within
 from .study import LINEAR, NH, REF_MESH
 
@@ -37,7 +38,7 @@ def floors(data):
 def verdicts(rows, data, u=None):
     """{(mesh, variant, model): [(state, within?) ...]}: a run reproduces a state when its
     total RMS error lies within its u_val at that state (``u`` {state: {model: u_val}},
-    ``cases.answers.u_vals``); where ``u`` does not name the model, when its total, axial and
+    ``cases.reporting.answers.u_vals``); where ``u`` does not name the model, when its total, axial and
     lateral RMS errors each lie within the floor (``beads.within``)."""
     fl = floors(data)
     out = {}
@@ -95,9 +96,9 @@ def against_continuum(rows, data, mesh, u):
 
 
 def state_u_vals(data, parameters):
-    """{state: {model: u_val}} of every state (``cases.answers.u_vals``), the continuum's
+    """{state: {model: u_val}} of every state (``cases.reporting.answers.u_vals``), the continuum's
     included."""
-    from ...answers import u_vals
+    from ...reporting.answers import u_vals
     truth = {**data, "parameters": parameters, "headline": {"continuum": NH}}
     out = {}
     for st in data["data"]["states"]:
@@ -150,8 +151,8 @@ def analyse(data, parameters):
 def scorecard(doc):
     """The index's row measured against reality: per model its bead RMS error over the RMS
     measured displacement at the largest strain, and whether its RMS in mm lies within its
-    validation uncertainty u_val (``cases.answers.validation``); band 0 within, 2 beyond."""
-    from ...answers import validation
+    validation uncertainty u_val (``cases.reporting.answers.validation``); band 0 within, 2 beyond."""
+    from ...reporting.answers import validation
     h = doc["headline"]
     val = validation(doc)
     cells = {}
@@ -188,7 +189,7 @@ def conclusion(doc):
     last = max(s["strain"] for s in doc["data"]["states"])
     at_last = {r["model"]: r for r in _rows(doc, mesh, DEFAULT) if r["strain"] == last}
     nh = at_last.get(NH, {}).get("bead_rms_mm")
-    from ...answers import validation
+    from ...reporting.answers import validation
     val = validation(doc)
     within = val["within"]
     line = (f"**Against the measured beads** (bonded plates, nominal travel, {mesh} mesh; the "

@@ -14,12 +14,12 @@ from model.presets import PRESETS
 from reference import hyperelastic, linear
 from reference.linear import converged_from
 from reference import truthcube as T
-from ... import stop
+from ...running import stop
 from ...framework import FINDINGS
-from ...progress import Progress
-from ...runner import jsonable
-from ...store import OFF, key
-from ...workers import dearest_first
+from ...running.progress import Progress
+from ...running.runner import jsonable
+from ...running.store import OFF, key
+from ...running.workers import dearest_first
 from .problem import (FAMILY, STEP_OF_SPACING, dirichlet as plate_dirichlet,
                       mesh as spacing_mesh, nominal_travels, schedule, step_strain)
 from .beads import Measured, errors, layer_axial, layer_lateral

@@ -5,9 +5,9 @@ import json
 from pathlib import Path
 
 from model import PbcmError
-from ...output import SWEEP_MARK as MARK, OutputError, owned, writable_folder, write_atomic
+from ...running.output import SWEEP_MARK as MARK, OutputError, owned, writable_folder, write_atomic
 from ...registry import CASES
-from ...store import RunStore
+from ...running.store import RunStore
 from . import SHIPPED
 from . import engine, report, spec as specs, table
 
@@ -18,7 +18,7 @@ class SweepUsageError(PbcmError):
 
 
 def spec_path(given):
-    """The spec file: ``given`` itself, or the shipped cases/studies/sweeps/<given>.toml."""
+    """The spec file: ``given`` itself, or the shipped cases/cli/sweeps/<given>.toml."""
     path = Path(given)
     if not path.is_file() and (SHIPPED / f"{given}.toml").is_file():
         return SHIPPED / f"{given}.toml"
@@ -39,7 +39,7 @@ def run(args):
     path = spec_path(args.spec)
     spec = specs.load(path, CASES)
     if path.resolve().parent == SHIPPED.resolve():   # the same words however it was named
-        spec.source = f"cases/studies/sweeps/{path.name}"
+        spec.source = f"cases/cli/sweeps/{path.name}"
     if args.scheduler and (args.workers or args.serial):
         raise SweepUsageError("--scheduler runs on that cluster's workers: drop --workers and "
                               "--serial (start more workers with `dask worker ADDRESS`)")

@@ -19,7 +19,7 @@ metrics.json is one or the other.
 """
 from dataclasses import dataclass
 
-from .document import fmt, rel
+from .numbers import fmt, rel
 
 from .names import UNIT_SUFFIXES, err_name, load_name, ref_name  # noqa: F401 (the names' home)
 
@@ -105,7 +105,7 @@ def metric(name):
     m = CATALOGUE.get(name) or _derived(name)
     if m is None:
         raise KeyError(f"{name!r} is not a metric of the catalogue: declare it in "
-                       "cases/catalogue.py")
+                       "cases/measuring/catalogue.py")
     return m
 
 

@@ -25,10 +25,10 @@ from model.compose import label, parse
 from model.errors import PbcmError
 from model.terms import registered
 from model.terms.shear import Shear
-from .. import metrics as M
-from .. import stop
-from ..runner import FINDINGS, linear_regime, reaction_along, reference
-from ..workers import one_blas_thread
+from ..measuring import metrics as M
+from ..running import stop
+from ..running.runner import FINDINGS, linear_regime, reaction_along, reference
+from ..running.workers import one_blas_thread
 
 
 class FitError(PbcmError):
@@ -220,9 +220,9 @@ def worst_change(rows):
 
 
 def report(doc):
-    """A report (cases.document.Document) of a fit document: the constants, their
+    """A report (cases.reporting.document.Document) of a fit document: the constants, their
     conditioning, and the errors before and after on the training and left-out cases."""
-    from ..document import Document, fmt
+    from ..reporting.document import Document, fmt
     d = Document(f"pbcm fit: {doc['model']}")
     rms = {k: _rms([r[k] for r in doc["train_rows"]]) for k in ("before", "after")}
     vrms = {k: _rms([r[k] for r in doc["validate_rows"]]) for k in ("before", "after")}

@@ -7,12 +7,12 @@ import math
 
 import numpy as np
 
-from .catalogue import err_name, ref_name
+from ..measuring.catalogue import err_name, ref_name
 from .document import Table, rel, rel_range
-from .error_model import standings, u_num
+from ..measuring.error_model import standings, u_num
 
 # what a ranking by a case's own metric measures: the total error, the mesh's own included
-# (the model-form ranking is the error model's, cases.scorecard)
+# (the model-form ranking is the error model's, cases.reporting.scorecard)
 AGAINST = (" against its reference (total error, the mesh's discretisation error included: "
            "not a ranking of the models, which the model-form error is)")
 

@@ -14,10 +14,10 @@ from model.compose import slug
 from model.mesh import write as write_mesh
 from . import costs, figures
 from .document import Document, fmt, rel
-from . import catalogue
+from ..measuring import catalogue
 from . import rankings
 from . import scorecard
-from .runner import jsonable
+from ..running.runner import jsonable
 
 TIMING_KEYS = ("dyn_wall_s",)   # wall times: in run.json, never in metrics.json
 

@@ -32,7 +32,7 @@ import math
 import numpy as np
 from scipy.optimize import brentq, least_squares
 
-from ...error_model import ROUND_OFF
+from ...measuring.error_model import ROUND_OFF
 
 FS_THREE, FS_TWO = 1.25, 3.0   # Roache's safety factors for 3+ and for 2 levels
 ASSUMED_ORDER = 1.0            # the order assumed with two levels

@@ -7,7 +7,7 @@ import io
 import json
 from pathlib import Path
 
-from ...output import write_atomic
+from ...running.output import write_atomic
 
 RUNS = "runs"
 

@@ -9,7 +9,7 @@ import numpy as np
 
 from . import scorecard
 from .document import GLOSSARY, Cell, Document, Link, fmt, rel, rel_range
-from .output import SWEEP_MARK
+from ..running.output import SWEEP_MARK
 
 # headline error bands of the scorecard: within 5 %, within 20 %, beyond
 BANDS = ((0.05, "#c8e6c9", "within 5 %"), (0.20, "#fff59d", "within 20 %"),
@@ -19,12 +19,12 @@ BANDS = ((0.05, "#c8e6c9", "within 5 %"), (0.20, "#fff59d", "within 20 %"),
 
 
 def _declared(case):
-    from .registry import CASES
+    from ..registry import CASES
     return CASES[case]
 
 
 def populations(root, cases):
-    """The scorecard's populations (``cases.scorecard``) of the cases' metrics under ``root``,
+    """The scorecard's populations (``cases.reporting.scorecard``) of the cases' metrics under ``root``,
     and the loaded metrics."""
     data = {c: json.loads((Path(root) / c / "metrics.json").read_text()) for c in cases}
     declared = {c: _declared(c) for c in cases}
@@ -180,11 +180,11 @@ def failed_checks(data, studies=None):
 
 
 def index_documents(root, cases, studies=(), missing=()):
-    """The Markdown and HTML of reports/index: the answers (``cases.answers``) and their
+    """The Markdown and HTML of reports/index: the answers (``cases.reporting.answers``) and their
     table first, then the studies, the scorecard and its conclusion; ``missing``, the
     library's cases without a folder, named first (every answer is over the cases found)."""
     from . import answers
-    from .registry import studies as declared
+    from ..registry import studies as declared
     root = Path(root)
     pops, data = populations(root, cases)
     models = []
@@ -258,7 +258,7 @@ TERMS = {
     "on the finite-strain solve against neo-Hookean P1 and the neo-Hookean continuum, a run "
     "without an equilibrium a failed run; for the modes, the largest relative frequency "
     "error against P1's modes paired by shape, a run with an unpaired mode a failed run (its "
-    "largest error is undefined). What the scorecard ranks (cases/error_model.py).",
+    "largest error is undefined). What the scorecard ranks (cases/measuring/error_model.py).",
     "discretisation error": "(Q_P1 - Q_c) / |Q_c|: how far FEM P1 on a mesh is from the "
     "converged continuum; the same for every model on that mesh.",
     "total error": "(Q_model - Q_c) / |Q_c| = model-form error + discretisation error for a "
@@ -377,11 +377,11 @@ TERMS = {
 def glossary_documents():
     """The Markdown and HTML of reports/glossary: the index's terms, then every metric of the
     catalogue (label, name, unit, definition), written once for every report to link to."""
-    from . import catalogue
+    from ..measuring import catalogue
     doc = Document("pbcm glossary")
     doc.h(2, "Terms")
     doc.ul(f"{k}: {v}" for k, v in TERMS.items())
-    from .registry import studies
+    from ..registry import studies
     for name, study in studies().items():
         if study.definitions():
             doc.h(2, f"The {name} study")
@@ -397,7 +397,7 @@ def glossary_documents():
 def write_index(root, cases, studies, missing=()):
     """index.md/.html and glossary.md/.html under ``root``, each written atomically;
     ``missing``: the library's cases with no folder there (named in the index)."""
-    from .output import write_atomic
+    from ..running.output import write_atomic
     root = Path(root)
     md, html = index_documents(root, cases, studies, missing)
     write_atomic(root / "index.md", md)

@@ -1,4 +1,4 @@
-"""The scorecard's populations on the error model (``cases.error_model``): per case and
+"""The scorecard's populations on the error model (``cases.measuring.error_model``): per case and
 boundary condition, every model's model-form error against FEM P1 on the same tetrahedra, the
 discretisation error those tetrahedra share, the total against the continuum, and the
 uncertainties a comparison of them is read against; then the rankings across populations, with
@@ -9,8 +9,8 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 
 from .document import rel, rel_range
-from . import error_model as E
-from .framework import LINEAR_STRAIN
+from ..measuring import error_model as E
+from ..framework import LINEAR_STRAIN
 
 # an identity check passes where a law that coincides with P1's in the linear regime stays
 # within ten times the regime's strain of it (its geometric nonlinearity there is of the order

@@ -26,7 +26,7 @@ import math
 from pathlib import Path
 import tomllib
 
-from . import catalogue
+from ..measuring import catalogue
 from .output import SWEEP_MARK, TMP_TAG
 
 POLICY = "policy.toml"

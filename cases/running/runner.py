@@ -12,11 +12,11 @@ import numpy as np
 from model.bc import bc_arrays
 from model.terms.shear import Shear
 from reference import hyperelastic, linear
-from . import metrics as M
+from ..measuring import metrics as M
 from . import stop
-from .catalogue import FINITE, STATIC, err_name, load_name, ref_name
-from .error_model import at_load
-from .framework import FINDINGS, Reference, linear_scale
+from ..measuring.catalogue import FINITE, STATIC, err_name, load_name, ref_name
+from ..measuring.error_model import at_load
+from ..framework import FINDINGS, Reference, linear_scale
 from .progress import Progress
 from .store import OFF, key
 from .workers import one_blas_thread, tick
@@ -284,7 +284,7 @@ def failed_runs(mesh_name, bc, models, phase, exc, mesh=None):
 
 def what(case, s, mesh_name, bc, static_only=None):
     """What determines the results of one (mesh, bc) of ``case`` beside the model: the case,
-    mesh, bc and every setting but the selection (the run store's key, ``cases.store``)."""
+    mesh, bc and every setting but the selection (the run store's key, ``cases.running.store``)."""
     d = {k: v for k, v in s.describe().items() if k not in ("meshes", "bcs", "models")}
     return {"case": case.name, "mesh": mesh_name, "bc": bc, **d,
             "static_only": s.static_only if static_only is None else static_only}
@@ -303,7 +303,7 @@ def unit(case, s, mesh_name, bc, mesh_of=None, step=None, store=OFF, reuse_full=
     """The runs and figure fields of one (mesh, bc): its references, then every model.
     ``mesh_of(name)`` builds (or recalls) the mesh; ``step(text, done)`` reports progress
     (``done`` items of the case's total finished since the last call). The references and
-    each model's run are taken from ``store`` (a ``cases.store.RunStore``) where it has them,
+    each model's run are taken from ``store`` (a ``cases.running.store.RunStore``) where it has them,
     and kept there when computed."""
     step = step or (lambda text, done: None)
     mesh_of = mesh_of or (lambda name: case.mesh(name, s))
@@ -436,9 +436,9 @@ def _built_once(case, s, warn=True):
 def run(case, s, log=True, workers=None, store=OFF, reuse_full=False):
     """Run every (mesh, bc, model) of ``case`` with settings ``s``; return the runs (metrics)
     and the fields for the figures ({(mesh, bc, model or 'fem-p2'): arrays}). The (mesh, bc)
-    units run in this process, or on ``workers`` (a started ``cases.workers.Workers``), one
+    units run in this process, or on ``workers`` (a started ``cases.running.workers.Workers``), one
     mesh with all its bcs per task; the results are the same either way and come in the
-    declared order. ``store`` (a ``cases.store.RunStore``) gives what it has and keeps what
+    declared order. ``store`` (a ``cases.running.store.RunStore``) gives what it has and keeps what
     is computed; ``reuse_full``: a static-only run takes a full run's stored rows."""
     units = [(mesh_name, bc) for mesh_name in s.meshes for bc in s.bcs]
     per_unit = len(s.models) + 1

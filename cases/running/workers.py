@@ -86,7 +86,7 @@ def dearest_first(fn, jobs, workers, done=lambda i: None, cost=None):
     """``fn(job)`` for every job, in this process or on ``workers`` (a started executor), the
     dearest first (``cost``: one expected cost per job, so that the longest unit does not
     start last and run alone); ``done(i)`` as each finishes; the results in the jobs'
-    order. A stop (cases.stop) is honoured between units."""
+    order. A stop (cases.running.stop) is honoured between units."""
     from . import stop
     results = [None] * len(jobs)
     order = sorted(range(len(jobs)), key=lambda i: -(cost[i] if cost is not None else 0))

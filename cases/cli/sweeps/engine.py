@@ -7,15 +7,15 @@ which worker finished first).
 
 A worker that dies mid-task (killed, out of memory) does not lose its task: it runs again
 on another worker (Dask: up to ``distributed.scheduler.allowed-failures`` times, 3 by default;
-local: ``cases.workers.RETRIES``). A task that exhausts them is recorded as failed for this sweep but not stored: a
+local: ``cases.running.workers.RETRIES``). A task that exhausts them is recorded as failed for this sweep but not stored: a
 rerun tries it again.
 """
 from dataclasses import dataclass, field, replace
 from functools import partial
 
-from ...progress import Progress
-from ...store import OFF
-from ...workers import SchedulerError, executor
+from ...running.progress import Progress
+from ...running.store import OFF
+from ...running.workers import SchedulerError, executor
 from .spec import NUMERIC_AXES
 from .table import RunStore
 from .task import run_unit
@@ -90,7 +90,7 @@ def plan(spec, registry, store, retry_failed=False):
 def run(spec, registry, out, scheduler=None, workers=None, serial=False, retry_failed=False,
         log=True, store=OFF):
     """Run the sweep ``spec`` into the folder ``out``; return its Outcome. The units go to
-    the one executor (``cases.workers``): local processes, the Dask cluster at
+    the one executor (``cases.running.workers``): local processes, the Dask cluster at
     ``scheduler``, or this process (``serial``); each model's run is taken from ``store`` (the
     run store) where a case or an earlier sweep computed it."""
     table = RunStore(out)

@@ -42,7 +42,7 @@ REFERENCE_KINDS = ("reference", "convergence-reference", "convergence-reference-
                    "artefact-reference", "truthcube-reference", "truthcube-fit",
                    "manufactured")
 PACKAGES = ("model", "reference", "cases")
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 SKIP = {"__pycache__"}
 
 

@@ -4,37 +4,12 @@ import html
 import re
 from pathlib import Path
 
+from ..measuring.numbers import fmt, rel, rel_range  # noqa: F401 (a report's numbers)
+
 
 MAX_COLUMNS = 10            # a table wider than this is split (a report reads in a minute)
 GLOSSARY = "glossary.md"    # the one list of definitions, at the top of the reports folder
 CONCLUSION_LINES = 3        # a report opens with at most this many lines
-
-
-def rel(v, digits=3):
-    """A relative quantity for a report: 'n/a' for None, '< 1e-09' where its magnitude is
-    below round-off (``error_model.ROUND_OFF``, which differs from one processor to the next),
-    else ``digits`` significant figures."""
-    from .error_model import ROUND_OFF
-    if v is not None and not isinstance(v, bool) and abs(v) < ROUND_OFF:
-        return f"< {ROUND_OFF:.0e}"
-    return fmt(v, digits)
-
-
-def rel_range(lo, hi):
-    """'lo-hi' of two relative values, or the round-off bound alone where both are below it."""
-    return rel(hi) if rel(hi).startswith("<") else f"{rel(lo)}-{rel(hi)}"
-
-
-def fmt(v, digits=3):
-    """A number for a report cell: 'n/a' for None, yes/no for a bool, ``digits`` significant
-    figures for a float."""
-    if v is None:
-        return "n/a"
-    if isinstance(v, bool):
-        return "yes" if v else "no"
-    if isinstance(v, float):
-        return f"{v:.{digits}g}"
-    return str(v)
 
 
 class Cell:

@@ -18,7 +18,7 @@ FILE = "bench.json"
 FOLDER = "bench"                 # beside the case folders: reports/bench/bench.json
 SOURCE = f"reports/{FOLDER}/{FILE}"
 BASE = "fem-linear"              # the baseline every ratio is taken against
-CHECKOUT = Path(__file__).resolve().parents[1] / "reports" / FOLDER / FILE
+CHECKOUT = Path(__file__).resolve().parents[2] / "reports" / FOLDER / FILE
 
 
 def read(path):

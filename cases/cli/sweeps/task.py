@@ -4,10 +4,10 @@ becomes the ``failed`` entry of the runs it touched.
 """
 import time
 
-from ... import runner
+from ...running import runner
 from ...registry import CASES
-from ...store import OFF
-from ...workers import one_blas_thread
+from ...running.store import OFF
+from ...running.workers import one_blas_thread
 
 
 def run_unit(unit, store=OFF):

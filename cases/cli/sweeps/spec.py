@@ -148,7 +148,7 @@ def load(path, registry):
     path = Path(path)
     if not path.is_file():
         raise SpecError(f"sweep spec {path} does not exist (or is not a file); give a .toml "
-                        "file (e.g. cases/studies/sweeps/nu.toml)")
+                        "file (e.g. cases/cli/sweeps/nu.toml)")
     try:
         data = tomllib.loads(path.read_text())
     except tomllib.TOMLDecodeError as exc:

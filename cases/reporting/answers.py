@@ -12,8 +12,8 @@ import numpy as np
 
 from .costs import FILE as BENCH_FILE, FOLDER as BENCH_FOLDER
 from .document import fmt, rel, rel_range
-from .error_model import P1_LINEAR, ROUND_OFF, input_spread
-from .metrics import PATCH_TOL
+from ..measuring.error_model import P1_LINEAR, ROUND_OFF, input_spread
+from ..measuring.metrics import PATCH_TOL
 
 COST_TETS = 1e4          # the mesh size of the cost column (tetrahedra)
 CONSISTENCY = ("paper-cube", "sliding")     # the patch test whose converged limit is the error
@@ -532,7 +532,7 @@ def _imbalance(root, models):
     torque (net_force_rel, net_torque_rel, at the continuum's deformed state) exceeds
     BALANCE_TOL in some run of a case folder under ``root``, with the largest and where: such
     a model creates momentum or angular momentum, whatever its errors."""
-    from .registry import CASES
+    from ..registry import CASES
     said = []
     for key, what in (("net_force_rel", "force"), ("net_torque_rel", "torque")):
         worst = {}
@@ -783,7 +783,7 @@ def u_vals(truth, strain, floor):
     where the continuum has no variants, each model's own spread over them (on the mesh they
     ran on); u_num the neo-Hookean reference's change over its last refinement.
     Returns ({model: u_val}, u_num, {model: u_input}, the variants' mesh)."""
-    from .error_model import u_val
+    from ..measuring.error_model import u_val
     nh = truth["headline"].get("continuum")
     at = [r for r in truth.get("references", []) if abs(r.get("strain", -1) - strain) < 1e-9
           and r.get("model") == nh and not r.get("failed")]

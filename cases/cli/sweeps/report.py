@@ -14,10 +14,10 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
 from model import PbcmError  # noqa: E402
-from ...document import Document, fmt  # noqa: E402
-from ...catalogue import ref_name  # noqa: E402
+from ...reporting.document import Document, fmt  # noqa: E402
+from ...measuring.catalogue import ref_name  # noqa: E402
 from .spec import NUMERIC_AXES  # noqa: E402
-from ...output import write_atomic  # noqa: E402
+from ...running.output import write_atomic  # noqa: E402
 
 MAX_PANELS = 12       # more combinations of the other axes than this: the first ones drawn
 MAX_FAILURES = 40     # failed runs listed one by one; the rest counted
