@@ -41,6 +41,16 @@ def scaled(dirichlet, k):
     return {i: tuple(None if v is None else v * k for v in u) for i, u in dirichlet.items()}
 
 
+# the material every case and study runs by default (the paper cube's), and its record in a
+# metrics document: one place for both
+DEFAULT_E, DEFAULT_NU, DEFAULT_RHO = 10e3, 0.45, 1000.0
+
+
+def material_record(E, nu, rho):
+    """The material as a metrics document records it (SI, units in the keys)."""
+    return {"E_Pa": E, "nu": nu, "rho_kg_m3": rho}
+
+
 @dataclass
 class Settings:
     """What one run of a case does: the material (defaults E = 10 kPa, nu = 0.45,
@@ -48,9 +58,9 @@ class Settings:
     resolution of the references. A case subclasses it to add its own fields (geometry, load,
     steps) and names them in ``problem()``."""
 
-    E: float = 10e3
-    nu: float = 0.45
-    rho: float = 1000.0
+    E: float = DEFAULT_E
+    nu: float = DEFAULT_NU
+    rho: float = DEFAULT_RHO
     meshes: tuple = ()
     bcs: tuple = ()
     models: tuple = ()
@@ -70,7 +80,7 @@ class Settings:
     def problem(self):
         """The parameters that define the problem the metrics answer (what a bound was
         measured at). Subclasses add their geometry and loads."""
-        return {"E_Pa": self.E, "nu": self.nu, "rho_kg_m3": self.rho,
+        return {**material_record(self.E, self.nu, self.rho),
                 "p2_levels": self.p2_levels, **regimes(self)}
 
     @property

@@ -6,11 +6,15 @@ import numbers
 from .errors import MaterialError
 
 
-def poisson_message(nu):
-    """Why ``nu`` is not a Poisson's ratio the models and references accept."""
+def poisson_problem(nu):
+    """Why ``nu`` is not a Poisson's ratio the models and references accept, or None: the one
+    check every entry (the command line, a problem file, a Material) makes."""
+    if -1.0 < nu < 0.5:
+        return None
     why = ("0.5 and above is incompressible, which the volume term cannot represent: use 0.49 "
-           "at most" if nu >= 0.5 else "-1 and below has no bulk stiffness")
-    return f"Poisson's ratio nu must satisfy -1 < nu < 0.5, got {nu} ({why})"
+           "at most" if nu >= 0.5 else "it must be above -1: at -1 and below the bulk "
+           "modulus vanishes")
+    return f"Poisson's ratio nu must satisfy -1 < nu < 0.5, got {nu:g} ({why})"
 
 
 @dataclass(frozen=True)
@@ -28,8 +32,8 @@ class Material:
                 raise MaterialError(f"Material.{name} must be a finite number, got {v!r}")
         if self.E <= 0:
             raise MaterialError(f"Young's modulus E must be > 0 Pa, got {self.E}")
-        if not -1.0 < self.nu < 0.5:
-            raise MaterialError(poisson_message(self.nu))
+        if poisson_problem(self.nu):
+            raise MaterialError(poisson_problem(self.nu))
         if self.rho <= 0:
             raise MaterialError(f"density rho must be > 0 kg/m^3, got {self.rho}")
 

@@ -7,6 +7,7 @@ import re
 from pathlib import Path
 
 import model
+from ..framework import DEFAULT_E, DEFAULT_NU, DEFAULT_RHO
 from ..running.output import StagedFolder  # noqa: F401 (the commands' staging)
 
 
@@ -35,14 +36,10 @@ def number(flag, what, low=None, high=None, integer=False, open_low=True):
 
 
 def poisson(text):
+    from model.material import poisson_problem
     v = number("--nu", "Poisson's ratio, a number between -1 and 0.5")(text)
-    if v >= 0.5:
-        raise argparse.ArgumentTypeError(
-            f"--nu must be below 0.5, got {text} (0.5 is incompressible, which the volume "
-            "term cannot represent: use 0.49 at most)")
-    if v <= -1:
-        raise argparse.ArgumentTypeError(f"--nu must be above -1, got {text} (at -1 the bulk "
-                                         "modulus vanishes)")
+    if poisson_problem(v):
+        raise argparse.ArgumentTypeError(f"--nu: {poisson_problem(v)}")
     return v
 
 
@@ -201,10 +198,11 @@ def add_selection(p):
                    help="each case's quick settings (fewer meshes, coarser references; "
                         "what CI runs)")
     p.add_argument("--E", type=number("--E", "Young's modulus in Pa, a number > 0", low=0),
-                   help="Young's modulus [Pa] (default 10e3)")
-    p.add_argument("--nu", type=poisson, help="Poisson's ratio, -1 < nu < 0.5 (default 0.45)")
+                   help=f"Young's modulus [Pa] (default {DEFAULT_E:g})")
+    p.add_argument("--nu", type=poisson,
+                   help=f"Poisson's ratio, -1 < nu < 0.5 (default {DEFAULT_NU:g})")
     p.add_argument("--rho", type=number("--rho", "a density in kg/m^3, a number > 0", low=0),
-                   help="density [kg/m^3] (default 1000)")
+                   help=f"density [kg/m^3] (default {DEFAULT_RHO:g})")
     add_executor(p)
     add_store(p)
 

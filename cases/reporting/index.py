@@ -8,7 +8,7 @@ from pathlib import Path
 import numpy as np
 
 from . import scorecard
-from .document import GLOSSARY, Cell, Document, Link, fmt, rel, rel_range
+from .document import GLOSSARY, Cell, Document, Link, rel, rel_range
 from ..running.output import SWEEP_MARK
 
 # headline error bands of the scorecard: within 5 %, within 20 %, beyond

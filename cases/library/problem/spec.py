@@ -19,7 +19,7 @@ from model import PRESETS, Material
 from model.bc import merge
 from model.errors import MeshError, ModelError
 from model.loads import boundary_facets
-from model.material import poisson_message
+from model.material import poisson_problem
 from model.mesh import read_with_sets
 
 LENGTH_UNITS = {"m": 1.0, "cm": 1e-2, "mm": 1e-3, "um": 1e-6, "in": 0.0254}
@@ -384,9 +384,10 @@ def _material(t):
     nu = t.number("nu", "Poisson's ratio")
     rho = t.number("rho", "density [kg/m^3]")
     t.done()
-    for key, v, ok in (("E", E, E > 0), ("nu", nu, -1 < nu < 0.5), ("rho", rho, rho > 0)):
+    for key, v, ok in (("E", E, E > 0), ("nu", nu, not poisson_problem(nu)),
+                       ("rho", rho, rho > 0)):
         if not ok:
-            raise t.error(key, poisson_message(nu) if key == "nu" else
+            raise t.error(key, poisson_problem(nu) if key == "nu" else
                           f"must be > 0, got {v:g}; give a positive {key}")
     return Material(E=float(E), nu=float(nu), rho=float(rho))
 

@@ -13,7 +13,8 @@ from model.mesh import cube
 from model.paper_mesh import unmatched_faces
 from reference import hyperelastic, linear
 from ...measuring import metrics as M
-from ...framework import FINDINGS, LOAD_SPLITS, solve_split
+from ...framework import (DEFAULT_E, DEFAULT_NU, DEFAULT_RHO, FINDINGS, LOAD_SPLITS,
+                          material_record, solve_split)
 from ...library import paper_cube as P
 from ...running.progress import Progress
 from ...running.runner import free_components, jsonable
@@ -129,9 +130,9 @@ def mesh_factors(name, spec, mesh):
 class ArtefactSettings:
     """Material (the paper cube's), the factors and the mode."""
 
-    E: float = 10e3
-    nu: float = 0.45
-    rho: float = 1000.0
+    E: float = DEFAULT_E
+    nu: float = DEFAULT_NU
+    rho: float = DEFAULT_RHO
     quick: bool = False
     bcs: tuple = P.BCS
     loads: tuple = ("paper", "linear")
@@ -150,7 +151,7 @@ class ArtefactSettings:
         return mesh_specs(self.quick)
 
     def problem(self):
-        return {"E_Pa": self.E, "nu": self.nu, "rho_kg_m3": self.rho, "size_mm": P.SIZE_MM,
+        return {**material_record(self.E, self.nu, self.rho), "size_mm": P.SIZE_MM,
                 "push_mm": P.PUSH_MM, "linear_scale": LINEAR_SCALE, "damping_1_s": self.damping,
                 "reference": {"element": "P2", "mesh": f"{REF_MESH[0]} {REF_MESH[1]}^3",
                               "refinements": REF_LEVELS}}

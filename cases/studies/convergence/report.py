@@ -1,7 +1,6 @@
 """The convergence study's files: metrics.json (runs, fits, references, effective elasticity,
 accuracy per cost, and the rows the gate reads), report.md/.html and the figures. Every
 sentence is computed from the data it is written with."""
-import numpy as np
 
 from ...measuring import catalogue
 from ...reporting.document import Document, fmt, rel

@@ -14,7 +14,7 @@ from ...measuring import metrics as M
 from ...running import stop
 from ...running.progress import Progress
 from ...running.store import OFF, key
-from ...framework import MESH_FAMILIES
+from ...framework import DEFAULT_E, DEFAULT_NU, DEFAULT_RHO, MESH_FAMILIES, material_record
 from ...running.runner import FINDINGS, free_components, jsonable
 from ...running.workers import dearest_first, one_blas_thread
 from .cost import accuracy_per_cost
@@ -40,9 +40,9 @@ class ConvergenceSettings:
     """What the study runs: material, problems, mesh families, models, the mesh sizes h [mm],
     the load scale (linear regime) and the lattice patch of the effective elasticity."""
 
-    E: float = 10e3
-    nu: float = 0.45
-    rho: float = 1000.0
+    E: float = DEFAULT_E
+    nu: float = DEFAULT_NU
+    rho: float = DEFAULT_RHO
     problems: tuple = tuple(PROBLEMS)
     meshes: tuple = MESH_FAMILIES
     models: tuple = tuple(PRESETS)
@@ -64,7 +64,7 @@ class ConvergenceSettings:
 
     def problem(self):
         """What the gate compares: the problem the metrics answer."""
-        return {"E_Pa": self.E, "nu": self.nu, "rho_kg_m3": self.rho,
+        return {**material_record(self.E, self.nu, self.rho),
                 "h_mm": [round(h, 6) for h in self.h_mm], "load_scale": self.load_scale,
                 "ref_ladders_mm": {p: list(self.ladder(p)) for p in self.problems},
                 "max_nodes": MAX_NODES, "patch_n": self.patch_n}

@@ -4,6 +4,7 @@ from dataclasses import dataclass, field, replace
 
 from model import Material
 from model.candidates import BASE, CANDIDATES, NORMAL_FORMS, short  # noqa: F401 (the study's names)
+from ...framework import DEFAULT_E, DEFAULT_NU, DEFAULT_RHO, material_record
 from ...measuring.catalogue import STATIC, err_name
 from ...reporting.costs import step_cost_us
 from ...measuring.error_model import decomposed
@@ -21,9 +22,9 @@ class ExtensionSettings:
     """Material, the models (the paper's model, the candidates and the FEM yardstick) and the
     mode; each case and the convergence study run with their own quick or full settings."""
 
-    E: float = 10e3
-    nu: float = 0.45
-    rho: float = 1000.0
+    E: float = DEFAULT_E
+    nu: float = DEFAULT_NU
+    rho: float = DEFAULT_RHO
     models: tuple = (BASE, *CANDIDATES, YARDSTICK)
     quick: bool = False
     cases: tuple = None        # library cases (None: every one)
@@ -50,7 +51,7 @@ class ExtensionSettings:
 
     def problem(self):
         """What the gate compares: each case's problem and the convergence study's."""
-        return {"E_Pa": self.E, "nu": self.nu, "rho_kg_m3": self.rho,
+        return {**material_record(self.E, self.nu, self.rho),
                 "cases": {n: c.problem() for n, c in self.case_settings().items()},
                 "convergence": self.convergence_settings().problem()}
 
