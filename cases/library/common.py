@@ -11,6 +11,7 @@ from ..reporting.rankings import (best_and_worst, estimate, failures,  # noqa: F
                                   finite_load, per_run, ranking)
 
 CUBE_BCS = ("clamped", "sliding")    # the compressed cube's bases
+CUBE_MM = 32.0                        # the paper's cube: its side, every cube case's
 
 
 def cube_boundary_sets(mesh, bc, size):

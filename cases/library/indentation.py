@@ -22,7 +22,7 @@ from ..measuring.error_model import Scalar
 from ..framework import Case, Knob, MM, Settings
 from . import common
 
-SIZE_MM, PATCH_MM, DEPTH_MM = 32.0, 8.0, 2.0
+SIZE_MM, PATCH_MM, DEPTH_MM = common.CUBE_MM, 8.0, 2.0
 RIM_MM = 4.0  # the width over which the punch's rim slopes from the face's depth to nothing
 STEPS = 4     # load steps of every model and of the neo-Hookean reference
 DEVIATES = 0.1  # a surface profile this far from FEM's (relative L2) is drawn in colour

@@ -11,7 +11,7 @@ from ..measuring.error_model import P1_LINEAR, Norm
 from ..framework import MM, Case, Reference, Settings
 from . import common
 
-SIZE_MM, NODES = 32.0, 5
+SIZE_MM, NODES = common.CUBE_MM, 5
 N_MODES = transient.N_MODES
 
 

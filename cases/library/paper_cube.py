@@ -18,7 +18,7 @@ from ..framework import MM, Case, Knob, MESH_FAMILIES, Settings, regimes
 from . import common
 from . import paper_cube_report as report
 
-SIZE_MM = 32.0
+SIZE_MM = common.CUBE_MM
 NODES_PER_SIDE = 5
 PUSH_MM = 1.7
 SPEED_MM_S = 1.7

@@ -12,7 +12,7 @@ from ..measuring.error_model import Scalar
 from ..framework import FINDINGS, Case, Knob, Loads, MM, Settings
 from . import common
 
-SIZE_MM = 32.0
+SIZE_MM = common.CUBE_MM
 GRAVITY = 9.81
 
 

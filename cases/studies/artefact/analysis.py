@@ -1311,7 +1311,7 @@ def _reading_sure(v):
 PAPER_BULGES_MM, PAPER_NECKS_MM = (0.0, 16.0, 32.0), (8.0, 24.0)   # its Figure 1
 
 
-def extrema(profile, size_mm=32.0, held=()):
+def extrema(profile, size_mm=P.SIZE_MM, held=()):
     """(bulges, necks) of a layer profile: the layers' heights y [mm] where it is above
     (below) every neighbouring layer by more than SAME of its mean |value| (a uniform profile
     to round-off has neither), the end layers against their one neighbour; the layers
@@ -1331,7 +1331,7 @@ def extrema(profile, size_mm=32.0, held=()):
     return up, down
 
 
-def reproduces(profile, size_mm=32.0, held=()):
+def reproduces(profile, size_mm=P.SIZE_MM, held=()):
     """Whether a 5-layer profile shows the paper's alternation: bulges at exactly
     PAPER_BULGES_MM and necks at exactly PAPER_NECKS_MM."""
     up, down = extrema(profile, size_mm, held)

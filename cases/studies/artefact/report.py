@@ -11,6 +11,7 @@ from ...reporting import figures  # noqa: F401  (selects matplotlib's file backe
 from ...reporting.document import GLOSSARY, Document, fmt, rel
 from ...reporting.report import environment, write_study
 from ...running.runner import jsonable
+from ...library import paper_cube as P
 from .analysis import (CLEAR, COARSE, DECAYS, DECIDING_LEAK, END_LAYERS, GROWS, LEAK_SHARE,
                        MIN_RESOLVED, NEAR, PAPER_BULGES_MM, PAPER_COST, PAPER_NECKS_MM, RATIO,
                        SAME, WIDTHS, _compress, answer, classes, failure, how_sure,
@@ -603,7 +604,7 @@ def profiles_figure(path, panels, title, decides=None, clear=None):
     for ax, (bc, rows) in zip(axes[0], panels.items()):
         if rows:
             n = len(rows[0]["bulge_profile_mm"])
-            y = np.linspace(0.0, 32.0, n)
+            y = np.linspace(0.0, P.SIZE_MM, n)
             ax.plot(rows[0]["bulge_profile_fem_mm"], y, "k-o", lw=2.5,
                     label="continuum (neo-Hookean P2)", zorder=3)
             for yy in PAPER_BULGES_MM:
