@@ -96,8 +96,7 @@ def checks(term, mesh, x):
             np.linalg.norm(np.cross(r, f).sum(axis=0))
             / (np.linalg.norm(r, axis=1) * np.linalg.norm(f, axis=1)).sum()), EXACT))
     if term.conservative:
-        h = FD_STEP * np.linalg.norm(mesh.points[mesh.edges[:, 1]]
-                                     - mesh.points[mesh.edges[:, 0]], axis=1).mean()
+        h = FD_STEP * mesh.mean_edge
         g = _fd_gradient(term.energy, x, h)
         out.append(("forces equal minus the energy gradient",
                     float(np.abs(f + g).max() / size), GRADIENT))

@@ -55,8 +55,7 @@ class JacobianPattern:
     def __init__(self, mesh, rel_step=1e-6):
         adj = node_adjacency(mesh)
         colour = colour_nodes(adj)
-        self.h = rel_step * np.linalg.norm(
-            mesh.points[mesh.edges[:, 1]] - mesh.points[mesh.edges[:, 0]], axis=1).mean()
+        self.h = rel_step * mesh.mean_edge
         self.n = 3 * mesh.n_nodes
         self.groups = []
         for c in range(colour.max() + 1):
@@ -129,8 +128,7 @@ def factorise(J):
 
 def force_scale(model):
     """E h^2 with h the mean edge length: the size of a nodal force at unit strain [N]."""
-    m = model.mesh
-    h = np.linalg.norm(m.points[m.edges[:, 1]] - m.points[m.edges[:, 0]], axis=1).mean()
+    h = model.mesh.mean_edge
     return model.material.E * h * h
 
 
