@@ -119,9 +119,8 @@ GROWTH = 1e3
 def factorise(J):
     """Sparse LU of the Newton matrix, ordered for a structurally symmetric matrix (minimum
     degree on J + J^T, diagonal pivots preferred, 1 % threshold so that the non-symmetric
-    Jacobians of the corner and balanced readings still pivot where they must): 2 to 3 times
-    faster than the default column ordering on the convergence study's meshes (bcc, 4 721
-    nodes: 0.87 against 1.59 s)."""
+    Jacobians of the corner and balanced readings still pivot where they must): faster than
+    the default column ordering on the convergence study's meshes."""
     return splu(J.tocsc(), permc_spec="MMD_AT_PLUS_A", diag_pivot_thresh=0.01,
                 options={"SymmetricMode": True})
 

@@ -31,7 +31,7 @@ class Cantilever(Case):
              "closed form Euler-Bernoulli + Timoshenko)")
     settings_class = CantileverSettings
     bcs = ("clamped",)
-    fem_solver = "direct"   # AMG-CG stagnates on this slender beam: 16 s direct, 32 s AMG
+    fem_solver = "direct"   # AMG-CG stagnates on this slender beam
     headline = "tip_deflection_rel_err"
     headline_pair = "disp_rel_l2_p2"
     decomposed = Scalar("tip_deflection_mm", "tip_deflection_fem_mm", "tip deflection")
