@@ -888,3 +888,13 @@ def test_the_papers_figure_one_is_reproduced_only_by_its_alternation():
     assert text.index("clamped base: reproduced by none") < text.index("sliding base")
     assert "sliding base: reproduced by a;" in text
     assert "the continuum, b: flat (no bulge, no neck)" in text
+
+
+def test_tracking_is_read_on_the_whole_interval_both_ways():
+    """The consistency hypothesis tracks only where the correlation's whole 95 % interval lies
+    at 0.7 or above, and does not track only where it lies below: a correlation of 0.75 whose
+    interval reaches 0.3 is 'not resolved', never 'tracks'."""
+    assert analysis._track(0.95, [0.75, 0.99]) == "tracks"
+    assert analysis._track(0.75, [0.3, 0.93]) == "not resolved"
+    assert analysis._track(0.2, [-0.4, 0.6]) == "does not track"
+    assert analysis._track(0.9, None).startswith("not resolved")

@@ -694,11 +694,11 @@ def rank_interval(rho, n):
 
 
 def _track(rho, ci):
-    """'tracks' where the interval lies above 0 and the correlation is TRACKS or more, 'does not
-    track' where the interval lies below TRACKS, else 'not resolved'."""
+    """'tracks' where the whole interval lies at TRACKS or above, 'does not track' where it
+    lies below TRACKS, else 'not resolved' (one rule, read on the interval both ways)."""
     if ci is None:
         return "not resolved (too few models)"
-    if ci[0] > 0 and rho >= TRACKS:
+    if ci[0] >= TRACKS:
         return "tracks"
     if ci[1] < TRACKS:
         return "does not track"

@@ -14,7 +14,7 @@ from ...running.runner import jsonable
 from ...library import paper_cube as P
 from .analysis import (CLEAR, COARSE, DECAYS, DECIDING_LEAK, END_LAYERS, GROWS, LEAK_SHARE,
                        MIN_RESOLVED, NEAR, PAPER_BULGES_MM, PAPER_COST, PAPER_NECKS_MM, RATIO,
-                       SAME, WIDTHS, _compress, answer, classes, failure, how_sure,
+                       SAME, TRACKS, WIDTHS, _compress, answer, classes, failure, how_sure,
                        paper_figure, paper_figure_text,
                        reading_table, reading_verdict, signature_own, times)
 from .study import (DECISIVE, LINEAR_SCALE, READINGS, SPLITS, SPLITS_TRIED,
@@ -345,7 +345,8 @@ def _mirror(d, doc):
                                    for x, v in cps.items()) or "n/a",
                          (f"{times(r.get('mirror_ratio'))} [{times(max(r['mirror_lo'], 0))}"
                           f"-{times(r['mirror_hi']) if r['mirror_hi'] is not None else 'inf'}]"
-                          if r.get("sign") and r.get("mirror_lo") is not None else
+                          + ("" if r.get("sign") else " (part not resolved)")
+                          if r.get("mirror_lo") is not None else
                           times(r.get("mirror_ratio"))),
                          _sig(r["unmirrored"]), r["kind"]])
     d.table(["model", "configuration", "signature +- u", "over own mean: clear?",
@@ -454,8 +455,8 @@ def _consistency(d, cs, us=()):
         f"with models whose signature and that error agree to {SAME:g} (3 significant "
         f"figures) and to {COARSE:g} (2) counted once (near-duplicate variants are one "
         "observation), each with its 95 % interval (Fisher z, variance 1.06 / (n - 3)); "
-        f"'tracks' where the interval lies above 0 and the correlation is 0.7 or more, 'does "
-        "not track' where the interval lies below 0.7; the verdict only where all four "
+        f"'tracks' where the whole interval lies at {TRACKS:g} or above, 'does not track' "
+        f"where it lies below {TRACKS:g}; the verdict only where all four "
         f"agree; 'not testable' where fewer than {MIN_RESOLVED} models' signatures are "
         f"resolved ({RATIO:g} times their u: a correlation over signatures that cannot be told "
         "from 0 ranks the leak)."
