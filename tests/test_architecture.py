@@ -38,9 +38,10 @@ def imports_of(name, path, known):
                 source = ".".join(base + ([node.module] if node.module else []))
             else:
                 source = node.module
-            # `from pkg import sub` imports the submodule when there is one
+            # `from pkg import sub` imports the submodule when there is one, and runs the
+            # package's __init__ first: both are imported
             targets = [f"{source}.{a.name}" if f"{source}.{a.name}" in known else source
-                       for a in node.names]
+                       for a in node.names] + [source]
         else:
             continue
         for t in targets:

@@ -32,13 +32,13 @@ def run(args):
     import json
     from model.compose import label, slug
     from ..registry import CASES
-    from . import fitting as fit
+    from .fitting import check_cases, fit, fitted_terms, report
     name = label(args.model)
-    fit.fitted_terms(name)                       # a model with nothing to fit: refused now
+    fitted_terms(name)                       # a model with nothing to fit: refused now
     train = [case_named(c) for c in args.cases]
     validate = [case_named(c) for c in args.validate] if args.validate is not None else [
         c for n, c in CASES.items() if c.static and n not in args.cases]
-    fit.check_cases(train, validate)
+    check_cases(train, validate)
     for c in [*train, *validate]:
         choose("mesh", args.meshes, c.meshes)
         choose(f"boundary condition of {c.name}", args.bcs, c.bcs)
@@ -47,9 +47,9 @@ def run(args):
                                    }.items() if v is not None}
     with StagedFolder(Path(args.out) if args.out else Path("reports") / "fit" / slug(name),
                       mark="fit.json") as out:
-        doc = fit.fit(name, train, validate, quick=args.quick, overrides=overrides)
+        doc = fit(name, train, validate, quick=args.quick, overrides=overrides)
         (out.path / "fit.json").write_text(json.dumps(doc, indent=1) + "\n")
-        fit.report(doc).write(out.path)
+        report(doc).write(out.path)
         path = out.commit()
     for k, v in doc["constants_fitted"].items():
         print(f"{k:<24} auto {doc['constants_auto'][k]:.5g} -> fitted {v:.5g} "
