@@ -31,7 +31,7 @@ distinct ones."""
 import numpy as np
 from scipy.stats import spearmanr
 
-from ...reporting.document import fmt, rel
+from ...reporting.document import fmt
 from ...library import paper_cube as P
 from ...measuring.metrics import ALTERNATION_CLEAR, nyquist_weights
 from .study import (DECISIVE, LINEAR_SCALE, SPLITS, SPLITS_TRIED,
@@ -932,37 +932,6 @@ def by_reading(us):
     return out
 
 
-def _short_kind(k):
-    return ("failed" if k.startswith("failed") else "at the threshold"
-            if k.startswith("at the") else k)
-
-
-def _cause_groups(tags):
-    """Sentences grouping the models of one sign by what their own part rests on: how many
-    configurations resolve it, where it is the mirror's, and what the other configurations say."""
-    groups = {}
-    for name, t in tags.items():
-        if t["tag"] not in ("+", "-"):
-            continue
-        key = (t["tag"], t["resolved"], t["of"], tuple(t["mirror"]), tuple(t["every"]),
-               tuple(t["open"]), tuple(sorted((k, _short_kind(v))
-                                              for k, v in t["rest"].items())))
-        groups.setdefault(key, []).append(name)
-    out = {"+": [], "-": []}
-    for (sign, k, of, mirror, every, open_, rest), names in groups.items():
-        bits = [f"{k} of {of} configurations"]
-        if mirror:
-            bits.append(f"the mirror's on {', '.join(mirror)}")
-        if every:
-            bits.append(f"on every split on {', '.join(every)}")
-        if open_:
-            bits.append(f"mirror not decided on {', '.join(open_)}")
-        if rest:
-            bits.append("; ".join(f"{k_} {v}" for k_, v in rest))
-        out[sign].append(f"{_compress(names)} ({'; '.join(bits)})")
-    return out
-
-
 def times(x):
     """A ratio for a sentence: two significant figures, whole from 100, powers of ten from
     1e4; 'inf' for an unbounded one."""
@@ -987,23 +956,6 @@ def _five_text(us):
                 f"({u['check']['worst_field']}) on its {u['check']['free']} layers"
                 if u["check"].get("worst") is not None else u["check"].get("why", ""))
                 for u in five) + ")")
-
-
-def _fem_text(dec):
-    """FEM P1's signature on the mirrored split per deciding configuration, against its own u; exact
-    (an identity check) on the sliding base."""
-    exact = [_where((u["n"], u["bc"])) for u in dec if u["identity"]]
-    parts = [f"{u['n']} {u['bc']}: {rel(u['fem_five'], 2)} +- {fmt(u['u_fem'], 2)} of the "
-             "reference's mean" + (f" ({fmt(u['fem_mm'], 2)} mm)" if u.get("fem_mm") else "")
-             + {"above": ": resolved", "at": ": at the threshold, not decided",
-                "below": ": not resolved"}.get(u["fem_vs"], "")
-             for u in dec if not u["identity"]]
-    if exact:
-        parts.append(f"0 to round-off on {', '.join(exact)} (P1 is exact for the homogeneous "
-                     "field of the sliding base: an identity check, which shows only that P1 "
-                     "adds no period-2 part to that field; there a model's part is its whole "
-                     "signature)")
-    return "; ".join(parts)
 
 
 def _below_text(dec):
@@ -1041,24 +993,6 @@ def order_text(bc, o):
             + "; two sizes only: the order is not decided)")
 
 
-def resolved_counts(dec):
-    """Per deciding configuration: (configuration, resolved, of, {the others' class: how
-    many}): the distinct
-    models whose own part is resolved (its sign stated) over those with a part or a failed
-    run there."""
-    out = []
-    for u in dec:
-        rows = [r for r in u["rows"] if r["same_as"] is None
-                and (r.get("part") is not None or r["kind"].startswith("failed"))]
-        rest = {"at the threshold": sum(r.get("part_vs_u") == "at" for r in rows),
-                "not resolved": sum(r.get("part_vs_u") == "below" for r in rows),
-                "failed": sum(r["kind"].startswith("failed") for r in rows)}
-        out.append((_where((u["n"], u["bc"])), sum(r.get("part_vs_u") == "above"
-                                                   for r in rows), len(rows),
-                    {k: v for k, v in rest.items() if v}))
-    return out
-
-
 def mirror_counts(u):
     """Per configuration that reads: the distinct models by what their own part is: the
     mirror's (by sign), on every split, mirror not decided, at the threshold, not resolved,
@@ -1076,24 +1010,6 @@ def mirror_counts(u):
         out[key].append(r["name"])
     out["resolved"] = len(out["+"]) + len(out["-"]) + len(out["every"]) + len(out["open"])
     return out
-
-
-def _mirror_text(u):
-    c = mirror_counts(u)
-    mirror = len(c["+"]) + len(c["-"])
-    bits = [f"{c['of']} distinct models, {c['resolved']} resolved"]
-    if mirror:
-        bits.append(f"the mirror's {mirror} ("
-                    + "; ".join(f"{s} {len(c[s])}: {_compress(c[s])}" for s in ("+", "-")
-                                if c[s]) + ")")
-    for key, word in (("every", "on every split"), ("open", "mirror not decided"),
-                      ("at", "at the threshold"), ("unresolved", "not resolved"),
-                      ("failed", "failed")):
-        if c[key]:
-            bits.append(f"{word} {len(c[key])}")
-    if c["control_failed"]:
-        bits.append(f"a control failed for {len(c['control_failed'])} (read on the others)")
-    return f"{_where((u['n'], u['bc']))}: " + ", ".join(bits)
 
 
 def failed_cells(cells):
