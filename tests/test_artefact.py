@@ -867,7 +867,8 @@ def test_a_resolved_part_below_the_clear_level_answers_the_mirror_and_says_it_is
     assert "Under refinement, a resolved period-2 part is the mirror's" in a["text"]
     assert "Large enough to see? On 17 clamped, 17 sliding every model's signature is below " \
         "the clear level 0.01" in a["text"]
-    assert "the pattern these runs resolve is not a visible one there" in a["text"]
+    assert "the period-2 part over the whole height these runs resolve is below the clear " \
+        "level there" in a["text"]
     assert a["all_below"] and a["causes"] == ["the mirror symmetry (a)"]
 
 

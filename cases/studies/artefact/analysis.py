@@ -1070,12 +1070,12 @@ def answer(cells, models=None):
                  f"; on every split: {against_}")
               + (f"; FEM P1's own signature is resolved and the mirror's on "
                  f"{', '.join(fem_units)}" if fem_units else "")
-              + (f". FEM P1's own signature on the mirrored split over its largest on the "
-                 f"conforming splits: {', '.join(fem_ratio)} (within the metric's leak bound, "
-                 "so not resolved: the discretisation's own period-2 error on the mirrored "
-                 "mesh is suggested, not shown)" if fem_ratio else "")
+              + (f". FEM P1's own signature on the mirrored split is resolved nowhere (over "
+                 f"its largest on the conforming splits: {', '.join(fem_ratio)}, within the "
+                 "metric's leak bound)" if fem_ratio else "")
               + (f". The own part {'; '.join(slopes)}" if slopes else "")
-              + ". Per configuration, the classes are in the tables below")
+              + ". Per configuration, the classes are in the artefact report's tables; the "
+              "counts are of model parts, which share one mesh pair per configuration")
     b_text = ((f"{ns['removed']} of {ns['tested']} distinct pairs (a calibrated reading's "
                "resolved own part with and without an active term, the split held fixed) "
                f"reduced {RATIO:g}-fold"
@@ -1121,7 +1121,8 @@ def answer(cells, models=None):
             f"Normal stress: {b_text}. (c) Consistency (the linear regime: the signature at "
             f"the linear load against the patch-test error): {c_text}. "
             + (f"Large enough to see? {below['text'][0].upper()}{below['text'][1:]}: the "
-               "pattern these runs resolve is not a visible one there."
+               "period-2 part over the whole height these runs resolve is below the clear "
+               "level there."
                if below and below["all_below"] else
                f"Large enough to see? {below['head'][0].upper()}{below['head'][1:]}."
                if below else
@@ -1188,7 +1189,8 @@ def how_sure(ans, verdict):
     return ("**How sure.** " + (
         f"The cause rests on the configurations (size, base) where own parts are resolved "
         f"({', '.join(resting) or 'none'}; {len(dec)} of {len(us)} have {DECISIVE} and more "
-        f"layers): {len(rows)} distinct models on those {len(dec)}, {len(rows) - lost} "
+        f"layers): {len(rows)} distinct models on those {len(dec)} configurations, "
+        f"{len(rows) - lost} "
         f"with an own part"
         + (f", {lost} failed on the mirrored split" if lost else "")
         + "; one mesh per split and size (no spread over meshes of one continuum problem); "
