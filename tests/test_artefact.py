@@ -18,11 +18,11 @@ FIVE, SIX, BCC, UNMIRRORED = (SPLITS[k] for k in ("five", "six", "bcc", "five-un
 
 
 @pytest.fixture
-def nine_decides(monkeypatch):
-    """The decomposition's logic on worlds whose 9-layer sliding configuration decides: the
-    deciding leak raised to the clear level (the study's own is a fifth of it, under which
-    only the 17-layer sliding configuration of the real runs decides)."""
-    monkeypatch.setattr(analysis, "DECIDING_LEAK", analysis.CLEAR)
+def nine_decides():
+    """The decomposition's logic on worlds whose 9-layer sliding configuration decides (its
+    leak is below the deciding level; the 9-layer clamped one's is at it)."""
+    assert analysis.leakage(reference(9, "sliding"),
+                            _free_layers("sliding", 9))["versus_clear"] == "below"
 
 
 def reference(n, bc):
@@ -110,23 +110,25 @@ def test_the_lateral_displacement_error_is_signed():
     assert analysis.inward([inverted, cell("five", FIVE, "ok", 0.02)]) == ["m"]
 
 
-@pytest.mark.parametrize("n, bc, decides", [(9, "sliding", False), (17, "sliding", True),
-                                            (9, "clamped", False), (5, "sliding", False)])
+@pytest.mark.parametrize("n, bc, decides", [(9, "sliding", True), (17, "sliding", True),
+                                            (17, "clamped", True), (9, "clamped", False),
+                                            (5, "sliding", False)])
 def test_the_metric_check_decides_only_where_smooth_fields_leak_below_a_fifth_of_the_clear_level(
         n, bc, decides):
-    """The metric's check on the layers it reads: the pure (-1)^k pattern reads 1; beside the
-    uniform sliding reference the weights absorb degree n - 2; a configuration decides only
-    where its worst smooth field (barrel, Gaussians of 2 and 4 layer spacings, end boundary
-    layers) leaks below a fifth of the clear level (0.002), not within 20 % of it: 17 sliding
-    layers do (3.8e-05), 9 sliding layers do not (an end layer leaks 0.0024), nor 7 clamped
-    free layers (a Gaussian of 2 spacings leaks more than 0.01), nor 5 layers."""
+    """The metric's check on the layers it reads: the pure (-1)^k pattern reads 1; the weights
+    absorb quadratics (cubics too beside the uniform sliding reference, by symmetry); a
+    configuration decides only where its worst smooth field (barrel, Gaussians of 2, 3 and 5
+    layer spacings, end layers of 2 and 5) leaks below a fifth of the clear level (0.002),
+    not within 20 % of it: 9 and 17 layers do, 7 clamped free layers do not (a Gaussian of
+    2 spacings leaks about 0.0021, at the threshold), nor 5 layers."""
     ref = reference(n, bc)
     got = analysis.leakage(ref, _free_layers(bc, n))
     assert got["alternation_reads"] == pytest.approx(1.0, rel=1e-9)
-    assert got["degree"] == got["free"] - (2 if bc == "sliding" else 3)
-    assert set(got["leaks"]) == {"barrel", "Gaussian, sd 2 layers", "Gaussian, sd 4 layers",
-                                 "end layer, decay 2", "end layer, decay 1",
-                                 "end layer, decay 0.5"}
+    assert got["degree"] == (3 if bc == "sliding" else 2)
+    assert set(got["leaks"]) == {"barrel", "Gaussian, sd 2 layers", "Gaussian, sd 3 layers",
+                                 "Gaussian, sd 5 layers", "end layer, decay 2",
+                                 "end layer, decay 5"}
+    assert set(got["sharp"]) == {"end layer, decay 1", "end layer, decay 0.5"}
     assert analysis.DECIDING_LEAK == pytest.approx(analysis.CLEAR / 5)
     assert (got["worst"] < 0.8 * analysis.DECIDING_LEAK) == decides
     assert (got["versus_clear"] == "below") == decides
@@ -135,32 +137,38 @@ def test_the_metric_check_decides_only_where_smooth_fields_leak_below_a_fifth_of
 
 
 @pytest.mark.parametrize("n", [9, 17])
-def test_the_metric_check_covers_sharp_two_sided_end_layers(n):
-    """The check's worst smooth field covers end boundary layers that decay within one layer
-    spacing at both ends at once (as the conforming splits' profiles do on the sliding base):
-    such a layer of any decay from 0.5 to 2 spacings scores no more than the unit's leak, and
-    on 9 sliding layers the leak is their closed form 2 (1 - e^-2)^8 / 2^8 (decay 0.5 at both
-    ends, the binomial weights' ends)."""
+def test_the_metric_check_bounds_every_end_layer_by_its_two_leaks(n):
+    """An end boundary layer at both ends at once (as the conforming splits' profiles have on
+    the sliding base) of any decay from 2 to 5 spacings scores no more than the smooth leak,
+    and of any decay from 0.5 to 1 no more than the sharp one, which is larger: a layer that
+    falls by e within a spacing is half an alternation on these layers."""
     free = _free_layers("sliding", n)
     got = analysis.leakage(reference(n, "sliding"), free)
     k = np.arange(n, dtype=float)
     w = M.nyquist_weights(reference(n, "sliding"), np.arange(n))
-    for d in (0.5, 0.7, 1.0, 1.5, 2.0):
+    sharp = max(got["sharp"].values())
+    for d in (2.0, 3.0, 5.0):
         both = np.exp(-k / d) + np.exp(-(n - 1 - k) / d)
         assert abs(w @ both) / both.max() <= got["worst"] * (1 + 1e-9), d
-    if n == 9:
-        assert got["worst"] == pytest.approx(2 * (1 - np.exp(-2)) ** 8 / 2 ** 8, rel=1e-6)
-        assert got["worst_field"] == "end layer, decay 0.5"
+    for d in (0.5, 0.7, 1.0):
+        both = np.exp(-k / d) + np.exp(-(n - 1 - k) / d)
+        assert abs(w @ both) / both.max() <= sharp * (1 + 1e-9), d
+    assert sharp > got["worst"]
 
 
-@pytest.mark.parametrize("n, reads", [(9, 74 / 256), (17, 274 / 65536)])
-def test_the_metric_check_measures_its_blindness_to_end_layer_alternation(n, reads):
-    """An alternation confined to the 3 end layers at each end (amplitude 1, 0 between) reads
-    only the binomial weights' tails beside a uniform reference: 2 (1 + 8 + 28) / 2^8 on 9
-    layers, 2 (1 + 16 + 120) / 2^16 on 17, the sensitivity the report states beside every
-    'below the clear level'; a full (-1)^k pattern reads 1."""
-    got = analysis.leakage(reference(n, "sliding"), _free_layers("sliding", n))
-    assert got["ends"] == pytest.approx(reads, rel=1e-9)
+@pytest.mark.parametrize("n, bc", [(9, "sliding"), (17, "sliding"), (17, "clamped")])
+def test_the_metric_check_measures_its_blindness_to_end_layer_alternation(n, bc):
+    """An alternation confined to the 3 end free layers at each end (amplitude 1, 0 between)
+    reads the weights' end tails, sum over those layers of w_k (-1)^k, below 1 (the metric
+    sees less of an end-only pattern: the report states it beside every 'below the clear
+    level'); a full (-1)^k pattern reads 1."""
+    free = _free_layers(bc, n)
+    k = np.flatnonzero(free)
+    got = analysis.leakage(reference(n, bc), free)
+    w = M.nyquist_weights(reference(n, bc)[free], k)
+    tails = np.r_[np.arange(3), np.arange(len(k) - 3, len(k))]
+    assert got["ends"] == pytest.approx(abs(np.sum(w[tails] * (-1.0) ** k[tails])), rel=1e-12)
+    assert 0 < got["ends"] < 1
     assert got["alternation_reads"] == pytest.approx(1.0, rel=1e-9)
 
 
@@ -247,9 +255,10 @@ def test_the_mirror_holds_where_only_the_mirrored_split_alternates(nine_decides)
     assert a["text"].startswith("Not decided for the paper's own 5-node cube (")
     assert "Under refinement, a resolved period-2 part is the mirror's wherever its source is " \
         "decided, and none is on every split (a); provisional" in a["text"]
-    assert "the paper's sign (+): the mirror's in 8 of 8 resolved parts (b, msm; on 9 " \
-        "clamped, 9 sliding, 17 clamped, 17 sliding); the reversed sign (-): no resolved " \
-        "part" in a["text"]
+    assert "the paper's sign (+): the mirror's on 4 of 4 configurations with a resolved part " \
+        "(9 clamped: 2 of 2 resolved parts, b, msm; 9 sliding: 2 of 2 resolved parts, b, " \
+        "msm; 17 clamped: 2 of 2 resolved parts, b, msm; 17 sliding: 2 of 2 resolved parts, " \
+        "b, msm); the reversed sign (-): no resolved part" in a["text"]
     assert "one mesh per split each, n = 1" in a["text"]
     assert a["text"].index("Not decided for the paper's own 5-node cube") < \
         a["text"].index("mirror's wherever")
@@ -375,7 +384,8 @@ def test_a_part_on_every_split_is_not_the_mirrors():
 def test_a_failed_control_is_a_hole_in_that_control_and_every_failed_cell_is_named():
     """A control cell that failed (an inverted element) is a hole counted against the model:
     the model keeps its own part, read against the controls that ran, with the failed
-    control named; a failed mirrored cell fails the model's observation there; the answer
+    control named, and its mirror is not decided (a failure never shrinks the design into a
+    verdict); a failed mirrored cell fails the model's observation there; the answer
     lists every failed cell of the study and 'how sure' names each."""
     world = _world(_mirror_world)
     for c in world:
@@ -390,7 +400,8 @@ def test_a_failed_control_is_a_hole_in_that_control_and_every_failed_cell_is_nam
     ans = analysis.answer(world)
     u = _unit(ans, 17, "sliding")
     b = next(r for r in u["rows"] if r["name"] == "b")
-    assert b["kind"] == "own +, the mirror's (six (Kuhn) failed: read on bcc)"
+    assert b["kind"] == ("own +, mirror not decided (a control failed; the ratio on those that "
+                         "ran is 3 or more) (six (Kuhn) failed: read on bcc)")
     assert b["ctrls"] == [BCC]
     assert b["failed_controls"][0].startswith("six (Kuhn): failed (inverted element: "
                                               "tetrahedron 3")
@@ -419,7 +430,9 @@ def test_normal_stress_is_tested_only_where_the_term_is_active(nine_decides):
     ns = a["hypotheses"]["normal_stress"]
     assert ns["decided"] and ns["holds"] and ns["removed"] == ns["tested"] == 4
     assert all(p["reduced"] == "above" for p in ns["pairs"])
-    assert ns["signs"] == ["+"] and "4 of 4 distinct pairs" in a["text"]
+    assert ns["signs"] == ["+"]
+    assert "the paper's sign (+): 4 of 4 reduced 3-fold" in a["text"]
+    assert "the reversed sign (-): not tested" in a["text"]
     assert "a normal-stress term removes it (b)" in a["text"]
 
 
@@ -659,8 +672,9 @@ def test_the_cause_says_for_how_many_models_the_own_part_is_resolved_on_each_uni
             return 0.0
         return (0.04 if model == "b" else 0.06) if n == 9 else 0.0
     a = analysis.answer(_world(one))
-    assert "the paper's sign (+): the mirror's in 4 of 4 resolved parts (b, b+n; on 9 " \
-        "clamped, 9 sliding)" in a["text"]
+    assert "the paper's sign (+): the mirror's on 2 of 2 configurations with a resolved part " \
+        "(9 clamped: 2 of 2 resolved parts, b, b+n; 9 sliding: 2 of 2 resolved parts, b, " \
+        "b+n)" in a["text"]
     assert analysis.mirror_counts(_unit(a, 9, "sliding"))["+"] == ["b", "b+n"]
     counts = analysis.mirror_counts(_unit(a, 17, "sliding"))
     assert (counts["of"], counts["resolved"], counts["unresolved"]) == (1, 0, ["b"])
@@ -826,12 +840,12 @@ def test_the_cost_is_the_benchs_at_the_papers_size_alone():
 
 def test_the_studys_definitions_state_the_metrics_leak_one_flutter_and_the_configuration():
     """The glossary lines the study adds: the signature is exactly 0 only on polynomials up
-    to the degree it absorbs (a leak otherwise, and the deciding leak a fifth of the clear
+    to degree 2 (a leak otherwise, a larger one on sharp end layers, and the deciding leak a fifth of the clear
     level), a growth rate above 0 flutters, and the unit of analysis is the configuration
     (size, base) with one mesh per split (n = 1)."""
     from cases.studies.artefact import STUDY
     text = " ".join(STUDY.definitions())
-    assert "polynomials up to the degree it absorbs" in text and "leak" in text
+    assert "polynomials up to degree 2" in text and "sharp leak" in text
     assert f"below 0.2 of the clear level {analysis.CLEAR:g} (0.002)" in text
     assert "above 0 1/s" in text and "clamped base only" in text
     assert "configuration (size, base)" in text and "n = 1" in text
@@ -840,17 +854,18 @@ def test_the_studys_definitions_state_the_metrics_leak_one_flutter_and_the_confi
 
 def test_the_signature_is_exact_on_polynomials_and_leaks_on_other_smooth_fields():
     """What the definitions say: on 5 sliding layers the weights read 0 to round-off on every
-    polynomial up to degree 3 and a half-sine barrel leaks 0.021 of its height; on 9 clamped
-    layers (7 free) a Gaussian of 2 layer spacings leaks more than the clear level: exact zero
-    only for polynomials, a stated leak otherwise."""
+    polynomial up to the degree they absorb (3) and a half-sine barrel leaks about 0.02 of
+    its height; on 9 clamped layers (7 free) a Gaussian of 2 layer spacings leaks below the
+    clear level but not below a fifth of it: exact zero only for polynomials, a stated leak
+    otherwise."""
     got = analysis.leakage(reference(5, "sliding"), _free_layers("sliding", 5))
     w = M.nyquist_weights(reference(5, "sliding"), np.arange(5))
     k = np.arange(5, dtype=float)
     for d in range(got["degree"] + 1):
         assert abs(w @ k ** d) < 1e-9 * np.abs(k ** d).max()
-    assert got["degree"] == 3 and got["leaks"]["barrel"] == pytest.approx(0.021, abs=5e-4)
+    assert got["degree"] == 3 and got["leaks"]["barrel"] == pytest.approx(0.021, abs=2e-3)
     clamped = analysis.leakage(reference(9, "clamped"), _free_layers("clamped", 9))
-    assert clamped["leaks"]["Gaussian, sd 2 layers"] > analysis.CLEAR
+    assert analysis.DECIDING_LEAK < clamped["leaks"]["Gaussian, sd 2 layers"] < analysis.CLEAR
 
 
 def test_a_resolved_part_below_the_clear_level_answers_the_mirror_and_says_it_is_not_seen():

@@ -127,24 +127,23 @@ def layer_profile(points, u, layers, size, tol=None):
 
 def alternation(profile, reference, free=None):
     """The period-2 (Nyquist) component of a layer profile, the pattern's own signature:
-    ``beta`` [the profiles' unit] of the exact fit over the ``free`` layers (those whose
-    lateral motion nothing prescribes; all when None; they must be consecutive),
+    ``beta`` [the profiles' unit] of the fit over the ``free`` layers (those whose lateral
+    motion nothing prescribes; all when None; they must be consecutive),
 
-        profile_k = alpha reference_k + q(k) + beta (-1)^k,
+        profile_k = alpha reference_k + s_k + beta (-1)^k,
 
-    q a polynomial of the highest degree that still leaves (-1)^k apart from it and the
-    reference (on n free layers n - 2 beside a uniform reference, as the sliding cube's;
-    n - 3, or n - 4 beside a symmetric barrel on odd n, whose symmetric directions it
-    shares with (-1)^k), and ``beta`` over the reference's mean |profile|
-    (``relative``). beta is the one weighted sum of the layers that is blind to the
-    reference's shape at any scale and to every such polynomial, and reads a pure (-1)^k
-    pattern as its amplitude: the continuum against itself and any barrel the polynomial
-    spans score 0 to round-off, a smooth bulge almost 0 on many layers (a Gaussian of
-    standard deviation 2 layers: below 3e-3 of its height on 9 layers, 1e-4 on 17) but not
-    on five, where at most a cubic is absorbed (the paper's own view: it cannot tell a
-    smooth bump from an alternation). +beta puts the layers of even index from the base out
-    (the ends and the middle layer of five: the paper's sign). (None, None) where the free
-    layers absorb less than a quadratic (three free layers of a clamped five-layer cube)."""
+    s a smooth part, read with the weights of :func:`nyquist_weights`, and ``beta`` over the
+    reference's mean |profile| (``relative``). The weights are blind to the reference at any
+    scale and to polynomials up to degree 2 (EXACT_DEGREE) and read a pure
+    (-1)^k pattern as its amplitude: the continuum against itself and a parabolic barrel score
+    0 to round-off; of every other smooth field (a bulge or an end layer of two layer spacings
+    or wider) they read the least their layers allow (a Gaussian of standard deviation 2
+    layers: below 3e-3 of its height on 7 free layers, 3e-4 on 9, 2e-5 on 15 and 17) but not
+    on five,
+    where the layers leave one weighting (the paper's own view: it cannot tell a smooth bump
+    from an alternation). +beta puts the layers of even index from the base out (the ends
+    and the middle layer of five: the paper's sign). (None, None) where the free layers leave
+    no signature (three free layers of a clamped five-layer cube)."""
     b, r = np.asarray(profile, float), np.asarray(reference, float)
     if b.shape != r.shape or b.ndim != 1 or b.size < 3:
         raise MetricError(f"alternation needs two profiles of the same three or more layers, "
@@ -165,23 +164,57 @@ def alternation(profile, reference, free=None):
     return finite("alternation_mm", beta), finite("alternation_rel", beta / scale)
 
 
+# the smooth fields the signature's weights are designed to be blind to (in layer spacings):
+# Gaussian bulges of these standard deviations centred anywhere from two of them before the
+# first free layer to two after the last, and end layers decaying over these lengths
+SMOOTH_WIDTHS = (2.0, 2.5, 3.0, 4.0, 6.0, 8.0, 12.0, 24.0)
+SMOOTH_DECAYS = (2.0, 3.0, 4.0)
+SMOOTH_STEP = 0.25      # the Gaussians' centres, this fraction of a layer spacing apart
+EXACT_DEGREE = 2        # polynomials up to this degree (a parabolic barrel) read 0 exactly
+
+
+def smooth_family(k):
+    """The design fields of :func:`nyquist_weights` on the consecutive layers ``k``, one per
+    row, each scaled to a largest |value| of 1: the Gaussians of SMOOTH_WIDTHS, the end
+    layers of SMOOTH_DECAYS (at the first layer, the last, both alike and opposite) and the
+    half-sine barrel vanishing one layer outside them."""
+    k = np.asarray(k, float)
+    first, last = k[0], k[-1]
+    rows = [np.exp(-(k - c) ** 2 / (2 * s * s)) for s in SMOOTH_WIDTHS
+            for c in np.arange(first - 2 * s, last + 2 * s + 1e-9, SMOOTH_STEP)]
+    for d in SMOOTH_DECAYS:
+        base, top = np.exp(-(k - first) / d), np.exp(-(last - k) / d)
+        rows += [base, top, base + top, base - top]
+    rows.append(np.sin(np.pi * (k - first + 1) / (last - first + 2)))
+    a = np.array(rows)
+    return a / np.abs(a).max(axis=1, keepdims=True)
+
+
 def nyquist_weights(reference, k):
-    """The weights w of :func:`alternation` on the layers ``k`` (consecutive indices): the
-    part of (-1)^k orthogonal to ``reference`` and to the polynomials of the highest degree
-    that leaves (-1)^k apart from them, scaled so that w . (-1)^k = 1 (of the sums blind to
-    those, the one least sensitive to noise); None where that degree is below 2."""
+    """The weights w of :func:`alternation` on the layers ``k`` (consecutive indices): of the
+    weightings blind to ``reference`` and to the polynomials up to EXACT_DEGREE with
+    w . (-1)^k = 1, the one whose scores on :func:`smooth_family` have the
+    least sum of squares (a minimum-leakage filter: the smooth part is whatever varies over
+    two layer spacings or more, not a polynomial the layers happen to span); None where
+    (-1)^k lies in the span of what the weights must be blind to."""
+    k = np.asarray(k, float)
     n = len(k)
+    alt = (-1.0) ** k
     x = np.linspace(-1.0, 1.0, n) if n > 1 else np.zeros(1)
-    alt = (-1.0) ** np.asarray(k, float)
-    for degree in range(n - 2, 1, -1):
-        smooth = np.column_stack([reference, np.polynomial.legendre.legvander(x, degree)])
-        smooth = smooth / np.linalg.norm(smooth, axis=0)     # unit columns: ranks at RANK_TOL
-        u, sv, _ = np.linalg.svd(smooth, full_matrices=False)
-        basis = u[:, sv > RANK_TOL * sv[0]]
-        apart = alt - basis @ (basis.T @ alt)
-        if np.linalg.norm(apart) > 1e3 * RANK_TOL * np.linalg.norm(alt):
-            return apart / (apart @ alt)
-    return None     # (-1)^k is smooth on these layers
+    exact = np.column_stack([reference, np.polynomial.legendre.legvander(x, EXACT_DEGREE)])
+    exact = exact / np.linalg.norm(exact, axis=0)          # unit columns: ranks at RANK_TOL
+    u, sv, _ = np.linalg.svd(exact, full_matrices=True)
+    rank = int((sv > RANK_TOL * sv[0]).sum())
+    null = u[:, rank:]                 # every weighting blind to the exact fields
+    a = null.T @ alt
+    if np.linalg.norm(a) <= 1e3 * RANK_TOL * np.linalg.norm(alt):
+        return None                    # (-1)^k is exact-smooth on these layers
+    s = smooth_family(k) @ null
+    gram = s.T @ s
+    # a ridge at round-off keeps the solve defined where the family spans fewer directions
+    gram += 1e-12 * np.trace(gram) / len(gram) * np.eye(len(gram))
+    z = np.linalg.solve(gram, a)
+    return null @ (z / (a @ z))
 
 
 def paper_pattern(profile):

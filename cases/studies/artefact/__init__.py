@@ -28,13 +28,14 @@ class Artefact(Study):
         return [
             "configuration (size, base) (artefact study): the study's unit of analysis, one "
             "number of nodes per side with one base; it has one mesh per split (n = 1), so "
-            "its uncertainty is the leak of smooth fields alone.",
+            "its uncertainty is the metric's leak alone.",
             "signature leak (artefact study): the period-2 signature is exactly 0 (to "
-            "round-off) on the reference and on polynomials up to the degree it absorbs; any "
-            "other smooth field (a barrel, a Gaussian bulge, an end layer) scores a leak, "
-            "largest on few layers; a configuration decides only where its worst smooth test "
-            f"field leaks below {LEAK_SHARE:g} of the clear level {CLEAR:g} "
-            f"({DECIDING_LEAK:g}).",
+            "round-off) on the reference and on polynomials up to degree 2; any other smooth "
+            "field (a barrel, a Gaussian bulge, an end layer, each varying over two layer "
+            "spacings or more) scores a small leak, largest on few layers, and an end layer "
+            "sharper than that a larger one (the sharp leak); a configuration decides only "
+            f"where its worst smooth test field leaks below {LEAK_SHARE:g} of the clear level "
+            f"{CLEAR:g} ({DECIDING_LEAK:g}).",
             "stable, flutter (artefact study): one definition, the glossary's growth: a mode "
             f"flutters where its growth rate at rest is above {GROWS:g} 1/s; stable means rate "
             "0; a flutter grows beyond the mass damping we assume where its rate exceeds half "

@@ -53,8 +53,10 @@ ROUND_OFF_FLOOR = 1e-8      # no uncertainty below this (the static solves' own 
 SAME = 1e-3            # two signatures agreeing to this (relative, 3 significant figures): one
 COARSE = 1e-2          # the coarser clustering (2 significant figures) (c) is also read at
 ACTIVE = 1e-6          # a term changes a signature beyond round-off from this (relative)
-WIDTHS = (2, 4)        # the test Gaussians' standard deviations, in layer spacings
-DECAYS = (2, 1, 0.5)   # the test boundary layers' decay lengths, in layer spacings
+WIDTHS = (2, 3, 5)     # the test Gaussians' standard deviations, in layer spacings (2 the
+#                        narrowest smooth bulge; 3 and 5 between the weights' design widths)
+DECAYS = (2, 5)        # the smooth test boundary layers' decay lengths, in layer spacings
+SHARP_DECAYS = (1, 0.5)   # end layers sharper than two spacings: not smooth on these layers
 MIN_RESOLVED = 4       # (c) correlates over at least this many resolved signatures
 END_LAYERS = 3         # the end-localised alternation: this many free layers at each end
 Z95 = 1.96             # the two-sided 95 % normal quantile
@@ -126,20 +128,23 @@ def same(a, b, tol=SAME):
 
 # ---------------------------------------------------------------------------- the metric
 
-def test_fields(n, free):
+def test_fields(n, free, decays=DECAYS):
     """{name: [profiles]}: the smooth fields the signature must score (almost) 0 on, over
     ``n`` layers, ``free`` the layers it reads: a half-sine barrel over the cube, Gaussian
-    bulges of standard deviation WIDTHS layer spacings centred on each free layer, and end
-    boundary layers of each decay length DECAYS (in layer spacings, from the first and last
-    free layer) at the base, at the top, and at both with the same and with opposite signs."""
+    bulges of standard deviation WIDTHS layer spacings centred on each free layer and half-way
+    between (not the weights' own design fields: those sit on a quarter-layer grid at other
+    widths), and end boundary layers of each decay length ``decays`` (in layer spacings, from
+    the first and last free layer) at the base, at the top, and at both with the same and
+    with opposite signs."""
     k = np.arange(n, dtype=float)
-    centres = np.flatnonzero(free)
-    first, last = centres[0], centres[-1]
-    out = {"barrel": [np.sin(np.pi * k / (n - 1))]}
-    for s in WIDTHS:
+    layers = np.flatnonzero(free)
+    first, last = layers[0], layers[-1]
+    centres = np.arange(first, last + 0.25, 0.5)
+    out = {"barrel": [np.sin(np.pi * k / (n - 1))]} if decays is DECAYS else {}
+    for s in (WIDTHS if decays is DECAYS else ()):
         out[f"Gaussian, sd {s} layers"] = [np.exp(-(k - c) ** 2 / (2 * s ** 2))
                                            for c in centres]
-    for d in DECAYS:
+    for d in decays:
         base, top = np.exp(-np.abs(k - first) / d), np.exp(-np.abs(last - k) / d)
         out[f"end layer, decay {d:g}"] = [base, top, base + top, base - top]
     return out
@@ -173,24 +178,30 @@ def leakage(reference, free):
     """The signature's check on one (size, base): ``reference`` the continuum's layer profile,
     ``free`` the layers read. The number of free layers, the polynomial degree the weights
     absorb, their gain (sum |w|: the most a field of height 1 can score; ||w||_2: what
-    uncorrelated noise of 1 per layer reads), what the pure (-1)^k pattern reads (1), per test
-    field its largest |score| over its height on the free layers, ``worst`` the largest of
-    those and the field, and ``ends`` what an alternation of amplitude 1 on END_LAYERS free
-    layers at each end reads (the metric's sensitivity to end-localised bulging). None where
-    no signature exists (three free layers)."""
+    uncorrelated noise of 1 per layer reads), what the pure (-1)^k pattern reads (1), per
+    smooth test field its largest |score| over its height on the free layers, ``worst`` the
+    largest of those and the field, ``sharp`` the same of end layers sharper than two layer
+    spacings (SHARP_DECAYS: on these layers half an alternation, so not in the leak) and
+    ``ends`` what an alternation of amplitude 1 on END_LAYERS free layers at each end reads
+    (the metric's sensitivity to end-localised bulging). None where no signature exists
+    (three free layers)."""
     reference = np.asarray(reference, float)
     free = np.asarray(free, bool)
     k = np.flatnonzero(free)
     w = nyquist_weights(reference[free], k)
     if w is None:
         return None
-    leaks = {name: max(abs(w @ f[free]) / np.abs(f[free]).max() for f in fields)
-             for name, fields in test_fields(len(reference), free).items()}
+
+    def score(fields):
+        return {name: max(abs(w @ f[free]) / np.abs(f[free]).max() for f in fs)
+                for name, fs in fields.items()}
+    leaks = score(test_fields(len(reference), free))
     worst = max(leaks, key=leaks.get)
     return {"free": int(free.sum()), "degree": absorbed_degree(w, len(k)),
             "gain": float(np.abs(w).sum()), "noise_gain": float(np.linalg.norm(w)),
             "alternation_reads": float(w @ (-1.0) ** k.astype(float)),
             "leaks": leaks, "worst": leaks[worst], "worst_field": worst,
+            "sharp": score(test_fields(len(reference), free, SHARP_DECAYS)),
             "versus_clear": against(leaks[worst], DECIDING_LEAK),
             "ends": float(abs(w @ end_alternation(len(reference), free)[free]))}
 
@@ -303,16 +314,43 @@ def smooth_amplitude(diff, reference, free):
     return float(np.abs(d - alpha * rf).max() / np.abs(r).mean())
 
 
+def end_step(diff, reference, free):
+    """The largest step between the two outermost free layers at either end of
+    (diff - alpha reference), over the reference's mean |profile|: how tall an end layer
+    sharper than two spacings could be (an alternation's own steps are in it too, so it
+    bounds more than it needs to)."""
+    d, r = np.asarray(diff, float)[free], np.asarray(reference, float)
+    rf = r[free]
+    alpha = float(d @ rf / (rf @ rf)) if rf @ rf else 0.0
+    e = d - alpha * rf
+    return float(max(abs(e[1] - e[0]), abs(e[-1] - e[-2])) / np.abs(r).mean())
+
+
+def leaks_of(check):
+    """(smooth, sharp) of a configuration's check: the worst smooth test field's leak and the
+    worst end layer sharper than two spacings'; (0, 0) where it has none."""
+    return (check.get("worst") or 0.0, max((check.get("sharp") or {}).values(), default=0.0))
+
+
+def leak_u(diff, reference, free, leak):
+    """What the metric's leak puts into a signature read off ``diff`` (over the reference's
+    mean): the smooth leak times the smooth amplitude and the sharp end layers' leak times
+    the end step, in quadrature; ``leak`` (smooth, sharp) or one number (smooth only)."""
+    smooth, sharp = leak if isinstance(leak, tuple) else (leak, 0.0)
+    return float(np.hypot(smooth * smooth_amplitude(diff, reference, free),
+                          sharp * end_step(diff, reference, free)))
+
+
 def signature_u(c, leak, floor=0.0):
-    """The uncertainty of a cell's signature (over the reference's mean): the configuration's worst
-    smooth-field leakage ``leak`` times the smooth amplitude of (model - reference), with
-    ``floor`` (the reference's own period-2 error, bounded by FEM P1's on the conforming
-    splits) and round-off, in quadrature; None where the cell has no profile."""
+    """The uncertainty of a cell's signature (over the reference's mean): ``leak_u`` of
+    (model - reference), with ``floor`` (the reference's own period-2 error, bounded by FEM
+    P1's on the conforming splits) and round-off, in quadrature; None where the cell has no
+    profile."""
     p, r = _arr(c.get("bulge_profile_mm")), _arr(c.get("bulge_profile_fem_mm"))
     if p is None or r is None or c.get("failed"):
         return None
-    a = smooth_amplitude(p - r, r, _free_layers(c["bc"], len(r)))
-    return float(np.sqrt((leak * a) ** 2 + floor ** 2 + ROUND_OFF_FLOOR ** 2))
+    lu = leak_u(p - r, r, _free_layers(c["bc"], len(r)), leak)
+    return float(np.sqrt(lu ** 2 + floor ** 2 + ROUND_OFF_FLOOR ** 2))
 
 
 def cell_clear(c, leak=0.0, floor=0.0):
@@ -365,15 +403,15 @@ def _index(cells):
 def _part(c, fem, ref, free, leak):
     """(part, u) of a model's cell against FEM P1's on the same tetrahedra: the difference of
     their signatures (over the reference's mean) and its uncertainty, the configuration's
-    ``leak`` times the smooth amplitude of (model - FEM P1), with round-off, in quadrature;
-    (None, None) where either is missing."""
+    ``leak_u`` of (model - FEM P1), with round-off, in quadrature; (None, None) where either
+    is missing."""
     if c is None or fem is None or c.get("alternation_rel") is None \
             or fem.get("alternation_rel") is None:
         return None, None
     d = c["alternation_rel"] - fem["alternation_rel"]
-    a = smooth_amplitude(np.asarray(c["bulge_profile_mm"]) - np.asarray(fem["bulge_profile_mm"]),
-                         ref, free)
-    return d, float(np.hypot(leak * a, ROUND_OFF_FLOOR))
+    lu = leak_u(np.asarray(c["bulge_profile_mm"]) - np.asarray(fem["bulge_profile_mm"]), ref,
+                free, leak)
+    return d, float(np.hypot(lu, ROUND_OFF_FLOOR))
 
 
 def _mirror_call(d, u, parts):
@@ -402,11 +440,11 @@ def units(cells, models=None):
     on the conforming controls (six, bcc: those run for every model at that size, the same
     for every model), each with its own uncertainty, and its class.
 
-    The leak of a configuration is its worst smooth test field's score (``metric_check``). u of a
-    model's part: sqrt((leak x A)^2 + round-off^2), A the smooth amplitude of (model - FEM P1)
-    (FEM P1 with the continuum's neo-Hookean law); a control's part the same on its split
-    (the conforming splits the model and FEM P1 ran on at that size). u of a signature (FEM
-    P1's or a model's): leak x the smooth amplitude of (cell - reference), with the floor (FEM
+    The leak of a configuration is its worst smooth test field's score and its worst sharp end
+    layer's (``metric_check``). u of a model's part: ``leak_u`` of (model - FEM P1) (FEM P1
+    with the continuum's neo-Hookean law) with round-off, in quadrature; a control's part the
+    same on its split (the conforming splits the model and FEM P1 ran on at that size). u of
+    a signature (FEM P1's or a model's): ``leak_u`` of (cell - reference), with the floor (FEM
     P1's largest signature on any conforming split run at that size: the reference's own
     period-2 error is bounded by it). On the sliding base FEM P1 is exact (a homogeneous
     field), an identity check, not a measured error.
@@ -428,7 +466,7 @@ def units(cells, models=None):
     for n, bc in sorted({(c["nodes_per_side"], c["bc"]) for c in cells
                          if c["split"] == MIRRORED}):
         chk = check.get((n, bc), {})
-        leak = chk.get("worst", 0.0)
+        leak = leaks_of(chk)
         # a configuration reads own parts from DECISIVE layers (the leak is in every u); its
         # clear-level calls decide only where the leak is below DECIDING_LEAK ("decides")
         reads = n >= DECISIVE and chk.get("worst") is not None
@@ -507,6 +545,11 @@ def units(cells, models=None):
                                          if parts else None)})
             if parts:
                 lo, hi, call, why = _mirror_call(d, u, parts)
+                if row["failed_controls"] and call != "at":
+                    # a failed control is a failure of the model, not a smaller design: the
+                    # mirror read on the controls left is not decided
+                    call, why = "at", ("a control failed; the ratio on those that ran is " + (
+                        f"{RATIO:g} or more" if call == "above" else f"below {RATIO:g}"))
                 row.update({"mirror_lo": lo, "mirror_hi": hi, "mirror_vs": call,
                             "mirror_why": why})
             if not reads:
@@ -533,7 +576,8 @@ def units(cells, models=None):
         distinct = [r for r in rows if r["same_as"] is None]
         out.append({"n": n, "bc": bc, "check": chk, "decides": bool(chk.get("decides")),
                     "reads": reads,
-                    "leak": leak, "controls": ctrls, "missing_controls": missing,
+                    "leak": leak[0], "sharp_leak": leak[1], "controls": ctrls,
+                    "missing_controls": missing,
                     "fem_five": fem_five, "fem_mm": None if fem is None else
                     fem.get("alternation_mm"), "u_fem": u_fem, "fem_vs": fem_vs,
                     "fem_clear": fem_clear,
@@ -645,8 +689,10 @@ def normal_stress(cells, us):
             continue
         a, b = base.get("alternation_rel"), w.get("alternation_rel")
         if same(a, b, ACTIVE):
-            skip("the term changes nothing here (to 1e-6; the fitted constants are not "
-                 "stored, so whether the fit set it to 0 is not known)")
+            cn = (w.get("constants") or {}).get(normal.split(" ")[0] + "_c")
+            skip("the term changes nothing here (to 1e-6; " + (
+                "its constant is not stored" if cn is None else f"its constant c_n = {cn:.2g}")
+                + ")")
             continue
         if r.get("part_vs_u") != "above":
             skip(f"{short(base['model'])} has no resolved own part")
@@ -727,7 +773,7 @@ def consistency(cells):
     resolved (|signature| at least RATIO times its u, the configuration's leak in it): a
     correlation over signatures that cannot be told from 0 ranks the leak."""
     check = metric_check(cells)
-    leak = {k: v.get("worst", 0.0) for k, v in check.items()}
+    leak = {k: leaks_of(v) for k, v in check.items()}
     per, size = {}, {}
     for c in cells:
         if (c["nodes_per_side"] < DECISIVE or c["bc"] != "sliding" or c["family"] == CONTROL
@@ -750,7 +796,7 @@ def consistency(cells):
                 continue
             pts.append((s, e))
             u = signature_u(v["linear"], leak.get((v["linear"]["nodes_per_side"], "sliding"),
-                                                  0.0))
+                                                  (0.0, 0.0)))
             call = against(abs(s) / u, RATIO)
             (clear if call == "above" else at_ if call == "at" else []).append(short(model))
         if len(pts) < 3:
@@ -1055,40 +1101,50 @@ def answer(cells, models=None):
     slopes = [order_text(bc, o) for bc, o in m["orders"].items() if o["orders"]]
 
     def sign_text(s_):
-        v, mv = sign_rows[s_], mirrored[s_]
-        if not v:
+        # the configuration (one mesh pair) is the unit: per configuration, its model parts
+        per = {}
+        for w, r in sign_rows[s_]:
+            per.setdefault(w, []).append(r)
+        if not per:
             return f"{word[s_]} ({s_}): no resolved part"
-        where = list(dict.fromkeys(w for w, _ in mv))
-        return (f"{word[s_]} ({s_}): the mirror's in {len(mv)} of {len(v)} resolved parts"
-                + (f" ({_compress(list(dict.fromkeys(r['name'] for _, r in mv)))}; on "
-                   f"{', '.join(where)})" if mv else "")
-                + (", the rest not decided" if len(mv) < len(v) else ""))
+        held = [w for w, rs in per.items() if any(r.get("mirror_vs") == "above" for r in rs)]
+        return (f"{word[s_]} ({s_}): the mirror's on {len(held)} of {len(per)} configurations "
+                "with a resolved part (" + "; ".join(
+                    f"{w}: {sum(r.get('mirror_vs') == 'above' for r in rs)} of {len(rs)} "
+                    "resolved parts" + (f", {_compress(mv)}" if (mv := list(dict.fromkeys(
+                        r["name"] for r in rs if r.get("mirror_vs") == "above"))) else "")
+                    for w, rs in per.items()) + ")")
     fem_ratio = [f"{_where((u['n'], u['bc']))} {times(u['fem_ratio'])}" for u in dec
-                 if not u["identity"] and u.get("fem_ratio") is not None]
+                 if not u["identity"] and u.get("fem_ratio") is not None
+                 and u.get("fem_vs") != "above"]
     a_text = ("; ".join(sign_text(s_) for s_ in ("+", "-"))
               + ("; none is on every split" if not against_ else
                  f"; on every split: {against_}")
               + (f"; FEM P1's own signature is resolved and the mirror's on "
                  f"{', '.join(fem_units)}" if fem_units else "")
-              + (f". FEM P1's own signature on the mirrored split is resolved nowhere (over "
+              + (f". FEM P1's own signature on the mirrored split is not resolved (over "
                  f"its largest on the conforming splits: {', '.join(fem_ratio)}, within the "
                  "metric's leak bound)" if fem_ratio else "")
               + (f". The own part {'; '.join(slopes)}" if slopes else "")
-              + ". Per configuration, the classes are in the artefact report's tables; the "
-              "counts are of model parts, which share one mesh pair per configuration")
-    b_text = ((f"{ns['removed']} of {ns['tested']} distinct pairs (a calibrated reading's "
-               "resolved own part with and without an active term, the split held fixed) "
-               f"reduced {RATIO:g}-fold"
-               + (f" ({ns['at_threshold']} at the threshold)" if ns["at_threshold"] else "")
-               + (f"; |with| / |without| {fmt(min(p['ratio'] for p in ns['pairs']), 2)}-"
-                  f"{fmt(max(p['ratio'] for p in ns['pairs']), 2)}" if ns["pairs"] else "")
-               + (f"; every tested pair is beside a reading of {word[ns['signs'][0]]} ("
-                  f"{_names(ns['readings'])}): for {word['+' if ns['signs'] == ['-'] else '-']}"
-                  " (b) is not tested"
-                  + (f" (beside {_names(ns['inactive_other_sign'])} every term changes "
-                     "nothing: its fitted constant is not stored, so whether the fit set it "
-                     "to 0 is not known)" if ns["inactive_other_sign"] else "")
-                  if len(ns["signs"]) == 1 else ""))
+              + ". Each configuration is one mesh pair (n = 1) that its models share; the "
+              "classes are in the artefact report's tables")
+    def b_sign(s_):
+        ps = [p for p in ns["pairs"] if p["sign"] == s_]
+        if not ps:
+            return f"{word[s_]} ({s_}): not tested" + (
+                f" (beside {_names(ns['inactive_other_sign'])} every fitted term changes "
+                "nothing: the fit sets its constant to 0 or near it, as cells.md states)"
+                if ns["inactive_other_sign"] and s_ not in ns["signs"] else "")
+        at_ = sum(p["reduced"] == "at" for p in ps)
+        return (f"{word[s_]} ({s_}): {sum(p['reduced'] == 'above' for p in ps)} of {len(ps)} "
+                f"reduced {RATIO:g}-fold" + (f" ({at_} at the threshold)" if at_ else "")
+                + f", |with| / |without| {fmt(min(p['ratio'] for p in ps), 2)}-"
+                f"{fmt(max(p['ratio'] for p in ps), 2)} ("
+                + _names(sorted({p["model"] for p in ps})) + "; on "
+                + ", ".join(dict.fromkeys(_where((p["n"], p["bc"])) for p in ps)) + ")")
+    b_text = ("distinct pairs (a calibrated reading's resolved own part with and without an "
+              "active term, the split held fixed), by the sign of the part: "
+              + "; ".join(b_sign(s_) for s_ in ("+", "-"))
               if ns["decided"] else "not tested (no term active beside a resolved own part)")
     c_text = ("not testable (" + "; ".join(
         f"{', '.join(meshes)}: {why}" for why, meshes in _by_value(
@@ -1105,7 +1161,7 @@ def answer(cells, models=None):
     below = _below_text(seen_at) if seen_at else None
     said = (["under refinement, a resolved period-2 part is the mirror's wherever its source "
              "is decided, and none is on every split (a); provisional: its u holds the "
-             "metric's leak and the solver's tolerance only"] if a_holds else []) + (
+             "metric's leaks and the solver's tolerance only"] if a_holds else []) + (
         ["a normal-stress term removes it (b)"] if ns["holds"] else []) + (
         ["it tracks the patch-test error (c)"] if cs["holds"] else [])
     lead = (f"Not decided for {paper}; the paper's 374-tetrahedron "
@@ -1115,8 +1171,8 @@ def answer(cells, models=None):
                "parts"))
     text = (f"{lead}. (a) Mirror symmetry, on the configurations (size, base) where own parts "
             f"are resolved ({', '.join(resting) or 'none'}; one mesh per split each, n = 1; a "
-            f"part is resolved where it is {RATIO:g} times its u, the metric's leak of smooth "
-            f"fields; the mirror's where it is also {RATIO:g} times the model's part on each "
+            f"part is resolved where it is {RATIO:g} times its u, the metric's leaks of smooth "
+            f"fields and of sharp end layers; the mirror's where it is also {RATIO:g} times the model's part on each "
             f"conforming split without the mirror, within both u), by sign: {a_text}. (b) "
             f"Normal stress: {b_text}. (c) Consistency (the linear regime: the signature at "
             f"the linear load against the patch-test error): {c_text}. "
@@ -1194,10 +1250,11 @@ def how_sure(ans, verdict):
         f"with an own part"
         + (f", {lost} failed on the mirrored split" if lost else "")
         + "; one mesh per split and size (no spread over meshes of one continuum problem); "
-        "each u holds the leak of smooth fields (the worst test field's) and the solver's "
+        "each u holds the metric's leaks (the worst smooth test field's and the worst sharp "
+        "end layer's) and the solver's "
         f"tolerance ({ROUND_OFF_FLOOR:g}), not the sensitivity to the fitted constants (fitted "
-        "per mesh, not stored) nor a spread over meshes: the verdicts are provisional on "
-        "those"
+        "per mesh, stored in cells.md, not varied) nor a spread over meshes: the verdicts are "
+        "provisional on those"
         + ("; orders from two sizes only; " if any(
             o["orders"] for o in ans["hypotheses"]["mirror"]["orders"].values()) else "; ")
         + (f"at a threshold (within {NEAR:.0%}): {', '.join(at)}; " if at

@@ -7,12 +7,13 @@ from pathlib import Path
 import numpy as np
 
 from ...measuring import catalogue
+from ...measuring.metrics import EXACT_DEGREE, SMOOTH_DECAYS, SMOOTH_WIDTHS
 from ...reporting import figures  # noqa: F401  (selects matplotlib's file backend before pyplot)
 from ...reporting.document import GLOSSARY, Document, fmt, rel
 from ...reporting.report import environment, write_study
 from ...running.runner import jsonable
 from ...library import paper_cube as P
-from .analysis import (CLEAR, COARSE, DECAYS, DECIDING_LEAK, END_LAYERS, GROWS, LEAK_SHARE,
+from .analysis import (CLEAR, COARSE, DECAYS, SHARP_DECAYS, DECIDING_LEAK, END_LAYERS, GROWS, LEAK_SHARE,
                        MIN_RESOLVED, NEAR, PAPER_BULGES_MM, PAPER_COST, PAPER_NECKS_MM, RATIO,
                        SAME, TRACKS, WIDTHS, _compress, answer, classes, failure, how_sure,
                        paper_figure, paper_figure_text,
@@ -158,7 +159,10 @@ def _what_was_run(d, s, doc):
         "'literal') and with c fitted by the patch-test calibration (the paper's c is 1: a "
         "calibrated reading is the paper's equations with another constant), each calibrated "
         "one with each normal-stress term (not in the paper's equations; its constant fitted "
-        "per mesh; the fitted constants are not stored), msm, msm with the variational shear "
+        "per mesh, as every calibrated constant, each stored with its cells and printed in "
+        "cells.md), pbcm-balanced with each normal-stress term at a fixed c_n = 1 (its fit "
+        "gives c_n = 0 on the mirrored split, so the fitted pairs cannot test a normal "
+        "stress beside the paper's sign), msm, msm with the variational shear "
         f"at c = 1, and {YARDSTICK} (FEM P1: constant-strain FEM with the continuum's own "
         "neo-Hookean law on the same tetrahedra, the control). On the finest bcc (9009 nodes) "
         "the calibrated readings and the control only (the cost of its Newton matrices): "
@@ -191,18 +195,23 @@ def _what_was_run(d, s, doc):
         "six split. The reference enters every model's signature alike; the floor (FEM P1's "
         "largest signature on the conforming splits) bounds its period-2 part, and it "
         "cancels in a model's part (model - FEM P1).",
-        "The signature (the alternation): beta of the exact fit profile_k = alpha "
-        "reference_k + q(k) + beta (-1)^k over the free layers (reference_k: the glossary's "
-        "profile_FEM, the continuum's; every layer sliding, all but the two held ones "
-        "clamped), q the polynomial of the highest degree that leaves (-1)^k apart, which "
-        "depends on the reference: n - 2 on n free layers beside the sliding base's uniform "
-        "reference, n - 3 beside the clamped base's barrel (here: " + ", ".join(
-            f"{_unit(u)} degree {u['check']['degree']} on {u['check']['free']}"
-            for u in units if u["check"].get("degree") is not None) + " free layers). "
-        "It is exactly 0 (to round-off) only on the reference and on polynomials up to that "
-        "degree; any other smooth field leaks (a half-sine barrel, a Gaussian bulge, an end "
-        "layer): the metric's check below states each configuration's leak, and that leak "
-        "is every signature's uncertainty there. "
+        "The signature (the alternation): beta of the fit profile_k = alpha reference_k + "
+        "s_k + beta (-1)^k over the free layers (reference_k: the glossary's profile_FEM, "
+        "the continuum's; every layer sliding, all but the two held ones clamped), s_k a "
+        "smooth part: whatever varies over two layer spacings or more. beta is read by one "
+        "weighted sum of the free layers, exactly blind to the reference at any scale and to "
+        f"polynomials up to degree {EXACT_DEGREE} (a tilt, a parabolic barrel), reading a pure "
+        "(-1)^k pattern as 1, and of all such sums the one whose squared scores on a family "
+        "of smooth fields (Gaussian bulges of standard deviation "
+        + ", ".join(f"{x:g}" for x in SMOOTH_WIDTHS) + " layer spacings centred anywhere "
+        "along the layers and beyond them, end layers decaying over "
+        + ", ".join(f"{x:g}" for x in SMOOTH_DECAYS) + " spacings, a half-sine barrel) sum "
+        "least. It is exactly 0 (to round-off) on the reference and on those polynomials; "
+        "any other smooth field leaks a little, and an end layer sharper than two spacings "
+        "more (on these layers it is half an alternation): the metric's check below states "
+        "each configuration's two leaks, and they are in every signature's uncertainty there "
+        "(the smooth leak times the field's smooth amplitude, the sharp one times its step "
+        "between the two outermost free layers at either end). "
         "Positive: the layers of even index from the base out bulge (the paper's sign). "
         "Two normalisations: over the reference's mean |lateral displacement| over all "
         "layers (the glossary's alternation rel, stored and gated; on the clamped base the "
@@ -216,45 +225,55 @@ def _what_was_run(d, s, doc):
         f"(size, base) decides only where its worst smooth test field leaks below {LEAK_SHARE:g} "
         f"of the clear level ({DECIDING_LEAK:g}: as a reference's estimate must be below a "
         "fifth of the error it ranks); each configuration has one mesh per split (n = 1), so "
-        "every uncertainty is the leak of smooth fields alone. A ratio within "
+        "every uncertainty is the metric's leak alone. A ratio within "
         f"{NEAR:.0%} of the factor {RATIO:g} is 'at the threshold: not decided'."])
 
 
 def _metric_check(d, doc):
     us = doc["answer"]["hypotheses"]["mirror"]["units"]
     d.h(2, "The metric's check")
-    d.p("The signature's weights on test fields of each (size, base), the layers it reads: "
-        "a half-sine barrel, Gaussian bulges of standard deviation "
-        + " and ".join(map(str, WIDTHS)) + " layer spacings centred on each free layer, end "
-        "boundary layers decaying over " + ", ".join(f"{x:g}" for x in DECAYS) + " layer "
-        "spacings from the first and last free layer (at the base, at the top, at both with "
-        "the same and with opposite signs); each the largest |score| over the field's height. "
-        f"The pure (-1)^k pattern must read 1; sum |w| is the most any field of height 1 can "
-        "score, ||w||_2 what uncorrelated noise of 1 per layer reads (rms). 'Leak' is the "
-        "worst smooth field's: the uncertainty of every signature and part in this "
-        "configuration is "
-        "that leak times the smooth amplitude of the field it reads. 'End alternation' is "
+    d.p("The signature's weights on test fields of each (size, base), the layers it reads "
+        "(not the fields the weights were designed on: other widths, centres on each free "
+        "layer and half-way between): a half-sine barrel, Gaussian bulges of standard "
+        "deviation " + ", ".join(map(str, WIDTHS)) + " layer spacings, end boundary layers "
+        "decaying over " + " and ".join(f"{x:g}" for x in DECAYS) + " layer spacings from the "
+        "first and last free layer (at the base, at the top, at both with the same and with "
+        "opposite signs), and, apart, end layers sharper than two spacings (decaying over "
+        + " and ".join(f"{x:g}" for x in SHARP_DECAYS) + "); each the largest |score| over "
+        "the field's height. The pure (-1)^k pattern must read 1; sum |w| is the most any "
+        "field of height 1 can score, ||w||_2 what uncorrelated noise of 1 per layer reads "
+        "(rms). 'Leak' is the worst smooth field's and 'sharp leak' the worst sharp end "
+        "layer's: the uncertainty of every signature and part in this configuration holds "
+        "the leak times the smooth amplitude of the field it reads and the sharp leak times "
+        "its end step. 'End alternation' is "
         f"what a pure (-1)^k pattern confined to the {END_LAYERS} free layers at each end "
         "(amplitude 1, 0 between) reads: the metric's sensitivity to an alternation of the "
         "end layers only; below 1 it misses most of it, and a 'below the clear level' there "
         f"does not exclude one. A configuration decides only with {DECISIVE} or more layers "
         f"and every smooth field's leak below {LEAK_SHARE:g} of the clear level "
         f"({DECIDING_LEAK:g}), not within {NEAR:.0%} of it.")
-    rows = []
+    rows, rows2 = [], []
     for u in us:
         c = u["check"]
         lk = c.get("leaks") or {}
+        sharp = c.get("sharp") or {}
         rows.append([_unit(u), c.get("free", "n/a"), c.get("degree", "n/a"),
                      fmt(c.get("gain"), 3), fmt(c.get("noise_gain"), 3),
                      fmt(c.get("alternation_reads"), 3), fmt(lk.get("barrel"), 2)]
                     + [fmt(lk.get(f"Gaussian, sd {w} layers"), 2) for w in WIDTHS]
-                    + [fmt(lk.get(f"end layer, decay {x:g}"), 2) for x in DECAYS]
-                    + [fmt(c.get("worst"), 2), fmt(c.get("ends"), 2),
-                       "yes" if u["decides"] else f"no: {c.get('why')}"])     # clear calls
+                    + [fmt(lk.get(f"end layer, decay {x:g}"), 2) for x in DECAYS])
+        rows2.append([_unit(u)]
+                     + [fmt(sharp.get(f"end layer, decay {x:g}"), 2) for x in SHARP_DECAYS]
+                     + [fmt(c.get("worst"), 2), fmt(max(sharp.values(), default=None), 2)
+                        if sharp else "n/a", fmt(c.get("ends"), 2),
+                        "yes" if u["decides"] else f"no: {c.get('why')}"])     # clear calls
     d.table(["configuration (nodes, base)", "free layers", "degree absorbed", "sum |w|", "||w||_2",
              "(-1)^k reads", "barrel"] + [f"Gaussian sd {w}" for w in WIDTHS]
-            + [f"end layer, decay {x:g}" for x in DECAYS]
-            + ["leak (worst)", "end alternation reads", "clear calls decide"], rows)
+            + [f"end layer, decay {x:g}" for x in DECAYS], rows)
+    d.table(["configuration (nodes, base)"] + [f"sharp end layer, decay {x:g}"
+                                               for x in SHARP_DECAYS]
+            + ["leak (worst)", "sharp leak", "end alternation reads", "clear calls decide"],
+            rows2)
     view = doc["answer"]["paper_view"]
     msm = next((c for c in doc["cells"] if c["model"] == "msm" and c["mesh"] == "five"
                 and c["bc"] == "sliding" and c["load"] == "paper"
@@ -698,7 +717,9 @@ def cells_document(doc, s):
         "row). 'not run': the cell is not in the study's design (the linear load on the "
         "finest meshes, some models on the finest); 'n/a': no signature on the free layers "
         "(three free layers of the clamped five-layer cube); 'failed': the static solve "
-        f"failed, with its cause. Definitions: [glossary](../{GLOSSARY}).")
+        f"failed, with its cause. 'constants': each term's constant as built on that mesh "
+        "(fitted by the patch-test calibration where the model says auto, else given). "
+        f"Definitions: [glossary](../{GLOSSARY}).")
     combos = [(bc, load) for bc in s.bcs for load in s.loads]
     for mesh in s.meshes:
         rows = {}
@@ -709,10 +730,18 @@ def cells_document(doc, s):
             continue
         first = next(iter(rows.values()))
         c.h(2, f"{mesh} ({next(iter(first.values()))['tets']} tetrahedra)")
-        c.table(["model"] + [f"{bc}/{load}" for bc, load in combos],
-                [["reference, mean lateral [mm]"] + [_scale(first.get(k)) for k in combos]]
-                + [[short(m)] + [_cell(r.get(k)) for k in combos] for m, r in rows.items()])
+        c.table(["model"] + [f"{bc}/{load}" for bc, load in combos] + ["constants"],
+                [["reference, mean lateral [mm]"] + [_scale(first.get(k)) for k in combos]
+                 + [""]]
+                + [[short(m)] + [_cell(r.get(k)) for k in combos] + [_constants(r)]
+                   for m, r in rows.items()])
     return c
+
+
+def _constants(row):
+    """'shear_c 0.125, normal_edge_c 0' of a model's cells on one mesh (the same in each)."""
+    got = next((x.get("constants") for x in row.values() if x.get("constants")), None)
+    return ", ".join(f"{k} {fmt(v, 3)}" for k, v in got.items()) if got else "n/a"
 
 
 def _scale(x):

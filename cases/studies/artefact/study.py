@@ -34,6 +34,7 @@ REF_MESH = ("six", 5)         # the reference's own mesh (refined REF_LEVELS tim
 REF_LEVELS = 1
 # msm with the paper's shear force at the paper's constant: with c = auto the fit sets c = 0
 # on every mesh (the springs alone are stiffer than 2G in the modes the shear adds to)
+FIXED_NORMAL_C = 1.0          # the normal terms' constant where it is held, not fitted
 MSM_SHEAR = label("msm + shear(reading=variational, c=1)")
 
 
@@ -51,6 +52,13 @@ def model_specs(quick=False):
         for form in NORMAL_FORMS:
             out[label(f"pbcm-{r} + {form}(c=auto)")] = {
                 "family": "particle", "reading": r, "constant": "calibrated", "normal": form}
+    # beside pbcm-balanced (the paper's sign) the fit sets every c_n to 0 on the mirrored five
+    # split, so the terms are also run at a fixed c_n = 1 (the shear's own scale, G): whether
+    # a normal stress changes the paper's sign of the pattern is then tested, not assumed
+    for form in NORMAL_FORMS:
+        out[label(f"pbcm-balanced + {form}(c={FIXED_NORMAL_C:g})")] = {
+            "family": "particle", "reading": "balanced", "constant": "calibrated",
+            "normal": fixed_normal(form)}
     out["msm"] = {"family": "msm", "reading": "none", "constant": "springs", "normal": "edges"}
     out[MSM_SHEAR] = {"family": "msm", "reading": "variational", "constant": "literal",
                       "normal": "edges"}
@@ -62,13 +70,21 @@ def model_specs(quick=False):
     return out
 
 
+def fixed_normal(form):
+    """The ``normal`` factor of a term at the fixed constant FIXED_NORMAL_C."""
+    return f"{form} (c_n = {FIXED_NORMAL_C:g})"
+
+
 def short(model):
     """The name tables and figures use: 'pbcm-balanced +normal_edge' for a reading with a
-    normal term, 'msm +shear (c = 1)' for msm with the shear term, else the model."""
+    fitted normal term, 'pbcm-balanced +normal_edge (c_n = 1)' with a fixed one, 'msm +shear
+    (c = 1)' for msm with the shear term, else the model."""
     for r in READINGS:
         for form in NORMAL_FORMS:
             if model == label(f"pbcm-{r} + {form}(c=auto)"):
                 return f"pbcm-{r} +{form}"
+            if model == label(f"pbcm-{r} + {form}(c={FIXED_NORMAL_C:g})"):
+                return f"pbcm-{r} +{fixed_normal(form)}"
     return "msm +shear (c = 1)" if model == MSM_SHEAR else model
 
 
@@ -227,14 +243,16 @@ def _model_rows(model, factors, name, spec, mesh, s, u_refs):
     try:
         pm = build(model, mesh, s.material)
     except FINDINGS as exc:
-        return [{**base, "bc": bc, "load": load, "failed": f"build: {exc}",
+        return [{**base, "constants": None, "bc": bc, "load": load, "failed": f"build: {exc}",
                  "bulge_profile_mm": None, "alternation_mm": None, "alternation_rel": None,
                  "disp_rel_l2": None, "load_steps": None, "growth_rate_1_s": None,
                  "flutter": None}
                 for bc in s.bcs for load in loads]
     # the paper's RK4 run on its own lattice (a dense eigenproblem: 5 nodes per side only)
     rate = P.growth_rate(pm, mesh, "clamped") if spec[1] == P.NODES_PER_SIDE else None
-    return [{**base, "bc": bc, "load": load, "growth_rate_1_s": rate,
+    # each term's constant as built (fitted or given): {term_c: value}
+    constants = {k: v for k, v in pm.info.items() if k.endswith("_c")}
+    return [{**base, "constants": constants, "bc": bc, "load": load, "growth_rate_1_s": rate,
              "flutter": None if rate is None else rate > 0.0,
              **cell(pm, mesh, spec[1], bc, load, u_refs[(bc, load)])}
             for bc in s.bcs for load in loads]
