@@ -364,3 +364,26 @@ def test_calibration_may_drop_a_term_and_says_so(mat):
     f = base.forces(x)
     assert np.allclose(pm.forces(x), f, rtol=1e-8, atol=1e-8 * np.abs(f).max())
     assert "calibration_dropped" not in base.info
+
+
+def test_every_term_with_a_fitted_constant_is_a_calibrated_term():
+    """Every term whose constant c the calibration can fit (c = "auto": the shear readings
+    among them) is a CalibratedTerm: its c is checked and fitted one way, and a shear reading whose forces are
+    not an energy's gradient refuses an energy while its calibrated one is defined."""
+    from model.terms import TERMS, CalibratedTerm
+    mesh = cube(3, 0.01, "five")
+    mat = Material(E=3000.0, nu=0.45, rho=1000.0)
+    fitted = [name for name, cls in TERMS.items() if cls.params.get("c") == "auto"]
+    assert "shear" in fitted
+    assert [n for n in fitted if not issubclass(TERMS[n], CalibratedTerm)] == []
+    sheared = mesh.points + 0.01 * mesh.points[:, [1]] * np.array([1.0, 0.0, 0.0])
+    for reading in ("corner", "balanced", "variational"):
+        t = Shear(mesh, mat, reading=reading, c=1.0)
+        assert t.unit_energy(mesh.points) < 1e-30 < t.unit_energy(sheared)
+        if reading == "variational":
+            assert t.energy(sheared) == pytest.approx(t.unit_energy(sheared), rel=1e-12)
+        else:
+            with pytest.raises(ModelError, match="not conservative"):
+                t.energy(mesh.points)
+    with pytest.raises(ModelError, match="shear c must be"):
+        Shear(mesh, mat, reading="corner", c=-1.0)

@@ -116,10 +116,12 @@ class Term:
 
 
 class CalibratedTerm(Term):
-    """A conservative term ``W = scale * coef * unit_energy`` whose ``c`` is ``"auto"`` (fitted
-    by ``model.calibrate`` when the model is built) or a positive number. A subclass provides
-    ``kernel_args(k)`` (the kernel and its arguments for the factor ``k = scale * coef``),
-    ``calibration_residuals(x, rows)`` and ``forces_numpy``; ``unit_energy`` follows."""
+    """A term ``W = scale * coef * unit_energy`` whose ``c`` is ``"auto"`` (fitted by
+    ``model.calibrate`` when the model is built, on ``unit_energy``) or a positive number. A
+    subclass provides ``kernel_args(k)`` (the kernel and its arguments for the factor ``k =
+    scale * coef``), ``calibration_residuals(x, rows)`` and ``forces_numpy``; ``unit_energy``
+    follows. Conservative unless the subclass says not (a shear reading whose forces are not
+    W's gradient: then W is only what the calibration fits, and ``energy`` is refused)."""
 
     conservative = True
     params = {"c": "auto"}

@@ -21,7 +21,7 @@ Every reading takes tau = c G gamma, c the factor ``c`` (1: the paper's literal 
 """
 import numpy as np
 
-from . import Term, register
+from . import CalibratedTerm, Term, register
 from ._kernels import COMBOS, volume_gradient_numpy
 from ._blocks import blocked, blocked_tets
 from ._shear_kernels import (shear_balanced, shear_balanced_reference, shear_balanced_tets,
@@ -66,7 +66,7 @@ def strains_numpy(x, tets, gamma0):
 
 
 @register
-class Shear(Term):
+class Shear(CalibratedTerm):
     """Shear stresses from the 24 corner shear strains of each tetrahedron (paper eqs. 4-5).
 
     Parameters
@@ -83,23 +83,17 @@ class Shear(Term):
     fit_constant = "c"
 
     def __init__(self, mesh, material, scale=1.0, **params):
-        super().__init__(mesh, material, scale, **params)
+        super().__init__(mesh, material, scale, **params)   # c, coef, G, vol0
         if self.p["reading"] not in READINGS:
             raise ModelError(f"shear reading {self.p['reading']!r} unknown; choose one of "
                              f"{', '.join(READINGS)}")
         self.reading = READINGS[self.p["reading"]]
+        # only the variational reading's forces are its energy's gradient
         self.conservative = self.p["reading"] == "variational"
         # the corner reading's forces do not sum to zero; the balanced reading's do, but
         # their torques do not (docs/model.md "Shear force")
         self.momentum = self.p["reading"] != "corner"
         self.angular_momentum = self.p["reading"] == "variational"
-        c = self.p["c"]
-        if c != "auto" and not (isinstance(c, (int, float)) and np.isfinite(c) and c > 0):
-            raise ModelError(f"shear c must be 'auto' or a positive number, got {c!r}")
-        self.coef = None if c == "auto" else float(c)
-        self.calibrate = c == "auto"
-        self.G = material.G  # scale multiplies forces and energy after calibration
-        self.vol0 = mesh.volumes
         self.gamma0 = np.zeros((mesh.n_tets, 24))
         self.gamma0 = self.strains(mesh.points)
         self._threads = None
@@ -109,9 +103,6 @@ class Shear(Term):
 
     def describe(self):
         return f"shear/{self.p['reading']}"
-
-    def info(self):
-        return {**super().info(), "c": self.coef}
 
     def strains(self, x):
         """The 24 shear strains (m, 24) at positions x."""
@@ -126,14 +117,12 @@ class Shear(Term):
         """Maximum |tau| = G max |gamma| per tetrahedron (the paper's Figure 1), material G."""
         return self.material.G * np.abs(self.strains(x)).max(axis=1)
 
-    def kernel(self):
-        if self.coef is None:
-            raise ModelError(f"{self.p['reading']} shear with c='auto' is not calibrated yet: "
-                             "build the model with model.build, or pass a number for c")
-        return KERNELS[self.reading], (*self._blocked, self._factor())
+    def kernel_args(self, k):
+        return KERNELS[self.reading], (*self._blocked, self.G * k)
 
     def _factor(self):
-        return self.scale * self.G * self.coef
+        """The kernels' factor G c scale (kernel_args's, for the reference kernels)."""
+        return self.G * (self.scale * self.coef)
 
     def reference_kernel(self):
         self.kernel()        # the same checks
@@ -189,12 +178,10 @@ class Shear(Term):
             raise DegenerateTetError(f"tetrahedron {bad} is inverted or flattened", [bad])
         return gam, 0.5 * self.G * self.vol0[rows]
 
-    def unit_energy(self, x):
-        """Energy of the variational reading with c = 1 and scale 1: (1/2) G V0 sum gamma^2
-        (what calibration fits, so that ``scale`` survives it)."""
-        return float(0.5 * self.G * np.sum(self.vol0[:, None] * self.strains(x) ** 2))
-
     def energy(self, x):
+        """The variational reading's energy (CalibratedTerm's: unit_energy, (1/2) G V0 sum
+        gamma^2, what calibration fits for every reading, times scale and c); the other
+        readings' forces have none."""
         if not self.conservative:
-            return super().energy(x)
-        return self.scale * self.coef * self.unit_energy(x)
+            return Term.energy(self, x)
+        return super().energy(x)
