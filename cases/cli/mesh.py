@@ -2,6 +2,7 @@
 from pathlib import Path
 
 from model.mesh import SCHEMES, box, read
+from ..library.common import CUBE_MM
 from .common import UsageError, number
 
 def add(sub):
@@ -14,7 +15,7 @@ def add(sub):
                                        integer=True, open_low=False),
                    default=5, help="nodes per side (cube), default 5")
     m.add_argument("--size", type=number("--size", "a side length in mm, a number > 0", low=0),
-                   default=32.0, help="side in mm (cube), default 32")
+                   default=CUBE_MM, help=f"side in mm (cube), default {CUBE_MM:g}")
     m.add_argument("--scheme", choices=SCHEMES, default="five", help="cube tetrahedralisation")
     m.add_argument("--seed", type=int, default=0, help="seed of the 'unstructured' scheme")
     m.set_defaults(func=run)

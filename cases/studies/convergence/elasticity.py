@@ -8,11 +8,12 @@ from model.homogenize import (anisotropy_index, asymmetry, directional_young,
                               effective_stiffness, engineering_constants, kelvin_moduli,
                               moduli_errors)
 from model.mesh import cube
+from ...library.common import CUBE_MM
 from ...running import stop
 from ...running.runner import FINDINGS
 from ...running.store import OFF, key
 
-PATCH_MM = 32.0
+PATCH_MM = CUBE_MM             # the patch cube: the paper's
 # directions of the directional Young's modulus figure: the x-y plane, every 5 degrees
 ANGLES_DEG = np.arange(0.0, 360.0 + 1e-9, 5.0)
 

@@ -107,7 +107,7 @@ class Problem:
 
 
 PROBLEMS = {
-    "paper-cube": Problem("paper-cube", (32.0, 32.0, 32.0), ("clamped", "sliding"), "driven",
+    "paper-cube": Problem("paper-cube", (common.CUBE_MM,) * 3, ("clamped", "sliding"), "driven",
                           label="top force"),
     "cantilever": Problem("cantilever", (64.0, 16.0, 16.0), ("clamped",), "tip_deflection_mm",
                           compliance=True, label="load / tip deflection"),
