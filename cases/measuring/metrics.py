@@ -138,12 +138,12 @@ def alternation(profile, reference, free=None):
     (-1)^k pattern as its amplitude: the continuum against itself and a parabolic barrel score
     0 to round-off; of every other smooth field (a bulge or an end layer of two layer spacings
     or wider) they read the least their layers allow (a Gaussian of standard deviation 2
-    layers: below 3e-3 of its height on 7 free layers, 3e-4 on 9, 2e-5 on 15 and 17) but not
-    on five,
-    where the layers leave one weighting (the paper's own view: it cannot tell a smooth bump
-    from an alternation). +beta puts the layers of even index from the base out (the ends
-    and the middle layer of five: the paper's sign). (None, None) where the free layers leave
-    no signature (three free layers of a clamped five-layer cube)."""
+    layers: below 3e-3 of its height on 7 free layers, 3e-4 on 9, 2e-5 on 15 and 17), but
+    little on five, where one direction is left to reduce the leak along (the paper's own
+    view: it cannot tell a smooth bump from an alternation). +beta puts the layers of even
+    index from the base out (the ends and the middle layer of five: the paper's sign). (None,
+    None) where the free layers leave no signature (three free layers of a clamped five-layer
+    cube)."""
     b, r = np.asarray(profile, float), np.asarray(reference, float)
     if b.shape != r.shape or b.ndim != 1 or b.size < 3:
         raise MetricError(f"alternation needs two profiles of the same three or more layers, "

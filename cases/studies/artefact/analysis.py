@@ -225,7 +225,7 @@ def metric_check(cells):
         if row is None:
             out[(n, bc)] = {"n": n, "bc": bc, "free": int(_free_layers(bc, n).sum()),
                             "decides": False, "why": f"{int(_free_layers(bc, n).sum())} free "
-                            "layers, no signature (they absorb less than a quadratic)"}
+                            "layers, no signature (the reference and a quadratic span them)"}
             continue
         reasons = ([f"fewer than {DECISIVE} layers"] if n < DECISIVE else []) + (
             [] if row["versus_clear"] == "below" else

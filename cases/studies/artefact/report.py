@@ -286,7 +286,8 @@ def _metric_check(d, doc):
             + (f"; reversed and clear: {', '.join(view['reversed'])}"
                if view.get("reversed") else "")
             + (f"; not decided: {', '.join(view['at'])}" if view["at"] else "")
-            + ". It decides nothing: on 5 layers the weights absorb only a cubic, and smooth "
+            + ". It decides nothing: on 5 layers the weights have one direction left to reduce "
+            "the leak along, and smooth "
             f"fields leak up to {fmt(view['check'].get('worst'), 2)} of their height. "
             + (f"msm's profile there, {', '.join(f'{x:.3f}' for x in msm['bulge_profile_mm'])}"
                f" mm, is a (-1)^k pattern of {fmt(msm['alternation_mm'], 3)} mm "
@@ -590,7 +591,7 @@ def _figures(d, out, s, doc):
               + ", ".join(f"{y:g}" for y in PAPER_BULGES_MM) + " mm, dashed) and necks ("
               + ", ".join(f"{y:g}" for y in PAPER_NECKS_MM) + " mm, dotted) marked; the legend "
               "gives each model's period-2 signature over the reference's mean and over its "
-              "own mean (n/a: the free layers absorb less than a quadratic, no period-2 "
+              "own mean (n/a: the reference and a quadratic span the free layers, no period-2 "
               "component exists there), marked 'clear' where it is clear on both "
               "normalisations and the configuration decides")
     meshes, models = list(s.meshes), list(s.models)
