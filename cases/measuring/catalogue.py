@@ -247,18 +247,19 @@ declare("bulge_profile_mm", "mm", "layer profile",
          "side-face nodes.")
 declare("alternation_mm", "mm", "alternation",
          "the bulge/neck signature: the period-2 (Nyquist) component of the layer profile "
-         "over the layers free to move laterally, beta of the exact fit profile_k = alpha "
-         "profile_FEM,k + q(k) + beta (-1)^k with q the polynomial of the highest degree that "
-         "leaves (-1)^k apart (on n free layers n - 2 beside a uniform reference, fewer beside "
-         "one that shares directions with (-1)^k: n - 3 on a clamped cube's layers; the "
-         "artefact report prints each configuration's). Zero to round-off for the "
-         "continuum against itself, scaled, and for polynomial barrels up to that degree; any "
-         "other smooth field leaks a stated fraction of its height (the artefact report's "
-         "metric check); the amplitude of a pure "
-         "(-1)^k pattern; positive puts the layers of even index from the base out (the ends "
-         "and the middle of five: the paper's sign). On five layers it cannot tell a smooth "
-         "bump from an alternation (the paper's own view); n/a where the free layers absorb "
-         "less than a quadratic (the clamped five-layer cube's three).", digits=2)
+         "over the layers free to move laterally, beta of profile_k = alpha profile_FEM,k + "
+         "s_k + beta (-1)^k read by one weighted sum of those layers: blind exactly to the "
+         "reference at any scale and to polynomials up to degree 2, reading a pure (-1)^k "
+         "pattern as its amplitude, and of all such sums the one least sensitive to a family "
+         "of smooth fields (Gaussian bulges two layer spacings wide and more, end layers "
+         "decaying over two spacings and more, a half-sine barrel). Zero to round-off for the "
+         "continuum against itself, scaled, and for parabolic barrels; any other smooth field "
+         "leaks a stated fraction of its height, and an end layer sharper than two spacings "
+         "more (the artefact report's metric check); positive puts the layers of even index "
+         "from the base out (the ends and the middle of five: the paper's sign). On five "
+         "layers it cannot tell a smooth bump from an alternation (the paper's own view); n/a "
+         "where the reference and a quadratic span the free layers (the clamped five-layer "
+         "cube's three).", digits=2)
 declare("alternation_rel", "1", "alternation rel",
          "the signature over the reference profile's mean |lateral displacement|; the "
          "pattern is called clear from 0.01.", "signed")

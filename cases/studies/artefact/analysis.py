@@ -131,15 +131,16 @@ def same(a, b, tol=SAME):
 def test_fields(n, free, decays=DECAYS):
     """{name: [profiles]}: the smooth fields the signature must score (almost) 0 on, over
     ``n`` layers, ``free`` the layers it reads: a half-sine barrel over the cube, Gaussian
-    bulges of standard deviation WIDTHS layer spacings centred on each free layer and half-way
-    between (not the weights' own design fields: those sit on a quarter-layer grid at other
-    widths), and end boundary layers of each decay length ``decays`` (in layer spacings, from
+    bulges of standard deviation WIDTHS layer spacings centred an eighth of a spacing off each
+    free layer and off each half-way point (off the weights' quarter-layer design grid; the
+    widths 2 and 3, the decay 2 and the clamped base's barrel are design fields too, 5 and
+    the decay 5 are not), and end boundary layers of each decay length ``decays`` (in layer spacings, from
     the first and last free layer) at the base, at the top, and at both with the same and
     with opposite signs."""
     k = np.arange(n, dtype=float)
     layers = np.flatnonzero(free)
     first, last = layers[0], layers[-1]
-    centres = np.arange(first, last + 0.25, 0.5)
+    centres = np.arange(first, last + 0.25, 0.5) + 0.125
     out = {"barrel": [np.sin(np.pi * k / (n - 1))]} if decays is DECAYS else {}
     for s in (WIDTHS if decays is DECAYS else ()):
         out[f"Gaussian, sd {s} layers"] = [np.exp(-(k - c) ** 2 / (2 * s ** 2))
@@ -203,7 +204,19 @@ def leakage(reference, free):
             "leaks": leaks, "worst": leaks[worst], "worst_field": worst,
             "sharp": score(test_fields(len(reference), free, SHARP_DECAYS)),
             "versus_clear": against(leaks[worst], DECIDING_LEAK),
-            "ends": float(abs(w @ end_alternation(len(reference), free)[free]))}
+            "ends": float(abs(w @ end_alternation(len(reference), free)[free])),
+            "paper_period": paper_period_reads(w, len(reference), free)}
+
+
+def paper_period_reads(w, n, free):
+    """What the weights ``w`` read of the paper's own pattern at its own period (bulges
+    16 mm apart, PAPER_BULGES_MM) and amplitude 1, at its worst phase, on ``n`` layers of the
+    cube: 1 on five layers (there the period is two layers, the period-2 component itself);
+    on more layers the period spans more layers and the signature reads it as smooth."""
+    y = np.linspace(0.0, P.SIZE_MM, n)[free]
+    period = PAPER_BULGES_MM[1] - PAPER_BULGES_MM[0]
+    phase = np.linspace(0.0, np.pi, 37)
+    return float(max(abs(w @ np.cos(2 * np.pi * y / period + p)) for p in phase))
 
 
 def _profile(cells, n, bc, load="paper"):
@@ -385,6 +398,8 @@ def failure(c):
     if "inverted" in why:
         return "failed (inverted element: " + why.split(" is ")[0] + ", " + \
             why.split("in term ")[-1].split(";")[0] + " term)"
+    if why.startswith("build: "):      # the model could not be made: its whole cause
+        return f"failed ({why.split(';')[0]})"
     return f"failed ({why.split(';')[0][:80]})"
 
 
@@ -429,7 +444,10 @@ def _mirror_call(d, u, parts):
     call = bounded(lo, hi, RATIO)
     why = None if call != "at" else (
         "the ratio at the threshold" if lo >= RATIO * (1 - NEAR) else
-        f"the ratio's lower bound {lo:.2g}, below {RATIO:g}")
+        f"the ratio within [{lo:.2g}, {hi:.2g}]: its upper bound within {NEAR:.0%} of "
+        f"{RATIO:g}" if hi is not None and hi < RATIO else
+        f"the ratio's lower bound {lo:.2g}, below {RATIO:g}"
+        + ("" if hi is not None else ", its upper bound unbounded (no control part resolved)"))
     return lo, hi, call, why
 
 
@@ -711,6 +729,8 @@ def normal_stress(cells, us):
         lo = max(abs(without) - uw, 0.0) / (abs(with_) + uv)
         hi = (abs(without) + uw) / max(abs(with_) - uv, ROUND_OFF_FLOOR)
         pairs.append({"n": n, "bc": bc, "term": normal, "model": name,
+                      "shear_c": [(base.get("constants") or {}).get("shear_c"),
+                                  (w.get("constants") or {}).get("shear_c")],
                       "base": short(base["model"]), "sign": r["sign"], "without": without,
                       "with": with_, "ratio": abs(with_) / abs(without),
                       "reduced": bounded(lo, hi, RATIO)})
@@ -741,14 +761,14 @@ def rank_interval(rho, n):
 
 def _track(rho, ci):
     """'tracks' where the whole interval lies at TRACKS or above, 'does not track' where it
-    lies below TRACKS, else 'not resolved' (one rule, read on the interval both ways)."""
+    lies below TRACKS, else 'not decided' (one rule, read on the interval both ways)."""
     if ci is None:
-        return "not resolved (too few models)"
+        return "not decided (too few models)"
     if ci[0] >= TRACKS:
         return "tracks"
     if ci[1] < TRACKS:
         return "does not track"
-    return "not resolved"
+    return "not decided (the interval holds 0.7)"
 
 
 def _cluster(pts, tol):
@@ -1026,7 +1046,41 @@ def _below_text(dec):
             "head": head, "all_below": not not_below, "n": top}
 
 
-def order_text(bc, o):
+def layer_mean_scaling(cells, bc):
+    """{model: largest over smallest of |signature [mm]| x n (n - 1) over the sizes it has on
+    the mirrored split (``bc``, the paper's push), three sizes or more}: 1 where the layer
+    mean's signature falls exactly as a node-level period-2 pattern of fixed strain (its mm
+    amplitude ~ h) averaged over each layer's side nodes (~ 1 / n) would; the fall of a layer
+    mean then says nothing about the nodes' own pattern. Models whose signatures agree to SAME
+    at every size are one observation (the first kept)."""
+    got = {}
+    for c in cells:
+        if (c["split"] == MIRRORED and c["bc"] == bc and c["load"] == "paper"
+                and c["family"] != CONTROL and c.get("alternation_mm")):
+            n = c["nodes_per_side"]
+            got.setdefault(short(c["model"]), {})[n] = abs(c["alternation_mm"]) * n * (n - 1)
+    out, seen = {}, []
+    for m, v in got.items():
+        if len(v) < 3 or any(v.keys() == w.keys() and all(same(v[n], w[n]) for n in v)
+                             for w in seen):
+            continue             # one observation with a model counted before it
+        seen.append(v)
+        out[m] = max(v.values()) / min(v.values())
+    return out
+
+
+def _period_text(dec):
+    """What the signature tests under refinement: the pattern at the paper's own period read
+    on each configuration that reads parts."""
+    got = [f"{_where((u['n'], u['bc']))} {fmt(u['check']['paper_period'], 2)}" for u in dec
+           if u["check"].get("paper_period") is not None]
+    return (" What is tested: a pattern of the paper's own period (bulges 16 mm apart: on its "
+            "5 layers the period-2 component itself) at amplitude 1 reads " + ", ".join(got)
+            + ": under refinement these runs test a period-2 pattern at the mesh's own scale, "
+            "not one at the paper's period, which this metric reads as smooth." if got else "")
+
+
+def order_text(bc, o, scaling=None):
     """The two-point slope of one base's own parts, with its uncertainty: never a decided
     order (two sizes cannot show the asymptotic range)."""
     v = sorted(o["orders"].values())
@@ -1036,7 +1090,22 @@ def order_text(bc, o):
             f"{len(v)} of {o['of']} distinct models, each "
             + (f"+- at most {fmt(max(us), 2)} from the parts' u propagated through the slope"
                if us else "from two sizes, no uncertainty")
-            + "; two sizes only: the order is not decided)")
+            + "; two sizes only: the order is not decided)" + _scaling_text(o, scaling))
+
+
+def _scaling_text(o, scaling):
+    """What ``layer_mean_scaling`` says of the slope: the models whose layer-mean signature
+    falls as a fixed node-level pattern averaged over a layer would, to 1 %."""
+    if not scaling:
+        return ""
+    n_c, n_f = o["sizes"]
+    same = sorted(m for m, r in scaling.items() if r <= 1.01)
+    return (f"; the slope a fixed node-level period-2 pattern averaged over each layer's side "
+            f"nodes would give is h^{np.log2(n_f * (n_f - 1) / (n_c * (n_c - 1))):.2f}, and "
+            f"{len(same)} of {len(scaling)} models' signature [mm] times n (n - 1) is the same "
+            "at 5, 9 and 17 nodes to 1 %" + (f" ({_compress(same)})" if same else "")
+            + ": the layer mean may fall while the nodes' own pattern does not (the side "
+            "nodes' displacements are not stored)" if same else "")
 
 
 def mirror_counts(u):
@@ -1098,7 +1167,8 @@ def answer(cells, models=None):
     mirrored = {s_: [(w, r) for w, r in v if r.get("mirror_vs") == "above"]
                 for s_, v in sign_rows.items()}
     a_holds = (any(mirrored.values()) or bool(fem_units)) and not against_
-    slopes = [order_text(bc, o) for bc, o in m["orders"].items() if o["orders"]]
+    slopes = [order_text(bc, o, layer_mean_scaling(cells, bc))
+              for bc, o in m["orders"].items() if o["orders"]]
 
     def sign_text(s_):
         # the configuration (one mesh pair) is the unit: per configuration, its model parts
@@ -1114,17 +1184,26 @@ def answer(cells, models=None):
                     "resolved parts" + (f", {_compress(mv)}" if (mv := list(dict.fromkeys(
                         r["name"] for r in rs if r.get("mirror_vs") == "above"))) else "")
                     for w, rs in per.items()) + ")")
-    fem_ratio = [f"{_where((u['n'], u['bc']))} {times(u['fem_ratio'])}" for u in dec
+    fem_ratio = [f"{_where((u['n'], u['bc']))} ({fmt(u['fem_five'], 2)} +- "
+                 f"{fmt(u['u_fem'], 2)}, {fmt(abs(u['fem_five']) / u['u_fem'], 2)} u; over its "
+                 f"largest on the conforming splits {times(u['fem_ratio'])}" for u in dec
                  if not u["identity"] and u.get("fem_ratio") is not None
-                 and u.get("fem_vs") != "above"]
+                 and u.get("fem_vs") != "above" and u.get("u_fem")]
+    resolved_rows = [r for v in sign_rows.values() for _, r in v]
+    with_ctrl = sum(any(p.get("resolved") == "above" for p in r["control_parts"].values())
+                    for r in resolved_rows)
     a_text = ("; ".join(sign_text(s_) for s_ in ("+", "-"))
               + ("; none is on every split" if not against_ else
                  f"; on every split: {against_}")
+              + (f" (only {with_ctrl} of {len(resolved_rows)} resolved parts have a resolved "
+                 "control part, without which 'on every split' cannot be read: the test "
+                 "can find the mirror's parts, and rarely the others)" if resolved_rows
+                 else "")
               + (f"; FEM P1's own signature is resolved and the mirror's on "
                  f"{', '.join(fem_units)}" if fem_units else "")
-              + (f". FEM P1's own signature on the mirrored split is not resolved (over "
-                 f"its largest on the conforming splits: {', '.join(fem_ratio)}, within the "
-                 "metric's leak bound)" if fem_ratio else "")
+              + (". FEM P1's own signature on the mirrored split is not resolved on "
+                 + ", ".join(fem_ratio) + ", within the metric's leak bound)"
+                 if fem_ratio else "")
               + (f". The own part {'; '.join(slopes)}" if slopes else "")
               + ". Each configuration is one mesh pair (n = 1) that its models share; the "
               "classes are in the artefact report's tables")
@@ -1136,8 +1215,15 @@ def answer(cells, models=None):
                 "nothing: the fit sets its constant to 0 or near it, as cells.md states)"
                 if ns["inactive_other_sign"] and s_ not in ns["signs"] else "")
         at_ = sum(p["reduced"] == "at" for p in ps)
+        moved = [p["shear_c"] for p in ps if None not in p["shear_c"]
+                 and not same(*p["shear_c"], SAME)]
         return (f"{word[s_]} ({s_}): {sum(p['reduced'] == 'above' for p in ps)} of {len(ps)} "
-                f"reduced {RATIO:g}-fold" + (f" ({at_} at the threshold)" if at_ else "")
+                f"reduced {RATIO:g}-fold" + (f" ({at_} not decided: at the threshold)" if at_
+                                             else "")
+                + (f"; in {len(moved)} of them the shear's fitted c moves with the term ("
+                   + ", ".join(sorted({f"{fmt(a, 2)} to {fmt(b, 2)}" for a, b in moved}))
+                   + "): such a pair changes the normal stress and the shear at once"
+                   if moved else "")
                 + f", |with| / |without| {fmt(min(p['ratio'] for p in ps), 2)}-"
                 f"{fmt(max(p['ratio'] for p in ps), 2)} ("
                 + _names(sorted({p["model"] for p in ps})) + "; on "
@@ -1159,9 +1245,15 @@ def answer(cells, models=None):
     resting = [w for w, c in counts.items() if c["resolved"]]
     seen_at = [u for u in us if u["decides"] and u["n"] >= DECISIVE]
     below = _below_text(seen_at) if seen_at else None
-    said = (["under refinement, a resolved period-2 part is the mirror's wherever its source "
-             "is decided, and none is on every split (a); provisional: its u holds the "
-             "metric's leaks and the solver's tolerance only"] if a_holds else []) + (
+    by_sign = ", ".join(f"{len(mirrored[s_])} of {len(sign_rows[s_])} with {word[s_]}"
+                        for s_ in ("+", "-") if sign_rows[s_])
+    said = ([f"under refinement, of the resolved period-2 parts {by_sign} are the mirror's "
+             "and none is on every split (a)" + (
+                 f", but only {with_ctrl} of the {len(resolved_rows)} could have been read as "
+                 "on every split (a control part resolved): for the rest the mirror is not "
+                 "tested against its alternative" if with_ctrl < len(resolved_rows) else "")
+             + "; provisional: its u holds the metric's leaks and the solver's tolerance only, "
+             "not the reference's own error"] if a_holds else []) + (
         ["a normal-stress term removes it (b)"] if ns["holds"] else []) + (
         ["it tracks the patch-test error (c)"] if cs["holds"] else [])
     lead = (f"Not decided for {paper}; the paper's 374-tetrahedron "
@@ -1184,6 +1276,7 @@ def answer(cells, models=None):
                if below else
                f"Large enough to see: not decided (no configuration's leak is below "
                f"{DECIDING_LEAK:g}).")
+            + _period_text(dec)
             + (f" One observation (identical cells): {'; '.join(_duplicates(dec))}."
                if _duplicates(dec) else ""))
     largest = {}
@@ -1236,10 +1329,13 @@ def how_sure(ans, verdict):
             and not r["kind"].startswith("n/a")]
     lost = sum(r["kind"].startswith("failed") for r in rows)
     failed = ans.get("failed") or []
-    by_model = {}
-    for model, mesh, bc, load, _ in failed:
-        by_model.setdefault(model, []).append(f"{mesh} {bc}" + (
-            f" ({load} load)" if load != "paper" else ""))
+    by_model, built = {}, {}
+    for model, mesh, bc, load, why in failed:
+        where = f"{mesh} {bc}" + (f" ({load} load)" if load != "paper" else "")
+        if "build:" in why:            # the model could not be made: one cause, stated
+            built.setdefault((model, why), []).append(where)
+        else:
+            by_model.setdefault(model, []).append(where)
     resting = [_where((u["n"], u["bc"])) for u in dec
                if any(r.get("sign") for r in u["rows"] if r["same_as"] is None)]
     return ("**How sure.** " + (
@@ -1260,11 +1356,13 @@ def how_sure(ans, verdict):
         + (f"at a threshold (within {NEAR:.0%}): {', '.join(at)}; " if at
            else f"none within {NEAR:.0%} of a threshold; ")
         if dec else "No configuration reads own parts; ")
-        + (f"failed cells ({len(failed)}, each a hole counted against its model; the static "
-           f"solve splits the push into up to {SPLITS_TRIED[-1]} equal steps first; not "
-           "diagnosed further): " + "; ".join(f"{k} on {', '.join(v)}"
-                                             for k, v in by_model.items()) + "; "
-           if failed else "")
+        + (f"failed cells ({len(failed)}, each a hole counted against its model)"
+           + "".join(f"; {model} on {len(v)} cells: {why[len('failed ('):-1]}"
+                     for (model, why), v in built.items())
+           + (f"; failed static solves (the push split into up to {SPLITS_TRIED[-1]} equal "
+              "steps first; not diagnosed further): " + "; ".join(
+                  f"{k} on {', '.join(v)}" for k, v in by_model.items()) if by_model else "")
+           + "; " if failed else "")
         + "the reading: " + (verdict["sure"] if verdict["decided"] else _reading_sure(verdict))
         + ".")
 
@@ -1313,9 +1411,20 @@ def reproduces(profile, size_mm=P.SIZE_MM, held=()):
     return tuple(up) == PAPER_BULGES_MM and tuple(down) == PAPER_NECKS_MM
 
 
+def visible(c):
+    """Whether a cell's signature is at the clear level or above on both normalisations (the
+    reference's mean and its own): a shape with a smaller period-2 part is not one a picture
+    shows."""
+    a, own = c.get("alternation_rel"), signature_own(c)
+    return a is not None and own is not None and min(abs(a), abs(own)) >= CLEAR
+
+
 def paper_figure(cells, names):
-    """{base: [(name, reproduced, bulges, necks)]} of the models ``names`` (and the continuum)
-    on the paper's setting: the mirrored five split at 5 nodes per side, the paper's push."""
+    """{base: [(name, reproduced, bulges, necks)]} of the models ``names``, msm and the
+    continuum on the paper's setting: the mirrored five split at 5 nodes per side, the paper's
+    push; ``reproduced`` True where the profile has the figure's bulges and necks and its
+    signature is visible (``visible``), 'faint' where it has them below the clear level."""
+    names = list(names) + [m for m in ("msm", YARDSTICK_MODEL) if m not in names]
     out = {}
     for bc in sorted({c["bc"] for c in cells}):
         got = {c["model"]: c for c in cells if c["split"] == MIRRORED and c["bc"] == bc
@@ -1332,7 +1441,8 @@ def paper_figure(cells, names):
             if c is None or not c.get("bulge_profile_mm"):
                 rows.append((short(m), None, [], []))
                 continue
-            rows.append((short(m), reproduces(c["bulge_profile_mm"], held=held),
+            shape = reproduces(c["bulge_profile_mm"], held=held)
+            rows.append((short(m), (True if visible(c) else "faint") if shape else False,
                          *extrema(c["bulge_profile_mm"], held=held)))
         out[bc] = rows
     return out
@@ -1347,13 +1457,16 @@ def paper_figure_text(fig, bc="clamped"):
     Figure 1 on the base ``bc`` (the paper's setting: clamped), the other bases after it."""
     def one(b):
         rows = fig.get(b, [])
-        yes = [n for n, r, _, _ in rows if r]
-        shape = _by_value({n: "no profile" if r is None else "flat (no bulge, no neck)"
-                           if not up and not down else
+        yes = [n for n, r, _, _ in rows if r is True]
+        shape = _by_value({n: "no profile" if r is None else
+                           f"the figure's bulges and necks, but its period-2 part below the "
+                           f"clear level {CLEAR:g}" if r == "faint" else
+                           "flat (no bulge, no neck)" if not up and not down else
                            f"bulges at {_ys(up)}, necks at {_ys(down)}"
-                           for n, r, up, down in rows if not r})
-        return (f"{b} base: reproduced by {_names(yes)}; " + "; ".join(
-            f"{', '.join(v)}: {k}" for k, v in shape.items()))
+                           for n, r, up, down in rows if r is not True})
+        return (f"{b} base: reproduced (visibly: the signature at the clear level or above) "
+                f"by {_names(yes)}; " + "; ".join(
+                    f"{', '.join(v)}: {k}" for k, v in shape.items()))
     others = [b for b in fig if b != bc]
     return ("The paper's Figure 1 (bulges at y = " + _ys(PAPER_BULGES_MM) + " mm, necks at "
             + _ys(PAPER_NECKS_MM) + " mm) on the paper's setting (mirrored five, 5 nodes per "
@@ -1422,7 +1535,8 @@ def mesh_stability(rates, damping):
         return None, "no growth rate"
     kinds = [(mesh, rate, _stable_class(rate, damping)) for mesh, rate in rates]
     order = list(dict.fromkeys(k for _, _, k in kinds))
-    by = "; ".join(f"{STABLE_WORDS[k]} on " + ", ".join(
+    by = "; ".join(f"{STABLE_WORDS[k]}" + (f" ({damping:g} 1/s)" if k in ("damping", False)
+                                            else "") + " on " + ", ".join(
         f"{m} ({fmt(r, 3)} 1/s)" for m, r, kk in kinds if kk == k) for k in order)
     if len(order) > 1:
         return None, "depends on the mesh: " + by
@@ -1609,8 +1723,8 @@ def reading_verdict(table, damping, spread=None, figure=None):
         names = {r["name"] for r in readings}
         fig = (" Figure 1 (the pattern on the paper's 5 layers, its own view: shown, never "
                "scored): " + "; ".join(
-                   f"on the {b} base reproduced by "
-                   + _names([n for n, ok, _, _ in figure[b] if ok and n in names])
+                   f"on the {b} base reproduced (visibly) by "
+                   + _names([n for n, ok, _, _ in figure[b] if ok is True and n in names])
                    for b in figure) + ".")
     text = ((f"Not decided: {why}. " if not decided else f"{why}. ")
             + (f"Each reading, observable by observable: {per}." if per else "") + fig + " "

@@ -160,9 +160,10 @@ def _what_was_run(d, s, doc):
         "calibrated reading is the paper's equations with another constant), each calibrated "
         "one with each normal-stress term (not in the paper's equations; its constant fitted "
         "per mesh, as every calibrated constant, each stored with its cells and printed in "
-        "cells.md), pbcm-balanced with each normal-stress term at a fixed c_n = 1 (its fit "
-        "gives c_n = 0 on the mirrored split, so the fitted pairs cannot test a normal "
-        "stress beside the paper's sign), msm, msm with the variational shear "
+        "cells.md), pbcm-balanced with each normal-stress term at a fixed c_n = 1 (beside "
+        "it the fit gives c_n below 1e-9 on the mirrored split, so the fitted pairs cannot "
+        "test a normal stress beside the paper's sign; its shear c is fitted again beside "
+        "the fixed term), msm, msm with the variational shear "
         f"at c = 1, and {YARDSTICK} (FEM P1: constant-strain FEM with the continuum's own "
         "neo-Hookean law on the same tetrahedra, the control). On the finest bcc (9009 nodes) "
         "the calibrated readings and the control only (the cost of its Newton matrices): "
@@ -233,8 +234,9 @@ def _metric_check(d, doc):
     us = doc["answer"]["hypotheses"]["mirror"]["units"]
     d.h(2, "The metric's check")
     d.p("The signature's weights on test fields of each (size, base), the layers it reads "
-        "(not the fields the weights were designed on: other widths, centres on each free "
-        "layer and half-way between): a half-sine barrel, Gaussian bulges of standard "
+        "(centred an eighth of a spacing off the weights' quarter-layer design grid; the "
+        "widths 2 and 3, the decay 2 and, on the clamped base, the barrel are among the "
+        "design fields, the width 5 and the decay 5 are not): a half-sine barrel, Gaussian bulges of standard "
         "deviation " + ", ".join(map(str, WIDTHS)) + " layer spacings, end boundary layers "
         "decaying over " + " and ".join(f"{x:g}" for x in DECAYS) + " layer spacings from the "
         "first and last free layer (at the base, at the top, at both with the same and with "
@@ -249,7 +251,10 @@ def _metric_check(d, doc):
         f"what a pure (-1)^k pattern confined to the {END_LAYERS} free layers at each end "
         "(amplitude 1, 0 between) reads: the metric's sensitivity to an alternation of the "
         "end layers only; below 1 it misses most of it, and a 'below the clear level' there "
-        f"does not exclude one. A configuration decides only with {DECISIVE} or more layers "
+        "does not exclude one. 'The paper's period reads': what a pattern at the paper's own "
+        "period (bulges 16 mm apart, amplitude 1, at its worst phase) reads: 1 on 5 layers, "
+        "where that period is two layers; on more layers it is smooth to this metric. "
+        f"A configuration decides only with {DECISIVE} or more layers "
         f"and every smooth field's leak below {LEAK_SHARE:g} of the clear level "
         f"({DECIDING_LEAK:g}), not within {NEAR:.0%} of it.")
     rows, rows2 = [], []
@@ -266,13 +271,15 @@ def _metric_check(d, doc):
                      + [fmt(sharp.get(f"end layer, decay {x:g}"), 2) for x in SHARP_DECAYS]
                      + [fmt(c.get("worst"), 2), fmt(max(sharp.values(), default=None), 2)
                         if sharp else "n/a", fmt(c.get("ends"), 2),
+                        fmt(c.get("paper_period"), 2),
                         "yes" if u["decides"] else f"no: {c.get('why')}"])     # clear calls
     d.table(["configuration (nodes, base)", "free layers", "degree absorbed", "sum |w|", "||w||_2",
              "(-1)^k reads", "barrel"] + [f"Gaussian sd {w}" for w in WIDTHS]
             + [f"end layer, decay {x:g}" for x in DECAYS], rows)
     d.table(["configuration (nodes, base)"] + [f"sharp end layer, decay {x:g}"
                                                for x in SHARP_DECAYS]
-            + ["leak (worst)", "sharp leak", "end alternation reads", "clear calls decide"],
+            + ["leak (worst)", "sharp leak", "end alternation reads",
+               "the paper's period reads", "clear calls decide"],
             rows2)
     view = doc["answer"]["paper_view"]
     msm = next((c for c in doc["cells"] if c["model"] == "msm" and c["mesh"] == "five"
@@ -308,7 +315,8 @@ def _mirror(d, doc):
         "calls decide (the metric's check); the leak; the controls (the conforming splits run "
         "for every model at that size; a model run on more reads its mirror against each it "
         "ran on); FEM P1's signature there (neo-Hookean P1: the mesh's own period-2 error) "
-        "+- u (leak times its smooth amplitude and the floor, in quadrature) and whether it "
+        "+- u (the leaks times its smooth amplitude and end step, and the floor, in "
+        "quadrature) and whether it "
         f"is resolved ({RATIO:g} times u); the floor (FEM P1's largest signature on any "
         "conforming split run at that size; on the sliding base FEM P1 is exact, an identity "
         "check); and the distinct models by class, n of N.")
@@ -333,12 +341,14 @@ def _mirror(d, doc):
              "FEM P1, mirrored +- u", "resolved", "floor", "FEM P1 / floor", "distinct models",
              "classes"], rows)
     d.p("Every distinct model on the mirrored split: its signature (over the reference's "
-        "mean) +- u (leak times the smooth amplitude of model - reference and the floor), "
+        "mean) +- u (the leaks times the smooth amplitude and end step of model - "
+        "reference, and the floor), "
         "over its own mean, whether it is clear (on both "
         "normalisations; where not decided each one's call), its lateral displacement error "
         "(its mean lateral displacement over the free layers over the continuum's, minus 1: "
         "positive moves out more, softer laterally), its own part (model - FEM P1 on the "
-        "same tetrahedra) +- u (leak times the smooth amplitude of model - FEM P1), its part "
+        "same tetrahedra) +- u (the leaks times the smooth amplitude and end step of "
+        "model - FEM P1), its part "
         "on each control +- its own u, the mirror ratio (|part| "
         "over the largest |control part|) and its interval from both uncertainties "
         "((|part| - u) / max(|control| + u_c) to (|part| + u) / max(|control| - u_c), "
