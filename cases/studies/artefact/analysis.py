@@ -1220,14 +1220,14 @@ def answer(cells, models=None):
         return (f"{word[s_]} ({s_}): {sum(p['reduced'] == 'above' for p in ps)} of {len(ps)} "
                 f"reduced {RATIO:g}-fold" + (f" ({at_} not decided: at the threshold)" if at_
                                              else "")
-                + (f"; in {len(moved)} of them the shear's fitted c moves with the term ("
-                   + ", ".join(sorted({f"{fmt(a, 2)} to {fmt(b, 2)}" for a, b in moved}))
-                   + "): such a pair changes the normal stress and the shear at once"
-                   if moved else "")
                 + f", |with| / |without| {fmt(min(p['ratio'] for p in ps), 2)}-"
                 f"{fmt(max(p['ratio'] for p in ps), 2)} ("
                 + _names(sorted({p["model"] for p in ps})) + "; on "
-                + ", ".join(dict.fromkeys(_where((p["n"], p["bc"])) for p in ps)) + ")")
+                + ", ".join(dict.fromkeys(_where((p["n"], p["bc"])) for p in ps)) + ")"
+                + (f"; in {len(moved)} of them the shear's fitted c moves with the term ("
+                   + ", ".join(sorted({f"{fmt(a, 3)} to {fmt(b, 3)}" for a, b in moved}))
+                   + "): such a pair changes the normal stress and the shear at once"
+                   if moved else ""))
     b_text = ("distinct pairs (a calibrated reading's resolved own part with and without an "
               "active term, the split held fixed), by the sign of the part: "
               + "; ".join(b_sign(s_) for s_ in ("+", "-"))
