@@ -144,6 +144,8 @@ DESCRIPTORS = frozenset({
     # the artefact study's factors: the mesh split and size, the model's parts, the load
     "split", "nodes_per_side", "unmatched_faces", "load", "family", "reading",
     "constant", "normal", "flutter",
+    # each term's constant as the artefact study built it ({term_c: value}, fitted or given)
+    "constants",
     # how the artefact study's static solve was run: the equal load steps that converged
     "load_steps",
     # the truth-cube study's factors: the plate assumption, the measured state
