@@ -1,7 +1,9 @@
-"""Isotropic linear-elastic material constants (SI units)."""
+"""Isotropic material constants (SI units) and the compressible neo-Hookean law they enter."""
 from dataclasses import dataclass
 import math
 import numbers
+
+from numba import njit
 
 from .errors import MaterialError
 
@@ -68,3 +70,20 @@ def lame(E, nu):
     ``nu``, checked as a :class:`Material` checks them: how a function that takes the two
     loose (the FEM references) gets its constants."""
     return Material(E, nu).lame
+
+
+# ---------------------------------------------------------------- the compressible neo-Hookean law
+# one law for the FEM term's kernels, its numpy twin and the reference's elements; each function
+# takes scalars or arrays, from Python or from compiled code
+
+@njit(cache=True)
+def neohookean_energy(I1, lnJ, lam, mu):
+    """W = mu/2 (I1 - 3) - mu ln J + lam/2 (ln J)^2 [J/m^3] of the deformation gradient F with
+    I1 = F:F and ln J = ln det F (lam = 0: its deviatoric part)."""
+    return 0.5 * mu * (I1 - 3.0) - mu * lnJ + 0.5 * lam * lnJ * lnJ
+
+
+@njit(cache=True)
+def neohookean_stress(lnJ, lam, mu):
+    """(a, b) of its first Piola stress P = dW/dF = a F + b F^-T: (mu, lam ln J - mu)."""
+    return mu, lam * lnJ - mu

@@ -1,4 +1,5 @@
-"""Element kernels of the compressible neo-Hookean law, displacement and mixed (u, p) forms.
+"""Element kernels of the compressible neo-Hookean law (``model.material``: its energy and
+stress, the ones the FEM term uses), displacement and mixed (u, p) forms.
 
     W(F) = mu/2 (F:F - 3) - mu ln J + lam/2 (ln J)^2
     P    = mu (F - F^-T) + lam ln J F^-T
@@ -23,6 +24,8 @@ with i = comp_a, k = comp_b, c = mu - lam ln J (mixed: c = mu - p, no lam term).
 """
 import numpy as np
 from numba import njit
+
+from model.material import neohookean_energy, neohookean_stress
 
 
 @njit(cache=True)
@@ -87,23 +90,24 @@ def neohookean(grad, comp, dx, ue, psi, pe, lam, mu, mixed, tangent, r_u, r_p, k
             if mixed:
                 for m in range(npb):
                     p += pe[e, m] * psi[e, q, m]
-                energy += (0.5 * mu * (I1 - 3.0) - mu * lnJ + p * lnJ
+                energy += (neohookean_energy(I1, lnJ, 0.0, mu) + p * lnJ
                            - 0.5 * p * p / lam) * w
                 for m in range(npb):
                     r_p[e, m] += (lnJ - p / lam) * psi[e, q, m] * w
+                ca, cb = mu, p - mu          # the law's stress with lam ln J read as p
             else:
                 p = lam * lnJ
-                energy += (0.5 * mu * (I1 - 3.0) - mu * lnJ
-                           + 0.5 * lam * lnJ * lnJ) * w
-            # P = mu F + (p - mu) Fi^T
+                energy += neohookean_energy(I1, lnJ, lam, mu) * w
+                ca, cb = neohookean_stress(lnJ, lam, mu)
+            # P = ca F + cb Fi^T
             for a in range(nb):
                 i = comp[a]
                 for m in range(3):
                     t[a, m] = (grad[e, q, a, 0] * Fi[0, m] + grad[e, q, a, 1] * Fi[1, m]
                                + grad[e, q, a, 2] * Fi[2, m])
                 ga = grad[e, q, a]
-                r_u[e, a] += (mu * (F[i, 0] * ga[0] + F[i, 1] * ga[1] + F[i, 2] * ga[2])
-                              + (p - mu) * t[a, i]) * w
+                r_u[e, a] += (ca * (F[i, 0] * ga[0] + F[i, 1] * ga[1] + F[i, 2] * ga[2])
+                              + cb * t[a, i]) * w
             if not tangent:
                 continue
             c = mu - p

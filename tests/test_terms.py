@@ -387,3 +387,31 @@ def test_every_term_with_a_fitted_constant_is_a_calibrated_term():
                 t.energy(mesh.points)
     with pytest.raises(ModelError, match="shear c must be"):
         Shear(mesh, mat, reading="corner", c=-1.0)
+
+
+def test_the_neohookean_law_is_one_and_its_stress_is_its_energy_gradient():
+    """The compressible neo-Hookean law is written once (model.material): its first Piola
+    stress a F + b F^-T matches central differences of its energy, and the FEM term's numpy
+    twin and the reference's element kernel take both from it (the same numbers)."""
+    from model.material import neohookean_energy, neohookean_stress
+    from model.terms.fem import FemNeoHookean
+    lam, mu = 2.3e4, 1.1e3
+    F = np.array([[1.05, 0.02, -0.01], [0.03, 0.97, 0.04], [-0.02, 0.01, 1.02]])
+
+    def W(G):
+        return neohookean_energy(np.sum(G * G), np.log(np.linalg.det(G)), lam, mu)
+    a, b = neohookean_stress(np.log(np.linalg.det(F)), lam, mu)
+    P = a * F + b * np.linalg.inv(F).T
+    h = 1e-6
+    fd = np.array([[(W(F + h * E) - W(F - h * E)) / (2 * h)
+                    for E in np.eye(9).reshape(9, 3, 3)[3 * i:3 * i + 3]] for i in range(3)])
+    assert np.allclose(P, fd, rtol=1e-7, atol=1e-6 * np.abs(P).max())
+    import reference._neohookean as element
+    import model.terms.fem as fem
+    assert element.neohookean_energy is fem.neohookean_energy is neohookean_energy
+    assert element.neohookean_stress is fem.neohookean_stress is neohookean_stress
+    mesh = cube(2, 0.01, "six")
+    term = FemNeoHookean(mesh, Material(E=3000.0, nu=0.45, rho=1000.0))
+    Fs = np.stack([F, F @ F])
+    assert np.allclose(term.energy_density(Fs), [neohookean_energy(np.sum(G * G),
+                       np.log(np.linalg.det(G)), term.lam, term.mu) for G in Fs], rtol=1e-14)

@@ -19,6 +19,7 @@ import numpy as np
 from numba import njit
 
 from . import Term, register
+from ..material import neohookean_energy, neohookean_stress
 from ._blocks import B, FLAG, OPTIONS, OUT, SCRATCH, blocked, blocked_tets, first_flat, gather, \
     scatter
 from ._kernels import (add_piola_forces, cofactor, cross, deformation_gradient,
@@ -176,9 +177,10 @@ def neohookean_forces(x, tets, Dinv, vol0, lam, mu, out):
         F, J = deformation_gradient(x, tets, t, Dinv)
         if J <= FLAT:
             return t
-        a = (lam * np.log(J) - mu) / J   # P = mu F + (lam ln J - mu) F^-T, F^-T = cof(F) / J
+        m, b = neohookean_stress(np.log(J), lam, mu)
+        a = b / J                        # P = m F + b F^-T, F^-T = cof(F) / J
         C = cofactor(F)
-        P = (lin(mu, F[0], a, C[0]), lin(mu, F[1], a, C[1]), lin(mu, F[2], a, C[2]))
+        P = (lin(m, F[0], a, C[0]), lin(m, F[1], a, C[1]), lin(m, F[2], a, C[2]))
         add_piola_forces(P, Dinv, vol0, tets, t, out)
     return -1
 
@@ -282,12 +284,10 @@ class FemNeoHookean(_ConstantStrain):
     _kernel = staticmethod(neohookean_forces)
 
     def piola(self, F):
-        J = np.linalg.det(F)[:, None, None]
+        m, b = neohookean_stress(np.log(np.linalg.det(F)), self.lam, self.mu)
         FinvT = np.transpose(np.linalg.inv(F), (0, 2, 1))
-        return self.mu * (F - FinvT) + self.lam * np.log(J) * FinvT
+        return m * F + b[:, None, None] * FinvT
 
     def energy_density(self, F):
-        J = np.linalg.det(F)
-        C = np.transpose(F, (0, 2, 1)) @ F
-        return (0.5 * self.mu * (np.trace(C, axis1=1, axis2=2) - 3) - self.mu * np.log(J)
-                + 0.5 * self.lam * np.log(J)**2)
+        return neohookean_energy(np.einsum("tij,tij->t", F, F), np.log(np.linalg.det(F)),
+                                 self.lam, self.mu)
