@@ -920,3 +920,58 @@ def test_tracking_is_read_on_the_whole_interval_both_ways():
     assert analysis._track(0.75, [0.3, 0.93]).startswith("not decided")
     assert analysis._track(0.2, [-0.4, 0.6]) == "does not track"
     assert analysis._track(0.9, None).startswith("not decided")
+
+
+def test_the_leak_uncertainty_holds_the_smooth_amplitude_and_the_end_step():
+    """u's leak term: the smooth leak times the largest |difference - alpha reference| and the
+    sharp leak times the step between the two outermost free layers, in quadrature; a pure
+    scale of the reference adds nothing."""
+    ref = reference(9, "sliding")
+    free = _free_layers("sliding", 9)
+    diff = 0.3 * ref + np.abs(ref).mean() * np.r_[0.02, 0.0, 0, 0, 0, 0, 0, 0.0, 0.0]
+    assert analysis.smooth_amplitude(diff, ref, free) == pytest.approx(
+        0.02 * 8 / 9, rel=1e-9)        # the step less its share taken by alpha
+    assert analysis.end_step(diff, ref, free) == pytest.approx(0.02, rel=1e-9)
+    assert analysis.leak_u(diff, ref, free, (0.001, 0.01)) == pytest.approx(
+        np.hypot(0.001 * 0.02 * 8 / 9, 0.01 * 0.02), rel=1e-9)
+    assert analysis.leak_u(0.7 * ref, ref, free, (0.5, 0.5)) < 1e-15
+
+
+def test_the_paper_period_is_the_period_two_component_on_five_layers_only():
+    """A pattern at the paper's own period (bulges 16 mm apart) reads 1 on the paper's 5
+    layers, where that period is two layers, and almost nothing on 17, where it is smooth."""
+    for n, lo, hi in ((5, 0.999, 1.001), (17, 0.0, 1e-3)):
+        free = _free_layers("sliding", n)
+        k = np.flatnonzero(free)
+        w = M.nyquist_weights(reference(n, "sliding")[free], k)
+        assert lo <= analysis.paper_period_reads(w, n, free) <= hi, n
+
+
+def test_a_layer_mean_falling_as_an_averaged_node_pattern_is_named():
+    """A signature [mm] in proportion to 1 / (n (n - 1)) at 5, 9 and 17 nodes (a fixed node
+    pattern averaged over each layer) scales as 1 to round-off; one falling as 1 / n^3 does
+    not; a model identical to one counted before is one observation."""
+    def cells(model, law):
+        return [{"split": FIVE, "bc": "sliding", "load": "paper", "family": "particle",
+                 "model": model, "nodes_per_side": n, "alternation_mm": law(n)}
+                for n in (5, 9, 17)]
+    got = analysis.layer_mean_scaling(
+        cells("a", lambda n: 0.3 / (n * (n - 1))) + cells("b", lambda n: 1.0 / n ** 3)
+        + cells("c", lambda n: 0.3 / (n * (n - 1))), "sliding")
+    assert set(got) == {"a", "b"}
+    assert got["a"] == pytest.approx(1.0, abs=1e-12) and got["b"] > 1.5
+
+
+def test_a_model_that_cannot_be_built_is_one_failure_with_its_cause():
+    """'How sure' groups a build failure (the model could not be made) by model and cause,
+    with how many cells it took, apart from the failed static solves."""
+    world = _world(_mirror_world)
+    for c in world:
+        if c["model"] == "b+n":
+            c.update(failed="build: calibration of shear/balanced gave c = 0: no term adds; "
+                     "pass a number for c", alternation_rel=None, alternation_mm=None)
+    ans = analysis.answer(world)
+    said = analysis.how_sure(ans, {"decided": True, "sure": "x"})
+    n = sum(c["model"] == "b+n" for c in world)
+    assert f"b+n on {n} cells: build: calibration of shear/balanced gave c = 0" in said
+    assert "failed static solves" not in said

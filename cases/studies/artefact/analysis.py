@@ -317,14 +317,21 @@ def signature_own(c):
     return c["alternation_mm"] / m
 
 
-def smooth_amplitude(diff, reference, free):
-    """The largest |diff - alpha reference| over the free layers (alpha the least-squares
-    scale, to which the signature is blind), over the reference's mean |profile| (the
-    normaliser of ``alternation_rel``): how large a smooth field could leak."""
+def _beside_reference(diff, reference, free):
+    """(diff - alpha reference) over the free layers, alpha the least-squares scale (to which
+    the signature is blind), and the reference's mean |profile| (``alternation_rel``'s
+    normaliser)."""
     d, r = np.asarray(diff, float)[free], np.asarray(reference, float)
     rf = r[free]
     alpha = float(d @ rf / (rf @ rf)) if rf @ rf else 0.0
-    return float(np.abs(d - alpha * rf).max() / np.abs(r).mean())
+    return d - alpha * rf, float(np.abs(r).mean())
+
+
+def smooth_amplitude(diff, reference, free):
+    """The largest |diff - alpha reference| over the free layers, over the reference's mean
+    |profile|: how large a smooth field could leak."""
+    e, scale = _beside_reference(diff, reference, free)
+    return float(np.abs(e).max() / scale)
 
 
 def end_step(diff, reference, free):
@@ -332,11 +339,8 @@ def end_step(diff, reference, free):
     (diff - alpha reference), over the reference's mean |profile|: how tall an end layer
     sharper than two spacings could be (an alternation's own steps are in it too, so it
     bounds more than it needs to)."""
-    d, r = np.asarray(diff, float)[free], np.asarray(reference, float)
-    rf = r[free]
-    alpha = float(d @ rf / (rf @ rf)) if rf @ rf else 0.0
-    e = d - alpha * rf
-    return float(max(abs(e[1] - e[0]), abs(e[-1] - e[-2])) / np.abs(r).mean())
+    e, scale = _beside_reference(diff, reference, free)
+    return float(max(abs(e[1] - e[0]), abs(e[-1] - e[-2])) / scale)
 
 
 def leaks_of(check):
