@@ -746,8 +746,8 @@ def test_the_quick_study_holds_its_gold_and_its_controls(quick_artefact, capsys)
     P1) on a conforming mesh never alternates and passes the sliding patch test to the
     linear load's own nonlinearity (its strain, against a linear reference), on the
     non-conforming unmirrored five split it fails it beyond that, msm on the mirrored five
-    split shows the paper's sign pattern, and the quick report says it decides nothing and
-    shows the metric's check."""
+    split shows the paper's sign pattern, and the quick report says it decides nothing, shows
+    the metric's check and states no class or verdict anywhere."""
     from cases.cli import main
     status = main(["check", "--metrics", str(quick_artefact.parent), "--gold",
                    str(ROOT / "gold"), "--allow-new"])
@@ -775,6 +775,10 @@ def test_the_quick_study_holds_its_gold_and_its_controls(quick_artefact, capsys)
     assert "**Quick: not decided**" in md and "## The metric's check" in md
     opening = md.split("\n## ")[0]          # a quick run states no cause and no reading
     assert doc["answer"]["text"] not in opening and doc["verdict"]["text"] not in opening
+    # nor a class, the linear check's conclusion or the reading's table anywhere below
+    for said in ("the mirror's", "property of the linear regime", "## (a) Mirror",
+                 "## Which reading"):
+        assert said not in md, said
     assert (quick_artefact / "cells.md").is_file()
 
 
