@@ -9,6 +9,7 @@ do that for every case alike. Millimetres stop at the case module's edge: everyt
 hands the runner is in SI units, except the quantities it names ``*_mm`` for its report.
 """
 import abc
+import importlib
 from dataclasses import dataclass, field, fields
 from typing import ClassVar
 
@@ -274,8 +275,9 @@ class Case(abc.ABC):
     qoi_errors : scalar quantities of interest that get ``<name>_rel_err`` = |model / FEM - 1|.
     quantity_compared : the metrics ``quantity_metrics`` computes from the model's and the
         reference's quantities (None where the linear regime failed).
-    notes : report lines on how the case is set up; the metrics' definitions come from the
-        catalogue.
+    narrative : the case's report prose, a :class:`Narrative` subclass or its "module:Class"
+        (imported on first use, so that the prose may import the case's constants); None:
+        the default narrative, which says what every case's report says.
     fem_solver : the linear FEM solver ("auto", "direct", "amg").
     draws_stress, magnify : whether the case draws its own stress panels; the magnification
         of the standard ones.
@@ -308,7 +310,7 @@ class Case(abc.ABC):
     columns: ClassVar[tuple] = ()
     qoi_errors: ClassVar[tuple] = ()
     quantity_compared: ClassVar[tuple] = ()   # the names quantity_metrics returns
-    notes: ClassVar[tuple] = ()
+    narrative: ClassVar[object] = None   # its Narrative subclass, or "module:Class"
     fem_solver: ClassVar[str] = "auto"    # the linear FEM solver (reference.solvers.linear_solve)
     draws_stress: ClassVar[bool] = False   # True: the case draws its own max |tau| panels
     magnify: ClassVar[float] = 5.0         # displacement magnification of the panels
@@ -322,8 +324,7 @@ class Case(abc.ABC):
     def __init_subclass__(cls, **kw):
         """A declaration error shows when the case is imported, not in its report."""
         super().__init_subclass__(**kw)
-        for attr in ("gated", "columns", "qoi_errors", "quantity_compared", "notes",
-                     "patch_tests"):
+        for attr in ("gated", "columns", "qoi_errors", "quantity_compared", "patch_tests"):
             if not isinstance(getattr(cls, attr), tuple):
                 raise TypeError(f"{cls.__name__}.{attr} must be a tuple (a one-element tuple "
                                 "needs its trailing comma)")
@@ -341,11 +342,6 @@ class Case(abc.ABC):
         return tuple(q for q in (cls.decomposed, at) if q is not None)
 
     # ------------------------------------------------------------------ settings
-    def notes_for(self, s):
-        """The report's notes for settings ``s``: ``notes`` unless a case's setup notes depend
-        on its settings."""
-        return self.notes
-
     def settings(self, quick=False, **kw):
         """The case's Settings: full by default, with ``quick`` overrides, then ``kw``
         (None values ignored: what the user did not give)."""
@@ -456,6 +452,43 @@ class Case(abc.ABC):
         """The command that runs this case, as a report tells its reader."""
         return f"pbcm run {self.name}"
 
+    def story(self):
+        """The case's :class:`Narrative` (``narrative``, or the default one)."""
+        told = self.narrative or Narrative
+        if isinstance(told, str):
+            module, _, name = told.partition(":")
+            told = getattr(importlib.import_module(module), name)
+        return told(self)
+
+class Narrative:
+    """A case's report prose, apart from its physics: the setup notes, what was run, the
+    opening lines, the findings, a table cell's text and the case's own sections, each
+    computed from the runs. Every hook has a default, so a new case needs no narrative; a
+    case that says more names a subclass in ``Case.narrative``. ``self.case`` is the case
+    told (its physics: closed form, quantities, declarations).
+
+    Attributes
+    ----------
+    notes : report lines on how the case is set up; the metrics' definitions come from the
+        catalogue.
+    """
+
+    notes: ClassVar[tuple] = ()
+
+    def __init__(self, case):
+        self.case = case
+
+    def __init_subclass__(cls, **kw):
+        super().__init_subclass__(**kw)
+        if not isinstance(cls.notes, tuple):
+            raise TypeError(f"{cls.__name__}.notes must be a tuple (a one-element tuple needs "
+                            "its trailing comma)")
+
+    def notes_for(self, s):
+        """The report's notes for settings ``s``: ``notes`` unless the setup notes depend on
+        the settings."""
+        return self.notes
+
     def what_was_run(self, s, runs):
         """Report lines saying what the case ran (geometry, loads, references)."""
         return []
@@ -501,11 +534,25 @@ class Study(abc.ABC):
     # the keys of its metrics.json that hold its runs (dicts with 'model', 'mesh' and, for a
     # run that gave no number, 'failed'): what the index reads so that no failure is unread
     runs_recorded: ClassVar[tuple] = ()
+    # its settings dataclass (``problem()``: what the gate compares; ``describe()``: the
+    # parameters metrics.json records), the settings --quick changes, the settings fields a
+    # caller may give (None: every one; the material and ``selections`` otherwise), and the
+    # metrics.json keys that hold the data its report is drawn from (none: no --rewrite)
+    settings_class: ClassVar[type] = None
+    quick: ClassVar[dict] = {}
+    takes: ClassVar[tuple] = None
+    recorded_keys: ClassVar[tuple] = ()
 
-    @abc.abstractmethod
     def settings(self, quick=False, **kw):
-        """The study's settings: full by default, quick overrides, then ``kw`` (None values
-        ignored). Settings have ``problem()`` (what the gate compares) and ``describe()``."""
+        """The study's settings: full by default, the ``quick`` overrides, then ``kw`` (None
+        values ignored, and the fields the study does not take: a selection it fixes)."""
+        names = {f.name for f in fields(self.settings_class) if f.init}
+        if self.takes is not None:
+            names &= {"E", "nu", "rho", *self.takes, *self.selections}
+        given = {k: tuple(v) if isinstance(v, list) else v for k, v in kw.items()
+                 if v is not None and k in names}
+        return self.settings_class(**{**(self.quick if quick else {}), **given,
+                                      "quick": quick})
 
     @abc.abstractmethod
     def run(self, s, workers=None, log=True, bench=None, store=None):
@@ -531,9 +578,32 @@ class Study(abc.ABC):
     def recorded(self, metrics):
         """``(settings, data)`` as a run recorded them in ``metrics`` (its metrics.json), for
         ``pbcm run NAME --rewrite``: the report drawn again from the recorded runs after a
-        change of the report's code, without computing. None: the study cannot."""
-        return None
+        change of the report's code, without computing; the settings from the recorded
+        parameters (``recorded_settings``), the data from ``recorded_keys`` with what the
+        report derives drawn again (``redrawn``). None: the study records no data."""
+        if not self.recorded_keys:
+            return None
+        p = metrics["parameters"]
+        s = self.settings(quick=p["quick"], **self.recorded_settings(p))
+        return s, self.redrawn(s, {k: metrics[k] for k in self.recorded_keys}, metrics)
+
+    def recorded_settings(self, parameters):
+        """The settings fields a run recorded in its ``parameters``: each under its own name or,
+        for the material, its record's (``material_record``)."""
+        names = {"E": "E_Pa", "rho": "rho_kg_m3"}
+        out = {}
+        for f in fields(self.settings_class):
+            key = f.name if f.name in parameters else names.get(f.name)
+            if f.init and f.name != "quick" and key in parameters:
+                v = parameters[key]
+                out[f.name] = tuple(v) if isinstance(v, list) else v
+        return out
+
+    def redrawn(self, s, data, metrics):
+        """The recorded ``data`` with what the report derives from it drawn again by the
+        current rules (a fit, a judgement; never a run); as recorded by default."""
+        return data
 
 
-__all__ = ["Case", "Study", "Settings", "Loads", "Traction", "Knob", "Reference",
+__all__ = ["Case", "Narrative", "Study", "Settings", "Loads", "Traction", "Knob", "Reference",
            "MM", "MESH_FAMILIES"]

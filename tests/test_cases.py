@@ -68,7 +68,7 @@ def test_the_full_setting_repeats_every_dynamic_run_at_a_quarter_of_the_step():
     (r,), _ = run(CASE, s, log=False)
     assert r["dyn_failed"] is None and r["dyn_failed_dt4"] is None
     assert r["verdict_changes_dt4"] is False
-    assert CASE.notes_for(s)[0].startswith("The dynamic run is repeated at a quarter")
+    assert CASE.story().notes_for(s)[0].startswith("The dynamic run is repeated at a quarter")
     with pytest.raises(ModelError, match="repeat_dt4 must be one of 'every', 'blew up'"):
         CASE.settings(quick=True, repeat_dt4="some")
 
@@ -168,7 +168,7 @@ def test_list(capsys):
 def test_paper_cube_conclusion_groups_the_artefact_by_model():
     """The first line names each model once with where it shows the pattern, says it is the
     paper's 5-layer view that decides nothing, and names the converged FEM's showing of it."""
-    from cases.library import paper_cube_report as R
+    from cases.library.narratives import paper_cube as R
     from cases.library.paper_cube import Config
     run = dict(model="msm", mesh="five", bc="sliding", disp_rel_l2_p2=0.1, paper_pattern=True,
                alternation_rel=0.07)
@@ -422,7 +422,7 @@ def test_a_profiles_shape_is_read_from_its_second_differences():
     """A barrel (one bulge falling to both ends), a waist, a period-2 alternation and a
     uniform profile are named as such, so that a 5-layer score never calls a barrel an
     alternation."""
-    from cases.library.paper_cube_report import shape
+    from cases.library.narratives.paper_cube import shape
     assert shape([0.3319, 0.4375, 0.4571, 0.4375, 0.3319]) == "a barrel"
     assert shape([0.28, 0.2199, 0.2187, 0.2199, 0.28]) == "a waist"
     assert shape([0.1452, 0.1233, 0.1452, 0.1233, 0.1452]) == "alternating"
@@ -446,7 +446,7 @@ def test_a_line_says_failed_at_the_median_with_the_runs_that_gave_a_number():
 def test_the_sliding_bases_blow_ups_are_said_apart_from_the_scored_clamped_ones():
     """The paper cube's blow-ups are counted on the clamped base, the one scored; the sliding
     base's (an ill-posed modal problem) are reported apart and never pooled with them."""
-    from cases.library.paper_cube_report import _blow_ups
+    from cases.library.narratives.paper_cube import _blow_ups
     runs = [{"model": "a", "bc": "clamped", "dyn_failed": None},
             {"model": "a", "bc": "sliding", "dyn_failed": "blew up"},
             {"model": "b", "bc": "clamped", "dyn_failed": "blew up"},

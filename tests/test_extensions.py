@@ -2,7 +2,6 @@
 identification (pbcm fit)."""
 import json
 
-import numpy as np
 import pytest
 
 from cases.cli import main

@@ -12,7 +12,7 @@ from conftest import floats_in
 
 from cases.cli import main
 from cases.measuring import catalogue
-from cases.framework import Case, Settings
+from cases.framework import Case, Narrative, Settings
 from cases.registry import CASES
 from model.errors import MeshError
 from model.loads import body_forces, traction_forces
@@ -27,13 +27,39 @@ def test_every_case_declares_the_contract():
         assert isinstance(case, Case) and case.name == name
         assert issubclass(case.settings_class, Settings)
         assert catalogue.metric(case.headline).direction == "max"   # an error
-        assert all(isinstance(t, tuple) for t in (case.gated, case.columns, case.notes))
-        assert all(isinstance(line, str) for line in case.notes)
+        story = case.story()
+        assert isinstance(story, Narrative) and story.case is case
+        assert all(isinstance(t, tuple) for t in (case.gated, case.columns, story.notes))
+        assert all(isinstance(line, str) for line in story.notes)
         for name in case.gated + case.columns:
             catalogue.metric(name)
         s = case.settings(quick=True)
         assert s.quick and set(s.meshes) <= set(case.meshes)
         assert set(catalogue.gated(*case.gated).values()) <= {"max", "min", "signed"}
+
+
+PROSE = ("notes", "notes_for", "what_was_run", "references_line", "conclusion", "findings",
+         "cell", "sections")
+
+
+def test_a_case_declares_physics_and_its_narrative_holds_the_prose():
+    """A case class declares the physics only: every report hook lives in its narrative (a
+    Narrative subclass); a case without one is told by the default narrative, whose hooks
+    say nothing of their own; a narrative's notes must be a tuple."""
+    for case in CASES.values():
+        assert not set(PROSE) & set(vars(type(case))), type(case).__name__
+        assert type(case.story()) is not Narrative
+    bare = type("Bare", (Case,), {"name": "bare", "title": "a bare case",
+                                  "mesh": lambda self, family, s: None,
+                                  "dirichlet": lambda self, mesh, bc, s: {}})()
+    told = bare.story()
+    assert type(told) is Narrative and told.case is bare
+    s = Settings()
+    assert (told.notes_for(s), told.what_was_run(s, []), told.conclusion(s, []),
+            told.findings(s, [])) == ((), [], [], {})
+    assert told.references_line(s).startswith("References: linear FEM P1 on the same mesh")
+    with pytest.raises(TypeError, match="notes must be a tuple"):
+        type("Loose", (Narrative,), {"notes": "one line"})
 
 
 @pytest.mark.parametrize("name", LIBRARY)
@@ -170,3 +196,21 @@ def test_a_failed_mesh_is_recorded_and_the_case_goes_on(tmp_path):
     assert good[0]["reaction_ratio"] > 0 and good[0]["disp_rel_l2_p2"] > 0
     write_case(tmp_path, case, s, runs, fields)
     assert "Runs that could not start" in (tmp_path / "report.md").read_text()
+
+
+@pytest.mark.parametrize("quick", [True, False])
+def test_a_study_takes_its_settings_back_from_the_parameters_it_recorded(quick):
+    """Every study derives its settings (full, quick, given) and, for a rewrite, takes them
+    back from the parameters its metrics.json records, equal to those it ran with; a selection
+    it fixes is not taken."""
+    from cases.registry import studies
+    for name, study in studies().items():
+        s = study.settings(quick=quick, E=12e3, nu=0.495, meshes=("bcc",))
+        assert (s.E, s.nu, s.quick) == (12e3, 0.495, quick), name
+        if "meshes" in study.selections:
+            assert tuple(s.meshes) == ("bcc",), name
+        elif hasattr(s, "meshes"):
+            assert tuple(s.meshes) != ("bcc",), name
+        recorded = json.loads(json.dumps(s.describe()))
+        taken = study.settings(quick=quick, **study.recorded_settings(recorded))
+        assert json.loads(json.dumps(taken.describe())) == recorded, name

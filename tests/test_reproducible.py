@@ -17,7 +17,7 @@ def test_round_off_is_printed_as_such_and_ties():
 def test_a_blow_up_is_said_by_its_time_to_two_figures():
     """'blew up at step 12379 (t = 0.2731 s ...' and 'at step 12499 (t = 0.2734 s ...' (two
     processors) read the same."""
-    from cases.library.paper_cube_report import _blowup
+    from cases.library.narratives.paper_cube import _blowup
     a = _blowup("time integration blew up at step 12379 (t = 0.2731 s, dt = 2.2e-05 s): x")
     b = _blowup("time integration blew up at step 12499 (t = 0.2734 s, dt = 2.2e-05 s): x")
     assert a == b == "t = 0.27 s"

@@ -24,6 +24,7 @@ class CantileverSettings(Settings):
 
 
 class Cantilever(Case):
+    narrative = "cases.library.narratives.cantilever:CantileverNarrative"
     name = "cantilever"
     resolution = Knob("spacing_mm", "lattice spacing [mm]")
     load = Knob("load_N", "end load [N]")
@@ -39,9 +40,6 @@ class Cantilever(Case):
     gated = ("tip_deflection_rel_err",)
     columns = ("tip_deflection_mm", "tip_deflection_fem_mm", "tip_deflection_rel_err")
     magnify = 3.0
-    notes = (
-        "The load reaches the particle model as consistent nodal forces (a third of traction x "
-        "area of each face triangle to its vertices), FEM integrates the traction itself.",)
 
     def mesh(self, family, s):
         return common.bar(family, LENGTH_MM, HEIGHT_MM, WIDTH_MM, s.spacing_mm)
@@ -65,34 +63,5 @@ class Cantilever(Case):
     def params(self, s):
         return {"length_mm": LENGTH_MM, "height_mm": HEIGHT_MM, "width_mm": WIDTH_MM,
                 "load_N": s.load_N, "E_Pa": s.E, "nu": s.nu, "spacing_mm": s.spacing_mm}
-
-    def what_was_run(self, s, runs):
-        return [f"Beam {LENGTH_MM:g} x {HEIGHT_MM:g} x {WIDTH_MM:g} mm, nodes every "
-                f"{s.spacing_mm:g} mm; x = 0 fully clamped; {s.load_N * 1e3:g} mN in -y as a "
-                "uniform traction on x = L."]
-
-    def conclusion(self, s, runs):
-        cf = self.closed_form(s, "clamped")["tip_deflection_mm"]
-        solved = [r for r in runs if r.get("tip_deflection_mm") is not None]
-        out = [common.best_and_worst(runs, "tip_deflection_rel_err", "Tip deflection")]
-        if solved:
-            fem = solved[0]["tip_deflection_fem_mm"]
-            out.append(f"FEM P2 deflects {fem:.4g} mm ({solved[0]['mesh']}), the closed form "
-                       f"{cf:.4g} mm: a fully clamped root is stiffer than beam theory's.")
-            soft = sorted({r["model"] for r in solved
-                           if r["tip_deflection_mm"] > r["tip_deflection_fem_mm"]})
-            out.append("Softer than FEM in bending: " + (", ".join(soft) or "none") + ". "
-                       + common.failures(runs))
-        return out
-
-    def findings(self, s, runs):
-        cf = self.closed_form(s, "clamped")["tip_deflection_mm"]
-        return {"Bending stiffness": common.ranking(runs, "tip_deflection_rel_err",
-                                                    "tip deflection error"),
-                "Reference against the closed form": common.vs_closed_form(
-                    "tip deflection", runs, "tip_deflection_fem_mm", cf, "mm"),
-                "Failures": [common.failures(runs)]}
-
-
 
 CASE = Cantilever()

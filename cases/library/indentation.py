@@ -105,6 +105,7 @@ def edge_tets(mesh, spacing):
 
 
 class Indentation(Case):
+    narrative = "cases.library.narratives.indentation:IndentationNarrative"
     name = "indentation"
     resolution = Knob("spacing_mm", "lattice spacing [mm]")
     title = ("Indentation of a 32 mm cube on a clamped base by a rigid punch, an 8 x 8 mm flat "
@@ -121,13 +122,6 @@ class Indentation(Case):
     columns = ("reaction_n", "reaction_fem_p2_n", "profile_rel_err", "edge_shear_pa",
                "edge_shear_fem_pa")
     magnify = 2.0
-    notes = (
-        "The punch force is the reaction on the top face along y (the punch's: the rest of "
-        "the top is free).",
-        "The prescribed field has kinks at the edges of the punch's face and rim: the "
-        "continuum's shear there is not bounded (it grows as the mesh is refined), so no "
-        "error of the edge shear against a reference is taken: each model's own value is "
-        "shown and gated as a regression, never compared or ranked.")
 
     def mesh(self, family, s):
         n = int(round(SIZE_MM / s.spacing_mm)) + 1
@@ -168,48 +162,5 @@ class Indentation(Case):
             return {"profile_rel_err": None}
         line = centre_line(mesh, s.spacing_mm * MM)
         return {"profile_rel_err": M.rel_l2(st.u[line, 1], ref.p2.u[line, 1])}
-
-    def what_was_run(self, s, runs):
-        return [f"Cube of side {SIZE_MM:g} mm, nodes every {s.spacing_mm:g} mm, base clamped; "
-                f"the centred {PATCH_MM:g} x {PATCH_MM:g} mm face of the punch moves the top "
-                f"(0, -{DEPTH_MM:g}, 0) mm in {s.steps} load steps, its {RIM_MM:g} mm rim "
-                "slopes linearly to the free surface (the punch holds what it presses): one "
-                "displacement field, prescribed at the models' top nodes and at the "
-                "references' every boundary point of every refinement."]
-
-    def conclusion(self, s, runs):
-        return [common.best_and_worst(runs, "reaction_rel_err", "Punch force"),
-                common.best_and_worst(runs, "profile_rel_err", "Surface profile"),
-                "The shear under the edge of the punch's face is not bounded in the continuum "
-                "(it grows as the mesh is refined): its values are in the tables, never "
-                "ranked. " + common.failures(runs)]
-
-    def findings(self, s, runs):
-        stiff = common.per_run(runs, lambda r: None if r.get("reaction_ratio") is None
-                               else r["reaction_ratio"] > 1, "Stiffer than FEM under the punch")
-        return {"Punch force": common.ranking(runs, "reaction_rel_err", "force error")
-                + [stiff],
-                "Surface profile": common.ranking(runs, "profile_rel_err", "profile error"),
-                "Failures": [common.failures(runs)]}
-
-
-    def sections(self, doc, s, runs, fields, out):
-        from ..reporting import figures
-        for mesh in s.meshes:
-            rs = [r for r in runs if r["mesh"] == mesh and not r.get("failed")]
-            if not rs:
-                continue
-            m = fields[(mesh, "clamped", "fem-p2")]["mesh"]
-            x = m.points[centre_line(m, s.spacing_mm * MM), 0] / MM
-            name = f"profile_{mesh}.png"
-            drawn = [r for r in rs if r["surface_profile_mm"] is not None]
-            figures.curves(out / name, x, rs[0]["surface_profile_fem_mm"], "FEM P2",
-                           [(r["model"], r["surface_profile_mm"]) for r in drawn],
-                           "x along the centre line [mm]", "u_y of the top surface [mm]",
-                           f"surface profile under the punch, mesh {mesh}",
-                           highlight={r["model"] for r in drawn
-                                      if (r.get("profile_rel_err") or 0.0) > DEVIATES})
-            doc.img(name, f"Surface profile along the centre line, mesh {mesh}")
-
 
 CASE = Indentation()

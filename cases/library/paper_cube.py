@@ -16,13 +16,17 @@ from . import transient
 from ..measuring.error_model import Scalar
 from ..framework import MM, Case, Knob, MESH_FAMILIES, Settings, regimes
 from . import common
-from . import paper_cube_report as report
 
 SIZE_MM = common.CUBE_MM
 NODES_PER_SIDE = 5
 PUSH_MM = 1.7
 SPEED_MM_S = 1.7
 BCS = common.CUBE_BCS
+# the paper cube's own columns (catalogue names)
+COLUMNS = ("alternation_mm", "alternation_rel", "paper_pattern", "growth_rate_1_s",
+           "dyn_vs_static_rel_l2",
+           "verdict_changes_dt4", "reaction_time_rel_l2", "disp_end_push_rel_l2", "rest_time_s",
+           "modal_rel_err", "modal_rel_err_free", "rigid_modes_free")
 
 REPEAT_DT4 = ("every", "blew up")   # which dynamic runs are repeated at a quarter of the step
 
@@ -193,6 +197,7 @@ class PaperCube(Case):
     1.7 mm at 1.7 mm/s, measured against FEM for every mesh, boundary condition and model,
     statically and dynamically (FEM transient, modes), with the bulge/neck profile and cost."""
 
+    narrative = "cases.library.narratives.paper_cube:PaperCubeNarrative"
     name = "paper-cube"
     title = "The paper's cube pushed down 1.7 mm (5.3 %), clamped or sliding base"
     settings_class = Config
@@ -211,8 +216,7 @@ class PaperCube(Case):
     patch_tests = ("sliding",)   # homogeneous: FEM exact, a consistent model too
     gated = ("alternation_rel", "reaction_time_rel_l2", "disp_end_push_rel_l2", "rest_time_s",
              "modal_rel_err", "modal_rel_err_free", "rigid_modes_free", "modes_unpaired")
-    columns = report.COLUMNS
-    notes = report.NOTES
+    columns = COLUMNS
     draws_stress = True
     quantity_compared = ("alternation_mm", "alternation_rel")
 
@@ -274,25 +278,6 @@ class PaperCube(Case):
         if bc == "sliding":     # ill-posed: held at two corner nodes, its modes rotate there
             r.update(dict.fromkeys(SCORED_DYNAMICS), rest_time_fem_s=None)
         return r
-
-    def notes_for(self, s):
-        return report.notes(s)
-
-    def what_was_run(self, s, runs):
-        return report.what_was_run(s, runs)
-
-    def conclusion(self, s, runs):
-        return report.conclusion(s, runs)
-
-    def findings(self, s, runs):
-        return report.findings(runs, s)
-
-
-    def cell(self, metric, run):
-        return report.cell(metric, run) or super().cell(metric, run)
-
-    def sections(self, doc, s, runs, fields, out):
-        report.sections(doc, s, runs, fields, out)
 
 
 CASE = PaperCube()

@@ -125,13 +125,14 @@ def _constants(runs):
 
 def build_report(case, s, runs, fields, out):
     doc = Document(f"pbcm report: {case.name}")
+    story = case.story()
     ok = [r for r in runs if not r.get("failed")]
     opening, costs_of_replacing = [], []
     if case.decompositions():
         opening, costs_of_replacing = scorecard.case_findings(
             case.name, case.decompositions(), runs, case.patch_tests, case.headline_estimate,
             case.per_mesh_continuum, case.locking_prone)
-    lines = opening + case.conclusion(s, runs)
+    lines = opening + story.conclusion(s, runs)
     preview = []
     if s.quick:     # a preview on fewer meshes: it decides nothing the full run could reverse
         preview, lines = lines, [
@@ -143,14 +144,14 @@ def build_report(case, s, runs, fields, out):
           "computed by the run that wrote this file, but the cost, which is `pbcm bench`'s "
           "(reports/bench).")
     doc.h(2, "What was run")
-    doc.ul([case.title + "."] + case.what_was_run(s, runs) + [
+    doc.ul([case.title + "."] + story.what_was_run(s, runs) + [
         f"Meshes {', '.join(s.meshes)}; boundary conditions {', '.join(s.bcs)}; models "
         f"{', '.join(s.models)}.",
         f"Material E = {s.E:g} Pa, nu = {s.nu:g}, rho = {s.rho:g} kg/m^3 "
         f"({case.material_from}).",
-        case.references_line(s),
+        story.references_line(s),
         "Quick mode." if s.quick else "Full mode."] + _constants(runs))
-    notes = case.notes_for(s)
+    notes = story.notes_for(s)
     if notes:
         doc.h(2, "Notes")
         doc.ul(notes)
@@ -158,7 +159,7 @@ def build_report(case, s, runs, fields, out):
     groups = {"What these meshes show": preview} if preview else {}
     if costs_of_replacing:
         groups["What replacing FEM P1 costs"] = costs_of_replacing
-    groups.update(case.findings(s, ok))
+    groups.update(story.findings(s, ok))
     groups.update(rankings.finite_load(ok))
     tets = [r["tets"] for r in runs if r.get("tets")]
     groups["Cost"] = groups.get("Cost", []) + costs.cost_items(
@@ -173,13 +174,14 @@ def build_report(case, s, runs, fields, out):
             doc.h(3, title)
             doc.items(items)
     _tables(doc, case, s, runs)
-    case.sections(doc, s, runs, fields, out)
+    story.sections(doc, s, runs, fields, out)
     _standard_figures(doc, case, s, runs, fields, out)
     return doc
 
 
 def _tables(doc, case, s, runs):
     shown = [catalogue.metric(n) for n in catalogue.TABLE + case.columns]
+    cell = case.story().cell
     for mesh in s.meshes:
         for bc in s.bcs:
             rs = [r for r in _runs(runs, mesh=mesh, bc=bc) if not r.get("failed")]
@@ -195,7 +197,7 @@ def _tables(doc, case, s, runs):
                       "strain of the linear reference 1e-4), each model's answer divided by "
                       "it again, against linear FEM:")
             doc.table(["model"] + [m.header for m in shown],
-                      [[r["model"]] + [case.cell(m, r) for m in shown] for r in rs])
+                      [[r["model"]] + [cell(m, r) for m in shown] for r in rs])
             _finite_table(doc, case, rs)
             bad = [r for r in rs if r["static_failed"]]
             if bad:
@@ -208,13 +210,14 @@ def _finite_table(doc, case, rs):
     if rs[0].get("nh_error_estimate") is None:
         return
     shown = [catalogue.metric(n) for n in catalogue.FINITE]
+    cell = case.story().cell
     line = (f"At the case's load, against the neo-Hookean reference (error estimate "
             f"{rel(rs[0]['nh_error_estimate'], 2)}")
     if rs[0].get("reaction_fem_nh_n") is not None:
         line += f", reaction {fmt(rs[0]['reaction_fem_nh_n'], 4)} N"
     doc.p(line + "):")
     doc.table(["model"] + [m.header for m in shown],
-              [[r["model"]] + [case.cell(m, r) for m in shown] for r in rs])
+              [[r["model"]] + [cell(m, r) for m in shown] for r in rs])
     bad = [r for r in rs if r.get("finite_failed")]
     if bad:
         doc.p("No equilibrium at the case's load (its metrics are n/a): " + "; ".join(

@@ -5,8 +5,6 @@ its uncertainty and a verdict (converges, floor, diverges); the effective elasti
 every model on every lattice, which explains the floors; and the error against the cost of one
 RK4 step, with the models on the Pareto front.
 """
-from dataclasses import fields
-
 from ...framework import Study
 from ...running.store import OFF
 from . import report
@@ -29,11 +27,8 @@ class Convergence(Study):
     # references down to 2 mm
     quick = {"h_mm": (8.0, 4.0), "meshes": ("five", "six"), "ref_finest_mm": 2.0}
 
-    def settings(self, quick=False, **kw):
-        kw = {k: v for k, v in kw.items() if v is not None}
-        names = {f.name for f in fields(ConvergenceSettings) if f.init}
-        base = {**(self.quick if quick else {}), "quick": quick}
-        return ConvergenceSettings(**{k: v for k, v in {**base, **kw}.items() if k in names})
+    settings_class = ConvergenceSettings
+    recorded_keys = RECORDED
 
     def run(self, s, workers=None, log=True, bench=None, store=None):
         return run(s, workers=workers, log=log, bench=bench, store=store or OFF)
@@ -49,15 +44,11 @@ class Convergence(Study):
         that one rule gives one verdict wherever the same runs are read."""
         return fits(runs, references)
 
-    def recorded(self, metrics):
-        """The settings and data a run recorded, for ``pbcm run convergence --rewrite``."""
-        p = metrics["parameters"]
-        s = ConvergenceSettings(
-            E=p["E_Pa"], nu=p["nu"], rho=p["rho_kg_m3"], problems=tuple(p["problems"]),
-            meshes=tuple(p["meshes"]), models=tuple(p["models"]), h_mm=tuple(p["h_mm"]),
-            load_scale=p["load_scale"], patch_n=p["patch_n"], quick=p["quick"],
-            ref_finest_mm=_finest(p["ref_ladders_mm"]))
-        data = {k: metrics[k] for k in RECORDED}
+    def recorded_settings(self, parameters):
+        return {**super().recorded_settings(parameters),
+                "ref_finest_mm": _finest(parameters["ref_ladders_mm"])}
+
+    def redrawn(self, s, data, metrics):
         # the fits are derived from the recorded runs and references: drawn again by the
         # current rule, never recomputing a run
         data["fits"] = fits(data["runs"], data["references"])
@@ -65,7 +56,7 @@ class Convergence(Study):
             data["cost"] = judge(data["cost"], data["runs"], EXACT, cancelling(data["fits"]),
                                  {(r["case"], r["bc"]): r.get("error_estimate") or 0.0
                                   for r in data["references"]})
-        return s, data
+        return data
 
 
 def _finest(ladders):

@@ -18,11 +18,9 @@ class TruthCube(Study):
     title = ("the Truth Cube: every model against 343 measured beads of a silicone cube "
              "compressed 5, 12.5 and 18.25 %")
 
-    def settings(self, quick=False, **kw):
-        keep = {"E", "nu", "models"}
-        return TruthCubeSettings(quick=quick, **{k: (tuple(v) if k == "models" else v)
-                                                 for k, v in kw.items()
-                                                 if k in keep and v is not None})
+    settings_class = TruthCubeSettings
+    takes = ("models",)       # the material (no rho: a static study) and the models
+    recorded_keys = ("rows", "references", "travels_mm", "nominal_travels_mm", "data")
 
     def run(self, s, workers=None, log=True, bench=None, store=None):
         return run(s, log=log, store=store or OFF, workers=workers)
@@ -35,12 +33,6 @@ class TruthCube(Study):
 
     def definitions(self):
         return report.definitions()
-
-    def recorded(self, metrics):
-        p = metrics["parameters"]
-        s = self.settings(quick=p["quick"], E=p["E_Pa"], nu=p["nu"], models=p["models"])
-        return s, {k: metrics[k] for k in ("rows", "references", "travels_mm",
-                                           "nominal_travels_mm", "data")}
 
 
 STUDY = TruthCube()

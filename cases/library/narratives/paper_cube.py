@@ -1,24 +1,21 @@
-"""The paper cube's own report pieces: its definitions, columns, findings (grouped), the
-Figure 1 analogue, the layer profiles, the step-time chart and the reaction history. Every
-sentence is computed from the runs."""
+"""The paper cube's report prose: its notes, findings (grouped), the Figure 1 analogue, the
+layer profiles, the step-time chart and the reaction history. Every sentence is computed from
+the runs."""
 
 import re
 
 import numpy as np
 
-from ..reporting import figures, rankings
-from ..measuring.metrics import ALTERNATION_CLEAR, PATCH_TOL, PATTERN_TOL
-from ..reporting.document import Table, fmt
+from ...reporting import figures, rankings
+from ...measuring.metrics import ALTERNATION_CLEAR, PATCH_TOL, PATTERN_TOL
+from ...reporting.document import Table, fmt
+from ...framework import Narrative
+from ..paper_cube import SPEED_MM_S
 
-SPEED_MM_S = 1.7
 PAPER_TETS = 374     # the paper's mesh (section 4), unpublished
 CAUCHY_TOL = 0.02    # an apparent Poisson ratio this close to 1/4 does not show anisotropy
 
-# the paper cube's own columns (catalogue names) and the notes beside the catalogue's definitions
-COLUMNS = ("alternation_mm", "alternation_rel", "paper_pattern", "growth_rate_1_s",
-           "dyn_vs_static_rel_l2",
-           "verdict_changes_dt4", "reaction_time_rel_l2", "disp_end_push_rel_l2", "rest_time_s",
-           "modal_rel_err", "modal_rel_err_free", "rigid_modes_free")
+# the notes beside the catalogue's definitions
 NOTES = ("The dynamic run is repeated at a quarter of the step (dt/4) to see whether its "
          "verdict holds; 'blew up' in dyn vs static is a dynamic run that did not finish.",
          "The sliding base holds lateral motion at two corner nodes only, so its lowest modes "
@@ -442,3 +439,25 @@ def sections(doc, cfg, runs, fields, out):
                               fem["reaction_y"]), f"dynamic run, mesh {m0}, {b0}",
                              f"FEM P2 static at {cfg.push_mm:g} mm")
     doc.img("reaction_time.png", f"Reaction force against time, mesh {m0}, {b0}")
+
+
+class PaperCubeNarrative(Narrative):
+    notes = NOTES
+
+    def notes_for(self, s):
+        return notes(s)
+
+    def what_was_run(self, s, runs):
+        return what_was_run(s, runs)
+
+    def conclusion(self, s, runs):
+        return conclusion(s, runs)
+
+    def findings(self, s, runs):
+        return findings(runs, s)
+
+    def cell(self, metric, run):
+        return cell(metric, run) or super().cell(metric, run)
+
+    def sections(self, doc, s, runs, fields, out):
+        sections(doc, s, runs, fields, out)
