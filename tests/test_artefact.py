@@ -10,7 +10,7 @@ import pytest
 
 from cases.measuring import metrics as M
 from cases.studies.artefact import analysis
-from cases.studies.artefact.study import SPLITS, _free_layers
+from cases.studies.artefact.study import HELD, SPLITS, _free_layers, held
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -254,7 +254,8 @@ def test_the_mirror_holds_where_only_the_mirrored_split_alternates(nine_decides)
     assert tags["b"]["label"] == "+ on 4 of 4 configurations" and len(tags["b"]["mirror"]) == 4
     assert a["text"].startswith("Not decided for the paper's own 5-node cube (")
     assert "Under refinement, of the resolved period-2 parts 8 of 8 with the paper's sign are " \
-        "the mirror's and none is on every split (a); provisional" in a["text"]
+        "the mirror's and none is on every split (a); its u holds the metric's leaks and the " \
+        "solver's tolerance; the reference cancels from every part" in a["text"]
     assert "the paper's sign (+): the mirror's on 4 of 4 configurations with a resolved part " \
         "(9 clamped: 2 of 2 resolved parts, b, msm; 9 sliding: 2 of 2 resolved parts, b, " \
         "msm; 17 clamped: 2 of 2 resolved parts, b, msm; 17 sliding: 2 of 2 resolved parts, " \
@@ -380,6 +381,37 @@ def test_a_part_on_every_split_is_not_the_mirrors():
         return 0.0 if model == "fem-neohookean" else 0.02
     a = analysis.answer(_world(everywhere))
     assert set(analysis.classes(_unit(a, 17, "sliding"))) == {"own +, on every split"}
+
+
+def test_a_calibrated_readings_mirror_is_read_against_the_same_reading_at_the_mirrored_fit():
+    """Where a reading was also run on the other splits with the shear's c fitted on the
+    mirrored five split (its held model), its controls are those cells, which differ from the
+    mirrored one in the split alone: a part that the reading refitted on each split shares
+    everywhere but the held reading lacks is the mirror's; the held cells are in no other
+    answer (they are not models of the consistency or the normal-stress tests)."""
+    def refit_everywhere(model, split, n, bc):
+        if model == "fem-neohookean":
+            return 0.0
+        if split == FIVE or model == "b":
+            return 0.32 / (n - 1)
+        return 0.001
+    models = MODELS + ((held("b"), "none", "particle", HELD),)
+    world = [c for c in _world(refit_everywhere, models=models)
+             if not (c["model"] == held("b") and c["split"] == FIVE)]
+    u = _unit(analysis.answer(world), 17, "sliding")
+    b = next(r for r in u["rows"] if r["name"] == "b")
+    assert b["controls_held"] and b["kind"] == "own +, the mirror's"
+    assert b["controls"][SIX] == pytest.approx(
+        next(c for c in world if c["model"] == held("b") and c["split"] == SIX
+             and c["nodes_per_side"] == 17 and c["bc"] == "sliding"
+             and c["load"] == "paper")["alternation_rel"])
+    assert not next(r for r in u["rows"] if r["name"] == "msm")["controls_held"]
+    assert held("b") not in {r["model"] for r in u["rows"]}
+    without = [c for c in world if c["model"] != held("b")]
+    assert analysis.consistency(analysis.main_cells(world)) == analysis.consistency(without)
+    refit = _unit(analysis.answer(without), 17, "sliding")
+    assert next(r for r in refit["rows"] if r["name"] == "b")["kind"] == \
+        "own +, on every split"
 
 
 def test_a_failed_control_is_a_hole_in_that_control_and_every_failed_cell_is_named():
@@ -979,3 +1011,23 @@ def test_a_model_that_cannot_be_built_is_one_failure_with_its_cause():
     n = sum(c["model"] == "b+n" for c in world)
     assert f"b+n on {n} cells: build: calibration of shear/balanced gave c = 0" in said
     assert "failed static solves" not in said
+
+
+def test_a_held_shear_constant_is_the_calibrated_readings_fit_on_the_named_mesh():
+    """A model whose shear c is held takes pbcm-<reading>'s fitted c on the mirrored five split
+    of the same size ('five') or on its own mesh ('this mesh'); a model without one is built
+    as named."""
+    from model import Material, build
+    from cases.studies.artefact.study import MIRRORED_FIVE, SAME_MESH, held_shear, make_mesh
+    s = type("S", (), {"material": Material(E=10e3, nu=0.45)})()
+    six = make_mesh("six", ("six", 5, 0))
+    five = make_mesh("five", ("five", 5, 0))
+    fit = {k: build("pbcm-balanced", m, s.material)
+           .info["shear_c"] for k, m in (("five", five), ("six", six))}
+    on_five = held_shear({"reading": "balanced", "shear_c_of": MIRRORED_FIVE},
+                         ("six", 5, 0), six, s)
+    on_six = held_shear({"reading": "balanced", "shear_c_of": SAME_MESH}, ("six", 5, 0), six, s)
+    assert on_five == {"shear": {"c": pytest.approx(fit["five"])}}
+    assert on_six == {"shear": {"c": pytest.approx(fit["six"])}}
+    assert fit["five"] != pytest.approx(fit["six"], rel=1e-3)
+    assert held_shear({"reading": "balanced"}, ("six", 5, 0), six, s) == {}

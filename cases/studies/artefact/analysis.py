@@ -34,8 +34,8 @@ from scipy.stats import spearmanr
 from ...reporting.document import fmt
 from ...library import paper_cube as P
 from ...measuring.metrics import ALTERNATION_CLEAR, nyquist_weights
-from .study import (DECISIVE, LINEAR_SCALE, SPLITS, SPLITS_TRIED,
-                    YARDSTICK as YARDSTICK_MODEL, _free_layers, short)
+from .study import (DECISIVE, HELD, LINEAR_SCALE, SPLITS, SPLITS_TRIED,
+                    YARDSTICK as YARDSTICK_MODEL, _free_layers, held, short)
 
 PAPER_COST = 10.0      # the paper (its Figure 2): the time of one step over msm's, more than 10
 RUN_S = P.PUSH_MM / P.SPEED_MM_S   # the paper's run: the push, 1.7 mm at 1.7 mm/s
@@ -419,6 +419,21 @@ def _index(cells):
             for c in cells}
 
 
+def control_model(at, m, n, bc):
+    """The model whose cells are ``m``'s controls at (n, bc): its held model (the shear's c of
+    the mirrored five split, so that the controls differ from it in the split alone) where that
+    ran on any split there, else ``m`` itself."""
+    h = held(m)
+    return h if any((h, x, n, bc, "paper") in at for x in (UNMIRRORED,) + CONFORMING_CONTROLS) \
+        else m
+
+
+def main_cells(cells):
+    """The cells every answer but the mirror's reads: without the held models (the mirror's
+    controls only)."""
+    return [c for c in cells if c.get("constant") != HELD]
+
+
 def _part(c, fem, ref, free, leak):
     """(part, u) of a model's cell against FEM P1's on the same tetrahedra: the difference of
     their signatures (over the reference's mean) and its uncertainty, the configuration's
@@ -498,8 +513,10 @@ def units(cells, models=None):
         mirrored = [m for m in order if (m, MIRRORED, n, bc, "paper") in at
                     and at[(m, MIRRORED, n, bc, "paper")]["family"] != CONTROL]
         ctrls = [x for x in CONFORMING_CONTROLS
-                 if all((m, x, n, bc, "paper") in at for m in mirrored + [YARDSTICK_MODEL])]
-        missing = {x: [short(m) for m in mirrored if (m, x, n, bc, "paper") not in at]
+                 if all((control_model(at, m, n, bc), x, n, bc, "paper") in at
+                        for m in mirrored + [YARDSTICK_MODEL])]
+        missing = {x: [short(m) for m in mirrored
+                       if (control_model(at, m, n, bc), x, n, bc, "paper") not in at]
                    for x in CONFORMING_CONTROLS if x not in ctrls}
         fem_five = None if fem is None else fem.get("alternation_rel")
         fem_all = {x: at[(YARDSTICK_MODEL, x, n, bc, "paper")].get("alternation_rel")
@@ -515,22 +532,23 @@ def units(cells, models=None):
         rows, seen = [], []
         for m in mirrored:
             c = at[(m, MIRRORED, n, bc, "paper")]
+            cm = control_model(at, m, n, bc)
             row = {"model": m, "name": short(m), "family": c["family"],
                    "constant": c["constant"], "five": c.get("alternation_rel"),
                    "five_mm": c.get("alternation_mm"), "own": signature_own(c),
                    "own_factor": own_factor(c), "lateral": lateral_error(c), "controls": {},
-                   "control_parts": {},
-                   "unmirrored": (at.get((m, UNMIRRORED, n, bc, "paper")) or {}).get(
+                   "control_parts": {}, "controls_held": cm != m,
+                   "unmirrored": (at.get((cm, UNMIRRORED, n, bc, "paper")) or {}).get(
                        "alternation_rel"), "same_as": None, "sign": None}
             row["u_sig"] = signature_u(c, leak, floor) if not c.get("failed") else None
             row["clear"], row["clear_by"] = clear_call(row["five"], row["u_sig"] or 0.0,
                                                        row["own_factor"])
             for x in CONFORMING_CONTROLS:
-                y = at.get((m, x, n, bc, "paper"))
+                y = at.get((cm, x, n, bc, "paper"))
                 row["controls"][x] = ("not run" if y is None else failure(y)
                                       if y.get("failed") else y.get("alternation_rel"))
             # the model's controls: each conforming split it and FEM P1 ran on at this size
-            own_ctrls = [x for x in CONFORMING_CONTROLS if (m, x, n, bc, "paper") in at
+            own_ctrls = [x for x in CONFORMING_CONTROLS if (cm, x, n, bc, "paper") in at
                          and (YARDSTICK_MODEL, x, n, bc, "paper") in at]
             row["ctrls"] = own_ctrls
             # a failed control is a hole in that control, counted against the model, never its
@@ -556,7 +574,7 @@ def units(cells, models=None):
             d, u = _part(c, fem, ref, free, leak)
             parts = []
             for x in own_ctrls:
-                cp, uc = _part(at[(m, x, n, bc, "paper")], at[(YARDSTICK_MODEL, x, n, bc,
+                cp, uc = _part(at[(cm, x, n, bc, "paper")], at[(YARDSTICK_MODEL, x, n, bc,
                                                                 "paper")], ref, free, leak)
                 row["control_parts"][x] = {"part": cp, "u": uc,
                                            "resolved": against(abs(cp) / uc, RATIO)}
@@ -1137,15 +1155,17 @@ def failed_cells(cells):
             if c.get("failed")]
 
 
-def answer(cells, models=None):
+def answer(cells, models=None, estimates=None):
     """The paper's question answered hypothesis by hypothesis from the configurations that
     read own parts (DECISIVE or more layers): (a) where a resolved own part is the mirror's,
     by sign, with its order in h; (b) whether a normal-stress term reduces it, and for which
     sign that was tested; (c) whether it tracks the patch-test error, in the linear regime;
     then whether it is large enough to see (the clear level, on the configurations that
-    decide it); 'not decided' for the paper's 5-node cube."""
+    decide it); 'not decided' for the paper's 5-node cube. ``estimates``: the references'
+    error estimates {"bc/load": estimate}, where known."""
     m = mirror(cells, models)
     us = m["units"]
+    every, cells = cells, main_cells(cells)    # the held models: the mirror's controls alone
     ns, cs = normal_stress(cells, us), consistency(cells)
     view, lin = paper_view(us), linear_check(cells)
     dec = [u for u in us if u["reads"]]
@@ -1154,7 +1174,7 @@ def answer(cells, models=None):
     base = {"hypotheses": hyp, "paper_view": view, "linear": lin, "ratio": RATIO,
             "decisive": DECISIVE, "clear_level": CLEAR, "near": NEAR,
             "deciding": m["deciding"], "asymmetry": reference_asymmetry(cells),
-            "inward": inward(cells), "failed": failed_cells(cells)}
+            "inward": inward(cells), "failed": failed_cells(every)}
     if not dec:
         text = "Not decided: " + paper + f". No mesh with {DECISIVE} or more layers was run."
         return {**base, "decided": False, "cause": "not decided", "text": text,
@@ -1221,6 +1241,10 @@ def answer(cells, models=None):
         at_ = sum(p["reduced"] == "at" for p in ps)
         moved = [p["shear_c"] for p in ps if None not in p["shear_c"]
                  and not same(*p["shear_c"], SAME)]
+        kept = [p for p in ps if None not in p["shear_c"] and same(*p["shear_c"], SAME)]
+        kept_text = (f"; in {len(kept)} of them the shear's c is held at the reading's fit "
+                     f"(only the normal stress changes: {sum(p['reduced'] == 'above' for p in kept)}"
+                     f" of {len(kept)} reduced)" if kept else "")
         return (f"{word[s_]} ({s_}): {sum(p['reduced'] == 'above' for p in ps)} of {len(ps)} "
                 f"reduced {RATIO:g}-fold" + (f" ({at_} not decided: at the threshold)" if at_
                                              else "")
@@ -1231,7 +1255,7 @@ def answer(cells, models=None):
                 + (f"; in {len(moved)} of them the shear's fitted c moves with the term ("
                    + ", ".join(sorted({f"{fmt(a, 3)} to {fmt(b, 3)}" for a, b in moved}))
                    + "): such a pair changes the normal stress and the shear at once"
-                   if moved else ""))
+                   if moved else "") + kept_text)
     b_text = ("distinct pairs (a calibrated reading's resolved own part with and without an "
               "active term, the split held fixed), by the sign of the part: "
               + "; ".join(b_sign(s_) for s_ in ("+", "-"))
@@ -1247,6 +1271,8 @@ def answer(cells, models=None):
         ["the missing normal stress (b)"] if ns["holds"] else []) + (
         ["the model's inconsistency (c)"] if cs["holds"] else [])
     resting = [w for w, c in counts.items() if c["resolved"]]
+    ref_est = max([v for k, v in (estimates or {}).items()
+                   if k.endswith("/paper") and v is not None], default=None)
     seen_at = [u for u in us if u["decides"] and u["n"] >= DECISIVE]
     below = _below_text(seen_at) if seen_at else None
     by_sign = ", ".join(f"{len(mirrored[s_])} of {len(sign_rows[s_])} with {word[s_]}"
@@ -1256,8 +1282,11 @@ def answer(cells, models=None):
                  f", but only {with_ctrl} of the {len(resolved_rows)} could have been read as "
                  "on every split (a control part resolved): for the rest the mirror is not "
                  "tested against its alternative" if with_ctrl < len(resolved_rows) else "")
-             + "; provisional: its u holds the metric's leaks and the solver's tolerance only, "
-             "not the reference's own error"] if a_holds else []) + (
+             + "; its u holds the metric's leaks and the solver's tolerance; the reference "
+             "cancels from every part (the model and FEM P1 are read against one profile) but "
+             "for the mean it is divided by" + (
+                 f", whose error estimate (at most {fmt(ref_est, 2)} at the push) moves a part "
+                 "by that fraction" if ref_est is not None else "")] if a_holds else []) + (
         ["a normal-stress term removes it (b)"] if ns["holds"] else []) + (
         ["it tracks the patch-test error (c)"] if cs["holds"] else [])
     lead = (f"Not decided for {paper}; the paper's 374-tetrahedron "
@@ -1678,9 +1707,10 @@ def reading_verdict(table, damping, spread=None, figure=None):
     meshes = list(dict.fromkeys(m for r in rated for m in r["growth_by_mesh"]))
     apart = list(dict.fromkeys(m for r in rated for m in r["growth_apart"]))
     stability = (
-        "Stability (the largest growth rate of the undamped model linearised at rest on the "
-        "clamped base only: this study linearised no other base, and the paper does not state "
-        "its base, so every stability call here holds for the clamped base alone; on this "
+        "Stability (the largest growth rate of the undamped model linearised at rest, read on "
+        "the clamped base only: the paper does not state its base, so every stability call "
+        "here holds for the clamped base alone (the sliding base's rates, linearised alike, "
+        "are in cells.md, not read); on this "
         "study's own cells of each conforming split of the paper's lattice at 5 nodes "
         f"per side: {', '.join(meshes) or 'none'} (the mirrored five has 320 tetrahedra; the "
         "paper's own 374-tetrahedron mesh and the paper-cube case's unstructured mesh are not "

@@ -45,7 +45,7 @@ def gate_rows(cells):
 def analyse(data, models, damping):
     table = reading_table(data["cells"], data["step_vs_msm"], readings(models), damping,
                           with_normal(models), data.get("step_vs_msm_range"))
-    found = {"answer": answer(data["cells"], models), "readings": table,
+    found = {"answer": answer(data["cells"], models, _estimates(data)), "readings": table,
              "verdict": reading_verdict(table, damping, data.get("bench_spread"),
                                         paper_figure(data["cells"], readings(models)))}
     found["how_sure"] = how_sure(found["answer"], found["verdict"])
@@ -151,7 +151,6 @@ def _what_was_run(d, s, doc):
     five = next((c for c in doc["cells"] if c["mesh"] == "five"), None)
     lit = [r for r in doc["readings"] if r["in_paper"] and r["model"].endswith("-literal")]
     asym = doc["answer"].get("asymmetry") or {}
-    units = doc["answer"].get("hypotheses", {}).get("mirror", {}).get("units", [])
     d.ul([
         f"Meshes: {', '.join(s.meshes)}: each split of the paper's lattice ("
         + ", ".join(SPLITS[k] for k in dict.fromkeys(spec[0] for spec in s.meshes.values()))
@@ -357,7 +356,9 @@ def _mirror(d, doc):
         "positive moves out more, softer laterally), its own part (model - FEM P1 on the "
         "same tetrahedra) +- u (the leaks times the smooth amplitude and end step of "
         "model - FEM P1), its part "
-        "on each control +- its own u, the mirror ratio (|part| "
+        "on each control +- its own u (a calibrated reading's controls, marked 'held', are "
+        "the same reading with the shear's c fitted on the mirrored five split of the same "
+        "size, so that they differ from it in the split alone), the mirror ratio (|part| "
         "over the largest |control part|) and its interval from both uncertainties "
         "((|part| - u) / max(|control| + u_c) to (|part| + u) / max(|control| - u_c), "
         "unbounded where every control's part is unresolved), the unmirrored five split (not "
@@ -379,8 +380,9 @@ def _mirror(d, doc):
                          _pm(r["five"], r.get("u_sig")), f"{fmt(r['own'], 3)}: {_clear(r)}",
                          _lateral(r["lateral"], est.get(f"{u['bc']}/paper")),
                          _pm(r.get("part"), r.get("u")),
-                         "; ".join(f"{x.split(' ')[0]} {_pm(v['part'], v['u'])}"
-                                   for x, v in cps.items()) or "n/a",
+                         ("held: " if r.get("controls_held") else "") + (
+                             "; ".join(f"{x.split(' ')[0]} {_pm(v['part'], v['u'])}"
+                                       for x, v in cps.items()) or "n/a"),
                          (f"{times(r.get('mirror_ratio'))} [{times(max(r['mirror_lo'], 0))}"
                           f"-{times(r['mirror_hi']) if r['mirror_hi'] is not None else 'inf'}]"
                           + ("" if r.get("sign") else " (part not resolved)")
@@ -541,8 +543,8 @@ def _reading(d, s, doc):
         "literal reading is not timed, its stored ratio being its calibrated reading's; for a "
         "model with a normal-stress term not decided: its added cost is this implementation's "
         "term) and stability (the largest growth rate of the undamped model linearised at "
-        "rest on the clamped base only (no other base was linearised; the paper does not "
-        "state its base), on each conforming split of the lattice, this study's own cells: "
+        "rest, read on the clamped base only (the sliding base's rates are in cells.md, not "
+        "read; the paper does not state its base), on each conforming split of the lattice, this study's own cells: "
         "not an RK4 run and not the paper's mesh; one definition, the glossary's: a mode "
         f"flutters where its rate is above {GROWS:g} 1/s, and grows beyond the damping we "
         f"assume ({s.damping:g} 1/s) where its rate exceeds {s.damping / 2:g} 1/s; matched "

@@ -31,7 +31,8 @@ STATIC_RTOL = 1e-10
 # first failures (an inverted tetrahedron at 8 steps) are told from a load-path problem
 SPLITS_TRIED = LOAD_SPLITS + (16, 32)
 REF_MESH = ("six", 5)         # the reference's own mesh (refined REF_LEVELS times, P2)
-REF_LEVELS = 1
+REF_LEVELS = 2               # two refinements: its own period-2 error 1.4e-5 on 17 clamped layers
+QUICK_REF_LEVELS = 1         # a preview's reference (its 9-node meshes decide nothing)
 # msm with the paper's shear force at the paper's constant: with c = auto the fit sets c = 0
 # on every mesh (the springs alone are stiffer than 2G in the modes the shear adds to)
 FIXED_NORMAL_C = 1.0          # the normal terms' constant where it is held, not fitted
@@ -53,21 +54,42 @@ def model_specs(quick=False):
             out[label(f"pbcm-{r} + {form}(c=auto)")] = {
                 "family": "particle", "reading": r, "constant": "calibrated", "normal": form}
     # beside pbcm-balanced (the paper's sign) the fit sets every c_n to 0 on the mirrored five
-    # split, so the terms are also run at a fixed c_n = 1 (the shear's own scale, G): whether
-    # a normal stress changes the paper's sign of the pattern is then tested, not assumed
+    # split, so the terms are also run at a fixed c_n = 1 (the shear's own scale, G) with the
+    # shear's c held at pbcm-balanced's fit on the same mesh: whether a normal stress changes
+    # the paper's sign of the pattern is then tested with nothing else changed
     for form in NORMAL_FORMS:
         out[label(f"pbcm-balanced + {form}(c={FIXED_NORMAL_C:g})")] = {
             "family": "particle", "reading": "balanced", "constant": "calibrated",
-            "normal": fixed_normal(form)}
+            "normal": fixed_normal(form), "shear_c_of": SAME_MESH}
+    # each calibrated reading on the other splits with the shear's c fitted on the mirrored
+    # five split of the same size: the mirror's controls then differ from it in the split alone
+    for r in READINGS:
+        out[held(f"pbcm-{r}")] = {"family": "particle", "reading": r, "constant": HELD,
+                                  "normal": "none", "shear_c_of": MIRRORED_FIVE}
     out["msm"] = {"family": "msm", "reading": "none", "constant": "springs", "normal": "edges"}
     out[MSM_SHEAR] = {"family": "msm", "reading": "variational", "constant": "literal",
                       "normal": "edges"}
     out[YARDSTICK] = {"family": "fem", "reading": "none", "constant": "none", "normal": "fem"}
     if quick:
         keep = ("pbcm-balanced", "pbcm-variational", "pbcm-balanced-literal",
-                label("pbcm-balanced + normal_edge(c=auto)"), "msm", YARDSTICK)
+                label("pbcm-balanced + normal_edge(c=auto)"), held("pbcm-balanced"), "msm",
+                YARDSTICK)
         out = {m: out[m] for m in keep}
     return out
+
+
+SAME_MESH, MIRRORED_FIVE = "this mesh", "five"   # where a held shear c was fitted
+HELD = "held (the mirrored five's fit)"
+
+
+def held(model):
+    """The name of a calibrated reading run with the shear's c of the mirrored five split."""
+    return f"{model} (c of mirrored five)"
+
+
+def builds(model):
+    """The spec ``model`` is built from (a held model: its calibrated reading's)."""
+    return model.removesuffix(" (c of mirrored five)")
 
 
 def fixed_normal(form):
@@ -114,12 +136,15 @@ def models_on(spec, models):
     """The models run on a mesh of ``spec``: every one, but on the finest bcc (9009 nodes,
     49152 tetrahedra: each Newton matrix's factors hold about 5e7 entries, some ten seconds a
     factorisation) the calibrated readings without a normal term and the control only; there
-    the other models read their mirror against the six split alone."""
+    the other models read their mirror against the six split alone. A held model is not run on
+    the mirrored five split, where it is its calibrated reading."""
     kind, n, _ = spec
+    # a held model on the mirrored five split is its calibrated reading itself
+    out = [m for m, f in models.items() if not (kind == "five" and f["constant"] == HELD)]
     if kind == "bcc" and n == max(SIZES):
-        return [m for m, f in models.items() if f["normal"] in ("none", "fem")
-                and f["constant"] in ("calibrated", "none")]
-    return list(models)
+        return [m for m in out if models[m]["normal"] in ("none", "fem")
+                and models[m]["constant"] in ("calibrated", "none", HELD)]
+    return out
 
 
 def loads_on(spec, loads):
@@ -159,6 +184,10 @@ class ArtefactSettings:
         self.material = Material(E=self.E, nu=self.nu, rho=self.rho)
 
     @property
+    def ref_levels(self):
+        return QUICK_REF_LEVELS if self.quick else REF_LEVELS
+
+    @property
     def models(self):
         return model_specs(self.quick)
 
@@ -170,7 +199,7 @@ class ArtefactSettings:
         return {**material_record(self.E, self.nu, self.rho), "size_mm": P.SIZE_MM,
                 "push_mm": P.PUSH_MM, "linear_scale": LINEAR_SCALE, "damping_1_s": self.damping,
                 "reference": {"element": "P2", "mesh": f"{REF_MESH[0]} {REF_MESH[1]}^3",
-                              "refinements": REF_LEVELS}}
+                              "refinements": self.ref_levels}}
 
     def cells(self):
         """[(mesh, model)]: every unit of work, in the order the cells are reported."""
@@ -195,12 +224,13 @@ def push_mm(load):
 
 def reference(bc, load, s):
     """The continuum on the reference mesh: linear P2 in the linear regime, neo-Hookean P2
-    at the paper's push (each refined REF_LEVELS times, with its error estimate)."""
+    at the paper's push (each refined ``s.ref_levels`` times, with its error estimate)."""
     mesh = cube(REF_MESH[1], P.SIZE_MM * P.MM, REF_MESH[0])
     dirichlet = P.static_bc(mesh, bc, push_mm(load))
     if load == "linear":
-        return linear.converged(mesh, s.E, s.nu, dirichlet, levels=REF_LEVELS)
-    return hyperelastic.converged(mesh, s.E, s.nu, dirichlet, levels=REF_LEVELS, mixed="auto")
+        return linear.converged(mesh, s.E, s.nu, dirichlet, levels=s.ref_levels)
+    return hyperelastic.converged(mesh, s.E, s.nu, dirichlet, levels=s.ref_levels,
+                                  mixed="auto")
 
 
 def _free_layers(bc, n_layers):
@@ -238,24 +268,41 @@ def _cells_key(s, name, model):
 
 
 def _model_rows(model, factors, name, spec, mesh, s, u_refs):
-    base = {"mesh": name, **mesh_factors(name, spec, mesh), "model": model, **factors}
+    base = {"mesh": name, **mesh_factors(name, spec, mesh), "model": model,
+            **{k: v for k, v in factors.items() if k != "shear_c_of"}}
     loads = loads_on(spec, s.loads)
     try:
-        pm = build(model, mesh, s.material)
+        pm = build(builds(model), mesh, s.material, **held_shear(factors, spec, mesh, s))
     except FINDINGS as exc:
         return [{**base, "constants": None, "bc": bc, "load": load, "failed": f"build: {exc}",
                  "bulge_profile_mm": None, "alternation_mm": None, "alternation_rel": None,
                  "disp_rel_l2": None, "load_steps": None, "growth_rate_1_s": None,
                  "flutter": None}
                 for bc in s.bcs for load in loads]
-    # the paper's RK4 run on its own lattice (a dense eigenproblem: 5 nodes per side only)
-    rate = P.growth_rate(pm, mesh, "clamped") if spec[1] == P.NODES_PER_SIDE else None
+    # the model linearised at rest with each base's constraints (a dense eigenproblem: the
+    # paper's 5 nodes per side only)
+    rates = {bc: P.growth_rate(pm, mesh, bc) if spec[1] == P.NODES_PER_SIDE else None
+             for bc in s.bcs}
     # each term's constant as built (fitted or given): {term_c: value}
     constants = {k: v for k, v in pm.info.items() if k.endswith("_c")}
-    return [{**base, "constants": constants, "bc": bc, "load": load, "growth_rate_1_s": rate,
-             "flutter": None if rate is None else rate > 0.0,
+    return [{**base, "constants": constants, "bc": bc, "load": load,
+             "growth_rate_1_s": rates[bc],
+             "flutter": None if rates[bc] is None else rates[bc] > 0.0,
              **cell(pm, mesh, spec[1], bc, load, u_refs[(bc, load)])}
             for bc in s.bcs for load in loads]
+
+
+def held_shear(factors, spec, mesh, s):
+    """``build``'s term parameters for a model whose shear c is held (``shear_c_of``): the
+    calibrated reading's fit on this mesh or on the mirrored five split of the same size;
+    none for the others."""
+    where = factors.get("shear_c_of")
+    if where is None:
+        return {}
+    on = mesh if where == SAME_MESH else make_mesh(mesh_name("five", spec[1]),
+                                                  ("five", spec[1], spec[2]))
+    fitted = build(f"pbcm-{factors['reading']}", on, s.material).info["shear_c"]
+    return {"shear": {"c": float(fitted)}}
 
 
 def _reference_unit(job):
