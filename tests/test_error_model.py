@@ -357,6 +357,20 @@ def test_consistency_limits_closer_than_their_uncertainty_are_tied():
     assert _limit_ties(chain) == " (tied within their +-: v, b; b, n)"   # v, n: 0.13 > 0.042
 
 
+def test_limits_of_different_quantities_that_overlap_are_named_not_ordered():
+    """A displacement limit and a stiffness limit are never tied, but where they overlap
+    within their uncertainties combined their order is not a finding: the pair is named as
+    not ordered; limits of one quantity, or apart, are not."""
+    from cases.reporting.answers import _limit_ties, _unordered
+    lims = [("n", (0.32, 0.03, "displacement")), ("v", (0.34, 7e-7, "stiffness")),
+            ("b", (0.45, 3e-5, "stiffness")), ("m", (0.59, 0.08, "displacement"))]
+    assert _limit_ties(lims) == ""
+    assert _unordered(lims) == (" (overlapping within their +- but limits of different "
+                                "quantities, so not ordered: n (displacement), v (stiffness))")
+    assert _unordered([lims[0], ("w", (0.33, 0.01, "displacement"))]) == ""
+    assert _unordered(lims[2:]) == ""
+
+
 def test_consistency_limit_reads_the_stiffness_the_displacement_is_blind_to():
     """On the sliding cube the top displacement is prescribed, so a model can match the shape
     while half as stiff: its consistency limit on a lattice is the larger of its displacement
@@ -958,3 +972,23 @@ def test_a_growing_stiffness_error_bounds_the_limit_and_fems_nonlinearity_is_no_
     assert lim["five"] == pytest.approx((2e-10, 2e-10, "displacement"))
     assert lim["bcc"][2] == "stiffness; displacement not decided"
     assert "displacement not decided on bcc (its stiffness 0.04 +- 0.01 there)" in _no_limit(lim)
+
+
+def test_a_studys_failed_runs_are_named_once_per_model_and_cause():
+    """The index names every failed run of a study, one entry per (study, model, cause) with
+    the runs it holds (a place once), so that a cause failing a model on every mesh is one
+    fact; a study with no failure says none."""
+    from cases.reporting.index import failed_checks
+    cause = "build: the fit gave c = 0; no term adds"
+    runs = [{"model": "m", "mesh": f"mesh{i}", "bc": "clamped", "failed": cause}
+            for i in range(8) for _ in range(2)]
+    runs += [{"model": "m", "mesh": "mesh0", "bc": "sliding", "failed": "inverted; reduce"},
+             {"model": "k", "mesh": "mesh1", "bc": "clamped", "failed": None}]
+    line = failed_checks({}, {"study": ({"cells": runs, "names": {"m": "model m"}},
+                                        ("cells",))})
+    assert ("model m on study 16 runs (mesh0/clamped, mesh1/clamped, mesh2/clamped, "
+            "mesh3/clamped, mesh4/clamped, mesh5/clamped and 2 more) (build: the fit gave "
+            "c = 0)") in line
+    assert "model m on study mesh0/sliding (inverted)" in line and "k on" not in line
+    assert failed_checks({}, {"study": ({"cells": []}, ("cells",))}).endswith(
+        "Failed runs of the studies (no number; each named in its report): none.")

@@ -238,6 +238,8 @@ def lines(root, models, pops=(), quick=False):
             for x in v.values())]
         rest = sorted((m for m in models if m not in passed), key=lambda m: _largest(lim[m]))
         nolimit = sorted({k for m in rest for k, v in lim[m].items() if not _whole(v)})
+        ranked = sorted(((m, _worst_limit(lim[m])) for m in rest if _worst_limit(lim[m])),
+                        key=lambda x: x[1][0])
         if conv["parameters"]["quick"]:     # the patches are the full run's: said
             out.append("**How far from the continuum?** Quick: not decided (`pbcm run "
                        "convergence` decides, on its finer levels); on the same patches as "
@@ -254,11 +256,10 @@ def lines(root, models, pops=(), quick=False):
                        "what its fit found there): "
                        + ", ".join(f"{m} {_limit_text(_worst_limit(lim[m]))}" + _no_limit(lim[m])
                                    for m in rest if _worst_limit(lim[m]))
-                       + _limit_ties(sorted(((m, _worst_limit(lim[m])) for m in rest
-                                             if _worst_limit(lim[m])), key=lambda x: x[1][0]),
-                                     "tied within their +- on the lattices (limits of one "
-                                     "quantity only), whatever each does "
+                       + _limit_ties(ranked, "tied within their +- on the lattices (limits "
+                                     "of one quantity only), whatever each does "
                                      "on the families where it has no limit")
+                       + _unordered(ranked)
                        + (f"; below {PATCH_TOL:g}: {', '.join(passed)}" if passed else "")
                        + (f"; no limit on {', '.join(nolimit)}" if nolimit else "")
                        + _diverging(lim)
@@ -346,6 +347,20 @@ def _limit_ties(limits_, said="tied within their +-"):
             groups.append((i, j))
     return (f" ({said}: " + "; ".join(
         ", ".join(m for m, _ in limits_[i:j + 1]) for i, j in groups) + ")" if groups else "")
+
+
+def _unordered(limits_):
+    """' (overlapping within their +- but limits of different quantities, so not ordered:
+    a, b)': neighbours (in the order given, by limit) whose values overlap within their
+    uncertainties combined while one is a displacement limit and the other a stiffness limit,
+    which no tie can join and no order ranks."""
+    pairs = []
+    for (ma, (a, ua, *wa)), (mb, (b, ub, *wb)) in zip(limits_, limits_[1:]):
+        qa, qb = (w[0].split(";")[0] if w else "" for w in (wa, wb))
+        if qa != qb and abs(a - b) < (ua ** 2 + ub ** 2) ** 0.5:
+            pairs.append(f"{ma} ({qa}), {mb} ({qb})")
+    return (" (overlapping within their +- but limits of different quantities, so not "
+            "ordered: " + "; ".join(pairs) + ")" if pairs else "")
 
 
 def _no_limit(values):

@@ -170,13 +170,27 @@ def failed_checks(data, studies=None):
         # a study may name its models for display ("names"), as its own report does
         runs = [(name, d, r) for name, (d, keys) in studies.items() for k in keys
                 for r in d.get(k) or [] if r.get("failed")]
+        # one entry per (study, model, cause), with the runs it holds: a cause that fails a
+        # model everywhere is one fact, not one per mesh
+        grouped = {}
+        for name, d, r in runs:
+            where = r["mesh"] + (f"/{r['bc']}" if r.get("bc") else "")
+            grouped.setdefault((name, d.get("names", {}).get(r["model"], r["model"]),
+                                str(r["failed"]).split(";")[0]), []).append(where)
         out += (" Failed runs of the studies (no number; each named in its report): "
-                + ("; ".join(f"{d.get('names', {}).get(r['model'], r['model'])} on "
-                             f"{name}/{r['mesh']}"
-                             + (f"/{r['bc']}" if r.get("bc") else "")
-                             + f" ({str(r['failed']).split(';')[0]})" for name, d, r in runs)
+                + ("; ".join(f"{model} on {name} " + (
+                    f"{wheres[0]}" if len(wheres) == 1 else
+                    f"{len(wheres)} runs ({_listed(wheres)})") + f" ({why})"
+                    for (name, model, why), wheres in grouped.items())
                    if runs else "none") + ".")
     return out
+
+
+def _listed(wheres, shown=6):
+    """``wheres`` once each (two loads on one mesh and base are one place), the first
+    ``shown`` of them and how many more."""
+    w = list(dict.fromkeys(wheres))
+    return ", ".join(w[:shown]) + (f" and {len(w) - shown} more" if len(w) > shown else "")
 
 
 def index_documents(root, cases, studies=(), missing=()):
