@@ -276,6 +276,27 @@ def test_rankings_keep_populations_apart_and_count_failed_runs():
     assert line.index("[sliding]") < line.index("a alone (") < line.index("[clamped]")
 
 
+def test_a_quantity_fem_p1_itself_fails_on_is_not_ranked():
+    """Where FEM P1 (the twin of either regime) fails at the median of a population, the
+    meshes do not resolve the quantity: the line ranks no model and names every failure;
+    where it fails in fewer runs the models are ranked as usual."""
+    from cases.reporting import rankings
+    runs = [{"model": m, "mesh": mesh, "bc": "clamped", "err": v}
+            for mesh in ("five", "six", "bcc", "unstructured")
+            for m, v in (("a", 0.2), ("b", 0.3), ("fem-linear", None if mesh != "five" else 0.1))]
+    line = rankings.best_and_worst(runs, "err", "Error")
+    assert ("Error against its reference (total error, the mesh's discretisation error "
+            "included: not a ranking of the models, which the model-form error is): not "
+            "ranked: FEM P1 itself fails at the median (fem-linear 3 of 4), so these meshes "
+            "do not resolve it. Failed runs, counted against their model: fem-linear "
+            "(3 of 4).") == line
+    one = [dict(r, err=0.1) if r["model"] == "fem-linear" and r["mesh"] == "six" else r
+           for r in runs]
+    assert "not ranked" not in rankings.best_and_worst(
+        [dict(r, err=0.1) if r["model"] == "fem-linear" and r["mesh"] == "bcc" else r
+         for r in one], "err", "Error")
+
+
 def test_failures_name_every_phase_that_found_no_equilibrium():
     """The failures line says which runs found no equilibrium in the linear regime and which
     at the case's load (where a reference of it exists), and claims 'every model found its

@@ -9,7 +9,7 @@ import numpy as np
 
 from ..measuring.catalogue import err_name, ref_name
 from .document import Table, rel, rel_range
-from ..measuring.error_model import standings, u_num
+from ..measuring.error_model import P1_FINITE, P1_LINEAR, standings, u_num
 
 # what a ranking by a case's own metric measures: the total error, the mesh's own included
 # (the model-form ranking is the error model's, cases.reporting.scorecard)
@@ -215,6 +215,16 @@ def best_and_worst(runs, metric, what, exact=False, estimate_key="p2_error_estim
         if not st or not any(s.values for _, s, _ in st):
             return f"No model gave {what}."
         best, worst = st[0][1], st[-1][1]
+        failed = [s for _, s, _ in st if s.failed]
+        twin = [s for _, s, _ in st if s.model in (P1_LINEAR, P1_FINITE)]
+        if twin and all(math.isinf(s.score) for s in twin):
+            # FEM P1 itself fails here: the meshes do not resolve the quantity, and an order of
+            # the other models would measure the meshes, not the models
+            return (f"{what}{AGAINST}: not ranked: FEM P1 itself fails at the median ("
+                    + ", ".join(f"{s.model} {s.failed} of {s.runs}" for s in twin)
+                    + "), so these meshes do not resolve it. Failed runs, counted against "
+                    "their model: " + ", ".join(f"{s.model} ({s.failed} of {s.runs})"
+                                                for s in failed) + ".")
         blind = [] if exact else _not_judged(st, u)
         if blind:    # a reference orders no error below five times its own u_num
             above = [s for _, s, _ in st if s not in blind]
@@ -229,7 +239,6 @@ def best_and_worst(runs, metric, what, exact=False, estimate_key="p2_error_estim
         else:
             line = (f"{what}{AGAINST}: from {best.model} ({_cell(best)}) to "
                     f"{worst.model} ({_cell(worst)}).")
-        failed = [s for _, s, _ in st if s.failed]
         if failed:
             line += (" Failed runs, counted against their model: " + ", ".join(
                 f"{s.model} ({s.failed} of {s.runs})" for s in failed) + ".")
@@ -249,7 +258,6 @@ def best_and_worst(runs, metric, what, exact=False, estimate_key="p2_error_estim
             line += (f" {best.model} is not resolved from {', '.join(st[0][2].unresolved)}: "
                      "beyond u_val, within both medians' spread over the meshes.")
         # the medians are what is ranked (judged, above five times u_num: nothing to add)
-        return line
         return line
     return " ".join(_labelled(runs, line_of))
 

@@ -739,7 +739,10 @@ def cells_document(doc, s):
         "finest meshes, some models on the finest); 'n/a': no signature on the free layers "
         "(three free layers of the clamped five-layer cube); 'failed': the static solve "
         f"failed, with its cause. 'constants': each term's constant as built on that mesh "
-        "(fitted by the patch-test calibration where the model says auto, else given). "
+        "(fitted by the patch-test calibration where the model says auto, else given; a "
+        "model named '(c of mirrored five)' holds its reading's shear c fitted on the "
+        "mirrored five split of the same size, and a normal term at c_n = 1 holds the shear's "
+        "c fitted on the same mesh without it). "
         f"Definitions: [glossary](../{GLOSSARY}).")
     combos = [(bc, load) for bc in s.bcs for load in s.loads]
     for mesh in s.meshes:
