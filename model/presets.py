@@ -11,7 +11,7 @@ PRESETS = {
     "pbcm-balanced": [("shear", {"reading": "balanced", "c": "auto"}), ("volume", {})],
     "pbcm-variational": [("shear", {"reading": "variational", "c": "auto"}), ("volume", {})],
     "pbcm-variational+normal": [("shear", {"reading": "variational", "c": "auto"}),
-                                ("normal", {"c": "auto"}), ("volume", {})],
+                                ("normal_edge", {"c": "auto"}), ("volume", {})],
     "msm": [("springs", {})],
     "msm+volume": [("springs", {}), ("volume", {})],
     # docs/model.md "Explicit FEM baselines": what a user would pick instead of a particle model

@@ -16,7 +16,7 @@ class ParticleModel:
     """Forces, energy, per-tetrahedron stresses, static equilibrium and RK4 dynamics.
 
     Build one with :func:`model.build`. ``info`` holds what a report must state: the terms,
-    their parameters and calibration constants (``shear_c``, ``normal_c``).
+    their parameters and calibration constants (``shear_c``, ``normal_edge_c``).
     """
 
     def __init__(self, mesh, material, terms, name="custom", threads=1):

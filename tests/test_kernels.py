@@ -19,11 +19,11 @@ TERMS = {
     "corner": ("shear", {"reading": "corner", "c": 0.4}),
     "balanced": ("shear", {"reading": "balanced", "c": 0.6}),
     "variational": ("shear", {"reading": "variational", "c": 0.3}),
-    "normal": ("normal", {"c": 0.7}),
+    "normal_edge": ("normal_edge", {"c": 0.7}),
     "fem_corotated": ("fem_corotated", {}),
 }
 # the terms whose kernel reports an edge of zero length rather than a flattened tetrahedron
-COLLAPSED_EDGE = {"normal"}
+COLLAPSED_EDGE = {"normal_edge"}
 # lattice and unstructured meshes; sizes not a multiple of the block (a padded last block)
 MESHES = {"five": lambda: cube(6, 0.03, "five"), "six": lambda: cube(5, 0.02, "six"),
           "bcc": lambda: cube(4, 0.03, "bcc"),

@@ -17,7 +17,7 @@ TERMS = {
     "corner": ("shear", {"reading": "corner", "c": 0.4}),
     "balanced": ("shear", {"reading": "balanced", "c": 0.6}),
     "variational": ("shear", {"reading": "variational", "c": 0.3}),
-    "normal": ("normal", {"c": 0.7}),
+    "normal_edge": ("normal_edge", {"c": 0.7}),
     "normal_tet": ("normal_tet", {"c": 0.7}),
     "normal_sbd": ("normal_sbd", {"c": 0.7}),
     "normal_corotated": ("normal_corotated", {"c": 0.7}),
@@ -26,7 +26,7 @@ TERMS = {
     "fem_corotated": ("fem_corotated", {}),
     "fem_neohookean": ("fem_neohookean", {}),
 }
-CONSERVATIVE = ["volume", "variational", "normal", "normal_tet", "normal_sbd", "normal_corotated",
+CONSERVATIVE = ["volume", "variational", "normal_edge", "normal_tet", "normal_sbd", "normal_corotated",
                 "springs", "fem_linear", "fem_corotated", "fem_neohookean"]
 # small strain is not invariant under a finite rotation: that is what co-rotation fixes
 ROTATION_INVARIANT = [k for k in TERMS if k != "fem_linear"]
@@ -68,7 +68,7 @@ def test_forces_invariant_under_rigid_motion(key, small_mesh, mat):
     assert np.allclose(t.forces(x @ R.T + 0.05), f @ R.T, atol=1e-12 * np.abs(f).max())
 
 
-@pytest.mark.parametrize("key", ["balanced", "variational", "volume", "springs", "normal",
+@pytest.mark.parametrize("key", ["balanced", "variational", "volume", "springs", "normal_edge",
                                  "normal_tet", "normal_sbd", "normal_corotated",
                                  "fem_linear", "fem_corotated", "fem_neohookean"])
 def test_zero_net_force(key, small_mesh, mat):
@@ -76,7 +76,7 @@ def test_zero_net_force(key, small_mesh, mat):
     assert np.linalg.norm(f.sum(axis=0)) <= 1e-10 * np.abs(f).sum()
 
 
-@pytest.mark.parametrize("key", ["variational", "volume", "springs", "normal", "normal_tet",
+@pytest.mark.parametrize("key", ["variational", "volume", "springs", "normal_edge", "normal_tet",
                                  "normal_sbd", "normal_corotated", "fem_corotated",
                                  "fem_neohookean"])
 def test_zero_net_torque(key, small_mesh, mat):
@@ -271,7 +271,7 @@ def test_scale_survives_calibration(small_mesh, mat):
     x = perturbed(small_mesh, 0.05)
     full = build("pbcm-variational+normal", small_mesh, mat)
     half = build("pbcm-variational+normal", small_mesh, mat, shear={"scale": 0.5},
-                 normal={"scale": 0.5}, volume={"scale": 0.5})
+                 normal_edge={"scale": 0.5}, volume={"scale": 0.5})
     assert half.info["shear_c"] == full.info["shear_c"]
     assert np.allclose(half.forces(x), 0.5 * full.forces(x), atol=1e-15)
     assert half.energy(x) == pytest.approx(0.5 * full.energy(x), rel=1e-12)

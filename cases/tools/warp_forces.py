@@ -8,7 +8,7 @@ one after the other into one force array. The laws are pbcm's own (model/terms/)
 * ``fem_linear``: small-strain constant-strain tetrahedra (``fem.linear_forces``);
 * ``volume``: p = -K (V - V0) / V, f_i = p dV/dx_i (``volume.volume_forces``);
 * ``springs``: van Gelder's edge springs of msm (``springs.spring_forces``);
-* ``normal``: the per-corner edge-strain deviation (``normal.normal_block``);
+* ``normal_edge``: the per-corner edge-strain deviation (``normal.normal_block``);
 * ``shear``: the three readings, written from the per-tetrahedron maths that
   ``model/terms/_shear_codegen.py`` writes for numba, translated line by line into a Warp
   kernel, so the two cannot drift apart.
@@ -45,7 +45,7 @@ if hasattr(wp.config, "log_level"):      # newer Warp logs its start-up and modu
 
 DTYPES = ("float32", "float64")
 # the terms written as Warp kernels; a model of these terms alone is covered
-TERMS = ("fem_linear", "volume", "springs", "shear", "normal", "normal_edge")
+TERMS = ("fem_linear", "volume", "springs", "shear", "normal_edge")
 COVERED = ("fem-linear", "msm", "msm+volume", "pbcm-corner", "pbcm-balanced",
            "pbcm-variational", "pbcm-variational+normal")
 NOT_COVERED = ("fem-corotated", "fem-neohookean")
@@ -316,7 +316,7 @@ class WarpForces:
                 fn = getattr(k.shear, f"shear_{term.p['reading']}")
                 self._add(fn, term, tets, self._array(vol0, scalar),
                           self._array(gamma0, scalar), scalar(factor))
-            else:       # normal, normal_edge
+            else:       # normal_edge
                 coef_G = term.kernel()[1][-1]
                 p = pm.mesh.points[pm.mesh.tets]
                 pairs = [(0, 1), (0, 2), (0, 3), (1, 2), (1, 3), (2, 3)]

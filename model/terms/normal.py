@@ -6,8 +6,8 @@ eps_j = (|d_j| - |D_j|) / |D_j| (d_j = x_j - x_a, D_j at rest) and their mean ep
     W = c_n G sum_T V0_T sum_a sum_j (eps_j - eps_a)^2,
 
 zero under uniform scaling (purely deviatoric, the volume term keeps the pressure).
-Registered as ``normal`` (the name of the ``pbcm-variational+normal`` preset) and as
-``normal_edge``, its name beside the other candidate forms.
+Registered as ``normal_edge``, its name beside the other candidate forms (the
+``pbcm-variational+normal`` preset adds it to the variational reading).
 """
 import numpy as np
 from numba import njit
@@ -140,10 +140,10 @@ def edge_vectors(x, tets):
 
 
 @register
-class Normal(CalibratedTerm):
+class NormalEdge(CalibratedTerm):
     """Deviatoric edge-strain term at each corner; ``c`` is ``"auto"`` or a positive number."""
 
-    name = "normal"
+    name = "normal_edge"
 
     def __init__(self, mesh, material, scale=1.0, **params):
         super().__init__(mesh, material, scale, **params)
@@ -181,11 +181,3 @@ class Normal(CalibratedTerm):
         np.add.at(out, self.mesh.tets[:, CORNER_EDGES[..., 1]], fj)
         np.add.at(out, self.mesh.tets[:, CORNER_EDGES[..., 0]], -fj)
         return out
-
-
-@register
-class NormalEdge(Normal):
-    """docs/model.md's per-corner edge-strain deviation (the term ``normal``) by its candidate
-    name."""
-
-    name = "normal_edge"

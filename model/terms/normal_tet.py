@@ -8,7 +8,7 @@ Keeping only their deviation from the tetrahedron's mean makes a purely deviator
 
     W = c_n G sum_T V0_T sum_e (E_e - mean_T E)^2,
 
-zero under rigid motion and uniform scaling. Unlike ``normal`` (docs/model.md's per-corner form,
+zero under rigid motion and uniform scaling. Unlike ``normal_edge`` (docs/model.md's per-corner form,
 three edges and engineering strain) each edge is counted once, against all six.
 """
 import numpy as np
