@@ -1382,8 +1382,9 @@ def how_sure(ans, verdict):
         "each u holds the metric's leaks (the worst smooth test field's and the worst sharp "
         "end layer's) and the solver's "
         f"tolerance ({ROUND_OFF_FLOOR:g}), not the sensitivity to the fitted constants (fitted "
-        "per mesh, stored in cells.md, not varied) nor a spread over meshes: the verdicts are "
-        "provisional on those"
+        "per mesh, stored in cells.md, not varied; a calibrated reading's controls hold its "
+        "mirrored fit's, so its mirror is not read across two constants) nor a spread over "
+        "meshes: the verdicts are provisional on those"
         + ("; orders from two sizes only; " if any(
             o["orders"] for o in ans["hypotheses"]["mirror"]["orders"].values()) else "; ")
         + (f"at a threshold (within {NEAR:.0%}): {', '.join(at)}; " if at
