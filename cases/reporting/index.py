@@ -343,11 +343,12 @@ TERMS = {
     "worst isotropy error": "the largest relative error of the six Kelvin moduli of the "
     "model's effective elasticity tensor (a relaxed lattice patch) against the isotropic "
     "target's, over the lattices.",
-    "largest |alternation|, 5-layer view (decides nothing)": "the largest |alternation rel| "
-    "of the paper cube's "
-    "runs, on its five layers: the paper's own view, which cannot tell a smooth barrel from "
-    "an alternation and decides nothing (the artefact study reads the cause on 9 and 17 "
-    "layers).",
+    "alternation on the mirrored five split, 5-layer view (signed, the larger over the bases; "
+    "decides nothing)": "the alternation rel of the paper cube's runs on the mirrored five "
+    "split (the paper's lattice), the larger in magnitude of its two bases, signed (positive: "
+    "the paper's sign): the paper's own view on five layers, which cannot tell a smooth "
+    "barrel from an alternation and decides nothing (the artefact study reads the cause on 9 "
+    "and 17 layers).",
     "RK4 run": "grows beyond the damping when the linearised growth rate of the clamped "
     "paper cube exceeds half the mass damping (so that the damped RK4 run grows), else stable "
     "under the damping (a positive growth below it, flutter in the paper cube's tables, is "

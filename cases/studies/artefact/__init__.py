@@ -39,7 +39,7 @@ class Artefact(Study):
             f"flutters where its growth rate at rest is above {GROWS:g} 1/s; stable means rate "
             "0; a flutter grows beyond the mass damping we assume where its rate exceeds half "
             "of it; linearised at rest with each base's constraints, and read on the clamped "
-            "base only (the paper does not state its base)."]
+            "base only (the paper fixes its base nodes)."]
 
     def run(self, s, workers=None, log=True, bench=None, store=None):
         return run(s, workers=workers, log=log, bench=bench, store=store or OFF)
