@@ -178,9 +178,9 @@ def failed_checks(data, studies=None):
             grouped.setdefault((name, d.get("names", {}).get(r["model"], r["model"]),
                                 str(r["failed"]).split(";")[0]), []).append(where)
         out += (" Failed runs of the studies (no number; each named in its report): "
-                + ("; ".join(f"{model} on {name} " + (
-                    f"{wheres[0]}" if len(wheres) == 1 else
-                    f"{len(wheres)} runs ({_listed(wheres)})") + f" ({why})"
+                + ("; ".join(f"{model} on " + (
+                    f"{name}/{wheres[0]}" if len(wheres) == 1 else
+                    f"{name}, {len(wheres)} runs ({_listed(wheres)})") + f" ({why})"
                     for (name, model, why), wheres in grouped.items())
                    if runs else "none") + ".")
     return out
