@@ -19,7 +19,7 @@ from .analysis import (CLEAR, COARSE, DECAYS, SHARP_DECAYS, DECIDING_LEAK, END_L
                        paper_figure, paper_figure_text,
                        reading_table, reading_verdict, signature_own, times)
 from .study import (DECISIVE, LINEAR_SCALE, READINGS, SPLITS, SPLITS_TRIED,
-                    YARDSTICK, short)
+                    YARDSTICK, _free_layers, short)
 
 GATED = catalogue.gated("alternation_rel", "disp_rel_l2")
 PAPER_TETS = 374        # the paper's own cube, as it reports it
@@ -612,8 +612,10 @@ def _figures(d, out, s, doc):
         d.img(fig, f"Layer profiles on the mirrored five split at {spec[1]} nodes per side, "
               f"each base: the continuum (black), the readings, msm and FEM P1 ({len(run)}; "
               "every other model's signature is in the tables); the paper's bulges (y = "
-              + ", ".join(f"{y:g}" for y in PAPER_BULGES_MM) + " mm, dashed) and necks ("
-              + ", ".join(f"{y:g}" for y in PAPER_NECKS_MM) + " mm, dotted) marked; the legend "
+              + ", ".join(f"{y:g}" for y in PAPER_BULGES_MM) + " mm, dashed grey) and necks ("
+              + ", ".join(f"{y:g}" for y in PAPER_NECKS_MM) + " mm, dotted grey) marked; each "
+              "model's profile less its period-2 component dotted in its colour (the gap to "
+              "its solid line is the component, layer by layer); the legend "
               "gives each model's period-2 signature over the reference's mean and over its "
               "own mean (n/a: the reference and a quadratic span the free layers, no period-2 "
               "component exists there), marked 'clear' where it is clear on both "
@@ -666,6 +668,12 @@ def profiles_figure(path, panels, title, decides=None, clear=None):
                        else ""))
                 ax.plot(c["bulge_profile_mm"], y, "-", marker=marks[i % len(marks)], ms=4.0,
                         lw=1.3, color=cmap(i % 10), label=f"{short(c['model'])} ({tag})")
+                if c.get("alternation_mm") is not None:
+                    # the profile less its period-2 component: the gap to the solid line is
+                    # the component, layer by layer
+                    alt = c["alternation_mm"] * (-1.0) ** np.arange(n) * _free_layers(bc, n)
+                    ax.plot(np.asarray(c["bulge_profile_mm"]) - alt, y, ":", lw=1.0,
+                            color=cmap(i % 10))
         n_free = len(rows[0]["bulge_profile_mm"]) - (2 if bc == "clamped" else 0) if rows else 0
         ax.set_title(f"{bc} base" + ("" if decides.get(bc) else
                                      "\n(the configuration's check fails: decides nothing)")
