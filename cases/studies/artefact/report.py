@@ -19,7 +19,7 @@ from .analysis import (CLEAR, COARSE, DECAYS, SHARP_DECAYS, DECIDING_LEAK, END_L
                        paper_figure, paper_figure_text,
                        reading_table, reading_verdict, signature_own, times)
 from .study import (DECISIVE, LINEAR_SCALE, READINGS, SPLITS, SPLITS_TRIED,
-                    YARDSTICK, _free_layers, short)
+                    YARDSTICK, HELD_SUFFIX, _free_layers, short)
 
 GATED = catalogue.gated("alternation_rel", "disp_rel_l2")
 PAPER_TETS = 374        # the paper's own cube, as it reports it
@@ -172,7 +172,7 @@ def _what_was_run(d, s, doc):
         "test a normal stress beside the paper's sign; its shear c held at pbcm-balanced's "
         "fit on the same mesh, so that only the normal stress changes), each calibrated "
         "reading on the other splits with the shear c fitted on the mirrored five split of "
-        "the same size ('(c of mirrored five)': its mirror's controls, which then differ from "
+        f"the same size ('{HELD_SUFFIX.strip()}': its mirror's controls, which then differ from "
         "it in the split alone), msm, msm with the variational shear "
         f"at c = 1, and {YARDSTICK} (FEM P1: constant-strain FEM with the continuum's own "
         "neo-Hookean law on the same tetrahedra, the control). On the finest bcc (9009 nodes) "
@@ -752,7 +752,7 @@ def cells_document(doc, s):
         "(three free layers of the clamped five-layer cube); 'failed': the static solve "
         f"failed, with its cause. 'constants': each term's constant as built on that mesh "
         "(fitted by the patch-test calibration where the model says auto, else given; a "
-        "model named '(c of mirrored five)' holds its reading's shear c fitted on the "
+        f"model named '{HELD_SUFFIX.strip()}' holds its reading's shear c fitted on the "
         "mirrored five split of the same size, and a normal term at c_n = 1 holds the shear's "
         "c fitted on the same mesh without it). "
         f"Definitions: [glossary](../{GLOSSARY}).")

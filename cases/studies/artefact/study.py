@@ -80,16 +80,17 @@ def model_specs(quick=False):
 
 SAME_MESH, MIRRORED_FIVE = "this mesh", "five"   # where a held shear c was fitted
 HELD = "held (the mirrored five's fit)"
+HELD_SUFFIX = " (c of mirrored five)"      # a held model's name: its calibrated reading's + this
 
 
 def held(model):
     """The name of a calibrated reading run with the shear's c of the mirrored five split."""
-    return f"{model} (c of mirrored five)"
+    return model + HELD_SUFFIX
 
 
 def builds(model):
     """The spec ``model`` is built from (a held model: its calibrated reading's)."""
-    return model.removesuffix(" (c of mirrored five)")
+    return model.removesuffix(HELD_SUFFIX)
 
 
 def fixed_normal(form):
