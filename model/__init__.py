@@ -10,7 +10,7 @@ True
 """
 from .material import Material
 from .errors import (PbcmError, MeshError, MaterialError, ModelError, DegenerateTetError,
-                     BlowUpError, ConvergenceError)
+                     BlowUpError, ConvergenceError, CalibrationDroppedError)
 from .presets import PRESETS
 from .system import ParticleModel
 
@@ -41,4 +41,4 @@ def build(model, mesh, material, threads=1, **term_params):
 
 __all__ = ["Material", "build", "PRESETS", "ParticleModel", "PbcmError", "MeshError",
            "MaterialError", "ModelError", "DegenerateTetError", "BlowUpError",
-           "ConvergenceError"]
+           "ConvergenceError", "CalibrationDroppedError"]

@@ -21,7 +21,7 @@ import numpy as np
 from scipy.optimize import least_squares, nnls
 
 from .static import JacobianPattern, jacobian
-from .errors import ModelError
+from .errors import CalibrationDroppedError, ModelError
 from .homogenize import condensed_stiffness, kelvin_moduli
 from .geometry import radius_ratio
 from .mesh import SLIVER_RADIUS_RATIO, _first, box
@@ -202,8 +202,8 @@ def _fit(terms, auto, mesh, material):
         raise ModelError(f"calibration of {names} failed: {exc}; pass a number for c") \
             from None
     if not np.any(coefs > 0):
-        raise ModelError(f"calibration of {names} gave c = 0: no term adds to the "
-                         "deviatoric fit on this mesh; pass a number for c")
+        raise CalibrationDroppedError(f"calibration of {names} gave c = 0: no term adds to "
+                                      "the deviatoric fit on this mesh; pass a number for c")
     bulk, mu = moduli(coefs)
     ratio = mu / (2 * G)
     if ratio.min() <= 0:

@@ -17,6 +17,10 @@ class ModelError(PbcmError, ValueError):
     """A model, term or boundary condition was specified wrongly."""
 
 
+class CalibrationDroppedError(ModelError):
+    """Every fitted constant came out 0: the fitted terms add nothing on this mesh."""
+
+
 class DegenerateTetError(PbcmError, FloatingPointError):
     """A tetrahedron inverted or flattened during a computation."""
 

@@ -138,3 +138,49 @@ def test_too_few_free_layers_and_bad_input():
         M.alternation(msm, np.zeros(5))
     with pytest.raises(M.MetricError, match="same"):
         M.alternation(msm, msm[:4])
+
+
+@pytest.mark.parametrize("kind", ["five", "six", "bcc"])
+def test_side_lines_read_a_node_level_checkerboard_that_the_layer_mean_averages_away(kind):
+    """Each vertical line of side-face nodes reads its own signature with the layer profile's
+    weights: a node-level pattern alternating along every line and across the face, (-1)^(i+k)
+    at amplitude a, reads +-a on each line, while the lines' mean (the layer profile's
+    signature, to round-off) holds only what the face's node count leaves uncancelled; a
+    smooth barrel on every line reads 0 to round-off."""
+    from model.mesh import cube
+    n, size, amp = 9, 0.032, 2e-6
+    mesh = cube(n, size, kind)
+    layers = np.linspace(0.0, size, n)
+    h = size / (n - 1)
+    p = mesh.points
+    y = p[:, 1] / size
+    ref_field = np.zeros_like(p)
+    ref_field[:, 0] = 1e-4 * (p[:, 0] / size - 0.5) * (1 + y * (1 - y))
+    ref_field[:, 2] = 1e-4 * (p[:, 2] / size - 0.5) * (1 + y * (1 - y))
+    ref = M.layer_profile(p, ref_field, layers, size)
+    checker = (-1.0) ** np.rint((p[:, 0] + p[:, 1] + p[:, 2]) / h)
+    u = ref_field.copy()
+    u[:, 0] += amp * checker * np.sign(p[:, 0] - size / 2)
+    u[:, 2] += amp * checker * np.sign(p[:, 2] - size / 2)
+    for name, free in (("sliding", None), ("clamped", np.r_[False, [True] * (n - 2), False])):
+        lines = M.side_line_profiles(p, u, layers, size)
+        got = M.line_alternations(lines, ref, free)
+        assert np.allclose(np.abs(got), amp, rtol=1e-9, atol=0), name
+        assert np.mean(got) == pytest.approx(
+            M.alternation(M.layer_profile(p, u, layers, size), ref, free)[0], abs=1e-18)
+        smooth = M.line_alternations(M.side_line_profiles(p, ref_field, layers, size), ref,
+                                     free)
+        assert np.abs(smooth).max() < 1e-15, name
+
+
+def test_side_lines_refuse_a_mesh_without_vertical_lines_of_nodes():
+    """A mesh whose side-face nodes do not stand on vertical lines is refused by name, not
+    read."""
+    from model.mesh import cube
+    size = 0.032
+    mesh = cube(5, size, "six")
+    p = mesh.points.copy()
+    on_face = np.isclose(p[:, 0], 0.0) & np.isclose(p[:, 1], size / 4)
+    p[np.flatnonzero(on_face)[1], 2] += 1e-4 if p[np.flatnonzero(on_face)[1], 2] < size else -1e-4
+    with pytest.raises(M.MetricError, match="no single side-face node"):
+        M.side_line_profiles(p, np.zeros_like(p), np.linspace(0.0, size, 5), size)

@@ -125,6 +125,53 @@ def layer_profile(points, u, layers, size, tol=None):
     return finite("layer_profile", np.array(out))
 
 
+def side_line_profiles(points, u, layers, size, tol=None):
+    """Outward lateral displacement along each vertical line of side-face nodes of a cube
+    [0, size]^3: one row per line (a face and a node position across it, taken from the
+    first layer; an edge line counts once per face, as in :func:`layer_profile`), one column
+    per y-layer, so that on a lattice the rows' mean is the layer profile. Raises where a
+    line lacks a node in some layer (a mesh without vertical lines of nodes)."""
+    tol = 1e-6 * size if tol is None else tol
+    layers = np.asarray(layers, float)
+    rows = []
+    for axis in (0, 2):
+        across = 2 - axis
+        for side, normal in ((0.0, -1.0), (size, 1.0)):
+            on_face = np.abs(points[:, axis] - side) <= tol
+            first = on_face & (np.abs(points[:, 1] - layers[0]) <= tol)
+            for t in np.sort(points[first, across]):
+                on_line = on_face & (np.abs(points[:, across] - t) <= tol)
+                row = []
+                for y in layers:
+                    at = np.flatnonzero(on_line & (np.abs(points[:, 1] - y) <= tol))
+                    if at.size != 1:
+                        raise MetricError(
+                            f"no single side-face node at y = {y:.6g} on the line "
+                            f"{'xz'[axis // 2]} = {side:.6g}, {'xz'[across // 2]} = {t:.6g}: "
+                            "the mesh has no vertical lines of nodes on its side faces")
+                    row.append(normal * u[at[0], axis])
+                rows.append(row)
+    if not rows:
+        raise MetricError("no side-face node in the first layer")
+    return finite("side_line_profiles", np.array(rows))
+
+
+def line_alternations(lines, reference, free=None):
+    """The signature of :func:`alternation` of each row of ``lines`` (:func:`side_line_profiles`)
+    [their unit], read with the weights of the layer profile ``reference`` (one weighting for
+    every line, so the rows' mean is the layer profile's signature); None where those layers
+    leave no signature."""
+    lines, r = np.atleast_2d(np.asarray(lines, float)), np.asarray(reference, float)
+    if lines.shape[1] != r.size:
+        raise MetricError(f"line_alternations: {lines.shape[1]} layers per line against a "
+                          f"reference of {r.size}")
+    keep = np.ones(r.size, bool) if free is None else np.asarray(free, bool)
+    w = nyquist_weights(r[keep], np.flatnonzero(keep))
+    if w is None:
+        return None
+    return finite("line_alternations_mm", lines[:, keep] @ w)
+
+
 def alternation(profile, reference, free=None):
     """The period-2 (Nyquist) component of a layer profile, the pattern's own signature:
     ``beta`` [the profiles' unit] of the fit over the ``free`` layers (those whose lateral

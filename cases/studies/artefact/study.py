@@ -6,7 +6,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from model import Material, build
+from model import CalibrationDroppedError, Material, build
 from model.candidates import NORMAL_FORMS
 from model.compose import label
 from model.mesh import cube
@@ -36,6 +36,7 @@ QUICK_REF_LEVELS = 1         # a preview's reference (its 9-node meshes decide n
 # msm with the paper's shear force at the paper's constant: with c = auto the fit sets c = 0
 # on every mesh (the springs alone are stiffer than 2G in the modes the shear adds to)
 FIXED_NORMAL_C = 1.0          # the normal terms' constant where it is held, not fitted
+LITERAL_NORMAL = "normal_edge"    # the normal term run beside the literal readings
 MSM_SHEAR = label("msm + shear(reading=variational, c=1)")
 
 
@@ -48,11 +49,17 @@ def model_specs(quick=False):
                             "normal": "none"}
         out[f"pbcm-{r}-literal"] = {"family": "particle", "reading": r, "constant": "literal",
                                     "normal": "none"}
-        # the normal terms on the calibrated readings only: beside a literal shear (c = 1,
-        # stiffer than 2G in every deviatoric mode) the fit sets every c_n to 0
+        # each normal term fitted beside the reading's shear c held at its own fit on the
+        # same mesh: the pair with and without it then differs in the normal stress alone
         for form in NORMAL_FORMS:
             out[label(f"pbcm-{r} + {form}(c=auto)")] = {
-                "family": "particle", "reading": r, "constant": "calibrated", "normal": form}
+                "family": "particle", "reading": r, "constant": "calibrated", "normal": form,
+                "shear_c_of": SAME_MESH}
+        # beside a literal shear (c = 1, stiffer than 2G in every deviatoric mode) a fit sets
+        # c_n to 0, so the literal reading takes the preset's normal term at c_n = 1
+        out[label(f"pbcm-{r}-literal + {LITERAL_NORMAL}(c={FIXED_NORMAL_C:g})")] = {
+            "family": "particle", "reading": r, "constant": "literal",
+            "normal": fixed_normal(LITERAL_NORMAL)}
     # beside pbcm-balanced (the paper's sign) the fit sets every c_n to 0 on the mirrored five
     # split, so the terms are also run at a fixed c_n = 1 (the shear's own scale, G) with the
     # shear's c held at pbcm-balanced's fit on the same mesh: whether a normal stress changes
@@ -106,8 +113,9 @@ def short(model):
         for form in NORMAL_FORMS:
             if model == label(f"pbcm-{r} + {form}(c=auto)"):
                 return f"pbcm-{r} +{form}"
-            if model == label(f"pbcm-{r} + {form}(c={FIXED_NORMAL_C:g})"):
-                return f"pbcm-{r} +{fixed_normal(form)}"
+            for reading in (f"pbcm-{r}", f"pbcm-{r}-literal"):
+                if model == label(f"{reading} + {form}(c={FIXED_NORMAL_C:g})"):
+                    return f"{reading} +{fixed_normal(form)}"
     return "msm +shear (c = 1)" if model == MSM_SHEAR else model
 
 
@@ -136,15 +144,14 @@ def mesh_specs(quick=False):
 def models_on(spec, models):
     """The models run on a mesh of ``spec``: every one, but on the finest bcc (9009 nodes,
     49152 tetrahedra: each Newton matrix's factors hold about 5e7 entries, some ten seconds a
-    factorisation) the calibrated readings without a normal term and the control only; there
-    the other models read their mirror against the six split alone. A held model is not run on
-    the mirrored five split, where it is its calibrated reading."""
+    factorisation, a model some five minutes) the models without a normal-stress term only;
+    there the normal terms read their mirror against the six split alone. A held model is not
+    run on the mirrored five split, where it is its calibrated reading."""
     kind, n, _ = spec
     # a held model on the mirrored five split is its calibrated reading itself
     out = [m for m, f in models.items() if not (kind == "five" and f["constant"] == HELD)]
     if kind == "bcc" and n == max(SIZES):
-        return [m for m in out if models[m]["normal"] in ("none", "fem")
-                and models[m]["constant"] in ("calibrated", "none", HELD)]
+        return [m for m in out if models[m]["normal"] in ("none", "fem", "edges")]
     return out
 
 
@@ -247,20 +254,29 @@ def cell(pm, mesh, n, bc, load, u_ref):
     alternation and the displacement error over the free components."""
     layers = [y * P.MM for y in P.layers_mm(n)]
     dirichlet = P.static_bc(mesh, bc, push_mm(load))
-    ref_profile = M.layer_profile(mesh.points, u_ref, layers, P.SIZE_MM * P.MM) / P.MM
+    size = P.SIZE_MM * P.MM
+    ref_profile = M.layer_profile(mesh.points, u_ref, layers, size) / P.MM
     free_layers = _free_layers(bc, len(layers))
-    out = {"bulge_profile_fem_mm": ref_profile.tolist(), "failed": None}
+
+    def lines(u):
+        """Each side-face line's signature [mm]: the node-level pattern the layer mean averages."""
+        got = M.line_alternations(M.side_line_profiles(mesh.points, u, layers, size) / P.MM,
+                                  ref_profile, free_layers)
+        return None if got is None else got.tolist()
+    out = {"bulge_profile_fem_mm": ref_profile.tolist(), "failed": None,
+           "line_alternation_fem_mm": lines(u_ref)}
     try:
         st, steps = solve_split(pm, dirichlet, splits=SPLITS_TRIED, rtol=STATIC_RTOL)
     except FINDINGS as exc:
         return {**out, "failed": str(exc), "bulge_profile_mm": None, "alternation_mm": None,
-                "alternation_rel": None, "disp_rel_l2": None, "load_steps": None}
-    profile = M.layer_profile(mesh.points, st.u, layers, P.SIZE_MM * P.MM) / P.MM
+                "alternation_rel": None, "disp_rel_l2": None, "load_steps": None,
+                "line_alternation_mm": None}
+    profile = M.layer_profile(mesh.points, st.u, layers, size) / P.MM
     amplitude, relative = M.alternation(profile, ref_profile, free_layers)
     free = free_components(dirichlet, mesh.n_nodes)
     return {**out, "bulge_profile_mm": profile.tolist(), "alternation_mm": amplitude,
             "alternation_rel": relative, "disp_rel_l2": M.rel_l2(st.u, u_ref, free),
-            "load_steps": steps}
+            "load_steps": steps, "line_alternation_mm": lines(st.u)}
 
 
 def _cells_key(s, name, model):
@@ -273,24 +289,39 @@ def _model_rows(model, factors, name, spec, mesh, s, u_refs):
             **{k: v for k, v in factors.items() if k != "shear_c_of"}}
     loads = loads_on(spec, s.loads)
     try:
-        pm = build(builds(model), mesh, s.material, **held_shear(factors, spec, mesh, s))
+        pm, dropped = _built(model, factors, spec, mesh, s)
     except FINDINGS as exc:
         return [{**base, "constants": None, "bc": bc, "load": load, "failed": f"build: {exc}",
                  "bulge_profile_mm": None, "alternation_mm": None, "alternation_rel": None,
                  "disp_rel_l2": None, "load_steps": None, "growth_rate_1_s": None,
-                 "flutter": None}
+                 "flutter": None, "line_alternation_mm": None,
+                 "line_alternation_fem_mm": None}
                 for bc in s.bcs for load in loads]
     # the model linearised at rest with each base's constraints (a dense eigenproblem: the
     # paper's 5 nodes per side only)
     rates = {bc: P.growth_rate(pm, mesh, bc) if spec[1] == P.NODES_PER_SIDE else None
              for bc in s.bcs}
     # each term's constant as built (fitted or given): {term_c: value}
-    constants = {k: v for k, v in pm.info.items() if k.endswith("_c")}
+    constants = {**{k: v for k, v in pm.info.items() if k.endswith("_c")}, **dropped}
     return [{**base, "constants": constants, "bc": bc, "load": load,
              "growth_rate_1_s": rates[bc],
              "flutter": None if rates[bc] is None else rates[bc] > 0.0,
              **cell(pm, mesh, spec[1], bc, load, u_refs[(bc, load)])}
             for bc in s.bcs for load in loads]
+
+
+def _built(model, factors, spec, mesh, s):
+    """``model`` built on ``mesh`` and the constants its fit dropped ({term_c: 0.0}): a normal
+    term beside a held shear whose fit comes out c_n = 0 adds nothing on this mesh, so the
+    model is its reading with that shear (a finding: the pair is one observation)."""
+    params = held_shear(factors, spec, mesh, s)
+    try:
+        return build(builds(model), mesh, s.material, **params), {}
+    except CalibrationDroppedError:
+        if factors["normal"] not in NORMAL_FORMS or not params:
+            raise
+    return (build(f"pbcm-{factors['reading']}", mesh, s.material, **params),
+            {f"{factors['normal']}_c": 0.0})
 
 
 def held_shear(factors, spec, mesh, s):
