@@ -145,7 +145,9 @@ def _full_step(x, du, s, free, residual):
 
 def _backtracked(x, du, rn, s, free, residual):
     """``x + alpha du`` and its residual, alpha halved from 1 until the largest free residual
-    falls below ``rn`` (or alpha below 1e-3)."""
+    falls below ``rn`` (or alpha below 1e-3). Where even the shortest step inverts a
+    tetrahedron the Newton direction leaves the admissible states at this load: a
+    ConvergenceError, so that a caller may split the load more finely."""
     alpha = 1.0
     while True:
         xt = x.copy()
@@ -154,9 +156,11 @@ def _backtracked(x, du, rn, s, free, residual):
             rt = residual(xt, s)
             if np.abs(rt[free]).max() < rn or alpha < 1e-3:
                 return xt, rt
-        except DegenerateTetError:
+        except DegenerateTetError as exc:
             if alpha < 1e-3:
-                raise
+                raise ConvergenceError(
+                    f"{exc}: every Newton step down to 1e-3 of its length inverts it at this "
+                    "load; increase load_steps") from exc
         alpha *= 0.5
 
 

@@ -1064,3 +1064,76 @@ def test_near_identical_models_are_one_observation_of_the_mirror():
     near = {"five": 0.000875, "unmirrored": 0.0004, "controls": {SIX: 1e-5, BCC: -2e-5}}
     far = dict(near, five=0.000858)
     assert analysis.one_observation(row, near) and not analysis.one_observation(row, far)
+
+
+def _with_lines(c, lines, cont=None):
+    """``c`` with side-line signatures ``lines`` [mm] (and the continuum's ``cont``, zeros by
+    default: a homogeneous field has none)."""
+    lines = np.asarray(lines, float)
+    return {**c, "line_alternation_mm": lines.tolist(),
+            "line_alternation_fem_mm": (np.zeros_like(lines) if cont is None
+                                        else np.asarray(cont, float)).tolist()}
+
+
+def test_the_node_level_part_reads_a_checkerboard_the_layer_mean_cancels_and_its_slope():
+    """A node-level part alternating across each face (+a, -a, ... on the side lines) reads
+    its amplitude a as the rms over the lines, while the layer mean keeps only what does not
+    cancel; on the controls a part 10 times smaller makes it the mirror's; halving h with
+    the amplitude halved (a pattern of fixed strain) reads a slope of 1, its strain's 0."""
+    cells = []
+    for n, a in ((9, 4e-3), (17, 2e-3)):
+        k = 4 * n
+        checker = a * (-1.0) ** np.arange(k)
+        checker[0] += a / 2          # a little survives the layer mean
+        for split in (FIVE, SIX, BCC):
+            amp = 1.0 if split == FIVE else 0.1
+            fem = _with_lines(cell("m", split, "fem-neohookean", 0.0, n=n, family="fem",
+                                   reading="none", constant="none", normal="fem"),
+                              np.zeros(k))
+            mod = _with_lines(cell("m", split, "pbcm-balanced", 0.0, n=n), amp * checker)
+            cells += [fem, mod]
+    got = analysis.node_pattern(cells)
+    nine = next(x for x in got["units"] if x["n"] == 9)
+    row = nine["rows"][0]
+    assert row["rms"] == pytest.approx(np.sqrt(np.mean((4e-3 * (-1.0) ** np.arange(36)
+                                                       + np.r_[2e-3, np.zeros(35)]) ** 2)))
+    assert row["mean"] == pytest.approx(2e-3 / 36)
+    assert row["resolved"] == "above" and row["mirror_vs"] == "above"
+    p, _ = got["slopes"]["sliding"]["orders"]["pbcm-balanced"]
+    assert p == pytest.approx(np.log2((4e-3 * np.sqrt(1 + 1.25 / 36)) /
+                                      (2e-3 * np.sqrt(1 + 1.25 / 68))), rel=1e-9)
+    assert "its strain (mm over h)" in analysis.node_text(got)
+
+
+def test_the_node_level_part_is_not_resolved_within_the_continuums_own_line_leak():
+    """A node-level part below 3 times the continuum's own line scores (a smooth shape as large
+    as the field) is not resolved, whatever its controls read."""
+    k = 36
+    cont = np.full(k, 1e-3)
+    cells = []
+    for split in (FIVE, SIX, BCC):
+        fem = _with_lines(cell("m", split, "fem-neohookean", 0.0, n=9, family="fem",
+                               reading="none", constant="none", normal="fem"), np.zeros(k), cont)
+        mod = _with_lines(cell("m", split, "pbcm-balanced", 0.0, n=9),
+                          np.full(k, 2e-3 if split == FIVE else 0.0), cont)
+        cells += [fem, mod]
+    row = analysis.node_pattern(cells)["units"][0]["rows"][0]
+    assert row["resolved"] == "below" and "mirror_vs" not in row
+
+
+def test_a_pattern_that_follows_the_split_and_not_the_patch_error_is_named_so():
+    """Within one model across the splits at the linear load: a resolved signature on the
+    mirrored split, more than 3 times every control's, with the controls' patch-test errors
+    larger, follows the split; where a control has the same-signed signature with a smaller
+    error, it follows the error."""
+    def world(ctrl_alt, ctrl_err):
+        cells = []
+        for split, alt, err in ((FIVE, 0.02, 0.1), (SIX, ctrl_alt, ctrl_err),
+                                (BCC, ctrl_alt, ctrl_err)):
+            cells.append({**cell("m", split, "pbcm-balanced", alt, n=9, load="linear"),
+                          "disp_rel_l2": err})
+            cells.append({**cell("m", split, "pbcm-balanced", alt, n=9), "disp_rel_l2": err})
+        return analysis.consistency_across(cells)[0]["rows"][0]
+    assert world(0.0005, 0.3)["follows"] == "split"
+    assert world(0.015, 0.05)["follows"] == "error"
+    assert world(0.015, 0.3)["follows"] == "not decided"

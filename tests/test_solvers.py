@@ -107,6 +107,20 @@ def test_static_errors(mat):
         pm.solve_static(bc)
 
 
+def test_a_newton_direction_that_inverts_a_tetrahedron_at_every_length_is_a_convergence_error():
+    """Where every backtracked Newton step inverts a tetrahedron, the solve raises a
+    ConvergenceError (naming the tetrahedron and asking for more load steps), the error a
+    caller answers by splitting the load, never a bare inversion that skips the split."""
+    import model.static as static
+    from model.errors import DegenerateTetError
+
+    def inverts(x, s):
+        raise DegenerateTetError("tetrahedron 7 (nodes [0, 1, 2, 3]) is inverted", [7])
+    x = np.zeros((2, 3))
+    with pytest.raises(ConvergenceError, match="tetrahedron 7.*increase load_steps"):
+        static._backtracked(x, np.ones(6), 1.0, 1.0, np.ones(6, bool), inverts)
+
+
 def test_damped_dynamics_settles_on_the_static_solution(mat):
     mesh = cube(3, L, "five")
     bot, top, bc = cube_bc(mesh, -1.7e-3)

@@ -34,8 +34,8 @@ from scipy.stats import spearmanr
 from ...reporting.document import fmt
 from ...library import paper_cube as P
 from ...measuring.metrics import ALTERNATION_CLEAR, nyquist_weights
-from .study import (DECISIVE, HELD, LINEAR_SCALE, SPLITS, SPLITS_TRIED,
-                    YARDSTICK as YARDSTICK_MODEL, _free_layers, held, short)
+from .study import (DECISIVE, FIXED_NORMAL_C, HELD, LINEAR_SCALE, LITERAL_NORMAL, SPLITS,
+                    SPLITS_TRIED, YARDSTICK as YARDSTICK_MODEL, _free_layers, held, short)
 
 PAPER_COST = 10.0      # the paper (its Figure 2): the time of one step over msm's, more than 10
 RUN_S = P.PUSH_MM / P.SPEED_MM_S   # the paper's run: the push, 1.7 mm at 1.7 mm/s
@@ -716,22 +716,23 @@ def mirror(cells, models=None):
 
 def normal_stress(cells, us):
     """Hypothesis (b), the missing normal stress: pairs (a configuration of the mirrored
-    split that reads own parts, a calibrated reading whose own part is resolved there, a
-    normal-stress term) where the term changes the signature beyond round-off (ACTIVE); each
+    split that reads own parts, a reading, calibrated or literal, whose own part is resolved
+    there, a normal-stress term) where the term changes the signature beyond round-off (ACTIVE); each
     pair's part without and with the term, and whether the term reduces the model's own part
     RATIO-fold (the interval of the ratio from both parts' u). The rest are listed as not
     tested, with why (the term changes nothing; no resolved own part; the configuration does
     not read; failed), and which signs of the own part the tested pairs cover."""
-    at = {(c["nodes_per_side"], c["bc"], c["reading"], c["normal"]): c for c in cells
-          if c["family"] == "particle" and c["constant"] == "calibrated"
+    at = {(c["nodes_per_side"], c["bc"], c["reading"], c["constant"], c["normal"]): c
+          for c in cells if c["family"] == "particle"
+          and c["constant"] in ("calibrated", "literal")
           and c["split"] == MIRRORED and c["load"] == "paper"}
     rows = {(u["n"], u["bc"]): {r["model"]: r for r in u["rows"]} for u in us}
     dec = {(u["n"], u["bc"]): u for u in us}
     pairs, untested = [], []
-    for (n, bc, reading, normal), w in sorted(at.items()):
+    for (n, bc, reading, constant, normal), w in sorted(at.items()):
         if normal == "none":
             continue
-        base = at.get((n, bc, reading, "none"))
+        base = at.get((n, bc, reading, constant, "none"))
         name = short(w["model"])
         if base is None:
             continue
@@ -901,6 +902,88 @@ def consistency(cells):
                      "failed": failed, "verdict": verdict})
     return {"rows": rows, "holds": bool(rows) and all(r["verdict"] == "tracks" for r in rows),
             "testable": any(not r["verdict"].startswith("not testable") for r in rows)}
+
+
+def consistency_across(cells):
+    """Hypothesis (c) read within one model across the splits: on the sliding base at the
+    linear load (a patch test) from DECISIVE layers, per distinct model (its controls its held
+    model's where run) the signature on the mirrored split against each conforming control's,
+    each with its u, beside the patch-test error (``disp_rel_l2``) on each. 'split' where the
+    mirrored signature is resolved and RATIO times every control's upper bound while some
+    control's patch-test error is at least the mirrored split's (within NEAR): the pattern
+    follows the split, not the error; 'error' where a control with a resolved signature of the
+    same sign has a patch-test error no larger (within NEAR) than the mirrored split's and
+    the mirrored signature is not RATIO times that control's upper bound: the pattern goes
+    with the error; else 'not decided'."""
+    check = metric_check(cells)
+    at = _index(cells)
+    out = []
+    for n in sorted({c["nodes_per_side"] for c in cells if c["split"] == MIRRORED
+                     and c["load"] == "linear" and c["nodes_per_side"] >= DECISIVE}):
+        leak = leaks_of(check.get((n, "sliding"), {}))
+        rows, seen = [], []
+        for c in cells:
+            if (c["split"] != MIRRORED or c["nodes_per_side"] != n or c["bc"] != "sliding"
+                    or c["load"] != "linear" or c["family"] == CONTROL
+                    or c.get("constant") == HELD or c.get("failed")
+                    or c.get("alternation_rel") is None or c.get("disp_rel_l2") is None):
+                continue
+            s_, e = c["alternation_rel"], c["disp_rel_l2"]
+            if any(same(s_, a) and same(e, b) for a, b in seen):
+                continue
+            seen.append((s_, e))
+            u = signature_u(c, leak)
+            cm = control_model(at, c["model"], n, "sliding")
+            ctrls = {}
+            for x in CONFORMING_CONTROLS:
+                y = at.get((cm, x, n, "sliding", "linear"))
+                if y is None or y.get("failed") or y.get("alternation_rel") is None:
+                    continue
+                ctrls[x] = {"sig": y["alternation_rel"], "u": signature_u(y, leak),
+                            "error": y["disp_rel_l2"]}
+            if not ctrls:
+                continue
+            resolved = against(abs(s_) / u, RATIO)
+            top = max(abs(v["sig"]) + v["u"] for v in ctrls.values())
+            worse = [x for x, v in ctrls.items() if v["error"] >= e * (1 - NEAR)]
+            if resolved == "above" and abs(s_) - u >= RATIO * top and worse:
+                follows = "split"
+            elif any(against(abs(v["sig"]) / v["u"], RATIO) == "above"
+                     and np.sign(v["sig"]) == np.sign(s_) and v["error"] <= e * (1 + NEAR)
+                     and abs(s_) - u < RATIO * (abs(v["sig"]) + v["u"])
+                     for v in ctrls.values()):
+                follows = "error"
+            else:
+                follows = "not decided"
+            rows.append({"name": short(c["model"]), "sig": s_, "u": u, "error": e,
+                         "resolved": resolved, "controls": ctrls, "worse": worse,
+                         "follows": follows})
+        out.append({"n": n, "rows": rows})
+    return out
+
+
+def across_text(across):
+    """(c) across the splits in a sentence per size."""
+    got = []
+    for x in across:
+        rs = x["rows"]
+        res = [r for r in rs if r["resolved"] == "above"]
+        sp = [r["name"] for r in rs if r["follows"] == "split"]
+        er = [r["name"] for r in rs if r["follows"] == "error"]
+        ratio = [min(v["error"] for v in r["controls"].values()) / r["error"] for r in rs
+                 if r["error"]]
+        got.append(
+            f"{x['n']} sliding, the linear load: of {len(rs)} distinct models, {len(res)} have "
+            f"a resolved signature on the mirrored split; in {len(sp)} it is {RATIO:g} times "
+            "every control's upper bound while a control's patch-test error is at least the "
+            "mirrored split's: the pattern follows the split, not the error"
+            + (f" ({_compress(sp)})" if sp else "")
+            + f"; in {len(er)} a control has the same-signed signature with no larger error"
+            + (f" ({_compress(er)})" if er else "")
+            + (f"; the controls' patch-test error over the mirrored split's "
+               f"{fmt(min(ratio), 2)}-{fmt(max(ratio), 2)} (the smaller control)"
+               if ratio else ""))
+    return "; ".join(got)
 
 
 def linear_check(cells):
@@ -1118,6 +1201,179 @@ def layer_mean_scaling(cells, bc):
     return out
 
 
+def _lines(c):
+    return None if c is None or c.get("failed") or c.get("line_alternation_mm") is None \
+        else np.asarray(c["line_alternation_mm"], float)
+
+
+def node_part(c, fem):
+    """(rms, mean) [mm] over the side-face lines of a model's line signatures less FEM P1's
+    on the same tetrahedra (``line_alternations``): the node-level period-2 part and what of
+    it survives the layer mean (the mean of the lines is the layer profile's part); (None,
+    None) where either lacks them."""
+    a, b = _lines(c), _lines(fem)
+    if a is None or b is None or a.shape != b.shape:
+        return None, None
+    d = a - b
+    return float(np.sqrt(np.mean(d * d))), float(np.mean(d))
+
+
+def node_u(fem):
+    """u [mm] of a node-level part on ``fem``'s mesh: the rms over the side lines of the
+    continuum's own line signatures (a smooth line shape as large as the whole field: the
+    leak a part, a fraction of that field, stays below), with the solver's round-off."""
+    if fem is None or fem.get("line_alternation_fem_mm") is None:
+        return None
+    r = np.asarray(fem["line_alternation_fem_mm"], float)
+    scale = np.abs(np.asarray(fem["bulge_profile_fem_mm"], float)).mean()
+    return float(np.hypot(np.sqrt(np.mean(r * r)), ROUND_OFF_FLOOR * scale))
+
+
+def node_pattern(cells):
+    """The side nodes' own period-2 pattern, per configuration (size, base) of the mirrored
+    split from DECISIVE layers at the push: per distinct model its node-level part (``node_part``
+    rms, mm) with u (``node_u``), resolved where RATIO times u, and the same part on each
+    conforming control (its held model's where run); the share of it the layer mean keeps;
+    FEM P1's own node-level pattern (FEM P1's lines less the continuum's) per split; and per
+    base the two-point slope in h of each model's resolved node-level part from one size to
+    the next (its strain, mm over h, falls at that slope less 1)."""
+    at = _index(cells)
+    out = []
+    for n, bc in sorted({(c["nodes_per_side"], c["bc"]) for c in cells
+                         if c["split"] == MIRRORED and c["nodes_per_side"] >= DECISIVE}):
+        fem = {x: at.get((YARDSTICK_MODEL, x, n, bc, "paper"))
+               for x in (MIRRORED,) + CONFORMING_CONTROLS}
+        u = node_u(fem[MIRRORED])
+        if u is None:
+            continue
+        fem_own = {}
+        for x, f in fem.items():
+            if _lines(f) is not None:
+                d = _lines(f) - np.asarray(f["line_alternation_fem_mm"], float)
+                fem_own[x] = {"rms": float(np.sqrt(np.mean(d * d))), "u": node_u(f)}
+        rows, seen = [], []
+        for c in cells:
+            if (c["split"] != MIRRORED or c["nodes_per_side"] != n or c["bc"] != bc
+                    or c["load"] != "paper" or c["family"] == CONTROL
+                    or c.get("constant") == HELD):
+                continue
+            rms, mean = node_part(c, fem[MIRRORED])
+            if rms is None:
+                continue
+            if any(same(rms, r) and same(mean, m_) for r, m_ in seen):
+                continue            # one observation with a model counted before it
+            seen.append((rms, mean))
+            cm = control_model(at, c["model"], n, bc)
+            ctrls = {}
+            for x in CONFORMING_CONTROLS:
+                cr, _ = node_part(at.get((cm, x, n, bc, "paper")), fem[x])
+                if cr is not None:
+                    ctrls[x] = (cr, node_u(fem[x]))
+            row = {"name": short(c["model"]), "model": c["model"], "rms": rms, "mean": mean,
+                   "u": u, "kept": abs(mean) / rms if rms else None,
+                   "resolved": against(rms / u, RATIO), "controls": ctrls}
+            if row["resolved"] == "above" and ctrls:
+                lo, hi, call, why = _mirror_call(rms, u, list(ctrls.values()))
+                moved = _constants_moved(c, [at[(cm, x, n, bc, "paper")] for x in ctrls])
+                if moved and call != "at":
+                    call, why = "at", f"its constants are fitted per split ({moved})"
+                row.update({"mirror_lo": lo, "mirror_hi": hi, "mirror_vs": call,
+                            "mirror_why": why})
+            rows.append(row)
+        out.append({"n": n, "bc": bc, "u": u, "fem_own": fem_own, "rows": rows})
+    slopes = {}
+    by = {(x["n"], x["bc"]): x for x in out}
+    for (n, bc), x in by.items():
+        fine = by.get((2 * n - 1, bc))
+        if fine is None:
+            continue
+        fr = {r["model"]: r for r in fine["rows"]}
+        got = {}
+        for r in x["rows"]:
+            f = fr.get(r["model"])
+            if f and r["resolved"] == "above" and f["resolved"] == "above":
+                got[r["name"]] = two_point_order(r["rms"], r["u"], f["rms"], f["u"])
+        slopes[bc] = {"sizes": (n, fine["n"]), "orders": got,
+                      "of": sum(r["model"] in fr for r in x["rows"])}
+    return {"units": out, "slopes": slopes}
+
+
+def node_text(nodes):
+    """The node-level pattern in a sentence per configuration and base: resolved, the
+    mirror's, the share the layer mean keeps, FEM P1's own per split, and the slope."""
+    parts = []
+    for x in nodes["units"]:
+        rs = x["rows"]
+        res = [r for r in rs if r["resolved"] == "above"]
+        mir = [r for r in res if r.get("mirror_vs") == "above"]
+        ctrl_res = sum(any(against(p / pu, RATIO) == "above" for p, pu in r["controls"].values())
+                       for r in rs)
+        kept = [r["kept"] for r in res if r["kept"] is not None]
+        fo = x["fem_own"]
+        parts.append(
+            f"{_where((x['n'], x['bc']))}: {len(res)} of {len(rs)} distinct models' node-level "
+            f"parts resolved (u {fmt(x['u'], 2)} mm), "
+            + (f"{fmt(min(r['rms'] for r in res), 2)}-{fmt(max(r['rms'] for r in res), 2)} mm, "
+               if res else "")
+            + f"{len(mir)} of them the mirror's, {ctrl_res} of {len(rs)} resolved on a "
+            "control split"
+            + (f"; the layer mean keeps {fmt(min(kept), 2)}-{fmt(max(kept), 2)} of it (the "
+               "rest cancels across each face)" if kept else "")
+            + ("; FEM P1's own " + ", ".join(
+                f"{x_.split(' ')[0]} {fmt(v['rms'], 2)}" + (
+                    "" if against(v["rms"] / v["u"], RATIO) == "above" else " (not resolved)")
+                for x_, v in fo.items()) + " mm" if fo else ""))
+    slopes = []
+    for bc, o in nodes["slopes"].items():
+        v = sorted(p for p, _ in o["orders"].values())
+        if not v:
+            slopes.append(f"{bc}: no model resolved at both {o['sizes'][0]} and "
+                          f"{o['sizes'][1]} nodes")
+            continue
+        slopes.append(
+            f"{bc}: h^{np.median(v):.2f} (median; {v[0]:.2f}-{v[-1]:.2f} over {len(v)} of "
+            f"{o['of']} models resolved at {o['sizes'][0]} and {o['sizes'][1]} nodes, each +- "
+            f"at most {fmt(max(q for _, q in o['orders'].values()), 2)}), its strain (mm over "
+            f"h) at h^{np.median(v) - 1:.2f}")
+    if not parts:
+        return ""
+    return ("The side nodes' own pattern (each vertical line of side-face nodes read with the "
+            "layer profile's weights, less FEM P1's line on the same tetrahedra; rms over the "
+            "lines; u the continuum's own line scores, a smooth shape as large as the field): "
+            + "; ".join(parts) + (". Under refinement the node-level part falls at "
+                                  + "; ".join(slopes) + " (two sizes only: the order is not "
+                                  "decided)" if slopes else ""))
+
+
+def mesh_pick(resolved, mirrors, against_, fem_units, nodes):
+    """What to mesh a lattice with, given the bulge/neck pattern: from the layer-level parts
+    (``resolved`` of them, ``mirrors`` the mirror's, ``against_`` on every split), FEM P1's own
+    (``fem_units``: where it is the mirror's) and the node-level parts (``node_pattern``): the
+    median over the models of the mirrored split's node-level part over its larger control's,
+    per configuration. A split is named to avoid only where some part is the mirror's and
+    none is on every split."""
+    node_rows = [r for x in nodes["units"] for r in x["rows"] if r["resolved"] == "above"]
+    node_mirror = [r for r in node_rows if r.get("mirror_vs") == "above"]
+    ratios = {}
+    for x in nodes["units"]:
+        got = [r["rms"] / max(p for p, _ in r["controls"].values()) for r in x["rows"]
+               if r["resolved"] == "above" and r["controls"]
+               and max(p for p, _ in r["controls"].values()) > 0]
+        if got:
+            ratios[_where((x["n"], x["bc"]))] = float(np.median(got))
+    if against_ or not (mirrors or node_mirror or fem_units):
+        return None
+    return ("a conforming split without the mirror (six or bcc), not the mirrored five: of "
+            f"the resolved period-2 parts of the layer mean {mirrors} of {resolved} are the "
+            "mirror's and none is on every split"
+            + (f"; at the side nodes {len(node_mirror)} of {len(node_rows)} resolved parts "
+               "are, the mirrored split's over its larger control's " + ", ".join(
+                   f"{w} {times(v)}" for w, v in ratios.items()) + " (median over the models)"
+               if node_rows else "")
+            + (f"; FEM P1's own on {', '.join(fem_units)}" if fem_units else "")
+            + " (one mesh per split and size: no spread over meshes)")
+
+
 def _period_text(dec):
     """What the signature tests under refinement: the pattern at the paper's own period read
     on each configuration that reads parts."""
@@ -1153,8 +1409,8 @@ def _scaling_text(o, scaling):
             f"nodes would give is h^{np.log2(n_f * (n_f - 1) / (n_c * (n_c - 1))):.2f}, and "
             f"{len(same)} of {len(scaling)} models' signature [mm] times n (n - 1) is the same "
             f"at {n_c} and {n_f} nodes to 1 %" + (f" ({_compress(same)})" if same else "")
-            + ": the layer mean may fall while the nodes' own pattern does not (the side "
-            "nodes' displacements are not stored)" if same else "")
+            + ": the layer mean may fall while the nodes' own pattern does not (read at the "
+            "nodes below)" if same else "")
 
 
 def mirror_counts(u):
@@ -1220,6 +1476,12 @@ def answer(cells, models=None, estimates=None):
     a_holds = (any(mirrored.values()) or bool(fem_units)) and not against_
     slopes = [order_text(bc, o, layer_mean_scaling(cells, bc))
               for bc, o in m["orders"].items() if o["orders"]]
+    nodes = node_pattern(every)
+    pick = mesh_pick(sum(len(v) for v in sign_rows.values()),
+                     sum(len(v) for v in mirrored.values()), against_, fem_units, nodes)
+    across = consistency_across(every)
+    across_said = across_text(across)
+    nodes_said = node_text(nodes)
 
     def sign_text(s_):
         # the configuration (one mesh pair) is the unit: per configuration, its model parts
@@ -1256,6 +1518,7 @@ def answer(cells, models=None, estimates=None):
                  + ", ".join(fem_ratio) + ", within the metric's leak bound)"
                  if fem_ratio else "")
               + (f". The own part {'; '.join(slopes)}" if slopes else "")
+              + (f". {nodes_said}" if nodes_said else "")
               + ". Each configuration is one mesh pair (n = 1) that its models share; the "
               "classes are in the artefact report's tables")
     def b_sign(s_):
@@ -1290,8 +1553,10 @@ def answer(cells, models=None, estimates=None):
                    + ", ".join(sorted({f"{fmt(a, 3)} to {fmt(b, 3)}" for a, b in moved}))
                    + "): such a pair changes the normal stress and the shear at once"
                    if moved else "") + kept_text)
-    b_text = ("distinct pairs (a calibrated reading's resolved own part with and without an "
-              "active term, the split held fixed), by the sign of the part: "
+    b_text = ("distinct pairs (a reading's resolved own part with and without an active "
+              "term, the split held fixed: a calibrated reading with each term fitted beside "
+              f"its shear's own c, a literal one with {LITERAL_NORMAL} at c_n = "
+              f"{FIXED_NORMAL_C:g}), by the sign of the part: "
               + "; ".join(b_sign(s_) for s_ in ("+", "-"))
               if ns["decided"] else "not tested (no term active beside a resolved own part)")
     c_text = ("not testable (" + "; ".join(
@@ -1338,7 +1603,9 @@ def answer(cells, models=None, estimates=None):
             f"fields and of sharp end layers; the mirror's where it is also {RATIO:g} times the model's part on each "
             f"conforming split without the mirror, within both u), by sign: {a_text}. (b) "
             f"Normal stress: {b_text}. (c) Consistency (the linear regime: the signature at "
-            f"the linear load against the patch-test error): {c_text}. "
+            f"the linear load against the patch-test error): {c_text}"
+            + (f"; within each model across the splits: {across_said}" if across_said else "")
+            + ". "
             + (f"Large enough to see? {below['text'][0].upper()}{below['text'][1:]}: the "
                "period-2 part over the whole height these runs resolve is below the clear "
                "level there."
@@ -1360,7 +1627,8 @@ def answer(cells, models=None, estimates=None):
             "clear": any(r["clear"] == "above" for u in seen_at for r in u["rows"]
                          if r["same_as"] is None),
             "all_below": bool(below and below["all_below"]), "by_reading": tags,
-            "largest": largest, "causes": causes, "counts": counts}
+            "largest": largest, "causes": causes, "counts": counts, "nodes": nodes,
+            "across": across, "mesh_pick": pick}
 
 
 def _duplicates(units_):

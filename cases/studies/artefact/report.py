@@ -18,8 +18,8 @@ from .analysis import (CLEAR, COARSE, DECAYS, SHARP_DECAYS, DECIDING_LEAK, END_L
                        SAME, TRACKS, WIDTHS, _compress, answer, classes, failure, how_sure,
                        paper_figure, paper_figure_text,
                        reading_table, reading_verdict, signature_own, times)
-from .study import (DECISIVE, LINEAR_SCALE, READINGS, SPLITS, SPLITS_TRIED,
-                    YARDSTICK, HELD_SUFFIX, _free_layers, short)
+from .study import (DECISIVE, FIXED_NORMAL_C, HELD_SUFFIX, LINEAR_SCALE, LITERAL_NORMAL,
+                    READINGS, SPLITS, SPLITS_TRIED, YARDSTICK, _free_layers, short)
 
 GATED = catalogue.gated("alternation_rel", "disp_rel_l2")
 PAPER_TETS = 374        # the paper's own cube, as it reports it
@@ -165,19 +165,26 @@ def _what_was_run(d, s, doc):
         f"Models: {len(s.models)}: each shear reading with the paper's constant (c = 1, "
         "'literal') and with c fitted by the patch-test calibration (the paper's c is 1: a "
         "calibrated reading is the paper's equations with another constant), each calibrated "
-        "one with each normal-stress term (not in the paper's equations; its constant fitted "
-        "per mesh, as every calibrated constant, each stored with its cells and printed in "
-        "cells.md), pbcm-balanced with each normal-stress term at a fixed c_n = 1 (beside "
-        "it the fit gives c_n below 1e-9 on the mirrored split, so the fitted pairs cannot "
-        "test a normal stress beside the paper's sign; its shear c held at pbcm-balanced's "
-        "fit on the same mesh, so that only the normal stress changes), each calibrated "
+        "one with each normal-stress term (not in the paper's equations; the shear's c held "
+        "at the reading's own fit on the same mesh and the term's c_n fitted beside it per "
+        "mesh, so that a pair with and without the term differs in the normal stress alone; "
+        "a fit of c_n = 0 leaves the reading itself; each constant stored with its cells and "
+        "printed in cells.md), each literal reading with "
+        f"{LITERAL_NORMAL} at c_n = {FIXED_NORMAL_C:g} (beside a literal shear the fit "
+        "sets c_n to 0), pbcm-balanced with each normal-stress term at a fixed c_n = "
+        f"{FIXED_NORMAL_C:g} (beside it the fit gives c_n near 0 on the mirrored split, so "
+        "the fitted pairs cannot test a normal stress beside the paper's sign; its shear c "
+        "held likewise), each calibrated "
         "reading on the other splits with the shear c fitted on the mirrored five split of "
         f"the same size ('{HELD_SUFFIX.strip()}': its mirror's controls, which then differ from "
         "it in the split alone), msm, msm with the variational shear "
         f"at c = 1, and {YARDSTICK} (FEM P1: constant-strain FEM with the continuum's own "
         "neo-Hookean law on the same tetrahedra, the control). On the finest bcc (9009 nodes) "
-        "the calibrated readings (fitted and held) and the control only (the cost of its "
-        "Newton matrices): the other models' mirror is read against the six split alone. The "
+        "the models without a normal-stress term only (the cost of its Newton matrices): the "
+        "normal terms' mirror is read against the six split alone. Each cell also keeps each "
+        "vertical line of side-face nodes' own signature (the layer profile's weights applied "
+        "to that line; the lines' mean is the layer profile's): the node-level pattern the "
+        "layer mean averages over a face. The "
         "literal readings and msm are not calibrated: their lateral displacement error is "
         "shown beside every signature"
         + (" (patch-test displacement errors " + ", ".join(
@@ -753,8 +760,9 @@ def cells_document(doc, s):
         f"failed, with its cause. 'constants': each term's constant as built on that mesh "
         "(fitted by the patch-test calibration where the model says auto, else given; a "
         f"model named '{HELD_SUFFIX.strip()}' holds its reading's shear c fitted on the "
-        "mirrored five split of the same size, and a normal term at c_n = 1 holds the shear's "
-        "c fitted on the same mesh without it). "
+        "mirrored five split of the same size, and a calibrated reading's normal term holds "
+        "the shear's c fitted on the same mesh without it; a normal term's c_n = 0: its fit "
+        "dropped it there, the model is its reading). "
         f"Definitions: [glossary](../{GLOSSARY}).")
     combos = [(bc, load) for bc in s.bcs for load in s.loads]
     for mesh in s.meshes:
