@@ -47,6 +47,21 @@ def test_an_undeclared_key_is_caught():
         metric("wobble_index")
 
 
+def test_a_metric_name_carries_the_suffix_of_its_declared_unit():
+    """A metric's unit suffix agrees with its declared unit: a suffix naming another unit, a
+    unit without its suffix and a ratio with one are refused by name; every declared metric
+    passes."""
+    with pytest.raises(ValueError, match="name it with the suffix '_pa'"):
+        catalogue.Metric("stiffness_Pa", "Pa", "k", "a stiffness")
+    with pytest.raises(ValueError, match="name it with the suffix '_n'"):
+        catalogue.Metric("force_n_steps", "N", "f", "a force per step")
+    with pytest.raises(ValueError, match="name it with no unit suffix"):
+        catalogue.Metric("ratio_mm", "1", "r", "a ratio")
+    for name, m in CATALOGUE.items():
+        assert catalogue.UNIT_OF_SUFFIX.get(catalogue.unit_suffix(name), "1") == (
+            "1" if m.unit == "count" else m.unit), name
+
+
 def test_twins_and_errors_are_derived_from_a_quantity():
     assert ref_name("bulge_profile_mm") == "bulge_profile_fem_mm"
     assert ref_name("paper_pattern") == "paper_pattern_fem"

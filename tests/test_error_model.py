@@ -411,8 +411,8 @@ def test_what_to_pick_is_computed_and_names_what_is_not_decided(tmp_path, monkey
         for model, f in (("fem-neohookean", 1.2), ("fem-linear", 1.0), ("a", a), ("b", b)):
             failed = (model, mesh) == ("b", "six")
             fin.append({"mesh": mesh, "bc": "clamped", "model": model,
-                        "force_n_steps": None if failed else [f],
-                        "force_fem_n_steps": [1.0], "nh_error_estimate": 0.01,
+                        "force_steps_n": None if failed else [f],
+                        "force_steps_fem_n": [1.0], "nh_error_estimate": 0.01,
                         "finite_failed": "no equilibrium" if failed else None})
     (tmp_path / "large-compression").mkdir()
     (tmp_path / "large-compression" / "metrics.json").write_text(json.dumps({

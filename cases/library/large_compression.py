@@ -107,7 +107,8 @@ class LargeCompression(Case):
     locking_prone = ("clamped",)     # bonded plates at nu = 0.45 on constant-strain tetrahedra
     headline = "force_rel_err_max"
     headline_pair = "disp_rel_l2_nh"
-    decomposed = Scalar("force_n_steps", "force_fem_n_steps", "force over the load steps", p1=P1_FINITE)
+    decomposed = Scalar("force_steps_n", "force_steps_fem_n", "force over the load steps",
+                        p1=P1_FINITE)
     decomposed_at_load = None         # the force over the load steps is at the load already
     headline_estimate = "nh_error_estimate"
     gated = ("force_rel_err_max", "lateral_rel_err_max")
@@ -162,24 +163,24 @@ class LargeCompression(Case):
     def reference_entries(self, ref):
         e = ref.extra
         nh_f, nh_l = np.array(e["force"]), np.array(e["lateral"])
-        return {"force_fem_n_steps": e["force"], "lateral_strain_fem_steps": e["lateral"],
-                "force_linear_n_steps": e["linear_force"],
+        return {"force_steps_fem_n": e["force"], "lateral_strain_fem_steps": e["lateral"],
+                "force_linear_steps_n": e["linear_force"],
                 "lateral_strain_linear_steps": e["linear_lateral"],
-                "homogeneous_force_law_n_steps": e["law_force"],
+                "homogeneous_force_law_steps_n": e["law_force"],
                 "linear_force_rel_err_max": float(np.abs(np.array(e["linear_force"]) / nh_f
                                                          - 1).max()),
                 "linear_lateral_rel_err_max": float(np.abs(np.array(e["linear_lateral"])
                                                            / nh_l - 1).max())}
 
     def run_extra(self, pm, mesh, bc, s, ref, st):
-        out = dict.fromkeys(("force_n_steps", "lateral_strain_steps", "force_rel_err_max",
-                             "lateral_rel_err_max", "homogeneous_force_n_steps",
-                             "homogeneous_energy_force_n_steps", "homogeneous_force_dev_max",
+        out = dict.fromkeys(("force_steps_n", "lateral_strain_steps", "force_rel_err_max",
+                             "lateral_rel_err_max", "homogeneous_force_steps_n",
+                             "homogeneous_energy_force_steps_n", "homogeneous_force_dev_max",
                              "homogeneous_failed"))
         if st is not None:
             f, lat = np.array(st.force), np.array(st.lateral)
             out.update({
-                "force_n_steps": st.force, "lateral_strain_steps": st.lateral,
+                "force_steps_n": st.force, "lateral_strain_steps": st.lateral,
                 "force_rel_err_max": M.finite(
                     "force_rel_err_max", np.abs(f / np.array(ref.extra["force"]) - 1).max()),
                 "lateral_rel_err_max": M.finite(
@@ -190,8 +191,8 @@ class LargeCompression(Case):
         except FINDINGS as exc:
             out["homogeneous_failed"] = str(exc)
             return out
-        out.update({"homogeneous_force_n_steps": force,
-                    "homogeneous_energy_force_n_steps": from_energy,
+        out.update({"homogeneous_force_steps_n": force,
+                    "homogeneous_energy_force_steps_n": from_energy,
                     "homogeneous_force_dev_max": M.finite(
                         "homogeneous_force_dev_max",
                         np.abs(np.array(force) / np.array(ref.extra["law_force"]) - 1).max())})
@@ -233,17 +234,17 @@ class LargeCompression(Case):
               "the energy's gradient. Not ranked: a law differs from neo-Hookean by "
               "construction.")
         for mesh in s.meshes:
-            rs = [r for r in runs if r["mesh"] == mesh and r.get("homogeneous_force_n_steps")]
+            rs = [r for r in runs if r["mesh"] == mesh and r.get("homogeneous_force_steps_n")]
             if not rs:
                 continue
-            lines = [(r["model"], np.array(r["homogeneous_force_n_steps"]) * 1e3)
+            lines = [(r["model"], np.array(r["homogeneous_force_steps_n"]) * 1e3)
                      for r in rs]
             lines += [(f"{r['model']} (energy)",
-                       np.array(r["homogeneous_energy_force_n_steps"]) * 1e3)
-                      for r in rs if r.get("homogeneous_energy_force_n_steps")]
+                       np.array(r["homogeneous_energy_force_steps_n"]) * 1e3)
+                      for r in rs if r.get("homogeneous_energy_force_steps_n")]
             name = f"homogeneous_{mesh}.png"
             figures.curves(out / name, strain,
-                           np.array(rs[0]["homogeneous_force_law_n_steps"]) * 1e3,
+                           np.array(rs[0]["homogeneous_force_law_steps_n"]) * 1e3,
                            "neo-Hookean law", lines, "compression [%]", "top force [mN]",
                            f"homogeneous compression, mesh {mesh}")
             doc.img(name, f"homogeneous top force against compression, mesh {mesh}")

@@ -21,7 +21,8 @@ from dataclasses import dataclass
 
 from .numbers import fmt, rel
 
-from .names import UNIT_SUFFIXES, err_name, load_name, ref_name  # noqa: F401 (the names' home)
+from .names import (UNIT_OF_SUFFIX, UNIT_SUFFIXES, err_name, load_name,  # noqa: F401
+                    ref_name, unit_suffix)
 
 
 @dataclass(frozen=True)
@@ -44,6 +45,14 @@ class Metric:
         if self.direction not in (None, "max", "min", "signed"):
             raise ValueError(f"metric {self.name}: direction {self.direction!r} is not "
                              "'max', 'min', 'signed' or None")
+        suffix = unit_suffix(self.name)
+        named = UNIT_OF_SUFFIX.get(suffix, "1")
+        if named != (self.unit if self.unit != "count" else "1"):
+            want = [k for k, v in UNIT_OF_SUFFIX.items() if v == self.unit]
+            raise ValueError(
+                f"metric {self.name}: its name says unit {named!r} (suffix {suffix!r}) but it "
+                f"is declared in {self.unit!r}; name it with "
+                + (f"the suffix {want[0]!r}" if want else "no unit suffix"))
 
     @property
     def header(self):
@@ -265,6 +274,13 @@ declare("alternation_mm", "mm", "alternation",
 declare("alternation_rel", "1", "alternation rel",
          "the signature over the reference profile's mean |lateral displacement|; the "
          "pattern is called clear from 0.01.", "signed")
+declare("line_alternation_mm", "mm", "line signatures",
+         "the signature of each vertical line of side-face nodes (one per face and node "
+         "position across it), read with the layer profile's weights: the node-level pattern "
+         "whose mean over the lines is alternation_mm.")
+declare("line_alternation_fem_mm", "mm", "continuum line signatures",
+         "line_alternation_mm of the continuum at the same nodes: the leak of its smooth "
+         "line shapes.")
 declare("alternation_max_rel", "1", "largest |alternation|",
          "a model's largest |alternation rel| over its paper-cube runs (extensions study).",
          "max")
@@ -367,11 +383,11 @@ declare("edge_shear_pa", "Pa", "edge shear",
          "the peak of the paper's max |tau| over the tetrahedra touching the punch's edge "
          "nodes (singular in the continuum: each model's own value, gated as a regression, "
          "never compared with a reference).", "signed", digits=4)
-declare("force_n_steps", "N", "force(steps)",
+declare("force_steps_n", "N", "force(steps)",
          "the top force at each compression step.")
-declare("force_fem_n_steps", "N", "neo-Hookean force(steps)",
+declare("force_steps_fem_n", "N", "neo-Hookean force(steps)",
          "the top force of the neo-Hookean P2 reference at each step.")
-declare("force_linear_n_steps", "N", "linear FEM force(steps)",
+declare("force_linear_steps_n", "N", "linear FEM force(steps)",
          "the top force of linear FEM P2 at each step.")
 declare("lateral_strain_steps", "1", "lateral strain(steps)",
          "the mean outward displacement of the side-face nodes over the half side, per step.")
@@ -388,12 +404,12 @@ declare("linear_force_rel_err_max", "1", "linear FEM force err",
          "error at this strain).")
 declare("linear_lateral_rel_err_max", "1", "linear FEM lateral err",
          "the lateral err max of linear FEM P2 against neo-Hookean.")
-declare("homogeneous_force_n_steps", "N", "homogeneous force(steps)",
+declare("homogeneous_force_steps_n", "N", "homogeneous force(steps)",
          "the top force of the homogeneous (sliding) compression at each step.")
-declare("homogeneous_energy_force_n_steps", "N", "energy force(steps)",
+declare("homogeneous_energy_force_steps_n", "N", "energy force(steps)",
          "dW/d(push) of the model's stored energy along the homogeneous compression, by "
          "central differences (conservative models).")
-declare("homogeneous_force_law_n_steps", "N", "neo-Hookean law force(steps)",
+declare("homogeneous_force_law_steps_n", "N", "neo-Hookean law force(steps)",
          "the neo-Hookean law's top force in homogeneous compression, in closed form.")
 declare("homogeneous_force_dev_max", "1", "law deviation",
          "the largest |F_model / F_law - 1| of the homogeneous compression over the steps: "
@@ -478,19 +494,19 @@ declare("patch_error", "1", "patch error",
          "the patch test's consistency error: the worst over the six unit strains of the RMS "
          "over the tetrahedra of |eps_h - eps| / |eps|, eps_h the relaxed solution's strain.",
          "max")
-declare("C_eff_Pa", "Pa", "C_eff",
+declare("C_eff_pa", "Pa", "C_eff",
          "the lattice's effective elasticity tensor (Voigt 6 x 6) from six homogeneous "
          "strains.")
-for _n in ("E_x", "E_y", "E_z", "E_110", "E_111", "E_xy_plane"):
-    declare(_n, "Pa", _n, f"the effective Young's modulus {_n[2:]} of C_eff.")
-for _n in ("G_xy", "G_xz", "G_yz"):
-    declare(_n, "Pa", _n, f"the effective shear modulus {_n[2:]} of C_eff.")
+for _n in ("E_x_pa", "E_y_pa", "E_z_pa", "E_110_pa", "E_111_pa", "E_xy_plane_pa"):
+    declare(_n, "Pa", _n[:-3], f"the effective Young's modulus {_n[:-3]} of C_eff.")
+for _n in ("G_xy_pa", "G_xz_pa", "G_yz_pa"):
+    declare(_n, "Pa", _n[:-3], f"the effective shear modulus {_n[:-3]} of C_eff.")
 for _n in ("nu_xy", "nu_xz", "nu_yx", "nu_yz", "nu_zx", "nu_zy"):
     declare(_n, "1", _n, f"the effective Poisson ratio {_n[3:]} of C_eff.")
-declare("K_eff_Pa", "Pa", "K_eff",
+declare("K_eff_pa", "Pa", "K_eff",
          "C_eff's bulk modulus: v.M v / 3 of its Mandel form M, v the unit volumetric "
          "direction.")
-declare("deviatoric_moduli_Pa", "Pa", "deviatoric moduli",
+declare("deviatoric_moduli_pa", "Pa", "deviatoric moduli",
          "C_eff's five deviatoric Kelvin moduli, ascending (each 2G when isotropic).")
 declare("bulk_rel_err", "1", "bulk err",
          "K_eff over the target's K, minus 1.")

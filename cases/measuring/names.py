@@ -2,7 +2,15 @@
 the case's load. Kept apart from the catalogue so that the error model can name keys without
 importing the reports' formatting."""
 
-UNIT_SUFFIXES = ("_mm", "_n", "_nm", "_hz", "_s", "_pa")
+# a run key's unit suffix and the unit it names (the longest suffix a name ends with counts)
+UNIT_OF_SUFFIX = {"_1_s": "1/s", "_mm": "mm", "_nm": "N m", "_n": "N", "_hz": "Hz", "_s": "s",
+                  "_pa": "Pa"}
+UNIT_SUFFIXES = tuple(UNIT_OF_SUFFIX)
+
+
+def unit_suffix(name):
+    """The unit suffix ``name`` ends with (the longest of UNIT_SUFFIXES), or None."""
+    return max((x for x in UNIT_SUFFIXES if name.endswith(x)), key=len, default=None)
 
 
 def ref_name(name):

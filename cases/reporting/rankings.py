@@ -58,7 +58,7 @@ JUDGES = 5
 # the continuum's value behind a relative error whose quantity is not named after it
 CONTINUUM_OF = {"reaction_rel_err": "reaction_fem_p2_n",
                 "reaction_rel_err_nh": "reaction_fem_nh_n",
-                "force_rel_err_max": "force_fem_n_steps",
+                "force_rel_err_max": "force_steps_fem_n",
                 "lateral_rel_err_max": "lateral_strain_fem_steps"}
 
 

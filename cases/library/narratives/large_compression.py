@@ -72,9 +72,9 @@ class LargeCompressionNarrative(Narrative):
             rs = [r for r in runs if r["mesh"] == mesh and not r.get("failed")]
             if not rs:
                 continue
-            solved = [r for r in rs if r["force_n_steps"] is not None]
+            solved = [r for r in rs if r["force_steps_n"] is not None]
             for key, fem, lin, label, scale in (
-                    ("force_n_steps", "force_fem_n_steps", "force_linear_n_steps",
+                    ("force_steps_n", "force_steps_fem_n", "force_linear_steps_n",
                      "top force [mN]", 1e3),
                     ("lateral_strain_steps", "lateral_strain_fem_steps",
                      "lateral_strain_linear_steps", "lateral strain", 1.0)):

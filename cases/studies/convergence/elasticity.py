@@ -36,14 +36,15 @@ def entry(model_name, family, s):
     diag = np.array([[1, 1, 0], [1, -1, 0], [1, 1, 1]], float)
     E_dir = directional_young(C, diag)
     theta = np.radians(ANGLES_DEG)
-    return {"model": model_name, "mesh": family, "C_eff_Pa": C.tolist(),
-            **{k: v for k, v in const.items()},
-            "E_110": float(E_dir[0]), "E_111": float(E_dir[2]),
-            "anisotropy_AU": anisotropy_index(C), "K_eff_Pa": K,
-            "deviatoric_moduli_Pa": mu.tolist(), "bulk_rel_err": err["bulk"],
+    return {"model": model_name, "mesh": family, "C_eff_pa": C.tolist(),
+            # the moduli in Pa carry the unit's suffix, the ratios none
+            **{(k + "_pa" if k[0] in "EG" else k): v for k, v in const.items()},
+            "E_110_pa": float(E_dir[0]), "E_111_pa": float(E_dir[2]),
+            "anisotropy_AU": anisotropy_index(C), "K_eff_pa": K,
+            "deviatoric_moduli_pa": mu.tolist(), "bulk_rel_err": err["bulk"],
             "deviatoric_rel_err": err["deviatoric"], "moduli_rel_err": err["largest"],
             "asymmetry": asymmetry(C),
-            "E_xy_plane": directional_young(
+            "E_xy_plane_pa": directional_young(
                 C, np.column_stack([np.cos(theta), np.sin(theta), 0 * theta])).tolist()}
 
 

@@ -383,7 +383,7 @@ def ties(s, data):
         fine = min(rs, key=lambda r: r["h_mm"])
         out.append(f"{f['model']} on {f['mesh']}: sliding-cube reaction ratio "
                    f"{fine['reaction_ratio']:.3g} at h = {fine['h_mm']:.3g} mm (limit "
-                   f"{fmt(f.get('ratio_inf'))}), lattice E_y,eff / E = {e['E_y'] / s.E:.3g}, "
+                   f"{fmt(f.get('ratio_inf'))}), lattice E_y,eff / E = {e['E_y_pa'] / s.E:.3g}, "
                    f"nu_yx = {e['nu_yx']:.3g} (target {s.nu:g}).")
     return out
 
@@ -561,10 +561,10 @@ def _elasticity_section(doc, out, s, data):
     doc.table(["lattice", "model", "E_x/E", "E_y/E", "E_z/E", "E_110/E", "E_111/E", "nu_yx",
                "nu_xz", "G_yz/G", "G_xz/G", "G_xy/G", "A_U", "K/K"]
               + [f"mu_{k}/2G" for k in range(1, 6)] + ["moduli err", "asymmetry"],
-              [[e["mesh"], e["model"], fmt(e["E_x"] / s.E), fmt(e["E_y"] / s.E),
-                fmt(e["E_z"] / s.E), fmt(e["E_110"] / s.E), fmt(e["E_111"] / s.E),
-                fmt(e["nu_yx"]), fmt(e["nu_xz"]), fmt(e["G_yz"] / G), fmt(e["G_xz"] / G),
-                fmt(e["G_xy"] / G), fmt(e["anisotropy_AU"], 2), fmt(1 + e["bulk_rel_err"])]
+              [[e["mesh"], e["model"], fmt(e["E_x_pa"] / s.E), fmt(e["E_y_pa"] / s.E),
+                fmt(e["E_z_pa"] / s.E), fmt(e["E_110_pa"] / s.E), fmt(e["E_111_pa"] / s.E),
+                fmt(e["nu_yx"]), fmt(e["nu_xz"]), fmt(e["G_yz_pa"] / G), fmt(e["G_xz_pa"] / G),
+                fmt(e["G_xy_pa"] / G), fmt(e["anisotropy_AU"], 2), fmt(1 + e["bulk_rel_err"])]
                + [fmt(1 + d) for d in e["deviatoric_rel_err"]]
                + [fmt(e["moduli_rel_err"], 2), fmt(e["asymmetry"], 2)] for e in eff])
     failed = [e for e in data["elasticity"] if e.get("failed")]
@@ -574,7 +574,7 @@ def _elasticity_section(doc, out, s, data):
     doc.h(3, "What the tensors explain")
     doc.ul(ties(s, data))
     directional_young(out / "directional_young.png", ANGLES_DEG, list(s.meshes),
-                            list(s.models), {(e["mesh"], e["model"]): e["E_xy_plane"]
+                            list(s.models), {(e["mesh"], e["model"]): e["E_xy_plane_pa"]
                                              for e in eff}, s.E)
     doc.img("directional_young.png", "Directional Young's modulus per lattice and model")
 
