@@ -2,6 +2,7 @@
 identification (pbcm fit)."""
 import json
 
+import numpy as np
 import pytest
 
 from cases.cli import main
@@ -372,3 +373,24 @@ def test_the_overall_range_also_leaves_one_mesh_family_out():
     assert R.overall_range(errors, [BASE, "c"])["c"] == pytest.approx([2.0, 2.0])
     lo, hi = R.overall_range(errors, [BASE, "c"], data)["c"]
     assert lo == pytest.approx(1.05) and hi == pytest.approx(2.0)   # six, or five, left out
+
+
+def test_a_fit_is_judged_against_fem_p1_by_default_and_the_continuum_on_request():
+    """The fit's reference is FEM P1 on the same tetrahedra unless the continuum is asked for:
+    its displacement, its reaction along the driven axis and its quantities; the continuum's
+    are the converged P2 solution's."""
+    from types import SimpleNamespace as NS
+    from cases.cli.fitting import AGAINST, FitError, Problem, fit
+    p1 = NS(u=np.ones((3, 3)), reaction=np.array([[0.0, -2.0, 0.0]] * 3))
+    p2 = NS(u=np.full((3, 3), 2.0))
+    case = NS(driven=lambda mesh, bc, s: ([0, 2], 1), qoi_errors=("tip",),
+              quantities=lambda mesh, u, r, s, bc: {"tip": float(u.sum())})
+    prob = Problem(case, "five", "clamped", None, None,
+                   NS(p1=p1, p2=p2, reaction=9.0, quantities={"tip": 18.0}))
+    u, reaction, q = prob.target("p1")
+    assert u is p1.u and reaction == 4.0 and q == {"tip": 9.0}
+    u, reaction, q = prob.target("continuum")
+    assert u is p2.u and reaction == 9.0 and q == {"tip": 18.0}
+    assert set(AGAINST) == {"p1", "continuum"}
+    with pytest.raises(FitError, match="--against 'p2'"):
+        fit("msm", [], [], against="p2")

@@ -17,6 +17,9 @@ def add(sub):
     ft.add_argument("--cases", nargs="+", required=True, help="cases to fit on")
     ft.add_argument("--validate", nargs="*", help="cases left out, to cross-validate on")
     ft.add_argument("--quick", action="store_true", help="each case's quick settings")
+    ft.add_argument("--against", choices=("p1", "continuum"), default="p1",
+                    help="the reference fitted to: FEM P1 on the same tetrahedra (default: "
+                         "the model-form error) or the converged continuum")
     ft.add_argument("--meshes", nargs="+", help="mesh families of every case (default: each "
                                                 "case's own)")
     ft.add_argument("--bcs", nargs="+", help="boundary conditions of every case (default: "
@@ -47,7 +50,8 @@ def run(args):
                                    }.items() if v is not None}
     with StagedFolder(Path(args.out) if args.out else Path("reports") / "fit" / slug(name),
                       mark="fit.json") as out:
-        doc = fit(name, train, validate, quick=args.quick, overrides=overrides)
+        doc = fit(name, train, validate, quick=args.quick, overrides=overrides,
+                  against=args.against)
         (out.path / "fit.json").write_text(json.dumps(doc, indent=1) + "\n")
         report(doc).write(out.path)
         path = out.commit()

@@ -5,7 +5,10 @@ a factor ``scale_j = exp(theta_j)`` on its calibrated (or given) constant; the r
 displacement of every (mesh, bc) of the training cases in the linear regime (the case's loads
 scaled to strains of 1e-4, the answer scaled back) against its linear FEM reference at the
 nodes, divided by the reference's norm, so that the cost is the sum of the squared
-``disp_rel_l2_p2`` of the runs. scipy's ``least_squares`` (trust region reflective) minimises
+displacement errors of the runs. The reference is FEM P1 on the same tetrahedra by default
+(``against="p1"``: the model-form error, what replacing FEM costs; a fit against the
+continuum on a coarse mesh would learn to cancel the mesh's own discretisation error, which
+does not carry to another mesh), or the converged continuum (``against="continuum"``). scipy's ``least_squares`` (trust region reflective) minimises
 it from theta = 0 (the model as built); the Jacobian at the optimum gives the conditioning
 (its singular values) and the standard errors and correlations of the constants. The cases
 left out are solved before and after: the cross-validation.
@@ -35,9 +38,13 @@ class FitError(PbcmError):
     """A fit that cannot be set up (no constant to fit, a case without a displacement)."""
 
 
+AGAINST = {"p1": "FEM P1 (linear, on the same tetrahedra: the model-form error)",
+           "continuum": "the converged continuum (linear P2)"}
+
+
 @dataclass
 class Problem:
-    """One (case, mesh, bc) with its reference displacement."""
+    """One (case, mesh, bc) with its references."""
 
     case: object
     family: str
@@ -49,6 +56,18 @@ class Problem:
     @property
     def name(self):
         return f"{self.case.name}/{self.family}/{self.bc}"
+
+    def target(self, against):
+        """(displacement [m], reaction along the driven axis [N] or None, quantities) of
+        the reference ``against`` names (AGAINST)."""
+        if against == "continuum":
+            return self.ref.p2.u, self.ref.reaction, self.ref.quantities
+        p1 = self.ref.p1
+        driven = self.case.driven(self.mesh, self.bc, self.settings)
+        reaction = None if driven is None else float(reaction_along(p1.reaction, driven))
+        q = (self.case.quantities(self.mesh, p1.u, p1.reaction, self.settings, self.bc)
+             if self.case.qoi_errors else {})
+        return p1.u, reaction, q
 
 
 def fitted_terms(spec):
@@ -95,25 +114,27 @@ def problems(case, s):
     return out
 
 
-def errors(spec, scales, probs):
+def errors(spec, scales, probs, against="p1"):
     """The residual (concatenated over the problems: the displacement at the nodes divided by
     the reference's norm; for a displacement-driven problem the reaction's relative error,
     without which a stiffness scale would not show in the displacements; the relative errors
-    of the case's quantities of interest) and each problem's error, the norm of its residual;
-    a problem the model cannot solve raises."""
+    of the case's quantities of interest), each against the reference ``against`` names
+    (AGAINST), and each problem's error, the norm of its residual; a problem the model cannot
+    solve raises."""
     res, errs = [], []
     for p in probs:
         stop.checkpoint()
         pm = build(spec, p.mesh, p.settings.material, **{t: {"scale": float(k)}
                                                          for t, k in scales.items()})
         st = linear_regime(p.case, pm, p.mesh, p.bc, p.settings, p.ref)
-        r = [(st.u - p.ref.p2.u).ravel() / np.linalg.norm(p.ref.p2.u)]
+        u_ref, reaction, quantities = p.target(against)
+        r = [(st.u - u_ref).ravel() / np.linalg.norm(u_ref)]
         driven = p.case.driven(p.mesh, p.bc, p.settings)
-        if driven is not None and p.ref.reaction:
-            r.append([reaction_along(st.reaction, driven) / p.ref.reaction - 1.0])
+        if driven is not None and reaction:
+            r.append([reaction_along(st.reaction, driven) / reaction - 1.0])
         if p.case.qoi_errors:       # the case's quantities of interest (a torque, a tip)
             q = p.case.quantities(p.mesh, st.u, st.reaction, p.settings, p.bc)
-            r.append([q[k] / p.ref.quantities[k] - 1.0 for k in p.case.qoi_errors])
+            r.append([q[k] / quantities[k] - 1.0 for k in p.case.qoi_errors])
         r = np.concatenate(r)
         res.append(r)
         errs.append(M.finite("fit error", float(np.linalg.norm(r))))
@@ -132,9 +153,12 @@ def constants(spec, scales, mesh, material):
     return out
 
 
-def fit(spec, train, validate, quick=True, overrides=None, progress=print):
-    """Fit ``spec``'s constants on the cases ``train`` (Case objects), cross-validate on
-    ``validate``; return the fit document (plain data)."""
+def fit(spec, train, validate, quick=True, overrides=None, progress=print, against="p1"):
+    """Fit ``spec``'s constants on the cases ``train`` (Case objects) against the reference
+    ``against`` names (AGAINST), cross-validate on ``validate``; return the fit document
+    (plain data)."""
+    if against not in AGAINST:
+        raise FitError(f"--against {against!r}: choose one of {', '.join(AGAINST)}")
     overrides = overrides or {}
     name = label(spec)
     terms = [t for t, _ in fitted_terms(spec)]
@@ -149,7 +173,7 @@ def fit(spec, train, validate, quick=True, overrides=None, progress=print):
         def residual(theta):
             scales = dict(zip(terms, np.exp(theta)))
             try:
-                r, e = errors(name, scales, train_p)
+                r, e = errors(name, scales, train_p, against)
             except FINDINGS as exc:   # no equilibrium at these constants: steer away
                 progress(f"fit: {', '.join(f'{t}={v:.4g}' for t, v in scales.items())} "
                          f"failed ({exc}); penalised")
@@ -161,7 +185,8 @@ def fit(spec, train, validate, quick=True, overrides=None, progress=print):
             return r
 
         theta0 = np.zeros(len(terms))
-        r0, before_train = errors(name, dict(zip(terms, np.ones(len(terms)))), train_p)
+        r0, before_train = errors(name, dict(zip(terms, np.ones(len(terms)))), train_p,
+                                  against)
         n_res = len(r0)
         sol = least_squares(residual, theta0, method="trf", diff_step=1e-4, x_scale=1.0,
                             bounds=(np.full(len(terms), np.log(1e-3)),
@@ -174,21 +199,21 @@ def fit(spec, train, validate, quick=True, overrides=None, progress=print):
         cov = np.linalg.pinv(J.T @ J) * sigma2
         se = np.sqrt(np.diag(cov))
         corr = cov / np.outer(se, se) if np.all(se > 0) else np.full_like(cov, np.nan)
-        after_train = errors(name, scales, train_p)[1]
+        after_train = errors(name, scales, train_p, against)[1]
         rows_v = []
         for p in valid_p:
             try:
-                b = errors(name, dict(zip(terms, np.ones(len(terms)))), [p])[1][0]
+                b = errors(name, dict(zip(terms, np.ones(len(terms)))), [p], against)[1][0]
             except FINDINGS as exc:
                 b = f"failed: {exc}"
             try:
-                a = errors(name, scales, [p])[1][0]
+                a = errors(name, scales, [p], against)[1][0]
             except FINDINGS as exc:
                 a = f"failed: {exc}"
             rows_v.append({"problem": p.name, "before": b, "after": a})
     mesh0, mat0 = train_p[0].mesh, train_p[0].settings.material
     return {
-        "model": name, "terms": terms, "quick": quick,
+        "model": name, "terms": terms, "quick": quick, "against": against,
         "train": [c.name for c in train], "validate": [c.name for c in validate],
         "scales": {t: float(v) for t, v in scales.items()},
         "scale_rel_se": {t: float(s) for t, s in zip(terms, se)},   # d ln(scale) = rel. error
@@ -237,10 +262,15 @@ def report(doc):
             f"to {fmt(worst['after'])} ({fmt(worst['factor'])} times): an rms can hide one "
             "problem the fit made worse. Fit where the reference problem is converged: a fit "
             "trained where the reference itself is far off learns the reference's error.")
-    d.p("Error of a problem: sqrt(disp_rel_l2^2 + reaction_rel_err^2 + the squared relative "
-        "errors of the case's quantities of interest) against its FEM reference (the reaction "
-        "where the problem is driven by a displacement); the fit minimises the sum of their "
-        "squares over the training problems.")
+    against = doc.get("against", "continuum")
+    d.p("Error of a problem: sqrt(disp_rel^2 + reaction_rel_err^2 + the squared relative "
+        "errors of the case's quantities of interest) in the linear regime against "
+        f"{AGAINST[against]} (the reaction where the problem is driven by a displacement); "
+        "the fit minimises the sum of their squares over the training problems"
+        + ("; against the model-form error a fit does not learn to cancel the mesh's own "
+           "discretisation error, which would not carry to another mesh."
+           if against == "p1" else "; on a coarse mesh such a fit also learns to cancel the "
+           "mesh's own discretisation error, which does not carry to another mesh."))
     d.p(f"Generated by `pbcm fit`: every number was computed by the fit that wrote this file "
         f"({doc['evaluations']} evaluations; optimizer: {doc['optimizer']}).")
     d.h(2, "Constants")

@@ -1433,9 +1433,13 @@ def mirror_counts(u):
 
 
 def failed_cells(cells):
-    """Every failed cell of the study (any split, base, load): (model, mesh, bc, load, why)."""
-    return [(short(c["model"]), c["mesh"], c["bc"], c["load"], failure(c)) for c in cells
-            if c.get("failed")]
+    """Every failed cell of the study (any split, base, load): (model, mesh, bc, load, why,
+    whether FEM P1 solved the same cell: then the problem is well posed and the failure the
+    model's)."""
+    solved = {(c["mesh"], c["bc"], c["load"]) for c in cells
+              if c["family"] == CONTROL and not c.get("failed")}
+    return [(short(c["model"]), c["mesh"], c["bc"], c["load"], failure(c),
+             (c["mesh"], c["bc"], c["load"]) in solved) for c in cells if c.get("failed")]
 
 
 def answer(cells, models=None, estimates=None):
@@ -1670,7 +1674,8 @@ def how_sure(ans, verdict):
     lost = sum(r["kind"].startswith("failed") for r in rows)
     failed = ans.get("failed") or []
     by_model, built = {}, {}
-    for model, mesh, bc, load, why in failed:
+    control_solved = sum(f[5] for f in failed if "build:" not in f[4])
+    for model, mesh, bc, load, why, _ in failed:
         where = f"{mesh} {bc}" + (f" ({load} load)" if load != "paper" else "")
         if "build:" in why:            # the model could not be made: one cause, stated
             built.setdefault((model, why), []).append(where)
@@ -1701,7 +1706,11 @@ def how_sure(ans, verdict):
            + "".join(f"; {model} on {len(v)} cells: {why[len('failed ('):-1]}"
                      for (model, why), v in built.items())
            + (f"; failed static solves (the push split into up to {SPLITS_TRIED[-1]} equal "
-              "steps first; not diagnosed further): " + "; ".join(
+              "steps, each Newton step backtracked down to 1e-3 of its length; FEM P1 solved "
+              f"{control_solved} of these {sum(map(len, by_model.values()))} cells on the same "
+              "tetrahedra" + (", so the problem is well posed and the failure the model's"
+                              if control_solved == sum(map(len, by_model.values())) else "")
+              + "): " + "; ".join(
                   f"{k} on {', '.join(v)}" for k, v in by_model.items()) if by_model else "")
            + "; " if failed else "")
         + "the reading: " + (verdict["sure"] if verdict["decided"] else _reading_sure(verdict))
