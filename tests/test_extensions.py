@@ -394,3 +394,30 @@ def test_a_fit_is_judged_against_fem_p1_by_default_and_the_continuum_on_request(
     assert set(AGAINST) == {"p1", "continuum"}
     with pytest.raises(FitError, match="--against 'p2'"):
         fit("msm", [], [], against="p2")
+
+
+def test_a_left_out_problem_that_is_a_training_problem_again_is_not_counted_as_left_out():
+    """A left-out problem with the training problem's nodes and reference displacement up to a
+    factor (a case scaling another's load) is one observation: named, never in the left-out
+    rms or the worst change."""
+    from types import SimpleNamespace as NS
+    from cases.cli.fitting import report, same_problem, worst_change
+    pts = np.random.default_rng(0).random((5, 3))
+    u = np.random.default_rng(1).random((5, 3))
+
+    def prob(u_):
+        return NS(mesh=NS(points=pts), ref=NS(p1=NS(u=u_)))
+    assert same_problem(prob(u), prob(3 * u)) and not same_problem(prob(u), prob(u + 0.1))
+    rows = [{"problem": "x/five/clamped", "before": "the training problem a",
+             "after": "the training problem a", "twin": "a"},
+            {"problem": "y/five/clamped", "before": 0.2, "after": 0.1}]
+    assert worst_change(rows)["problem"] == "y/five/clamped"
+    doc = {"model": "m", "train": ["a"], "validate": ["x", "y"], "quick": True,
+           "train_rows": [{"problem": "a", "before": 0.3, "after": 0.2}], "validate_rows": rows,
+           "evaluations": 3, "optimizer": "ok", "constants_fitted": {}, "constants_auto": {},
+           "scales": {}, "scale_rel_se": {}, "identified": {}, "singular_values": [1.0],
+           "condition_number": 1.0, "terms": ["shear"], "constants_on": "a mesh",
+           "against": "p1"}
+    text = report(doc).markdown()
+    assert "from 0.2 to 0.1" in text and "x/five/clamped (= a)" in text
+    assert "better in 1, worse in 0 of 1" in text

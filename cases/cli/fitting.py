@@ -202,6 +202,11 @@ def fit(spec, train, validate, quick=True, overrides=None, progress=print, again
         after_train = errors(name, scales, train_p, against)[1]
         rows_v = []
         for p in valid_p:
+            twin = next((t.name for t in train_p if same_problem(p, t)), None)
+            if twin is not None:     # the linear regime of one problem again: not left out
+                rows_v.append({"problem": p.name, "before": f"the training problem {twin}",
+                               "after": f"the training problem {twin}", "twin": twin})
+                continue
             try:
                 b = errors(name, dict(zip(terms, np.ones(len(terms)))), [p], against)[1][0]
             except FINDINGS as exc:
@@ -231,11 +236,24 @@ def fit(spec, train, validate, quick=True, overrides=None, progress=print, again
     }
 
 
+def same_problem(a, b):
+    """True where two problems are one in the linear regime: the same nodes and the same
+    reference displacement up to a factor (a case that scales another's load)."""
+    if a.mesh.points.shape != b.mesh.points.shape or not np.allclose(a.mesh.points,
+                                                                     b.mesh.points):
+        return False
+    ua, ub = a.ref.p1.u.ravel(), b.ref.p1.u.ravel()
+    na, nb = np.linalg.norm(ua), np.linalg.norm(ub)
+    return bool(na > 0 and nb > 0 and np.allclose(ua / na, ub / nb, atol=1e-9))
+
+
 def worst_change(rows):
     """The left-out problem whose error the fit multiplied most (after / before), with that
     factor; a problem that failed after the fit is the worst; None without any."""
     scored = []
     for r in rows:
+        if r.get("twin"):
+            continue
         b, a = r["before"], r["after"]
         if isinstance(a, str):
             return {**r, "factor": float("inf")}
@@ -250,12 +268,23 @@ def report(doc):
     from ..reporting.document import Document, fmt
     d = Document(f"pbcm fit: {doc['model']}")
     rms = {k: _rms([r[k] for r in doc["train_rows"]]) for k in ("before", "after")}
-    vrms = {k: _rms([r[k] for r in doc["validate_rows"]]) for k in ("before", "after")}
+    left = [r for r in doc["validate_rows"] if not r.get("twin")]
+    vrms = {k: _rms([r[k] for r in left]) for k in ("before", "after")}
+    twins = [f"{r['problem']} (= {r['twin']})" for r in doc["validate_rows"] if r.get("twin")]
+    better = [r["after"] < r["before"] for r in left
+              if not isinstance(r["after"], str) and not isinstance(r["before"], str)]
     d.p(f"Fitted on {', '.join(doc['train'])} ({'quick' if doc['quick'] else 'full'} "
         f"settings): the rms error of the training problems goes from "
         f"{fmt(rms['before'])} to {fmt(rms['after'])}"
         + (f"; on the cases left out ({', '.join(doc['validate'])}) from "
-           f"{fmt(vrms['before'])} to {fmt(vrms['after'])}." if doc["validate_rows"] else "."))
+           f"{fmt(vrms['before'])} to {fmt(vrms['after'])}" if left else "")
+        + (f" (each left-out problem: better in {sum(better)}, worse in "
+           f"{len(better) - sum(better)} of {len(better)}; the rms of so few problems carries "
+           "no spread, so a change smaller than the problems' own disagreement is not a "
+           "finding)" if better else "")
+        + (f"; left out but the same problem as a training one in the linear regime (one "
+           f"observation, not counted as left out): {', '.join(twins)}" if twins else "")
+        + ".")
     worst = worst_change(doc["validate_rows"])
     if worst:
         d.p(f"Worst change on a case left out: {worst['problem']}, from {fmt(worst['before'])} "
