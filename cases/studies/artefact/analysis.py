@@ -1298,6 +1298,30 @@ def node_pattern(cells):
     return {"units": out, "slopes": slopes}
 
 
+def node_lead(nodes):
+    """The node-level finding for the opening: per base, how the resolved node-level part's
+    strain changes from one size to the next (median and range over the models), and how
+    many of the largest size's parts are the mirror's; '' where no slope was read."""
+    said = []
+    for bc, o in nodes["slopes"].items():
+        v = sorted(p - 1 for p, _ in o["orders"].values())
+        fine = next((x for x in nodes["units"] if (x["n"], x["bc"]) == (o["sizes"][1], bc)),
+                    None)
+        if not v or fine is None:
+            continue
+        res = [r for r in fine["rows"] if r["resolved"] == "above"]
+        said.append(f"{bc} base: its strain (mm over h) goes as h^{np.median(v):.2f} from "
+                    f"{o['sizes'][0]} to {o['sizes'][1]} nodes (median; {v[0]:.2f} to "
+                    f"{v[-1]:.2f} over {len(v)} models), and at {o['sizes'][1]} nodes "
+                    f"{sum(r.get('mirror_vs') == 'above' for r in res)} of {len(res)} "
+                    "resolved parts are the mirror's")
+    return ("at the side nodes (each vertical line of side-face nodes, less FEM P1's; the "
+            "layer mean cancels most of it across each face) the mirrored split's period-2 "
+            "part on the " + "; on the ".join(said)
+            + " (two sizes: not an order; a strain exponent near 0 is a pattern refinement "
+            "does not remove)") if said else ""
+
+
 def node_text(nodes):
     """The node-level pattern in a sentence per configuration and base: resolved, the
     mirror's, the share the layer mean keeps, FEM P1's own per split, and the slope."""
@@ -1594,6 +1618,7 @@ def answer(cells, models=None, estimates=None):
              "for the mean it is divided by" + (
                  f", whose error estimate (at most {fmt(ref_est, 2)} at the push) moves a part "
                  "by that fraction" if ref_est is not None else "")] if a_holds else []) + (
+        [node_lead(nodes)] if node_lead(nodes) else []) + (
         ["a normal-stress term removes it (b)"] if ns["holds"] else []) + (
         ["it tracks the patch-test error (c)"] if cs["holds"] else [])
     lead = (f"Not decided for {paper}; the paper's 374-tetrahedron "
