@@ -289,8 +289,10 @@ def report(doc):
     if worst:
         d.p(f"Worst change on a case left out: {worst['problem']}, from {fmt(worst['before'])} "
             f"to {fmt(worst['after'])} ({fmt(worst['factor'])} times): an rms can hide one "
-            "problem the fit made worse. Fit where the reference problem is converged: a fit "
-            "trained where the reference itself is far off learns the reference's error.")
+            "problem the fit made worse." + (
+                " Fit where the reference problem is converged: a fit trained where the "
+                "reference itself is far off learns the reference's error."
+                if doc.get("against", "continuum") == "continuum" else ""))
     against = doc.get("against", "continuum")
     d.p("Error of a problem: sqrt(disp_rel^2 + reaction_rel_err^2 + the squared relative "
         "errors of the case's quantities of interest) in the linear regime against "
