@@ -1560,9 +1560,10 @@ def answer(cells, models=None, estimates=None):
         moved = [p["shear_c"] for p in ps if None not in p["shear_c"]
                  and not same(*p["shear_c"], SAME)]
         kept = [p for p in ps if None not in p["shear_c"] and same(*p["shear_c"], SAME)]
-        kept_text = (f"; in {len(kept)} of them the shear's c is held at the reading's fit "
-                     f"(only the normal stress changes: {sum(p['reduced'] == 'above' for p in kept)}"
-                     f" of {len(kept)} reduced)" if kept else "")
+        kept_text = (f"; in {len(kept)} of them the shear's c is held (the reading's fit, 1 "
+                     "for a literal reading; only the normal stress changes: "
+                     f"{sum(p['reduced'] == 'above' for p in kept)} of {len(kept)} reduced)"
+                     if kept else "")
         whys = _by_value({i: p["why"] for i, p in enumerate(ps) if p["reduced"] == "at"})
         decided = [p for p in ps if p["reduced"] != "at"]
         return (f"{word[s_]} ({s_}): {sum(p['reduced'] == 'above' for p in ps)} of {len(ps)} "
