@@ -143,9 +143,12 @@ def _full_step(x, du, s, free, residual):
     return (xt, rt) if np.all(np.isfinite(rt)) else None
 
 
+SHORTEST_STEP = 1e-3     # a Newton step is backtracked down to this fraction of its length
+
+
 def _backtracked(x, du, rn, s, free, residual):
     """``x + alpha du`` and its residual, alpha halved from 1 until the largest free residual
-    falls below ``rn`` (or alpha below 1e-3). Where even the shortest step inverts a
+    falls below ``rn`` (or alpha below SHORTEST_STEP). Where even the shortest step inverts a
     tetrahedron the Newton direction leaves the admissible states at this load: a
     ConvergenceError, so that a caller may split the load more finely."""
     alpha = 1.0
@@ -154,13 +157,13 @@ def _backtracked(x, du, rn, s, free, residual):
         xt.ravel()[free] += alpha * du
         try:
             rt = residual(xt, s)
-            if np.abs(rt[free]).max() < rn or alpha < 1e-3:
+            if np.abs(rt[free]).max() < rn or alpha < SHORTEST_STEP:
                 return xt, rt
         except DegenerateTetError as exc:
-            if alpha < 1e-3:
+            if alpha < SHORTEST_STEP:
                 raise ConvergenceError(
-                    f"{exc}: every Newton step down to 1e-3 of its length inverts it at this "
-                    "load; increase load_steps") from exc
+                    f"{exc}: every Newton step down to {SHORTEST_STEP:g} of its length inverts "
+                    "it at this load; increase load_steps") from exc
         alpha *= 0.5
 
 

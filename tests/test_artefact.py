@@ -1137,3 +1137,38 @@ def test_a_pattern_that_follows_the_split_and_not_the_patch_error_is_named_so():
     assert world(0.0005, 0.3)["follows"] == "split"
     assert world(0.015, 0.05)["follows"] == "error"
     assert world(0.015, 0.3)["follows"] == "not decided"
+
+
+def test_the_mesh_pick_names_the_mirrored_split_only_where_a_part_is_the_mirrors_and_none_on_every_split():
+    """The mesh pick avoids the mirrored five split where some resolved part (layer mean, side
+    nodes or FEM P1's own) is the mirror's and none is on every split, with the counts and the
+    median node-level ratio over the larger control; where a part is on every split, or none
+    is the mirror's, it names no split."""
+    row = {"resolved": "above", "rms": 2e-3, "controls": {SIX: (1e-5, 1e-6), BCC: (2e-5, 1e-6)},
+           "mirror_vs": "above"}
+    nodes = {"units": [{"n": 17, "bc": "sliding", "rows": [row]}], "slopes": {}}
+    said = analysis.mesh_pick(10, 4, 0, ["17 clamped"], nodes)
+    assert said.startswith("a conforming split without the mirror (six or bcc), not the "
+                           "mirrored five: of the resolved period-2 parts of the layer mean 4 "
+                           "of 10 are the mirror's")
+    assert "at the side nodes 1 of 1 resolved parts are" in said and "17 sliding 100" in said
+    assert "FEM P1's own on 17 clamped" in said
+    assert analysis.mesh_pick(10, 4, 1, ["17 clamped"], nodes) is None
+    empty = {"units": [], "slopes": {}}
+    assert analysis.mesh_pick(10, 0, 0, [], empty) is None
+
+
+def test_the_index_picks_a_mesh_from_the_full_artefact_run_only(tmp_path):
+    """The index's pick list carries the artefact study's mesh pick from a full run, never
+    from a quick one."""
+    from cases.reporting.answers import recommendation
+    folder = tmp_path / "artefact"
+    folder.mkdir()
+    for quick in (False, True):
+        (folder / "metrics.json").write_text(json.dumps(
+            {"parameters": {"quick": quick}, "answer": {"mesh_pick": "six or bcc"}}))
+        lines = recommendation(tmp_path, ["a"], [], False, {})
+        picked = [x for x in lines if x.startswith("- Meshing a cube lattice")]
+        assert picked == ([] if quick else [
+            "- Meshing a cube lattice for a particle model (the bulge/neck pattern; "
+            "[artefact study](artefact/report.md)): six or bcc."])

@@ -18,7 +18,7 @@ G. Szekely and M. Harders, "Identification of spring parameters for deformable o
 simulation", IEEE TVCG 13(5), 2007, who fit spring stiffnesses to a FEM stiffness matrix;
 the springs' own rule is A. van Gelder's (J. Graphics Tools 3(2), 1998; model/terms/springs.py).
 """
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 from scipy.optimize import least_squares
@@ -52,6 +52,7 @@ class Problem:
     settings: object
     mesh: object
     ref: object
+    _targets: dict = field(default_factory=dict, repr=False, compare=False)
 
     @property
     def name(self):
@@ -59,15 +60,18 @@ class Problem:
 
     def target(self, against):
         """(displacement [m], reaction along the driven axis [N] or None, quantities) of
-        the reference ``against`` names (AGAINST)."""
+        the reference ``against`` names (AGAINST), derived once (every evaluation of the fit
+        reads it)."""
         if against == "continuum":
             return self.ref.p2.u, self.ref.reaction, self.ref.quantities
-        p1 = self.ref.p1
-        driven = self.case.driven(self.mesh, self.bc, self.settings)
-        reaction = None if driven is None else float(reaction_along(p1.reaction, driven))
-        q = (self.case.quantities(self.mesh, p1.u, p1.reaction, self.settings, self.bc)
-             if self.case.qoi_errors else {})
-        return p1.u, reaction, q
+        if against not in self._targets:
+            p1 = self.ref.p1
+            driven = self.case.driven(self.mesh, self.bc, self.settings)
+            reaction = None if driven is None else float(reaction_along(p1.reaction, driven))
+            q = (self.case.quantities(self.mesh, p1.u, p1.reaction, self.settings, self.bc)
+                 if self.case.qoi_errors else {})
+            self._targets[against] = (p1.u, reaction, q)
+        return self._targets[against]
 
 
 def fitted_terms(spec):

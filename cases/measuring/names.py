@@ -13,29 +13,28 @@ def unit_suffix(name):
     return max((x for x in UNIT_SUFFIXES if name.endswith(x)), key=len, default=None)
 
 
+def _split(name):
+    """(stem, unit suffix or '') of ``name``."""
+    unit = unit_suffix(name) or ""
+    return name[:len(name) - len(unit)], unit
+
+
 def ref_name(name):
     """The run key of the FEM value of quantity ``name``: '_fem' before a unit suffix
     (bulge_profile_mm -> bulge_profile_fem_mm, paper_pattern -> paper_pattern_fem)."""
-    for unit in UNIT_SUFFIXES:
-        if name.endswith(unit):
-            return name[:-len(unit)] + "_fem" + unit
-    return name + "_fem"
+    stem, unit = _split(name)
+    return stem + "_fem" + unit
 
 
 def load_name(name):
     """The run key of quantity ``name`` at the case's load (the finite-strain solve):
     '_at_load' before a unit suffix (tip_deflection_mm -> tip_deflection_at_load_mm); its
     continuum value is ``ref_name`` of it."""
-    for unit in UNIT_SUFFIXES:
-        if name.endswith(unit):
-            return name[:-len(unit)] + "_at_load" + unit
-    return name + "_at_load"
+    stem, unit = _split(name)
+    return stem + "_at_load" + unit
 
 
 def err_name(name):
     """The run key of the relative error of quantity ``name`` (tip_deflection_mm ->
     tip_deflection_rel_err)."""
-    for unit in UNIT_SUFFIXES:
-        if name.endswith(unit):
-            return name[:-len(unit)] + "_rel_err"
-    return name + "_rel_err"
+    return _split(name)[0] + "_rel_err"

@@ -31,6 +31,8 @@ distinct ones."""
 import numpy as np
 from scipy.stats import spearmanr
 
+from model.static import SHORTEST_STEP
+
 from ...reporting.document import fmt
 from ...library import paper_cube as P
 from ...measuring.metrics import ALTERNATION_CLEAR, nyquist_weights
@@ -1509,7 +1511,7 @@ def answer(cells, models=None, estimates=None):
                      sum(len(v) for v in mirrored.values()), against_, fem_units, nodes)
     across = consistency_across(every)
     across_said = across_text(across)
-    nodes_said = node_text(nodes)
+    nodes_said, lead_nodes = node_text(nodes), node_lead(nodes)
 
     def sign_text(s_):
         # the configuration (one mesh pair) is the unit: per configuration, its model parts
@@ -1619,7 +1621,7 @@ def answer(cells, models=None, estimates=None):
              "for the mean it is divided by" + (
                  f", whose error estimate (at most {fmt(ref_est, 2)} at the push) moves a part "
                  "by that fraction" if ref_est is not None else "")] if a_holds else []) + (
-        [node_lead(nodes)] if node_lead(nodes) else []) + (
+        [lead_nodes] if lead_nodes else []) + (
         ["a normal-stress term removes it (b)"] if ns["holds"] else []) + (
         ["it tracks the patch-test error (c)"] if cs["holds"] else [])
     lead = (f"Not decided for {paper}; the paper's 374-tetrahedron "
@@ -1732,7 +1734,8 @@ def how_sure(ans, verdict):
            + "".join(f"; {model} on {len(v)} cells: {why[len('failed ('):-1]}"
                      for (model, why), v in built.items())
            + (f"; failed static solves (the push split into up to {SPLITS_TRIED[-1]} equal "
-              "steps, each Newton step backtracked down to 1e-3 of its length; FEM P1 solved "
+              f"steps, each Newton step backtracked down to {SHORTEST_STEP:g} of its length; FEM "
+              "P1 solved "
               f"{control_solved} of these {sum(map(len, by_model.values()))} cells on the same "
               "tetrahedra" + (", so the problem is well posed and the failure the model's"
                               if control_solved == sum(map(len, by_model.values())) else "")

@@ -6,6 +6,7 @@ from pathlib import Path
 
 import numpy as np
 
+from model.static import SHORTEST_STEP
 from ...measuring import catalogue
 from ...measuring.metrics import EXACT_DEGREE, SMOOTH_DECAYS, SMOOTH_WIDTHS
 from ...reporting import figures  # noqa: F401  (selects matplotlib's file backend before pyplot)
@@ -413,7 +414,8 @@ def _mirror(d, doc):
                 + ("" if solved else " (FEM P1 failed the same cell too)")
                 for m, mesh, bc, load, why, solved in failed)
             + f". The study's static solve splits the push into up to {SPLITS_TRIED[-1]} equal "
-            "steps, each Newton step backtracked down to 1e-3 of its length, before it reports "
+            f"steps, each Newton step backtracked down to {SHORTEST_STEP:g} of its length, "
+            "before it reports "
             "a failure; where FEM P1 solves the same cell on the same tetrahedra the problem is "
             "well posed and the failure the model's; these cells have no number.")
     tags = a.get("by_reading") or {}
