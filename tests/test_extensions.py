@@ -399,7 +399,8 @@ def test_a_fit_is_judged_against_fem_p1_by_default_and_the_continuum_on_request(
 def test_a_left_out_problem_that_is_a_training_problem_again_is_not_counted_as_left_out():
     """A left-out problem with the training problem's nodes and reference displacement up to a
     factor (a case scaling another's load) is one observation: named, never in the left-out
-    rms or the worst change."""
+    rms or the worst change; the left-out problems are read one by one (the fit carries where
+    every one improves, not where most worsen), and a quick fit says it is a preview."""
     from types import SimpleNamespace as NS
     from cases.cli.fitting import report, same_problem, worst_change
     pts = np.random.default_rng(0).random((5, 3))
@@ -420,4 +421,10 @@ def test_a_left_out_problem_that_is_a_training_problem_again_is_not_counted_as_l
            "against": "p1"}
     text = report(doc).markdown()
     assert "from 0.2 to 0.1" in text and "x/five/clamped (= a)" in text
-    assert "better in 1, worse in 0 of 1" in text
+    assert ("after over before: median 0.5 [0.5-0.5], better in 1, worse in 0 of 1: the fit "
+            "carries to the cases left out" in text)
+    assert "Quick settings: a preview" in text
+    rows[1]["after"] = 0.3
+    doc["quick"] = False
+    text = report(doc).markdown()
+    assert "worse in 1 of 1: the fit does not carry" in text and "Quick settings" not in text

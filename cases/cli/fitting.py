@@ -275,20 +275,28 @@ def report(doc):
     left = [r for r in doc["validate_rows"] if not r.get("twin")]
     vrms = {k: _rms([r[k] for r in left]) for k in ("before", "after")}
     twins = [f"{r['problem']} (= {r['twin']})" for r in doc["validate_rows"] if r.get("twin")]
-    better = [r["after"] < r["before"] for r in left
-              if not isinstance(r["after"], str) and not isinstance(r["before"], str)]
+    factors = [r["after"] / r["before"] for r in left if not isinstance(r["after"], str)
+               and not isinstance(r["before"], str) and r["before"] > 0]
+    failed = sum(isinstance(r["after"], str) for r in left)
+    better = sum(f < 1 for f in factors)
+    # the fit carries where every left-out problem improves, and does not where most worsen
+    # (a failed one counts as worse): read on the problems one by one, never on the rms alone
+    carries = (None if not factors and not failed else "carries" if better == len(left)
+               else "does not carry" if 2 * (len(left) - better) > len(left) else "not decided")
     d.p(f"Fitted on {', '.join(doc['train'])} ({'quick' if doc['quick'] else 'full'} "
         f"settings): the rms error of the training problems goes from "
         f"{fmt(rms['before'])} to {fmt(rms['after'])}"
         + (f"; on the cases left out ({', '.join(doc['validate'])}) from "
            f"{fmt(vrms['before'])} to {fmt(vrms['after'])}" if left else "")
-        + (f" (each left-out problem: better in {sum(better)}, worse in "
-           f"{len(better) - sum(better)} of {len(better)}; the rms of so few problems carries "
-           "no spread, so a change smaller than the problems' own disagreement is not a "
-           "finding)" if better else "")
+        + (f" (each left-out problem's error after over before: median "
+           f"{fmt(float(np.median(factors)), 2)} [{fmt(min(factors), 2)}-"
+           f"{fmt(max(factors), 2)}], better in {better}, worse in {len(left) - better} of "
+           f"{len(left)}" + (f", {failed} failed after the fit" if failed else "")
+           + f": the fit {carries} to the cases left out)" if carries else "")
         + (f"; left out but the same problem as a training one in the linear regime (one "
            f"observation, not counted as left out): {', '.join(twins)}" if twins else "")
-        + ".")
+        + "." + (" Quick settings: a preview; the same `pbcm fit` without --quick decides."
+                 if doc["quick"] else ""))
     worst = worst_change(doc["validate_rows"])
     if worst:
         d.p(f"Worst change on a case left out: {worst['problem']}, from {fmt(worst['before'])} "
