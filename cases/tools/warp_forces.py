@@ -39,6 +39,9 @@ from model.integrate import total_forces
 from model.mesh import cube
 from model.terms.volume import FLAT
 
+from ..framework import MM
+from ..library.common import CUBE_MM
+
 wp.config.quiet = True
 if hasattr(wp.config, "log_level"):      # newer Warp logs its start-up and module loads at INFO
     wp.config.log_level = getattr(wp, "LOG_WARNING", 30)
@@ -431,9 +434,9 @@ def numba_seconds_per_evaluation(pm, x, min_s=0.2):
 
 def bench_mesh(target):
     """The bench's mesh (cases.tools.bench.bench_mesh, which imports this module): the 'five'
-    cube of side 32 mm whose tetrahedron count is closest to ``target``."""
+    cube of the paper's side whose tetrahedron count is closest to ``target``."""
     k = max(1, round((target / 5.0) ** (1.0 / 3.0)))
-    return cube(k + 1, 0.032, "five")
+    return cube(k + 1, CUBE_MM * MM, "five")
 
 
 def time_model(pm, device, dtypes=DTYPES, seed=0, min_s=0.2):
