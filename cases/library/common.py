@@ -14,6 +14,12 @@ CUBE_BCS = ("clamped", "sliding")    # the compressed cube's bases
 CUBE_MM = 32.0                        # the paper's cube: its side, every cube case's
 
 
+def layers_mm(nodes_per_side, size_mm=CUBE_MM):
+    """The y-layers of a cube's layer profile [mm]: its lattice's node planes (the paper's five
+    at 0, 8, 16, 24, 32 mm on its 5 x 5 x 5 lattice)."""
+    return np.linspace(0.0, size_mm, nodes_per_side).tolist()
+
+
 def cube_boundary_sets(mesh, bc, size):
     """(driven, lateral, held) of a cube [0, size]^3 [m] pushed down on its top: the top
     nodes, moved in y; what the top holds laterally; and the mapping that holds the rest.

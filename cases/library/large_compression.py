@@ -18,7 +18,7 @@ from . import common
 
 SIZE_MM, NODES = common.CUBE_MM, 5
 PUSH_MM, STEPS = 9.6, 6
-LAYERS_MM = tuple(np.linspace(0.0, SIZE_MM, NODES).tolist())   # the lattice's node planes
+LAYERS_MM = tuple(common.layers_mm(NODES, SIZE_MM))
 ENERGY_STEP = 1e-3     # the energy's central difference: this fraction of the push
 
 

@@ -65,7 +65,7 @@ class Config(Settings):
         Selections (meshes, models) are not part of it."""
         return {"E_Pa": self.E, "nu": self.nu, "rho_kg_m3": self.rho, "size_mm": SIZE_MM,
                 "nodes_per_side": self.nodes_per_side, "push_mm": self.push_mm,
-                "speed_mm_s": SPEED_MM_S, "layers_mm": layers_mm(self.nodes_per_side),
+                "speed_mm_s": SPEED_MM_S, "layers_mm": common.layers_mm(self.nodes_per_side),
                 "p2_levels": self.p2_levels, "modal_refine": self.modal_refine,
                 "transient_element": self.transient_element,
                 "damping_1_s": self.damping, "rk4_safety": self.safety,
@@ -81,13 +81,7 @@ def make_mesh(name, nodes_per_side=NODES_PER_SIDE):
     return cube(nodes_per_side, SIZE_MM * MM, name)
 
 
-def layers_mm(nodes_per_side):
-    """The y-layers of the layer profile: the lattice's node planes (the paper's five at 0, 8,
-    16, 24, 32 mm on its 5 x 5 x 5 lattice)."""
-    return np.linspace(0.0, SIZE_MM, nodes_per_side).tolist()
-
-
-LAYERS_MM = tuple(layers_mm(NODES_PER_SIDE))     # the paper's own five layers
+LAYERS_MM = tuple(common.layers_mm(NODES_PER_SIDE))     # the paper's own five layers
 
 
 def apparent_poisson(profile, push_mm):
@@ -230,8 +224,8 @@ class PaperCube(Case):
         return boundary_sets(mesh, bc)[0], 1
 
     def quantities(self, mesh, u, reaction, s, bc):
-        profile = M.layer_profile(mesh.points, u, [y * MM for y in layers_mm(s.nodes_per_side)],
-                                  SIZE_MM * MM)
+        layers = [y * MM for y in common.layers_mm(s.nodes_per_side)]
+        profile = M.layer_profile(mesh.points, u, layers, SIZE_MM * MM)
         return {"bulge_profile_mm": (profile / MM).tolist(),
                 # the paper's pattern is one of five layers (its lattice)
                 "paper_pattern": M.paper_pattern(profile) if len(profile) == 5 else None,

@@ -16,6 +16,7 @@ from ...measuring import metrics as M
 from ...framework import (DEFAULT_E, DEFAULT_NU, DEFAULT_RHO, FINDINGS, LOAD_SPLITS,
                           material_record, solve_split)
 from ...library import paper_cube as P
+from ...library.common import layers_mm
 from ...running.progress import Progress
 from ...running.runner import free_components, jsonable
 from ...running.store import OFF, key
@@ -256,7 +257,7 @@ def cell(pm, mesh, n, bc, load, u_ref):
     """One cell: the model's static layer profile (``n`` node planes), the reference's
     (``u_ref`` (n_nodes, 3) [m], the continuum at the mesh's nodes) on the same nodes, the
     alternation and the displacement error over the free components."""
-    layers = [y * P.MM for y in P.layers_mm(n)]
+    layers = [y * P.MM for y in layers_mm(n)]
     dirichlet = P.static_bc(mesh, bc, push_mm(load))
     size = P.SIZE_MM * P.MM
     ref_profile = M.layer_profile(mesh.points, u_ref, layers, size) / P.MM
