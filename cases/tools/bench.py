@@ -25,7 +25,7 @@ from model.integrate import STEP_BUFFERS, rk4_ramp, total_forces
 from model.candidates import CANDIDATES
 from model.mesh import cube
 
-from ..framework import MM
+from ..framework import DEFAULT_E, DEFAULT_NU, DEFAULT_RHO, MM
 from ..library.common import CUBE_MM
 from ..reporting import figures
 from ..running import stop
@@ -209,7 +209,7 @@ def run(sizes=SIZES, models=None, rounds=7, progress=print, with_engines=True, d
     if with_engines and any(e.installed() for e in ENGINES.values()) \
             and ENGINE_REFERENCE not in timed_models:
         timed_models.append(ENGINE_REFERENCE)
-    mat = Material(10e3, 0.45, 1000.0)
+    mat = Material(DEFAULT_E, DEFAULT_NU, DEFAULT_RHO)
     for name in timed_models:   # load every module once, so that memory counts the model only
         build(name, bench_mesh(1), mat)
     rows, engine_rows, engines, device_rows = [], [], {}, []
