@@ -215,7 +215,8 @@ def test_report_draws_each_metric_against_each_axis(serial):
     for metric in ("reaction_ratio", "apparent_poisson"):
         assert (out / f"sweep_{metric}_vs_nu.png").is_file()
         assert f"![{metric} against nu](sweep_{metric}_vs_nu.png)" in text
-    assert "apparent_poisson: closest to FEM P2 over the sweep fem-linear" in text
+    assert "apparent_poisson: the total error against the converged continuum" in text
+    assert "closest" not in text and "farthest" not in text
 
 
 def test_a_rerun_resumes_and_rewrites_the_same_files(serial, tmp_path):
@@ -286,10 +287,19 @@ def test_findings_measure_each_model_against_its_target():
     # msm: |1.1 - 1| = 0.1 and |0.6 - 1| = 0.4, mean 0.25, worst 0.4 at nu 0.4; grows 4x
     assert body[0] == ["msm", 2, "0.25", "0.4", "nu 0.4", "0.1", "0.4"]
     assert body[1][:4] == ["fem-linear", 2, "0.01", "0.02"]
-    assert sentences[0].startswith("reaction_ratio: closest to 1 (FEM P2) over the sweep "
-                                   "fem-linear (mean |deviation| 0.01), farthest msm (0.25)")
+    assert sentences[0].startswith("reaction_ratio: the total error against the converged "
+                                   "continuum")
+    assert "ranks no model" in sentences[0]
     assert sentences[1] == ("reaction_ratio: the mean |deviation| grows by more than 1.25x "
                             "from nu = 0 to nu = 0.4: msm 0.1 -> 0.4, fem-linear 0 -> 0.02.")
+    # the patch test (sliding) and the clamped cube are never pooled: one block each
+    both = [{**r, "bc": bc} for r in rows for bc in ("clamped", "sliding")]
+    said, header, body = report.findings("reaction_ratio", both, spec, ["msm", "fem-linear"])
+    assert header[0] == "population" and [b[0] for b in body] == ["clamped"] * 2 + ["sliding"] * 2
+    assert body[0][1:] == ["msm", 2, "0.25", "0.4", "nu 0.4", "0.1", "0.4"]
+    assert any(x.startswith("reaction_ratio on sliding: the mean |deviation| grows") for x in said)
+    # a model-form error is named as such
+    assert report.kind("disp_rel_l2_p1", ("0", None)).startswith("the model-form error")
     # with an FEM column the target is FEM's value, row by row
     rows = [{"case": "paper-cube", "model": "msm", "nu": 0.4, "apparent_poisson": 0.16,
              "apparent_poisson_fem": 0.4}]

@@ -22,6 +22,7 @@ from ...running.output import write_atomic  # noqa: E402
 MAX_PANELS = 12       # more combinations of the other axes than this: the first ones drawn
 MAX_FAILURES = 40     # failed runs listed one by one; the rest counted
 CHANGE = 1.25         # "grows" / "shrinks" along an axis: a change by this factor or more
+ROUND_OFF = 1e-6      # deviations below this at both ends are solver round-off: no trend
 RATIOS = {"reaction_ratio"}   # model over FEM: the target is 1
 ERRORS = ("_rel_err", "_rel_l2", "_rel_l2_p1", "_rel_l2_p2", "_max_rel_p1", "_max_rel_p2")
 LOG_SPAN = 5.0        # a ratio or error spanning this factor is drawn on a log scale
@@ -71,11 +72,58 @@ def _mean(xs):
     return float(np.mean(xs)) if xs else None
 
 
+POPULATION = ("case", "bc")   # runs of one kind: one case under one boundary condition
+
+
+def kind(metric, t):
+    """What the deviation of ``metric`` from its target ``t`` measures, in words."""
+    if metric.endswith(("_p1", "_rel_l2_p1", "_max_rel_p1")):
+        return ("the model-form error (against FEM P1 with the same law on the same "
+                "tetrahedra): what replacing FEM by the model costs")
+    if (t is not None and "FEM P2" in t[0]) or metric.endswith("_p2"):
+        return ("the total error against the converged continuum (FEM P2 refined), the "
+                "mesh's own discretisation error included: a model whose error cancels "
+                "P1's scores well, so this is not a ranking of models")
+    return "the deviation from its target"
+
+
+def populations(rows, spec):
+    """[(label, rows)] of the runs grouped by case and boundary condition where the sweep has
+    more than one of them (a patch test is never pooled with a clamped cube); one group,
+    labelled '', otherwise."""
+    keys = [a for a in POPULATION if len({r.get(a) for r in rows}) > 1]
+    if not keys:
+        return [("", rows)]
+    groups = {}
+    for r in rows:
+        groups.setdefault(tuple(str(r.get(a)) for a in keys), []).append(r)
+    return [("/".join(k), g) for k, g in groups.items()]
+
+
 def findings(metric, rows, spec, models):
-    """(sentences, table header, table rows) on one metric over the sweep."""
-    axes = [a for a in ["case"] + spec.swept() if a != "model"]
-    if "case" not in spec.swept() and len(spec.cases) < 2:
-        axes.remove("case")
+    """(sentences, table header, table rows) on one metric over the sweep: one block of rows
+    and sentences per population (case and boundary condition), none pooled."""
+    pops = populations(rows, spec)
+    if len(pops) == 1:
+        return _findings(metric, rows, spec, models, "")
+    out, header, body = [], None, []
+    t = target(metric, rows)
+    if t is not None:
+        out.append(f"{metric}: {kind(metric, t)}; each model's mean |deviation| from {t[0]} "
+                   "per case and boundary condition is in the table, never pooled across "
+                   "them; the runs carry no uncertainty, so the sweep ranks no model.")
+    for label, group in pops:
+        said, h, b = _findings(metric, group, spec, models, label, lead=False)
+        out += said
+        header = ["population"] + h
+        body += [[label] + line for line in b]
+    return out, header, body
+
+
+def _findings(metric, rows, spec, models, label, lead=True):
+    """findings() on the rows of one population, its sentences prefixed with ``label``."""
+    axes = [a for a in ["case"] + spec.swept() if a not in ("model", *POPULATION)]
+    pre = f"{metric} on {label}" if label else metric
     t = target(metric, rows)
     if t is None:
         header = ["model", "runs", "min", "max"]
@@ -87,8 +135,8 @@ def findings(metric, rows, spec, models):
                 lo, hi = min(vs, key=lambda p: p[0]), max(vs, key=lambda p: p[0])
                 body.append([m, len(vs), f"{fmt(lo[0])} ({_where(lo[1], axes)})",
                              f"{fmt(hi[0])} ({_where(hi[1], axes)})"])
-        return [f"{metric} has no target (no FEM value, not a ratio or an error): its range "
-                "per model."], header, body
+        return ([f"{pre} has no target (no FEM value, not a ratio or an error): its range "
+                 "per model."] if lead or not label else []), header, body
     dev = deviations(metric, rows)
     numeric = [a for a in spec.swept() if a in NUMERIC_AXES]
     ends = {a: _ends(a, rows, spec) for a in numeric}
@@ -108,29 +156,29 @@ def findings(metric, rows, spec, models):
             line += [fmt(at[0]), fmt(at[1])]
             if None not in at:
                 said = f"{m} {fmt(at[0])} -> {fmt(at[1])}"
-                if at[1] > CHANGE * at[0] and at[1] > 1e-12:
+                if max(at) < ROUND_OFF:
+                    continue
+                if at[1] > CHANGE * at[0]:
                     trend[a][0].append(said)
                 elif at[1] * CHANGE < at[0]:
                     trend[a][1].append(said)
         body.append(line)
-    ranked = sorted((_mean([x for x, _ in d]), m) for m, d in dev.items())
     out = []
-    if ranked:
-        out.append(f"{metric}: closest to {t[0]} over the sweep {ranked[0][1]} (mean "
-                   f"|deviation| {fmt(ranked[0][0])}), farthest {ranked[-1][1]} "
-                   f"({fmt(ranked[-1][0])}).")
+    if lead and dev:
+        out.append(f"{pre}: {kind(metric, t)}; each model's mean |deviation| from {t[0]} is "
+                   "in the table; the runs carry no uncertainty, so the sweep ranks no model.")
     for a in numeric:
         grows, shrinks = trend[a]
         first, last = map(fmt, ends[a])
         if grows:
-            out.append(f"{metric}: the mean |deviation| grows by more than {CHANGE:g}x from "
+            out.append(f"{pre}: the mean |deviation| grows by more than {CHANGE:g}x from "
                        f"{a} = {first} to {a} = {last}: " + ", ".join(grows) + ".")
         if shrinks:
-            out.append(f"{metric}: it shrinks by more than {CHANGE:g}x from {a} = {first} to "
+            out.append(f"{pre}: it shrinks by more than {CHANGE:g}x from {a} = {first} to "
                        f"{a} = {last}: " + ", ".join(shrinks) + ".")
     if t[0] == "FEM P2":
         fem = ref_name(metric)
-        out += [f"{metric}: {m} {text}" for m in models
+        out += [f"{pre}: {m} {text}" for m in models
                 for text in _unfollowed(metric, fem, rows, spec, m, numeric)
                 + _opposite(metric, fem, rows, m, axes)]
     return out, header, body
@@ -353,4 +401,5 @@ def write(spec, rows, out, registry, table_path):
     return names
 
 
-__all__ = ["write", "findings", "target", "deviations", "figure", "MissingMetric"]
+__all__ = ["write", "findings", "populations", "kind", "target", "deviations", "figure",
+           "MissingMetric"]
