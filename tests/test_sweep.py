@@ -198,6 +198,12 @@ def test_a_blown_up_dynamic_run_is_a_partial_row():
                                "dyn_failed": None}, "k", 1.0)["status"] == "ok"
 
 
+def test_the_table_holds_no_timing_so_the_same_sweep_writes_the_same_table(serial):
+    """The table records what determines and measures each run, never how long it took."""
+    rows = table.read(serial[1] / "table.csv")
+    assert rows and not set(rows[0]) & TIMING
+
+
 def test_apparent_poisson_of_linear_fem_on_the_sliding_base_is_nu(serial):
     """Uniaxial stress: the lateral strain is -nu times the axial one, exactly for P1 and
     P2 (the solution is linear), so the FEM reference and the fem-linear model show nu."""

@@ -54,12 +54,17 @@ def cell(v):
     return json.dumps(v, sort_keys=True) if isinstance(v, (list, dict, tuple)) else v
 
 
+# how long a run took says where it ran, not what it gave: kept in its runs/<key>/metrics.json,
+# left out of the table, so that the same sweep writes the same table wherever it runs
+TIMING = ("task_wall_s",)
+
+
 def write(rows, folder, kind, first=()):
-    """Write ``rows`` as ``folder/table.parquet`` or ``folder/table.csv`` (``kind`` auto:
-    Parquet when pyarrow is present); return the path."""
+    """Write ``rows`` (less their TIMING columns) as ``folder/table.parquet`` or
+    ``folder/table.csv`` (``kind`` auto: Parquet when pyarrow is present); return the path."""
     if kind == "auto":
         kind = "parquet" if parquet_available() else "csv"
-    cols = columns(rows, first)
+    cols = [c for c in columns(rows, first) if c not in TIMING]
     table = [[cell(r.get(c)) for c in cols] for r in rows]
     if kind == "parquet":
         path = Path(folder) / "table.parquet"
