@@ -65,11 +65,14 @@ class Material:
         return math.sqrt((self.K + 4.0 * self.G / 3.0) / self.rho)
 
 
-def lame(E, nu):
-    """The Lame parameters (lambda, mu) of Young's modulus ``E`` [Pa] and Poisson's ratio
-    ``nu``, checked as a :class:`Material` checks them: how a function that takes the two
-    loose (the FEM references) gets its constants."""
-    return Material(E, nu).lame
+def as_material(value, who):
+    """``value`` when it is a :class:`Material`; otherwise a MaterialError naming ``who`` (the
+    function that takes it): every reference takes the one Material, checked once where it is
+    made, never loose constants."""
+    if isinstance(value, Material):
+        return value
+    raise MaterialError(f"{who} takes a model.material.Material (E [Pa], nu, rho [kg/m^3]), "
+                        f"got {type(value).__name__} {value!r}: pass Material(E=..., nu=...)")
 
 
 # ---------------------------------------------------------------- the compressible neo-Hookean law

@@ -11,13 +11,15 @@ def uniaxial_sliding(points, strain, nu, axis=1):
     return u
 
 
-def self_weight(points, E, nu, rho, g, height, axis=1):
-    """Exact 3-D solution of a prismatic block standing on its base x_axis = 0, top
-    x_axis = height traction-free, lateral faces free, under gravity g [m/s^2] along -axis:
-    sigma_aa = rho g (x_a - height), all other stresses zero. Lateral axes centred on 0."""
+def self_weight(points, material, g, height, axis=1):
+    """Exact 3-D solution of a prismatic block of ``material`` (a model.material.Material)
+    standing on its base x_axis = 0, top x_axis = height traction-free, lateral faces free,
+    under gravity g [m/s^2] along -axis: sigma_aa = rho g (x_a - height), all other stresses
+    zero. Lateral axes centred on 0."""
     p = np.asarray(points, dtype=float)
     z = p[:, axis]
     lat = [k for k in range(3) if k != axis]
+    E, nu, rho = material.E, material.nu, material.rho
     c = rho * g / E
     u = np.empty_like(p)
     u[:, axis] = c * (0.5 * z**2 - height * z) + 0.5 * nu * c * (p[:, lat] ** 2).sum(axis=1)
@@ -32,16 +34,16 @@ def self_weight_stress(points, rho, g, height, axis=1):
     return s
 
 
-def cantilever_tip_deflection(force, length, width, height, E, nu, kappa=5 / 6):
+def cantilever_tip_deflection(force, length, width, height, material, kappa=5 / 6):
     """Tip deflection of a clamped rectangular beam under an end shear force: Euler-Bernoulli
     bending P L^3 / (3 E I) plus Timoshenko shear P L / (kappa G A), bending about the
     width axis (I = width height^3 / 12)."""
     I = width * height**3 / 12
-    G = E / (2 * (1 + nu))
+    E, G = material.E, material.G
     return force * length**3 / (3 * E * I) + force * length / (kappa * G * width * height)
 
 
-def cantilever_first_frequency(length, width, height, E, nu, rho, kappa=5 / 6):
+def cantilever_first_frequency(length, width, height, material, kappa=5 / 6):
     """First bending frequency [Hz] of a clamped-free rectangular beam, bending across
     ``height``: Euler-Bernoulli (beta L = 1.87510) with the Timoshenko first-order correction
     for shear and rotary inertia, omega = omega_EB / sqrt(1 + (beta r)^2 (1 + E / (kappa G)))
@@ -49,7 +51,7 @@ def cantilever_first_frequency(length, width, height, E, nu, rho, kappa=5 / 6):
     supported beam, an approximation here; about 1 % at length / height 10)."""
     bl = 1.8751040687
     I, A = width * height**3 / 12, width * height
-    G = E / (2 * (1 + nu))
+    E, G, rho = material.E, material.G, material.rho
     omega_eb = bl**2 / length**2 * np.sqrt(E * I / (rho * A))
     r2 = I / A
     omega = omega_eb / np.sqrt(1 + (bl / length) ** 2 * r2 * (1 + E / (kappa * G)))

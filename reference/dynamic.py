@@ -17,7 +17,7 @@ import scipy.sparse as sp
 
 from model.bc import bc_arrays
 from model.errors import ModelError
-from model.material import Material
+from model.material import as_material
 from .assembly import stiffness
 from .discretisation import dirichlet_dofs, dof_hats, element_basis, skfem_mesh
 from .linear import body_load, dof_component
@@ -47,12 +47,13 @@ class DynamicResult:
     info: dict
 
 
-def solve(mesh, E, nu, rho, dirichlet_of_t, t_end, dt=None, damping=0.0, element="P1",
+def solve(mesh, material, dirichlet_of_t, t_end, dt=None, damping=0.0, element="P1",
           mass="consistent", u0=None, v0=None, body_force=None, frames=None, method="newmark"):
     """Integrate from rest (or ``u0``, ``v0`` (n, 3) at the input nodes) to ``t_end`` [s].
 
     Parameters
     ----------
+    material : the model.material.Material (E [Pa], nu, rho [kg/m^3]).
     dirichlet_of_t : callable t -> mapping node -> (ux, uy, uz) (None for a free component),
         the same ``bc_of_t`` the particle model takes (e.g. ``model.bc.Ramp``); the set of
         prescribed components must not change. P2 midpoints follow
@@ -73,7 +74,8 @@ def solve(mesh, E, nu, rho, dirichlet_of_t, t_end, dt=None, damping=0.0, element
     """
     if method not in ("newmark", "modal"):
         raise ModelError(f"method must be 'newmark' or 'modal', got {method!r}")
-    lam, mu = Material(E, nu, rho).lame
+    material = as_material(material, "reference.dynamic.solve")
+    lam, mu, rho = *material.lame, material.rho
     if mass not in ("consistent", "lumped"):
         raise ModelError(f"mass must be 'consistent' or 'lumped', got {mass!r}")
     if not (math.isfinite(t_end) and t_end > 0):

@@ -16,7 +16,7 @@ from skfem import Basis, ElementTetP1, FacetBasis
 
 from model.bc import bc_arrays, load_fractions
 from model.errors import ConvergenceError, ModelError
-from model.material import lame
+from model.material import as_material
 from ._neohookean import neohookean
 from .assembly import scalar_gradients
 from .discretisation import (INTORDER, dirichlet_dofs, element_basis, parent_of, probe,
@@ -137,7 +137,7 @@ class Discretisation:
                 + p * np.eye(3)[:, :, None, None]) / J
 
 
-def solve(mesh, E, nu, dirichlet, body_force=None, element="P1", refine=0, dirichlet_fn=None,
+def solve(mesh, material, dirichlet, body_force=None, element="P1", refine=0, dirichlet_fn=None,
           load_steps=1, rtol=1e-10, max_iter=30, on_step=None, mixed=False, traction=None,
           keep_steps=(), start=None):
     """Neo-Hookean equilibrium on ``mesh`` (a model.mesh.TetMesh) refined ``refine`` times.
@@ -159,7 +159,8 @@ def solve(mesh, E, nu, dirichlet, body_force=None, element="P1", refine=0, diric
     where no step is reported or kept): Newton starts from its field, interpolated here, and
     takes the whole load at once; where that does not converge or inverts an element, the
     load steps run from rest as without it. The solution is the same to the tolerance."""
-    lam, mu = lame(E, nu)
+    material = as_material(material, "reference.hyperelastic.solve")
+    lam, mu = material.lame
     if mixed and element != "P2":
         raise ModelError(f"the mixed (u, p) form is Taylor-Hood P2/P1: pass element='P2', got "
                          f"{element!r}")
@@ -187,7 +188,7 @@ def solve(mesh, E, nu, dirichlet, body_force=None, element="P1", refine=0, diric
     I = np.flatnonzero(~prescribed)
     Iu, Ip = I[I < ub.N], I[I >= ub.N]
     h = np.linalg.norm(np.diff(m.p[:, m.edges], axis=1), axis=0).mean()
-    floor_u, floor_p = rtol * E * h * h, rtol * h ** 3
+    floor_u, floor_p = rtol * material.E * h * h, rtol * h ** 3
     x = np.zeros(d.N)
     target = np.zeros(d.N)
     target[D] = x_D[D]
@@ -372,33 +373,34 @@ def forcing(rn, rn_last, floor):
                      1e-10))
 
 
-def uniaxial(stretch, E, nu):
+def uniaxial(stretch, material):
     """The law in homogeneous uniaxial stretch with free lateral faces: (lateral stretch l,
     nominal axial stress P [Pa]). The lateral faces are free when mu (l - 1/l) +
     lam ln(J) / l = 0 with J = stretch l^2; then P = mu (stretch - 1/stretch) +
     lam ln(J) / stretch (negative in compression)."""
     if not (np.isfinite(stretch) and stretch > 0):
         raise ModelError(f"a stretch must be a finite number > 0, got {stretch!r}")
-    lam, mu = lame(E, nu)
+    lam, mu = as_material(material, "reference.hyperelastic.uniaxial").lame
     lat = brentq(lambda t: mu * (t - 1 / t) + lam * np.log(stretch * t * t) / t,
                  stretch ** -0.5 * 1e-3, stretch ** -0.5 * 1e3)
     return float(lat), float(mu * (stretch - 1 / stretch)
                              + lam * np.log(stretch * lat * lat) / stretch)
 
 
-def converged(mesh, E, nu, dirichlet, levels=1, element="P2", mixed=True, **kw):
+def converged(mesh, material, dirichlet, levels=1, element="P2", mixed=True, **kw):
     """Solve on ``mesh`` refined 0..levels times and estimate the error of the finest, as
     ``reference.linear.converged`` does: the relative changes of the nodal displacement and
     of the stored energy between levels give an observed rate and a Richardson estimate; the
     larger of the two estimates is the reference's. ``mixed`` True, False or "auto" (mixed
     above nu = MIXED_ABOVE_NU); ``kw`` as :func:`solve` takes them."""
+    material = as_material(material, "reference.hyperelastic.converged")
     if mixed == "auto":
-        mixed = nu > MIXED_ABOVE_NU
+        mixed = material.nu > MIXED_ABOVE_NU
     if levels < 1:
         raise ModelError(f"converged needs levels >= 1 to estimate its error, got {levels}")
     sols = []
     for k in range(levels + 1):     # each level started from the one before (nested)
-        sols.append(solve(mesh, E, nu, dirichlet, element=element, mixed=mixed, refine=k,
+        sols.append(solve(mesh, material, dirichlet, element=element, mixed=mixed, refine=k,
                           start=sols[-1] if sols else None, **kw))
     return converged_from(sols)
 

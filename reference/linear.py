@@ -9,7 +9,7 @@ from skfem.models.elasticity import linear_stress
 
 from model.bc import bc_arrays
 from model.errors import ModelError
-from model.material import lame
+from model.material import as_material
 from .assembly import stiffness
 from .discretisation import (INTORDER, dirichlet_dofs, dof_hats, element_basis, probe,
                              refine_with_data, skfem_mesh)
@@ -81,12 +81,13 @@ def traction_load(facet_basis, fn):
     return _assemble_load(facet_basis, fn, "traction", normals=True)
 
 
-def solve(mesh, E, nu, dirichlet, body_force=None, traction=None, element="P1", refine=0,
+def solve(mesh, material, dirichlet, body_force=None, traction=None, element="P1", refine=0,
           dirichlet_fn=None, solver="auto"):
     """Linear elastic equilibrium on ``mesh`` (a model.mesh.TetMesh).
 
     Parameters
     ----------
+    material : the model.material.Material (E [Pa], nu; rho is not read).
     dirichlet : mapping node -> (ux, uy, uz), None for a free component (as the model takes).
     body_force : (3,) force per unit volume [N/m^3], e.g. rho * g, or a callable
         ``points (..., 3) -> (..., 3)`` (plain ndarrays, evaluated once per quadrature point).
@@ -102,7 +103,7 @@ def solve(mesh, E, nu, dirichlet, body_force=None, traction=None, element="P1", 
         interpolation when None (see ``reference.discretisation.prescribed_edges``).
     solver : "auto", "direct" or "amg" (see ``reference.solvers.linear_solve``).
     """
-    lam, mu = lame(E, nu)
+    lam, mu = as_material(material, "reference.linear.solve").lame
     n = mesh.n_nodes
     mask, vals = bc_arrays(dirichlet, n)
     if not mask.any():
@@ -144,11 +145,11 @@ def solve(mesh, E, nu, dirichlet, body_force=None, traction=None, element="P1", 
                               **sinfo}, basis=basis, dofs=u_all)
 
 
-def p1_stiffness(mesh, E, nu):
+def p1_stiffness(mesh, material):
     """The linear elastic P1 stiffness (3n x 3n, CSR) on ``mesh``'s own tetrahedra, its rows
     and columns node-major (u.ravel() of an (n, 3) field): the energy norm ||v||_K of the
     continuum's energy of a nodal field's P1 interpolant, v.K v = 2 x that energy."""
-    lam, mu = lame(E, nu)
+    lam, mu = as_material(material, "reference.linear.p1_stiffness").lame
     basis = element_basis(skfem_mesh(mesh), "P1")
     order = basis.nodal_dofs.T.ravel()
     return stiffness(basis, lam, mu)[order][:, order].tocsr()
@@ -231,11 +232,11 @@ def estimate(sols, h=None):
     return max(est, est_e), inc, rate, inc_e, rate_e
 
 
-def converged(mesh, E, nu, dirichlet, levels=2, **kw):
+def converged(mesh, material, dirichlet, levels=2, **kw):
     """Solve with P2 on ``mesh`` refined 0..levels times and estimate the error of the finest."""
     if levels < 1:
         raise ModelError(f"converged needs levels >= 1 to estimate its error, got {levels}")
-    return converged_from([solve(mesh, E, nu, dirichlet, element="P2", refine=k, **kw)
+    return converged_from([solve(mesh, material, dirichlet, element="P2", refine=k, **kw)
                            for k in range(levels + 1)])
 
 

@@ -18,7 +18,7 @@ import numpy as np
 from skfem import Basis, Functional
 
 from model.errors import ModelError
-from model.material import lame
+from model.material import Material, as_material
 
 
 @dataclass(frozen=True)
@@ -102,27 +102,28 @@ class Manufactured:
     """A field and a material: the loads that make the field the exact solution."""
 
     field: PlaneWaves
-    material: object          # LinearElastic or NeoHookean
-    E: float
-    nu: float
+    law: object               # LinearElastic or NeoHookean, at the material's constants
+    material: Material
 
     def stress(self, x):
-        return self.material.stress(self.field.grad(x))
+        return self.law.stress(self.field.grad(x))
 
     def body_force(self, x):
         """b(x) = -div S(u) [N/m^3] at points (..., 3), as the references take it."""
-        return -self.material.divergence(self.field.grad(x), self.field.hessian(x))
+        return -self.law.divergence(self.field.grad(x), self.field.hessian(x))
 
     def traction(self, x, n):
         """t(x, n) = S(u) n [Pa] at boundary points and normals (..., 3)."""
         return np.einsum("...ik,...k->...i", self.stress(x), np.asarray(n, float))
 
 
-def manufactured(field, material, E, nu):
-    """The problem of ``field`` for ``material`` ("linear" or "neo-Hookean") at E [Pa], nu."""
-    if material not in MATERIALS:
-        raise ModelError(f"unknown material {material!r}: choose one of {sorted(MATERIALS)}")
-    return Manufactured(field, MATERIALS[material](*lame(E, nu)), float(E), float(nu))
+def manufactured(field, law, material):
+    """The problem of ``field`` for the law ``law`` ("linear" or "neo-Hookean") of the
+    Material ``material``."""
+    if law not in MATERIALS:
+        raise ModelError(f"unknown law {law!r}: choose one of {sorted(MATERIALS)}")
+    material = as_material(material, "reference.manufactured.manufactured")
+    return Manufactured(field, MATERIALS[law](*material.lame), material)
 
 
 def waves(size, amplitude=1e-3):
@@ -193,12 +194,12 @@ def solve(mesh, problem, size, element="P1", mixed=False, faces="xyz", load_step
         return np.where(prescribed_faces(p, size, faces)[:, None], u(p), np.nan)
     kw = dict(body_force=problem.body_force, traction=problem.traction, element=element,
               dirichlet_fn=dirichlet_fn)
-    if isinstance(problem.material, LinearElastic):
+    if isinstance(problem.law, LinearElastic):
         if mixed:
             raise ModelError("the linear reference has no mixed form: pass mixed=False")
-        res = linear.solve(mesh, problem.E, problem.nu, bc, **kw)
+        res = linear.solve(mesh, problem.material, bc, **kw)
     else:
-        res = hyperelastic.solve(mesh, problem.E, problem.nu, bc, mixed=mixed,
+        res = hyperelastic.solve(mesh, problem.material, bc, mixed=mixed,
                                  load_steps=load_steps, start=start, **kw)
     e, n = l2_error(res.basis, res.dofs[:res.basis.N], u)
     return e / n, res

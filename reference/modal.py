@@ -10,7 +10,7 @@ from skfem.helpers import dot
 
 from model.bc import bc_arrays
 from model.errors import ModelError
-from model.material import Material
+from model.material import as_material
 from .assembly import stiffness
 from .discretisation import dirichlet_dofs, element_basis, refine_with_data, skfem_mesh
 
@@ -49,10 +49,11 @@ def lumped(M):
     return sp.diags(d * M.sum() / d.sum()).tocsr()
 
 
-def frequencies(mesh, E, nu, rho, dirichlet, k=6, mass="consistent", element="P2", refine=0):
+def frequencies(mesh, material, dirichlet, k=6, mass="consistent", element="P2", refine=0):
     """The ``k`` lowest eigenfrequencies of the structure clamped by ``dirichlet`` (values
     must be zero there; ``{}`` for free-free, whose six rigid modes come first at 0 Hz)."""
-    lam, mu = Material(E, nu, rho).lame
+    material = as_material(material, "reference.modal.frequencies")
+    lam, mu, rho = *material.lame, material.rho
     if mass not in ("consistent", "lumped"):
         raise ModelError(f"mass must be 'consistent' or 'lumped', got {mass!r}")
     mask, vals = bc_arrays(dirichlet, mesh.n_nodes)

@@ -11,6 +11,7 @@ from cases.measuring import metrics as M
 from cases.cli import main
 from cases.library.paper_cube import LAYERS_MM, SIZE_MM, make_mesh, static_bc
 from cases.reporting.report import TIMING_KEYS
+from model.material import Material
 from model import PRESETS, ModelError
 from reference import linear
 
@@ -116,7 +117,7 @@ def test_fem_against_itself_has_zero_error_and_alternation():
     L = SIZE_MM * 1e-3
     layers = [y * 1e-3 for y in LAYERS_MM]
     for bc in ("clamped", "sliding"):
-        u = linear.solve(mesh, 10e3, 0.45, static_bc(mesh, bc), element="P2").u
+        u = linear.solve(mesh, Material(10e3, 0.45), static_bc(mesh, bc), element="P2").u
         assert M.rel_l2(u, u) == 0 and M.max_rel(u, u) == 0
         profile = M.layer_profile(mesh.points, u, layers, L)
         free = np.ones(len(profile), bool)
@@ -336,7 +337,7 @@ def test_energy_norm_of_a_homogeneous_strain_and_of_rigid_motions():
     E, nu = 10e3, 0.3
     lam, mu = E * nu / ((1 + nu) * (1 - 2 * nu)), E / (2 * (1 + nu))
     mesh = cube(3, 0.02, "six")
-    K = linear.p1_stiffness(mesh, E, nu)
+    K = linear.p1_stiffness(mesh, Material(E, nu))
     eps = np.array([[1.0, 0.3, 0.0], [0.3, -0.5, 0.2], [0.0, 0.2, 0.4]]) * 1e-3
     u = mesh.points @ eps.T
     V = 0.02 ** 3

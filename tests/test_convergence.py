@@ -14,6 +14,7 @@ from cases.cli import main
 from cases.reporting.costs import step_cost_us
 from cases.studies.convergence.cost import pareto
 from cases.studies.convergence.extrapolation import EXACT, extrapolate, fit, observed_order
+from model.material import Material
 from model.mesh import cube
 from reference import linear
 
@@ -203,7 +204,7 @@ def test_reference_is_evaluated_off_its_nodes_by_its_basis():
     A = np.array([[1e-3, 2e-4, 0.0], [0.0, -5e-4, 3e-4], [1e-4, 0.0, 2e-4]])
     bc = {int(i): tuple(A @ m.points[i]) for i in range(m.n_nodes)
           if np.isclose(m.points[i], 0).any() or np.isclose(m.points[i], 0.032).any()}
-    r = linear.solve(m, 10e3, 0.3, bc, element="P2")
+    r = linear.solve(m, Material(10e3, 0.3), bc, element="P2")
     assert np.allclose(r.at(m.points), r.u, atol=1e-15)
     other = cube(4, 0.032, "unstructured").points
     assert np.allclose(r.at(other), other @ A.T, atol=1e-12)
@@ -529,7 +530,7 @@ def test_torsion_at_8_mm_on_five_is_every_models_rigid_turn():
     def off(u):
         return np.linalg.norm((u - rigid).reshape(-1)[free]) / np.linalg.norm(
             rigid.reshape(-1)[free])
-    p1 = linear.solve(mesh, s.E, s.nu, d, element="P1", solver="direct")
+    p1 = linear.solve(mesh, s.material, d, element="P1", solver="direct")
     assert off(p1.u) < 1e-10
     assert off(build("msm", mesh, s.material).solve_static(d, rtol=1e-12).u) < 1e-3
 

@@ -2,6 +2,7 @@
 import numpy as np
 import pytest
 
+from model.material import Material
 from model.bc import Ramp
 from model.errors import MaterialError, ModelError
 from model.mesh import box, cube
@@ -27,13 +28,13 @@ def bar():
 
 def released(bar, element, damping=0.0, periods=2.2, method="newmark"):
     mesh, fixed, pull = bar
-    u0 = linear.solve(mesh, E, 0.0, fixed, traction=pull, element=element).u
+    u0 = linear.solve(mesh, Material(E, 0.0), fixed, traction=pull, element=element).u
     if method == "modal":   # the same frames as the Newmark steps; a Ramp that stays put
-        r = dynamic.solve(mesh, E, 0.0, RHO, Ramp([], (0.0, 0.0, 0.0), 1.0, held=fixed),
+        r = dynamic.solve(mesh, Material(E, 0.0, RHO), Ramp([], (0.0, 0.0, 0.0), 1.0, held=fixed),
                           periods * T, element=element, u0=u0, damping=damping,
                           frames=int(round(periods * 400)) + 1, method="modal")
     else:
-        r = dynamic.solve(mesh, E, 0.0, RHO, lambda t: fixed, periods * T, dt=T / 400,
+        r = dynamic.solve(mesh, Material(E, 0.0, RHO), lambda t: fixed, periods * T, dt=T / 400,
                           element=element, u0=u0, damping=damping)
     tip = r.u[:, np.isclose(mesh.points[:, 0], L), 0].mean(axis=1)
     return r, tip
@@ -85,9 +86,9 @@ def test_slow_push_then_rest_gives_the_static_reaction(element, mass, method):
     top, bottom = mesh.nodes_on_plane("y", 0.032), mesh.nodes_on_plane("y", 0.0)
     held = {int(i): (0.0, 0.0, 0.0) for i in bottom}
     ramp = Ramp(top, (0.0, -0.32e-3, 0.0), 0.2, held=held)
-    r = dynamic.solve(mesh, E, 0.3, RHO, ramp, 1.0, damping=60.0, element=element, mass=mass,
-                      frames=11, method=method)
-    static = linear.solve(mesh, E, 0.3, ramp(1.0), element=element)
+    r = dynamic.solve(mesh, Material(E, 0.3, RHO), ramp, 1.0, damping=60.0, element=element,
+                      mass=mass, frames=11, method=method)
+    static = linear.solve(mesh, Material(E, 0.3), ramp(1.0), element=element)
     assert np.abs(r.u[-1] - static.u).max() < 1e-6 * np.abs(static.u).max()
     assert np.allclose(r.reaction[-1], static.reaction, atol=1e-4 * np.abs(static.reaction).max())
     assert r.reaction[-1][top, 1].sum() < 0          # the supports push the top down
@@ -103,19 +104,19 @@ def test_bad_input():
         args = dict(rho=RHO, t_end=0.01)
         args.update(kw)
         with pytest.raises((ModelError, MaterialError), match=word):
-            dynamic.solve(mesh, E, 0.3, args.pop("rho"), lambda t: held, args.pop("t_end"),
-                          **args)
+            dynamic.solve(mesh, Material(E, 0.3, args.pop("rho")), lambda t: held,
+                          args.pop("t_end"), **args)
     moving = Ramp([1], (0.0, 1e-4, None), 0.01, held=held)
     changing = (lambda t: held if t < 0.005 else moving(t))
     with pytest.raises(ModelError, match="prescribed components"):
-        dynamic.solve(mesh, E, 0.3, RHO, changing, 0.01, dt=1e-3)
+        dynamic.solve(mesh, Material(E, 0.3, RHO), changing, 0.01, dt=1e-3)
 
 
 def test_model_frequencies_of_one_spring_node_by_hand():
     """One tetrahedron of springs (van Gelder: k = E V / L^2), three nodes held: the free node
     vibrates at sqrt(eig(sum k e e^T) / m) / 2 pi, m = rho V / 4; free-free, six springs on
     four nodes leave exactly the six rigid modes."""
-    from model import Material, build
+    from model import build
     from model.mesh import TetMesh
     from cases.library.transient import model_frequencies
     X = 0.01 * np.array([[0.0, 0, 0], [1, 0, 0], [0, 1, 0], [0.2, 0.3, 1]])
@@ -153,7 +154,8 @@ def test_modal_ramp_equals_the_matrix_exponential(zeta):
     push = np.array([1e-4, -0.32e-3])
     T_push, t_end, nu = 0.03, 0.06, 0.3
     ramp = Ramp(top, (push[0], push[1], None), T_push, held=held)
-    r = dynamic.solve(mesh, E, nu, RHO, ramp, t_end, damping=zeta, frames=13, method="modal")
+    r = dynamic.solve(mesh, Material(E, nu, RHO), ramp, t_end, damping=zeta, frames=13,
+                      method="modal")
 
     basis = Basis(skfem_mesh(mesh), ElementVector(ElementTetP1()))
     K = asm(linear_elasticity(*lame_parameters(E, nu)), basis).toarray()
@@ -222,7 +224,7 @@ def test_modal_method_names_what_it_needs():
                            ((free,), {}, "rigid"), ((ramp,), {"method": "euler"}, "method")]:
         kw = {"method": "modal", **kw}
         with pytest.raises(ModelError, match=word):
-            dynamic.solve(mesh, E, 0.3, RHO, *args, 0.02, **kw)
+            dynamic.solve(mesh, Material(E, 0.3, RHO), *args, 0.02, **kw)
 
 
 def test_mac_of_shapes_and_spaces_worked_by_hand():
@@ -325,7 +327,6 @@ def test_fem_frequency_estimates_fall_under_refinement_as_rayleigh_ritz_bounds_d
     (an estimate of the wrong sign, or taken against the wrong level, goes red)."""
     from cases.library.transient import CLUSTER_EXTRA, N_MODES, fem_frequencies
     from model.mesh import cube
-    from model.material import Material
     mesh = cube(3, 0.032, "five")
     mat = Material(E=1e4, nu=0.3, rho=1e3)
     held = {int(i): (0.0, 0.0, 0.0) for i in mesh.nodes_on_plane("y", 0.0)}

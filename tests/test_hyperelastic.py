@@ -6,8 +6,8 @@ import numpy as np
 import pytest
 from scipy.optimize import brentq
 
+from model.material import Material
 from model.errors import ConvergenceError, ModelError
-from model.material import lame
 from model.mesh import box, cube
 from reference import hyperelastic, linear
 from reference.discretisation import skfem_mesh
@@ -38,7 +38,7 @@ def uniaxial(stretch, nu):
     """The compressible neo-Hookean law by hand: the lateral stretch that frees the lateral
     faces, mu (l - 1/l) + lam ln(J) / l = 0 with J = stretch l^2, and the axial nominal
     stress mu (s - 1/s) + lam ln(J) / s."""
-    lam, mu = lame(E, nu)
+    lam, mu = Material(E, nu).lame
     lt = brentq(lambda l: mu * (l - 1 / l) + lam * np.log(stretch * l * l) / l, 0.5, 2.0)
     J = stretch * lt * lt
     return lt, mu * (stretch - 1 / stretch) + lam * np.log(J) / stretch
@@ -48,8 +48,8 @@ def uniaxial(stretch, nu):
                                                 ("P2", True, 0.45), ("P2", True, 0.499)])
 def test_homogeneous_compression_is_the_law_worked_by_hand(element, mixed, nu):
     mesh = cube(3, L, "six")
-    r = hyperelastic.solve(mesh, E, nu, sliding_cube(mesh, 0.7), element=element, mixed=mixed,
-                           load_steps=3)
+    r = hyperelastic.solve(mesh, Material(E, nu), sliding_cube(mesh, 0.7), element=element,
+                           mixed=mixed, load_steps=3)
     lt, P = uniaxial(0.7, nu)
     expect = np.column_stack([(lt - 1) * mesh.points[:, 0], (lt - 1) * mesh.points[:, 1],
                               -0.3 * mesh.points[:, 2]])
@@ -79,8 +79,8 @@ def bonded_block(mesh, strain, height):
 def test_the_small_load_limit_is_linear_p2():
     mesh = box(4, 3, 4, 0.012, 0.008, 0.012, "five")
     bc = bonded_block(mesh, 1e-7, 0.012)
-    nh = hyperelastic.solve(mesh, E, 0.45, bc, element="P2")
-    lin = linear.solve(mesh, E, 0.45, bc, element="P2", solver="direct")
+    nh = hyperelastic.solve(mesh, Material(E, 0.45), bc, element="P2")
+    lin = linear.solve(mesh, Material(E, 0.45), bc, element="P2", solver="direct")
     assert np.linalg.norm(nh.u - lin.u) < 1e-6 * np.linalg.norm(lin.u)
     top = mesh.nodes_on_plane("z", 0.012)
     assert nh.reaction[top, 2].sum() == pytest.approx(lin.reaction[top, 2].sum(), rel=1e-6)
@@ -89,7 +89,7 @@ def test_the_small_load_limit_is_linear_p2():
 @pytest.mark.parametrize("mixed", [False, True])
 def test_residual_and_tangent_are_the_derivatives_of_the_energy(mixed):
     m = skfem_mesh(box(3, 3, 3, 0.01, 0.01, 0.01, "six"))
-    lam, mu = lame(E, 0.45)
+    lam, mu = Material(E, 0.45).lame
     d = Discretisation(m, "P2", mixed, lam, mu)
     rng = np.random.default_rng(1)
     x = np.zeros(d.N)
@@ -113,11 +113,11 @@ def test_residual_and_tangent_are_the_derivatives_of_the_energy(mixed):
 def test_the_mixed_form_solves_the_same_law_and_converges_with_an_estimate():
     mesh = box(3, 3, 4, 0.01, 0.01, 0.012, "five")
     bc = bonded_block(mesh, 0.1, 0.012)
-    conv = hyperelastic.converged(mesh, E, 0.45, bc, levels=2, mixed=True, load_steps=2)
+    conv = hyperelastic.converged(mesh, Material(E, 0.45), bc, levels=2, mixed=True, load_steps=2)
     assert conv.increments[1] < 0.5 * conv.increments[0]        # converging
     assert conv.rate > 1 and conv.energy_rate > 0.5
     assert conv.increments[-1] <= conv.error_estimate < 0.05
-    disp = hyperelastic.solve(mesh, E, 0.45, bc, element="P2", refine=2, load_steps=2)
+    disp = hyperelastic.solve(mesh, Material(E, 0.45), bc, element="P2", refine=2, load_steps=2)
     # the displacement form on the same mesh agrees within the mixed form's estimate
     diff = np.linalg.norm(disp.u - conv.result.u) / np.linalg.norm(conv.result.u)
     assert diff < conv.error_estimate
@@ -126,13 +126,14 @@ def test_the_mixed_form_solves_the_same_law_and_converges_with_an_estimate():
 def test_bad_input_is_refused_before_solving():
     mesh = cube(2, L, "six")
     with pytest.raises(ModelError, match="Taylor-Hood"):
-        hyperelastic.solve(mesh, E, 0.45, sliding_cube(mesh, 0.9), element="P1", mixed=True)
+        hyperelastic.solve(mesh, Material(E, 0.45), sliding_cube(mesh, 0.9), element="P1",
+                           mixed=True)
     with pytest.raises(ModelError, match="load_steps"):
-        hyperelastic.solve(mesh, E, 0.45, sliding_cube(mesh, 0.9), load_steps=0)
+        hyperelastic.solve(mesh, Material(E, 0.45), sliding_cube(mesh, 0.9), load_steps=0)
     with pytest.raises(ModelError, match="levels"):
-        hyperelastic.converged(mesh, E, 0.45, sliding_cube(mesh, 0.9), levels=0)
+        hyperelastic.converged(mesh, Material(E, 0.45), sliding_cube(mesh, 0.9), levels=0)
     with pytest.raises(ConvergenceError, match="inverted"):
-        hyperelastic.solve(mesh, E, 0.45, sliding_cube(mesh, -0.5), element="P1")
+        hyperelastic.solve(mesh, Material(E, 0.45), sliding_cube(mesh, -0.5), element="P1")
 
 
 def test_against_felupe_on_a_bonded_block_compressed_20_percent():
@@ -141,8 +142,8 @@ def test_against_felupe_on_a_bonded_block_compressed_20_percent():
     H = 0.01
     mesh = box(3, 3, 3, 0.01, 0.01, H, "five")
     nu = 0.45
-    lam, mu = lame(E, nu)
-    ours = hyperelastic.solve(mesh, E, nu, bonded_block(mesh, 0.2, H), element="P2",
+    lam, mu = Material(E, nu).lame
+    ours = hyperelastic.solve(mesh, Material(E, nu), bonded_block(mesh, 0.2, H), element="P2",
                               load_steps=4)
 
     m1 = fem.Mesh(np.array(mesh.points), np.array(mesh.tets), "tetra")
@@ -189,7 +190,7 @@ def test_a_dead_traction_gives_the_law_worked_by_hand():
     bc = {i: u for i, u in bc.items() if u != (None, None, None)}
     P = -0.2 * E
     stretch = brentq(lambda s: uniaxial(s, 0.45)[1] - P, 0.3, 1.0)
-    r = hyperelastic.solve(mesh, E, 0.45, bc, element="P2", traction=top_traction(P),
+    r = hyperelastic.solve(mesh, Material(E, 0.45), bc, element="P2", traction=top_traction(P),
                            load_steps=2)
     top = mesh.nodes_on_plane("z", L)
     assert r.u[top, 2] == pytest.approx((stretch - 1) * L, rel=1e-8)
@@ -199,15 +200,15 @@ def test_the_small_load_limit_with_a_traction_is_linear_p2():
     mesh = box(3, 3, 3, 0.01, 0.01, L, "five")
     bc = {int(i): (0.0, 0.0, 0.0) for i in mesh.nodes_on_plane("z", 0.0)}
     t = top_traction(1e-7 * E)
-    nh = hyperelastic.solve(mesh, E, 0.45, bc, element="P2", traction=t)
-    lin = linear.solve(mesh, E, 0.45, bc, element="P2", traction=t, solver="direct")
+    nh = hyperelastic.solve(mesh, Material(E, 0.45), bc, element="P2", traction=t)
+    lin = linear.solve(mesh, Material(E, 0.45), bc, element="P2", traction=t, solver="direct")
     assert np.linalg.norm(nh.u - lin.u) < 1e-6 * np.linalg.norm(lin.u)
 
 
 @pytest.mark.parametrize("nu, mixed", [(0.45, False), (0.49, True)])
 def test_auto_takes_the_mixed_form_above_the_locking_threshold(nu, mixed):
     mesh = cube(2, L, "six")
-    conv = hyperelastic.converged(mesh, E, nu, sliding_cube(mesh, 0.99), mixed="auto")
+    conv = hyperelastic.converged(mesh, Material(E, nu), sliding_cube(mesh, 0.99), mixed="auto")
     assert conv.result.info["mixed"] is mixed
 
 
@@ -246,13 +247,13 @@ def test_a_level_started_from_the_coarser_one_reaches_the_same_solution(mixed, m
     bc = {int(i): (0.0, 0.0, 0.0) for i in mesh.nodes_on_plane("z", 0.0)}   # a barrel
     bc.update({int(i): (0.0, 0.0, -0.15 * L) for i in mesh.nodes_on_plane("z", L)})
     kw = dict(element="P2", mixed=mixed, load_steps=3)
-    coarse = hyperelastic.solve(mesh, E, 0.45, bc, **kw)
-    plain = hyperelastic.solve(mesh, E, 0.45, bc, refine=1, **kw)
-    nested = hyperelastic.solve(mesh, E, 0.45, bc, refine=1, start=coarse, **kw)
+    coarse = hyperelastic.solve(mesh, Material(E, 0.45), bc, **kw)
+    plain = hyperelastic.solve(mesh, Material(E, 0.45), bc, refine=1, **kw)
+    nested = hyperelastic.solve(mesh, Material(E, 0.45), bc, refine=1, start=coarse, **kw)
     assert np.abs(nested.dofs - plain.dofs).max() < 1e-9 * np.abs(plain.dofs).max()
     assert nested.iterations < plain.iterations
     monkeypatch.setattr(hyperelastic, "NESTED_MAX_ITER", 0)     # the start gives up at once
-    fallen = hyperelastic.solve(mesh, E, 0.45, bc, refine=1, start=coarse, **kw)
+    fallen = hyperelastic.solve(mesh, Material(E, 0.45), bc, refine=1, start=coarse, **kw)
     assert np.array_equal(fallen.dofs, plain.dofs) and fallen.iterations == plain.iterations
 
 
@@ -272,10 +273,10 @@ def test_inexact_newton_reaches_the_solution_of_exact_tangent_solves(monkeypatch
     mesh = cube(7, L, "five")
     bc = {int(i): (0.0, 0.0, 0.0) for i in mesh.nodes_on_plane("z", 0.0)}
     bc.update({int(i): (0.0, 0.0, -0.15 * L) for i in mesh.nodes_on_plane("z", L)})
-    inexact = hyperelastic.solve(mesh, E, 0.4, bc, element="P2", load_steps=2)
+    inexact = hyperelastic.solve(mesh, Material(E, 0.4), bc, element="P2", load_steps=2)
     monkeypatch.setattr(hyperelastic, "ETA_MAX", 1e-10)
     monkeypatch.setattr(hyperelastic, "forcing", lambda *a: 1e-10)
-    exact = hyperelastic.solve(mesh, E, 0.4, bc, element="P2", load_steps=2)
+    exact = hyperelastic.solve(mesh, Material(E, 0.4), bc, element="P2", load_steps=2)
     assert inexact.info["dofs"] == exact.info["dofs"] > DIRECT_MAX_DOFS     # AMG-CG
     assert np.abs(inexact.dofs - exact.dofs).max() < 1e-8 * np.abs(exact.dofs).max()
     assert inexact.info["cg_iterations"] < 0.6 * exact.info["cg_iterations"]
@@ -301,14 +302,16 @@ def test_the_mixed_form_reuses_a_factorisation_and_reaches_the_same_solution(mon
     mesh = cube(4, L, "six")
     bc = {int(i): (0.0, 0.0, 0.0) for i in mesh.nodes_on_plane("z", 0.0)}
     bc.update({int(i): (0.0, 0.0, -0.3 * L) for i in mesh.nodes_on_plane("z", L)})
-    reused = hyperelastic.solve(mesh, E, 0.499, bc, element="P2", mixed=True, load_steps=3)
+    reused = hyperelastic.solve(mesh, Material(E, 0.499), bc, element="P2", mixed=True,
+                                load_steps=3)
 
     class EveryTime(solvers.SaddleSolver):
         def __call__(self, A, b, doflocs=None, comp=None, rtol=1e-10):
             self.lu = None
             return super().__call__(A, b, rtol=rtol)
     monkeypatch.setattr(hyperelastic, "SaddleSolver", EveryTime)
-    every = hyperelastic.solve(mesh, E, 0.499, bc, element="P2", mixed=True, load_steps=3)
+    every = hyperelastic.solve(mesh, Material(E, 0.499), bc, element="P2", mixed=True,
+                               load_steps=3)
     assert every.info["factorisations"] == every.iterations
     assert reused.info["factorisations"] < 0.5 * reused.iterations
     assert reused.info["gmres_iterations"] > 0

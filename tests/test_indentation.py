@@ -17,7 +17,7 @@ SPACING = 8.0     # coarse: the face is one lattice cell, resolved by the refine
 def punch_force(family, dirichlet_fn):
     s = CASE.settings(spacing_mm=SPACING)
     mesh = CASE.mesh(family, s)
-    conv = linear.converged(mesh, s.E, s.nu, CASE.dirichlet(mesh, "clamped", s), levels=1,
+    conv = linear.converged(mesh, s.material, CASE.dirichlet(mesh, "clamped", s), levels=1,
                             dirichlet_fn=dirichlet_fn, solver="direct")
     return reaction_along(conv.result.reaction, CASE.driven(mesh, "clamped", s)), \
         conv.error_estimate
@@ -83,7 +83,7 @@ def test_a_region_decides_new_boundary_points_by_where_they_lie():
     given = _face_only(pts)
     d = {int(i): tuple(given[i]) for i in np.flatnonzero(~np.isnan(given).any(axis=1))}
     for fn, all_held in ((Region(_face_only), True), (_face_only, False)):
-        r = linear.solve(mesh, s.E, s.nu, d, element="P2", dirichlet_fn=fn, solver="direct")
+        r = linear.solve(mesh, s.material, d, element="P2", dirichlet_fn=fn, solver="direct")
         under = (dof_component(r.basis) == 1) & in_patch(r.basis.doflocs.T)
         assert under.sum() > len(mesh.nodes_on_plane("y", 0.032)[in_patch(
             mesh.points[mesh.nodes_on_plane("y", 0.032)])])

@@ -78,10 +78,10 @@ def test_newmark_is_of_order_two_on_a_one_node_oscillator():
     held = Ramp([], (0.0, 0.0, 0.0), T, fixed=[0, 1, 2])
     v0 = np.zeros((4, 3))
     v0[3] = (0.05, -0.02, 0.1)
-    exact = dynamic.solve(mesh, E, nu, rho, held, T, v0=v0, method="modal", frames=2)
+    exact = dynamic.solve(mesh, Material(E, nu, rho), held, T, v0=v0, method="modal", frames=2)
     errors = []
     for n in (100, 200, 400, 800):
-        r = dynamic.solve(mesh, E, nu, rho, held, T, dt=T / n, v0=v0, frames=2)
+        r = dynamic.solve(mesh, Material(E, nu, rho), held, T, dt=T / n, v0=v0, frames=2)
         errors.append(np.linalg.norm(r.u[-1] - exact.u[-1]))
     assert np.all(np.abs(orders(errors) - 2) < TOL), orders(errors)
 
@@ -95,10 +95,10 @@ def test_newmark_is_of_order_two_on_a_small_mesh():
     held = Ramp([], (0.0, 0.0, 0.0), T, fixed=base)
     X = mesh.points
     v0 = 0.05 * np.c_[np.sin(np.pi * X[:, 1] / 0.04), 0 * X[:, 0], np.sin(np.pi * X[:, 1] / 0.04)]
-    exact = dynamic.solve(mesh, E, nu, rho, held, T, v0=v0, method="modal", frames=2)
+    exact = dynamic.solve(mesh, Material(E, nu, rho), held, T, v0=v0, method="modal", frames=2)
     errors = []
     for n in (100, 200, 400, 800):
-        r = dynamic.solve(mesh, E, nu, rho, held, T, dt=T / n, v0=v0, frames=2)
+        r = dynamic.solve(mesh, Material(E, nu, rho), held, T, dt=T / n, v0=v0, frames=2)
         errors.append(np.linalg.norm(r.u[-1] - exact.u[-1]))
     assert np.all(np.abs(orders(errors) - 2) < TOL), orders(errors)
 

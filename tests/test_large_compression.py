@@ -6,6 +6,7 @@ import pytest
 
 from cases.library import large_compression as lc
 from cases.registry import CASES
+from model.material import Material
 from model import build
 from model.terms.shear import Shear
 from reference.hyperelastic import uniaxial
@@ -16,14 +17,14 @@ CASE = CASES["large-compression"]
 def test_the_law_in_closed_form_is_the_hand_formula():
     # lateral stretch and nominal stress at stretch 0.7, E = 10 kPa, nu = 0.45, worked by hand
     # in tests/test_hyperelastic.py: 1.17085 and 4.4435 N on the 32 mm cube
-    lt, P = uniaxial(0.7, 10e3, 0.45)
+    lt, P = uniaxial(0.7, Material(10e3, 0.45))
     assert lt == pytest.approx(1.17085, abs=1e-5)
     assert -P * 0.032 ** 2 == pytest.approx(4.4435, abs=1e-4)
     s = CASE.settings()
     assert lc.law_force(s)[-1] == pytest.approx(4.4435, abs=1e-4)
-    assert uniaxial(1.0, 10e3, 0.45) == (1.0, 0.0)
+    assert uniaxial(1.0, Material(10e3, 0.45)) == (1.0, 0.0)
     with pytest.raises(Exception, match="stretch"):
-        uniaxial(-0.5, 10e3, 0.45)
+        uniaxial(-0.5, Material(10e3, 0.45))
 
 
 @pytest.fixture(scope="module")

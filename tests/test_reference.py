@@ -6,6 +6,7 @@ import numpy as np
 import pytest
 
 from model.errors import ConvergenceError, MaterialError, ModelError
+from model.material import Material
 from model.mesh import box, cube
 from reference import analytic, hyperelastic, linear, modal
 
@@ -29,7 +30,7 @@ def test_patch_test(nu, element):
     H = 1e-3 * np.array([[1.0, 0.3, -0.2], [0.5, -2.0, 0.1], [0.2, 0.4, 0.7]])
     exact = mesh.points @ H.T
     bc = {i: tuple(exact[i]) for i in boundary_nodes(mesh)}
-    r = linear.solve(mesh, E, nu, bc, element=element)
+    r = linear.solve(mesh, Material(E, nu), bc, element=element)
     assert rel(r.u, exact) < 1e-10
     lam, mu = nu * E / ((1 + nu) * (1 - 2 * nu)), E / (2 * (1 + nu))
     eps = 0.5 * (H + H.T)
@@ -53,7 +54,7 @@ def sliding_bc(mesh, d, size=L):
 def test_uniaxial_sliding_compression(nu, element):
     mesh = cube(5, L, "five")
     d = -1.7e-3
-    r = linear.solve(mesh, E, nu, sliding_bc(mesh, d), element=element)
+    r = linear.solve(mesh, Material(E, nu), sliding_bc(mesh, d), element=element)
     assert rel(r.u, analytic.uniaxial_sliding(mesh.points, d / L, nu)) < 1e-10
     top = mesh.nodes_on_plane("y", L)
     assert r.reaction[top, 1].sum() == pytest.approx(E * d / L * L * L, rel=1e-10)
@@ -63,7 +64,7 @@ def test_uniaxial_sliding_compression(nu, element):
 def self_weight_case(mesh, nu, rho=1000.0, g=9.81, H=0.02):
     """Block [-a, a] x [0, H] x [-a, a] on its base; the exact quadratic solution imposed on
     the base, gravity along -y, everything else free."""
-    exact = lambda p: analytic.self_weight(p, E, nu, rho, g, H)  # noqa: E731
+    exact = lambda p: analytic.self_weight(p, Material(E, nu, rho), g, H)  # noqa: E731
     base = mesh.nodes_on_plane("y", 0.0)
     ub = exact(mesh.points[base])
     bc = {i: tuple(v) for i, v in zip(base, ub)}
@@ -80,7 +81,7 @@ def centred_box(n, H=0.02, a=0.005):
 def test_self_weight_p2_is_exact(nu):
     mesh = centred_box(3)
     bc, exact, b = self_weight_case(mesh, nu)
-    r = linear.solve(mesh, E, nu, bc, body_force=b, element="P2", dirichlet_fn=exact)
+    r = linear.solve(mesh, Material(E, nu), bc, body_force=b, element="P2", dirichlet_fn=exact)
     assert rel(r.u, exact(mesh.points)) < 1e-8
     assert r.reaction[:, 1].sum() == pytest.approx(1000 * 9.81 * 0.01 * 0.01 * 0.02, rel=1e-9)
     # the stress is linear, so its tetrahedron average is the value at the centroid
@@ -97,7 +98,7 @@ def test_self_weight_p1_converges_towards_second_order(nu):
     for n in (5, 9, 17):
         mesh = centred_box(n)
         bc, exact, b = self_weight_case(mesh, nu)
-        r = linear.solve(mesh, E, nu, bc, body_force=b, element="P1")
+        r = linear.solve(mesh, Material(E, nu), bc, body_force=b, element="P1")
         errors.append(np.sqrt(((r.u - exact(mesh.points)) ** 2).mean()))
     rates = np.log2(np.array(errors[:-1]) / errors[1:])
     assert rates[1] > rates[0]
@@ -117,12 +118,12 @@ def beam_clamp(mesh, h):
 @pytest.mark.parametrize("nu", NUS)
 def test_cantilever_tip_deflection(nu):
     Lb, h, P = 0.1, 0.01, 1e-3
-    beam = analytic.cantilever_tip_deflection(P, Lb, h, h, E, nu)
+    beam = analytic.cantilever_tip_deflection(P, Lb, h, h, Material(E, nu))
     errs = []
     for nx, ny in ((11, 3), (21, 5)):
         mesh = box(nx, ny, ny, Lb, h, h, "six")
         load = np.array([0.0, -P / h**2, 0.0])
-        r = linear.solve(mesh, E, nu, beam_clamp(mesh, h), element="P2",
+        r = linear.solve(mesh, Material(E, nu), beam_clamp(mesh, h), element="P2",
                          traction=lambda x, n: np.where(np.isclose(x[..., :1], Lb), load, 0.0))
         errs.append(abs(-r.u[mesh.nodes_on_plane("x", Lb), 1].mean() / beam - 1))
     assert errs[-1] < 0.02 and errs[-1] <= errs[0] + 1e-4, errs
@@ -132,9 +133,9 @@ def test_cantilever_tip_deflection(nu):
 def test_cantilever_first_frequency(nu):
     Lb, h, rho = 0.1, 0.01, 1000.0
     mesh = box(11, 3, 3, Lb, h, h, "six")
-    f = analytic.cantilever_first_frequency(Lb, h, h, E, nu, rho)
+    f = analytic.cantilever_first_frequency(Lb, h, h, Material(E, nu, rho))
     for mass in ("consistent", "lumped"):
-        r = modal.frequencies(mesh, E, nu, rho, beam_clamp(mesh, h), k=2, mass=mass)
+        r = modal.frequencies(mesh, Material(E, nu, rho), beam_clamp(mesh, h), k=2, mass=mass)
         # the two lowest are the bending pair of the square section
         assert r.frequencies == pytest.approx([f, f], rel=0.03)
         assert r.modes.shape == (2, mesh.n_nodes, 3)
@@ -177,8 +178,8 @@ def test_neo_hookean_equals_linear_at_small_strain(nu):
     mesh = cube(4, L, "five")
     bc = {i: (0.0, 0.0, 0.0) for i in mesh.nodes_on_plane("y", 0.0)}
     bc.update({i: (1e-6 * L, -1e-6 * L, 0.0) for i in mesh.nodes_on_plane("y", L)})
-    rl = linear.solve(mesh, E, nu, bc)
-    rh = hyperelastic.solve(mesh, E, nu, bc)
+    rl = linear.solve(mesh, Material(E, nu), bc)
+    rh = hyperelastic.solve(mesh, Material(E, nu), bc)
     assert rel(rh.u, rl.u) < 1e-4 and rel(rh.stress, rl.stress) < 1e-4
     assert rel(rh.reaction, rl.reaction) < 1e-4
 
@@ -189,8 +190,8 @@ def test_rigid_rotation_stress_free_only_in_neo_hookean():
     c = mesh.points.mean(axis=0)
     U = (mesh.points - c) @ R.T + c - mesh.points
     bc = {i: tuple(U[i]) for i in boundary_nodes(mesh)}
-    rh = hyperelastic.solve(mesh, E, 0.3, bc, load_steps=4)
-    rl = linear.solve(mesh, E, 0.3, bc)
+    rh = hyperelastic.solve(mesh, Material(E, 0.3), bc, load_steps=4)
+    rl = linear.solve(mesh, Material(E, 0.3), bc)
     assert np.abs(rh.u - U).max() < 1e-12 * L
     assert np.abs(rh.stress).max() < 1e-9 * E
     assert np.abs(rl.stress).max() > 0.5 * E  # linear strain of a rotation is not zero
@@ -200,14 +201,14 @@ def test_converged_reference_reports_its_error():
     mesh = cube(3, L, "six")
     bc = {i: (0.0, 0.0, 0.0) for i in mesh.nodes_on_plane("y", 0.0)}
     bc.update({i: (0.0, -1e-3, 0.0) for i in mesh.nodes_on_plane("y", L)})
-    c = linear.converged(mesh, E, 0.3, bc, levels=2)
+    c = linear.converged(mesh, Material(E, 0.3), bc, levels=2)
     assert c.levels == [0, 1, 2] and c.result.info["refine"] == 2
     assert c.increments[1] < c.increments[0]
     disp_rate, disp_est = linear.richardson(c.increments)
     assert 0 < disp_est < c.increments[-1] and disp_rate > 1
     assert c.energy_increments[1] < c.energy_increments[0]
     assert c.error_estimate >= disp_est and c.error_estimate > 0
-    p1 = linear.solve(mesh, E, 0.3, bc)
+    p1 = linear.solve(mesh, Material(E, 0.3), bc)
     assert np.linalg.norm(p1.u - c.result.u) / np.linalg.norm(c.result.u) > 10 * c.error_estimate
 
 
@@ -239,49 +240,60 @@ def test_richardson_on_a_ladder_that_does_not_halve():
 def test_amg_and_direct_agree():
     mesh = cube(6, L, "six")
     bc = sliding_bc(mesh, -1e-3)
-    a = linear.solve(mesh, E, 0.3, bc, element="P2", solver="amg")
-    d = linear.solve(mesh, E, 0.3, bc, element="P2", solver="direct")
+    a = linear.solve(mesh, Material(E, 0.3), bc, element="P2", solver="amg")
+    d = linear.solve(mesh, Material(E, 0.3), bc, element="P2", solver="direct")
     assert a.info["solver"].startswith("amg-cg") and rel(a.u, d.u) < 1e-8
-    again = linear.solve(mesh, E, 0.3, bc, element="P2", solver="amg")
+    again = linear.solve(mesh, Material(E, 0.3), bc, element="P2", solver="amg")
     assert np.array_equal(a.u, again.u)      # pyamg's random spectral estimate is seeded
 
 
-def test_the_references_take_their_lame_constants_and_checks_from_material():
-    """The Lame constants the references use are the Material's, bit for bit, and a material
-    the model refuses the references refuse with the same message."""
-    from model import Material
-    from model.material import lame
-    for E_, nu in ((10e3, 0.45), (10000, 0.3), (2.5e5, -0.2), (1e3, 0.499)):
-        mat = Material(E_, nu)
-        assert lame(E_, nu) == (mat.lam, mat.G)
+def test_every_reference_takes_one_material_and_refuses_loose_constants():
+    """Every FEM reference and closed form takes the model's Material (its checks made once,
+    where it is made) and refuses anything else before computing, naming the function and
+    what to pass."""
+    from reference import dynamic
+    from reference.manufactured import manufactured, waves
+    mesh, held = cube(2, L, "five"), {0: (0.0, 0.0, 0.0)}
+    calls = {"reference.linear.solve": lambda m: linear.solve(mesh, m, held),
+             "reference.linear.p1_stiffness": lambda m: linear.p1_stiffness(mesh, m),
+             "reference.hyperelastic.solve": lambda m: hyperelastic.solve(mesh, m, held),
+             "reference.hyperelastic.uniaxial": lambda m: hyperelastic.uniaxial(0.9, m),
+             "reference.hyperelastic.converged": lambda m: hyperelastic.converged(mesh, m, held),
+             "reference.modal.frequencies": lambda m: modal.frequencies(mesh, m, held),
+             "reference.dynamic.solve": lambda m: dynamic.solve(mesh, m, lambda t: held, 1e-3),
+             "reference.manufactured.manufactured": lambda m: manufactured(waves(L), "linear", m)}
+    for who, call in calls.items():
+        for loose in (E, (E, 0.3), {"E": E, "nu": 0.3}):
+            with pytest.raises(MaterialError, match=re.escape(who) + ".*Material\\(E="):
+                call(loose)
+    with pytest.raises(AttributeError):     # a closed form reads the Material's constants
+        analytic.cantilever_tip_deflection(1.0, 0.1, 0.01, 0.01, E)
     for E_, nu in ((E, 0.5), (E, -1.0), (-E, 0.3), (float("nan"), 0.3)):
-        with pytest.raises(MaterialError) as by_model:
+        with pytest.raises(MaterialError):
             Material(E_, nu)
-        with pytest.raises(MaterialError, match=re.escape(str(by_model.value))):
-            linear.p1_stiffness(cube(2, L, "five"), E_, nu)
 
 
 def test_bad_input():
     mesh = cube(3, L, "five")
     with pytest.raises(ModelError, match="singular"):
-        linear.solve(mesh, E, 0.3, {})
+        linear.solve(mesh, Material(E, 0.3), {})
     with pytest.raises(ModelError, match="conflicting values for node 0"):
-        linear.solve(mesh, E, 0.3, [(0, (0.0, None, None)), (0, (1e-3, 0.0, 0.0))])
+        linear.solve(mesh, Material(E, 0.3), [(0, (0.0, None, None)), (0, (1e-3, 0.0, 0.0))])
     for nu in (0.5, -1.0, 0.7):
         with pytest.raises(MaterialError, match="nu"):
-            linear.solve(mesh, E, nu, {0: (0.0, 0.0, 0.0)})
+            linear.solve(mesh, Material(E, nu), {0: (0.0, 0.0, 0.0)})
     with pytest.raises(MaterialError, match="E must"):
-        linear.solve(mesh, -E, 0.3, {0: (0.0, 0.0, 0.0)})
+        linear.solve(mesh, Material(-E, 0.3), {0: (0.0, 0.0, 0.0)})
     with pytest.raises(ModelError, match="element"):
-        linear.solve(mesh, E, 0.3, {0: (0.0, 0.0, 0.0)}, element="Q1")
+        linear.solve(mesh, Material(E, 0.3), {0: (0.0, 0.0, 0.0)}, element="Q1")
     # one pinned node cannot hold the torque of gravity: the iterative solver cannot converge
     with pytest.raises(ConvergenceError, match="stagnated.*solver=\"direct\""):
-        linear.solve(mesh, E, 0.3, {0: (0.0, 0.0, 0.0)}, body_force=(0, -9810.0, 0),
+        linear.solve(mesh, Material(E, 0.3), {0: (0.0, 0.0, 0.0)}, body_force=(0, -9810.0, 0),
                      solver="amg")
     with pytest.raises(ConvergenceError, match="did not converge"):
         bc = {i: (0.0, 0.0, 0.0) for i in mesh.nodes_on_plane("y", 0.0)}
         bc.update({i: (0.0, -0.3 * L, 0.0) for i in mesh.nodes_on_plane("y", L)})
-        hyperelastic.solve(mesh, E, 0.3, bc, max_iter=2)
+        hyperelastic.solve(mesh, Material(E, 0.3), bc, max_iter=2)
 
 
 # ------------------------------------------------------------ Dirichlet data on new points
@@ -329,7 +341,8 @@ def test_one_cell_slab_with_declared_surfaces_matches_a_thick_mesh():
 
     def top_force(ny, fn):
         mesh = box(5, ny, 5, L, h, L, "six")
-        r = linear.converged(mesh, E, 0.45, slab_bc(mesh, h, push), levels=1, dirichlet_fn=fn)
+        r = linear.converged(mesh, Material(E, 0.45), slab_bc(mesh, h, push), levels=1,
+                             dirichlet_fn=fn)
         return -r.result.reaction[mesh.nodes_on_plane("y", h), 1].sum(), r
 
     thick, thick_ref = top_force(5, surfaces)
@@ -361,12 +374,12 @@ def test_load_callables_get_plain_arrays():
         return g
 
     for element in ("P1", "P2"):
-        r = linear.solve(mesh, E, 0.3, bc, traction=end_traction, element=element)
+        r = linear.solve(mesh, Material(E, 0.3), bc, traction=end_traction, element=element)
         assert np.isclose(r.reaction[:, 1].sum(), 3.0 * area, rtol=1e-10)
-        r = linear.solve(mesh, E, 0.3, bc, body_force=gravity, element=element)
+        r = linear.solve(mesh, Material(E, 0.3), bc, body_force=gravity, element=element)
         assert np.isclose(r.reaction[:, 1].sum(), 9810.0 * volume, rtol=1e-10)
     with pytest.raises(ModelError, match="traction must give"):
-        linear.solve(mesh, E, 0.3, bc, traction=lambda x, n: x[..., 0])
+        linear.solve(mesh, Material(E, 0.3), bc, traction=lambda x, n: x[..., 0])
 
 
 def cook_slab(n, thickness=1e-3):
@@ -391,8 +404,9 @@ def test_iterative_solver_converges_on_a_thin_bending_slab():
         t[..., 1] = np.where(np.isclose(x[..., 0], 0.048), 1.0, 0.0)
         return t
 
-    a = linear.solve(coarse, E, 0.45, bc_c, traction=shear, element="P2", solver="amg")
-    d = linear.solve(coarse, E, 0.45, bc_c, traction=shear, element="P2", solver="direct")
+    a = linear.solve(coarse, Material(E, 0.45), bc_c, traction=shear, element="P2", solver="amg")
+    d = linear.solve(coarse, Material(E, 0.45), bc_c, traction=shear, element="P2",
+                     solver="direct")
     assert a.info["dofs"] > 8000
     assert a.info["solver"].startswith("amg-cg (evolution")
     assert rel(a.u, d.u) < 1e-7
@@ -426,13 +440,13 @@ def test_solver_falls_back_or_names_the_direct_solver(monkeypatch):
     monkeypatch.setattr(solvers, "DIRECT_MAX_DOFS", 0)
     monkeypatch.setattr(solvers, "available_memory", lambda: 0)
     with pytest.raises(ConvergenceError, match='solver="direct"'):
-        linear.solve(mesh, E, 0.3, held, body_force=(0, -9810.0, 0))
+        linear.solve(mesh, Material(E, 0.3), held, body_force=(0, -9810.0, 0))
     monkeypatch.setattr(solvers, "available_memory", lambda: 2**40)
     bc = {int(i): (0.0, 0.0, 0.0) for i in mesh.nodes_on_plane("y", 0.0)}
-    r = linear.solve(mesh, E, 0.3, bc, body_force=(0, -9810.0, 0))
+    r = linear.solve(mesh, Material(E, 0.3), bc, body_force=(0, -9810.0, 0))
     assert r.info["solver"].startswith("amg-cg")
     with pytest.raises(ModelError, match="solver must be"):
-        linear.solve(mesh, E, 0.3, bc, solver="cholesky")
+        linear.solve(mesh, Material(E, 0.3), bc, solver="cholesky")
 
 
 def test_stiffness_is_reused_for_the_same_mesh_element_and_constants():

@@ -46,7 +46,7 @@ def test_the_sliding_cube_references_are_the_closed_forms(sliding):
     strain = PUSH_MM / SIZE_MM
     # homogeneous: the largest strain is the axial one
     assert ref.scale == pytest.approx(LINEAR_STRAIN / strain, rel=1e-9)
-    lt, _ = uniaxial(1 - strain, E, NU)
+    lt, _ = uniaxial(1 - strain, Material(E, NU))
     x = mesh.points
     expect = np.column_stack([(lt - 1) * x[:, 0], -strain * x[:, 1], (lt - 1) * x[:, 2]])
     assert np.abs(ref.nonlinear.result.u - expect).max() < 1e-9 * PUSH_MM * 1e-3
@@ -78,7 +78,7 @@ def test_fem_linear_at_the_load_is_off_by_its_linearisation_error(sliding):
     assert r["disp_rel_l2_p2"] < 1e-8              # the patch test, exact
     # by hand: u_lin = (nu e x, -e y, nu e z) against the neo-Hookean field
     e = PUSH_MM / SIZE_MM
-    lt, _ = uniaxial(1 - e, E, NU)
+    lt, _ = uniaxial(1 - e, Material(E, NU))
     x = mesh.points
     lin = np.column_stack([NU * e * x[:, 0], -e * x[:, 1], NU * e * x[:, 2]])
     nh = np.column_stack([(lt - 1) * x[:, 0], -e * x[:, 1], (lt - 1) * x[:, 2]])

@@ -30,7 +30,7 @@ def test_converged_linear_torque_is_at_or_above_saint_venant():
     s = CASE.settings(spacing_mm=8.0)
     mesh = CASE.mesh("five", s)
     bc = CASE.dirichlet_linear(mesh, "clamped", s)
-    conv = linear.converged(mesh, s.E, s.nu, bc, levels=2, solver="direct")
+    conv = linear.converged(mesh, s.material, bc, levels=2, solver="direct")
     sv = CASE.closed_form(s, "clamped")["torque_nm"]
     torque = CASE.quantities(mesh, conv.result.u, conv.result.reaction, s,
                              "clamped")["torque_nm"]
@@ -38,7 +38,7 @@ def test_converged_linear_torque_is_at_or_above_saint_venant():
     # above Saint-Venant, by the restraint of a clamped root on a bar 4 sides long (< 2 %)
     assert sv <= torque <= 1.02 * sv
     # the exact rotation, read as a small strain, loses the factor sin(theta) / theta
-    exact = linear.solve(mesh, s.E, s.nu, CASE.dirichlet(mesh, "clamped", s), element="P2",
+    exact = linear.solve(mesh, s.material, CASE.dirichlet(mesh, "clamped", s), element="P2",
                          refine=2, solver="direct")
     t_exact = CASE.quantities(mesh, exact.u, exact.reaction, s, "clamped")["torque_nm"]
     assert t_exact / torque == pytest.approx(np.sin(np.radians(10)) / np.radians(10),

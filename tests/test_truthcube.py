@@ -8,6 +8,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from model.material import Material
 from model import build
 from model.bc import load_fractions
 from model.errors import MeshError, ModelError
@@ -208,13 +209,13 @@ def test_frictionless_continuum_is_the_uniaxial_closed_form():
     m = cube(3, T.SIDE, "six")
     E, nu = 15e3, 0.499
     travel = 0.1 * T.SIDE
-    sol = hyperelastic.solve(m, E, nu, P.dirichlet(m, "frictionless", travel), element="P2",
-                             mixed=True, load_steps=[0.5, 1.0], keep_steps=[1])
-    lat, _ = hyperelastic.uniaxial(0.9, E, nu)
+    sol = hyperelastic.solve(m, Material(E, nu), P.dirichlet(m, "frictionless", travel),
+                             element="P2", mixed=True, load_steps=[0.5, 1.0], keep_steps=[1])
+    lat, _ = hyperelastic.uniaxial(0.9, Material(E, nu))
     x = m.points
     assert np.allclose(sol.u[:, 0], (lat - 1) * (x[:, 0] - T.SIDE / 2), atol=1e-9)
     assert np.allclose(sol.u[:, 2], travel * (1 - x[:, 2] / T.SIDE), atol=1e-9)
-    half, _ = hyperelastic.uniaxial(0.95, E, nu)
+    half, _ = hyperelastic.uniaxial(0.95, Material(E, nu))
     mid = sol.at(x, step=1)
     assert np.allclose(mid[:, 1], (half - 1) * (x[:, 1] - T.SIDE / 2), atol=1e-9)
     assert np.allclose(sol.at(x), sol.u, atol=1e-12)

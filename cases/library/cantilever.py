@@ -57,7 +57,7 @@ class Cantilever(Case):
 
     def closed_form(self, s, bc):
         d = analytic.cantilever_tip_deflection(s.load_N, LENGTH_MM * MM, WIDTH_MM * MM,
-                                               HEIGHT_MM * MM, s.E, s.nu)
+                                               HEIGHT_MM * MM, s.material)
         return {"tip_deflection_mm": d / MM}
 
     def params(self, s):

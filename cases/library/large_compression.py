@@ -62,7 +62,7 @@ def pushes(s):
 def law_force(s):
     """The neo-Hookean law's top force [N] in homogeneous compression at each step."""
     side = SIZE_MM * MM
-    return [-hyperelastic.uniaxial(1 - p / side, s.E, s.nu)[1] * side * side
+    return [-hyperelastic.uniaxial(1 - p / side, s.material)[1] * side * side
             for p in pushes(s)]
 
 
@@ -133,11 +133,11 @@ class LargeCompression(Case):
             force.append(top_force(mesh, reaction))
             lateral.append(lateral_strain(mesh, u))
 
-        nh = hyperelastic.converged(mesh, s.E, s.nu, dirichlet, levels=s.nh_levels,
+        nh = hyperelastic.converged(mesh, s.material, dirichlet, levels=s.nh_levels,
                                     element="P2", mixed=True, load_steps=s.steps,
                                     on_step=record)
-        conv = linear.converged(mesh, s.E, s.nu, dirichlet, levels=s.p2_levels)
-        p1 = linear.solve(mesh, s.E, s.nu, dirichlet, element="P1")
+        conv = linear.converged(mesh, s.material, dirichlet, levels=s.p2_levels)
+        p1 = linear.solve(mesh, s.material, dirichlet, element="P1")
         lin = conv.result
         k = np.arange(1, s.steps + 1) / s.steps      # linear FEM scales with the load
         return Reference(

@@ -81,7 +81,7 @@ class SelfWeight(Case):
     def exact(self, points, s):
         """The closed form (reference.analytic.self_weight) at points [m] of this block."""
         shift = np.array([SIZE_MM * MM / 2, 0.0, SIZE_MM * MM / 2])
-        return analytic.self_weight(points - shift, s.E, s.nu, s.rho, s.g, SIZE_MM * MM)
+        return analytic.self_weight(points - shift, s.material, s.g, SIZE_MM * MM)
 
     def loads(self, mesh, bc, s):
         return Loads(body_force=(0.0, -s.rho * s.g, 0.0))

@@ -26,7 +26,7 @@ def fem_transient(mesh, motion, top, cfg, rest_speed, element="P2"):
     mat = cfg.material
     t_push = motion.t_ramp
     t_end = t_push + cfg.hold_max
-    r = dynamic.solve(mesh, mat.E, mat.nu, mat.rho, motion, t_end, damping=cfg.damping,
+    r = dynamic.solve(mesh, mat, motion, t_end, damping=cfg.damping,
                       element=element, mass="consistent", frames=int(round(t_end / 0.01)) + 1,
                       method="modal")
     speed = np.abs(r.v).max(axis=(1, 2))
@@ -122,7 +122,7 @@ def fem_frequencies(mesh, material, dirichlet, refine=0, skip=0):
     nodes), and each of the N_MODES frequencies' refinement estimate, its relative change over
     the last refinement (None without one: ``refine`` 0)."""
     def solve(level):
-        r = modal.frequencies(mesh, material.E, material.nu, material.rho, dirichlet,
+        r = modal.frequencies(mesh, material, dirichlet,
                               k=N_MODES + CLUSTER_EXTRA + skip, refine=level)
         return r.frequencies[skip:], r.modes[skip:].reshape(N_MODES + CLUSTER_EXTRA, -1)
     freq, shapes = solve(refine)

@@ -52,8 +52,8 @@ def reference(case, mesh, bc, s, probe, extra=True, nonlinear=None):
     kw = {k: v for k, v in kw.items() if v is not None}
     kw["dirichlet_fn"] = case.dirichlet_fn(mesh, bc, s)
     lin = dict(kw, solver=case.fem_solver)
-    p1 = linear.solve(mesh, mat.E, mat.nu, dirichlet_lin, element="P1", **lin)
-    conv = linear.converged(mesh, mat.E, mat.nu, dirichlet_lin, levels=s.p2_levels, **lin)
+    p1 = linear.solve(mesh, mat, dirichlet_lin, element="P1", **lin)
+    conv = linear.converged(mesh, mat, dirichlet_lin, levels=s.p2_levels, **lin)
     p2 = conv.result
     driven = case.driven(mesh, bc, s)
     ref = Reference(dirichlet=dirichlet, f_ext=loads.nodal_forces(mesh), p1=p1, conv=conv,
@@ -65,7 +65,7 @@ def reference(case, mesh, bc, s, probe, extra=True, nonlinear=None):
                     scale=linear_scale(p2, mat))
     if extra if nonlinear is None else nonlinear:     # not for the linear regime alone
         try:
-            ref.nonlinear = hyperelastic.converged(mesh, mat.E, mat.nu, dirichlet,
+            ref.nonlinear = hyperelastic.converged(mesh, mat, dirichlet,
                                                    levels=s.nh_levels, mixed="auto",
                                                    load_steps=case.finite_steps(s), **kw)
             if driven is not None:
@@ -73,7 +73,7 @@ def reference(case, mesh, bc, s, probe, extra=True, nonlinear=None):
                     ref.nonlinear.result.reaction, driven))
             # the model-form error's twin at the load: P1 with the same law on the mesh (no
             # comparison at the load where it has no equilibrium, as where the continuum has none)
-            ref.nonlinear_p1 = hyperelastic.solve(mesh, mat.E, mat.nu, dirichlet, element="P1",
+            ref.nonlinear_p1 = hyperelastic.solve(mesh, mat, dirichlet, element="P1",
                                                   load_steps=case.finite_steps(s), **kw)
             nh = ref.nonlinear.result
             ref.quantities_at_load = at_load_quantities(case, mesh, bc, s, nh.u, nh.reaction)
@@ -121,7 +121,7 @@ def static_metrics(case, lr, mesh, bc, s, ref):
            "disp_rel_l2_p2": M.rel_l2(lr.u, ref.p2.u, free),
            "disp_max_rel_p2": M.max_rel(lr.u, ref.p2.u, free),
            "disp_energy_rel_p2": M.energy_rel(lr.u, ref.p2.u,
-                                              linear.p1_stiffness(mesh, s.E, s.nu))}
+                                              linear.p1_stiffness(mesh, s.material))}
     driven = case.driven(mesh, bc, s)
     if driven is None:
         out.update(reaction_n=None, reaction_ratio=None, reaction_rel_err=None)

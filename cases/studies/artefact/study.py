@@ -241,8 +241,8 @@ def reference(bc, load, s):
     mesh = cube(REF_MESH[1], P.SIZE_MM * P.MM, REF_MESH[0])
     dirichlet = P.static_bc(mesh, bc, push_mm(load))
     if load == "linear":
-        return linear.converged(mesh, s.E, s.nu, dirichlet, levels=s.ref_levels)
-    return hyperelastic.converged(mesh, s.E, s.nu, dirichlet, levels=s.ref_levels,
+        return linear.converged(mesh, s.material, dirichlet, levels=s.ref_levels)
+    return hyperelastic.converged(mesh, s.material, dirichlet, levels=s.ref_levels,
                                   mixed="auto")
 
 

@@ -65,7 +65,7 @@ def solve(model, mesh, material, eps, rtol):
     affine = (mesh.points - centre) @ eps.T
     bc = {int(i): tuple(affine[i]) for i in np.flatnonzero(boundary(mesh))}
     if model == "FEM P1":
-        return linear.solve(mesh, material.E, material.nu, bc, element="P1").u
+        return linear.solve(mesh, material, bc, element="P1").u
     return build(model, mesh, material).solve_static(bc, rtol=rtol).u
 
 

@@ -153,7 +153,7 @@ def solve_reference(problem, bc, s):
         stop.checkpoint()
         mesh = problem.mesh("five", h)
         loads = problem.loads(mesh, bc, ps, s.load_scale)
-        levels.append(linear.solve(mesh, s.E, s.nu, problem.dirichlet(mesh, bc, ps,
+        levels.append(linear.solve(mesh, s.material, problem.dirichlet(mesh, bc, ps,
                                                                       s.load_scale),
                                    element="P2", solver=problem.ref_solver(h),
                                    **_fem_loads(loads, mesh)))
@@ -206,7 +206,7 @@ def family_runs(problem, bc, family, s, ref, hs, store=OFF):
         base = {"case": problem.case, "mesh": family, "bc": bc, "h_mm": float(h),
                 "nodes": mesh.n_nodes, "tets": mesh.n_tets, "response_fem": fem}
         if found[FEM_P1] is None:
-            p1 = linear.solve(mesh, s.E, s.nu, dirichlet, element="P1",
+            p1 = linear.solve(mesh, s.material, dirichlet, element="P1",
                               solver=problem.spec.fem_solver, **_fem_loads(loads, mesh))
             found[FEM_P1] = store.put(keys[FEM_P1], {**base, "model": FEM_P1, **_metrics(
                 problem, mesh, bc, ps, p1.u, p1.reaction, u_ref, fem, dirichlet)})

@@ -6,6 +6,7 @@ from dataclasses import dataclass
 from functools import lru_cache
 from importlib import resources
 
+from model.material import Material
 from model.errors import ModelError
 from reference import manufactured as mms
 
@@ -31,7 +32,8 @@ class Entry:
     load_steps: int = 1       # Newton's load steps (the neo-Hookean ladders)
 
     def problem(self, size, E):
-        return mms.manufactured(mms.waves(size, self.amplitude), self.material, E, self.nu)
+        return mms.manufactured(mms.waves(size, self.amplitude), self.material,
+                                Material(E, self.nu))
 
 
 @lru_cache(maxsize=1)

@@ -118,7 +118,8 @@ def reference_mesh():
 def _nh_solves(plates, travels, nu, s, levels):
     m = reference_mesh()
     fractions, at = schedule(travels, REF_STEP_STRAIN)
-    return [hyperelastic.solve(m, s.E, nu, plate_dirichlet(m, plates, travels[-1]), element="P2",
+    return [hyperelastic.solve(m, Material(s.E, nu), plate_dirichlet(m, plates, travels[-1]),
+                               element="P2",
                                mixed=True, refine=k, load_steps=fractions, keep_steps=at)
             for k in levels], at
 
@@ -147,7 +148,7 @@ def linear_reference(plates, travels, nu, s, beads):
     :func:`continuum` gives the neo-Hookean one."""
     m = reference_mesh()
     bc = plate_dirichlet(m, plates, travels[-1])
-    sols = [linear.solve(m, s.E, nu, bc, element="P2", refine=k)
+    sols = [linear.solve(m, Material(s.E, nu), bc, element="P2", refine=k)
             for k in range(s.ref_levels + 1)]
     conv = converged_from(sols)
     u = sols[-1].at(beads)
