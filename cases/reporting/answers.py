@@ -962,8 +962,8 @@ def _decisive(art):
                     "over the bench's rounds at that size alone; missed where the whole range "
                     "is below the 20 % band around 10)",
             "stable": "stability (the linearised growth rate at rest on each conforming split "
-                      "of the paper's lattice, clamped base only: the paper does not state its "
-                      "base; a rate above 0 flutters, stable means rate 0 on every mesh, the "
+                      "of the paper's lattice, clamped base only, as the paper fixes its nodes "
+                      "at y = 0; a rate above 0 flutters, stable means rate 0 on every mesh, the "
                       "damping the paper does not state deciding only between the two)"}
 
     def cost(r):
@@ -981,8 +981,9 @@ def _decisive(art):
     per = "; ".join(
         f"{r['name']}: cost {words[r['matches']['cost']]} ({cost(r)}), stable "
         f"{words[r['matches']['stable']]} ({stable(r)})" for r in rows)
-    head = (f"{names.get(v['model'], v['model'])} ({v['why']})" if v.get("decided") else
-            f"Not decided ({v['why']})")
+    head = ((f"Plainly: {v['plain']}. " if v.get("plain") else "")
+            + (f"{names.get(v['model'], v['model'])} ({v['why']})" if v.get("decided") else
+               f"Not decided ({v['why']})"))
     return (head + " ([artefact study](artefact/report.md)). "
             + ("No reading reproduces all the paper's observables. "
                if v.get("none_reproduces") else
@@ -1009,10 +1010,10 @@ def _cause_numbers(art):
     if not any(c["nodes_per_side"] >= decisive for c in art.get("cells", [])):
         return (f"Quick: not decided (this run lacks the meshes of {decisive} and more nodes "
                 "per side; `pbcm run artefact` decides) ([artefact study](artefact/report.md)).")
-    # the study's own statement of how sure it is travels with its answer, never left behind
-    sure = art.get("how_sure", "").replace("**How sure.** ", "How sure: ")
-    said = " ".join(x for x in (a.get("text"), sure) if x)
-    return (said + " " if said else "") + "([artefact study](artefact/report.md))."
+    # the study's one-sentence verdicts, their evidence and how sure in its report
+    said = " ".join(a.get("verdicts") or []) or a.get("text")
+    return (said + " " if said else "") + ("The evidence and how sure: the [artefact "
+                                          "study](artefact/report.md).")
 
 
 __all__ = ["lines", "table"]

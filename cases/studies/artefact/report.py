@@ -65,7 +65,10 @@ def write(out, study, s, data):
 def conclusion(doc):
     """The study's three lines: the cause, the reading and how sure; a quick run's are a
     preview that decides nothing."""
-    lines = [f"**What causes the bulge/neck pattern.** {doc['answer']['text']}",
+    verdicts = " ".join(doc["answer"].get("verdicts") or [])
+    lines = ([f"**What causes the bulge/neck pattern.** {verdicts} The evidence, hypothesis by "
+              "hypothesis, follows."] if verdicts else []) + [
+             f"**The evidence.** {doc['answer']['text']}",
              f"**Which reading.** {doc['verdict']['text']}", doc["how_sure"]]
     if doc["parameters"].get("quick"):     # the cells below show what it measured
         return ["**Quick: not decided** (`pbcm run artefact` decides, on meshes of 9 and 17 "
