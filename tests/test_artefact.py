@@ -1147,15 +1147,16 @@ def test_the_mesh_pick_names_the_mirrored_split_only_where_a_part_is_the_mirrors
     row = {"resolved": "above", "rms": 2e-3, "controls": {SIX: (1e-5, 1e-6), BCC: (2e-5, 1e-6)},
            "mirror_vs": "above"}
     nodes = {"units": [{"n": 17, "bc": "sliding", "rows": [row]}], "slopes": {}}
-    said = analysis.mesh_pick(10, 4, 0, ["17 clamped"], nodes)
+    layer = "4 of 10 resolved parts with the paper's sign the mirror's"
+    said = analysis.mesh_pick(layer, 4, 0, ["17 clamped"], nodes)
     assert said.startswith("a conforming split without the mirror (six or bcc), not the "
-                           "mirrored five: of the resolved period-2 parts of the layer mean 4 "
-                           "of 10 are the mirror's")
-    assert "at the side nodes 1 of 1 resolved parts are" in said and "17 sliding 100" in said
+                           "mirrored five: at the side nodes the mirrored split's period-2 "
+                           "part over its larger control's is 17 sliding 100 [100-100]")
+    assert "1 of 1 resolved parts (a model on a configuration each) the mirror's" in said and f"in the layer mean {layer}" in said
     assert "FEM P1's own on 17 clamped" in said
-    assert analysis.mesh_pick(10, 4, 1, ["17 clamped"], nodes) is None
+    assert analysis.mesh_pick(layer, 4, 1, ["17 clamped"], nodes) is None
     empty = {"units": [], "slopes": {}}
-    assert analysis.mesh_pick(10, 0, 0, [], empty) is None
+    assert analysis.mesh_pick("", 0, 0, [], empty) is None
 
 
 def test_the_index_picks_a_mesh_from_the_full_artefact_run_only(tmp_path):

@@ -1373,7 +1373,8 @@ def node_text(nodes):
 
 def mesh_pick(resolved, mirrors, against_, fem_units, nodes):
     """What to mesh a lattice with, given the bulge/neck pattern: from the layer-level parts
-    (``resolved`` of them, ``mirrors`` the mirror's, ``against_`` on every split), FEM P1's own
+    (``resolved`` their counts by sign in words, ``mirrors`` the mirror's, ``against_`` on
+    every split), FEM P1's own
     (``fem_units``: where it is the mirror's) and the node-level parts (``node_pattern``): the
     median over the models of the mirrored split's node-level part over its larger control's,
     per configuration. A split is named to avoid only where some part is the mirror's and
@@ -1386,16 +1387,17 @@ def mesh_pick(resolved, mirrors, against_, fem_units, nodes):
                if r["resolved"] == "above" and r["controls"]
                and max(p for p, _ in r["controls"].values()) > 0]
         if got:
-            ratios[_where((x["n"], x["bc"]))] = float(np.median(got))
+            ratios[_where((x["n"], x["bc"]))] = (float(np.median(got)), min(got), max(got))
     if against_ or not (mirrors or node_mirror or fem_units):
         return None
-    return ("a conforming split without the mirror (six or bcc), not the mirrored five: of "
-            f"the resolved period-2 parts of the layer mean {mirrors} of {resolved} are the "
-            "mirror's and none is on every split"
-            + (f"; at the side nodes {len(node_mirror)} of {len(node_rows)} resolved parts "
-               "are, the mirrored split's over its larger control's " + ", ".join(
-                   f"{w} {times(v)}" for w, v in ratios.items()) + " (median over the models)"
-               if node_rows else "")
+    return ("a conforming split without the mirror (six or bcc), not the mirrored five: at "
+            "the side nodes the mirrored split's period-2 part over its larger control's is "
+            + ", ".join(f"{w} {times(v[0])} [{times(v[1])}-{times(v[2])}]"
+                        for w, v in ratios.items())
+            + f" (median [range] over the models), {len(node_mirror)} of {len(node_rows)} "
+            "resolved parts (a model on a configuration each) the mirror's, the others not "
+            "decided, none on every split; in "
+            f"the layer mean {resolved}"
             + (f"; FEM P1's own on {', '.join(fem_units)}" if fem_units else "")
             + " (one mesh per split and size: no spread over meshes)")
 
@@ -1594,7 +1596,10 @@ def answer(cells, models=None, estimates=None):
     slopes = [order_text(bc, o, layer_mean_scaling(cells, bc))
               for bc, o in m["orders"].items() if o["orders"]]
     nodes = node_pattern(every)
-    pick = mesh_pick(sum(len(v) for v in sign_rows.values()),
+    pick = mesh_pick(", ".join(f"{len(mirrored[s_])} of {len(sign_rows[s_])} resolved parts "
+                               f"with {w_} the mirror's" for s_, w_ in (
+                                   ("+", "the paper's sign"), ("-", "the reversed sign"))
+                               if sign_rows[s_]),
                      sum(len(v) for v in mirrored.values()), against_, fem_units, nodes)
     across = consistency_across(every)
     across_said = across_text(across)
