@@ -105,9 +105,8 @@ class StaticResult:
 # this much; otherwise the Jacobian is formed and factorised afresh (a full Newton step)
 CHORD_GAIN = 10.0
 # a full Newton step is taken even where it raises the residual, by less than GROWTH times (its
-# residual is second order in the step, and the next step then converges: pbcm-corner on the
-# convergence study's cantilever goes from 1.6e-8 N to 1.0e-6 N, then to 4.7e-12 N, where a
-# backtracking search took 47 Jacobians); where WATCH more iterations have not brought the
+# residual is second order in the step, and the next step then converges, where a
+# backtracking search can take tens of Jacobians); where WATCH more iterations have not brought the
 # residual below the one before it, the solve returns there and backtracks for the rest of the
 # load step (a watchdog, Chamberlain et al. 1982). A step that raises it more has left Newton's
 # basin (the same model under the cantilever case's 1000 times larger load: from 4e-5 N to

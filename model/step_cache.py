@@ -1,8 +1,8 @@
 """The compiled RK4 step of a composition of terms, kept on disk between processes.
 
 ``integrate.rk4_ramp`` takes the terms' kernels as first-class functions, which numba cannot
-cache on disk: every process compiled it again for every composition (about 3 s each, 9
-presets: half a minute per process, and every worker, test and command is a process). Here the
+cache on disk: every process compiled it again for every composition, and every worker,
+test and command is a process. Here the
 step of one composition is written out as a small module that names its kernels (so it holds
 no first-class function), its source the same as ``rk4_ramp``'s, and numba caches it beside
 the module. The module's file name carries a fingerprint of everything it compiles in: the

@@ -1,8 +1,8 @@
 """The linear elastic stiffness of a vector H1 basis, assembled by a numba kernel.
 
 scikit-fem's ``asm(linear_elasticity(lam, mu), basis)`` evaluates the form once per pair of
-local basis functions in Python: 900 pairs for a P2 tetrahedron, 14 s for the paper cube's bcc
-mesh refined twice. This kernel takes the same basis (its quadrature, its gradients, its dof
+local basis functions in Python: 900 pairs for a P2 tetrahedron, so the time grows with the
+pairs times the elements. This kernel takes the same basis (its quadrature, its gradients, its dof
 numbering) and sums the same integrand element by element, so the matrix is scikit-fem's to
 rounding (tests/test_reference.py compares them); only the loop moved to compiled code.
 

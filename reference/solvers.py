@@ -107,8 +107,8 @@ class NewtonSolver:
     """:func:`linear_solve` over the tangents of one Newton solve (one sparsity, spectra that
     change little): once the default AMG stagnated and the direct solver took over, the later
     tangents go to the direct solver at once, rather than stagnating again first. Its AMG
-    hierarchy is not lent to the next tangent: on the quick indentation CG then took two to
-    three times the iterations."""
+    hierarchy is not lent to the next tangent: a hierarchy built for another tangent
+    preconditions this one worse, and CG takes more iterations."""
 
     def __init__(self, solver="auto"):
         self.solver = solver

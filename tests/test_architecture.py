@@ -214,6 +214,21 @@ def test_the_rooms_table_names_every_folder_of_the_harness_and_every_module_in_i
         assert missing == [], (folder, missing)
 
 
+def test_the_rooms_table_names_every_module_of_model_reference_the_studies_and_the_tools():
+    """The rows of model/, reference/, cases/studies/ and cases/tools/ name every module and
+    sub-package in them (the command and case folders name theirs by rule: one module per
+    command, one per case)."""
+    rows = _rooms_table()
+    for folder in ("model", "reference", "cases/studies", "cases/tools"):
+        path = ROOT / folder
+        names = ({p.stem for p in path.glob("*.py") if p.stem != "__init__"}
+                 | {p.parent.name for p in path.glob("*/__init__.py")})
+        text = rows[folder]
+        missing = sorted(n for n in names if not any(
+            form in text for form in (f"`{n}`", f".{n}`", f"`{n}.py`", f"`{n}/`")))
+        assert missing == [], (folder, missing)
+
+
 def _stated_rules():
     """[(room, [rooms it must not import])] from the doc's bullets of the form
     "`A/` imports neither `B/` nor `C/`" or "`A/` imports no `B/`"."""

@@ -41,7 +41,7 @@ def test_kelvin_moduli_of_isotropic_and_cubic_tensors_worked_by_hand():
 
 @pytest.mark.parametrize("reading", READINGS)
 def test_a_given_c_acts_on_every_reading(reading):
-    """c = 0.5 halves the forces of each reading (before, corner and balanced ignored it)."""
+    """A given c scales every reading's forces: c = 0.5 halves them."""
     mesh = cube(3, 0.032, "five")
     x = perturbed(mesh, 0.05, seed=3)
     one = make_term("shear", mesh, MAT, reading=reading, c=1.0).forces(x)

@@ -350,8 +350,8 @@ def test_energy_norm_of_a_homogeneous_strain_and_of_rigid_motions():
 
 
 def test_stiffer_than_fem_is_said_run_by_run():
-    """'msm stiffer in torsion' was said of a median though msm was softer on six: a
-    statement of direction is made per run."""
+    """A statement of direction (stiffer or softer than FEM) is made run by run, never of a
+    median that hides a run going the other way."""
     from cases.reporting import rankings
     runs = [{"model": "msm", "mesh": "five", "bc": "clamped", "ratio": 1.2},
             {"model": "msm", "mesh": "six", "bc": "clamped", "ratio": 0.63},

@@ -301,8 +301,8 @@ def test_two_mixed_modes_pair_as_one_space_though_their_frequencies_differ():
 @pytest.mark.parametrize("family", ["five", "six", "bcc", "unstructured"])
 def test_fem_p1_pairs_all_its_modes_with_fem_p2_and_with_itself(family, bc):
     """The modes case's cube: FEM P1 (lumped mass) differs from FEM P2 only by
-    discretisation, so every one of its first 10 modes must pair (mesh P2: the old pairing
-    left 1 to 3 unpaired on six and bcc clamped and on unstructured)."""
+    discretisation, so every one of its first 10 modes pairs with a mode of FEM P2 on the
+    mesh, on every family and both supports."""
     from cases.measuring.error_model import P1_LINEAR
     from cases.library import transient
     from cases.library.modes import CASE, ModesSettings

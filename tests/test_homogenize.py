@@ -92,9 +92,9 @@ def test_a_patch_is_refused_when_its_interior_is_not_held():
 
 
 def test_isotropy_judged_by_moduli_sees_a_soft_shear_modulus_the_frobenius_norm_hides():
-    """At nu = 0.45 the bulk block dominates ||C||: one shear modulus 12 % low moves the
-    Frobenius distance by under 1 % (the old criterion passed it), while the largest relative
-    modulus error is the 12 % (the deviatoric modulus 2 C44 over 2G)."""
+    """Isotropy is judged by the largest relative modulus error, which sees one shear modulus
+    12 % low (the deviatoric modulus 2 C44 over 2G) where the Frobenius distance of C moves
+    by under 1 % (at nu = 0.45 the bulk block dominates ||C||)."""
     E, nu = 10e3, 0.45
     C = isotropic_stiffness(E, nu)
     soft = C.copy()

@@ -15,7 +15,7 @@ def add(sub):
                     "to that precision is kept as it is), full mode by installing the case "
                     "folder as the committed reports/CASE. Without --metrics it first runs "
                     "every case and study, and only when --run asks for it: in full mode "
-                    "(about 30 minutes on 2 cores from an empty run store) unless --quick is "
+                    "(the whole main job, as `pbcm report` runs it) unless --quick is "
                     "given. It keeps the gold rows of "
                     "runs it did not see (other modes, meshes, models) unless --prune is "
                     "given; --margin sets the policy's rtol. It prints every value it adds, "
@@ -31,8 +31,8 @@ def add(sub):
     b.add_argument("--metrics", help="bless the metrics.json files under this folder instead "
                                      "of a fresh run")
     b.add_argument("--run", action="store_true",
-                   help="without --metrics: run every case and study first (minutes in "
-                        "quick mode, about 30 minutes in full mode), then bless")
+                   help="without --metrics: run every case and study first (the quick or "
+                        "the full main job), then bless")
     add_selection(b)
     b.set_defaults(func=run)
 
@@ -49,8 +49,8 @@ def run(args):
     if not args.metrics and not args.run:
         print("pbcm bless: error: nothing to bless: give --metrics DIR (metrics already "
               "measured, e.g. by `pbcm report --quick --out DIR`), or --run to run every case "
-              "and study first" + (" (quick mode)" if args.quick else " (full mode: about 30 "
-                                   "minutes)"), file=sys.stderr)
+              "and study first" + (" (quick mode)" if args.quick else " (full mode: the whole "
+                                   "main job, as `pbcm report` runs it)"), file=sys.stderr)
         return 2
     if args.metrics and args.run:
         print("pbcm bless: error: --run and --metrics exclude each other: bless what was "

@@ -44,7 +44,7 @@ class Config(Settings):
     hold_max: float = 2.0         # longest hold after the push [s]
     # which dynamic runs are repeated at dt/4 (REPEAT_DT4): "every" one, or only those that
     # "blew up" at dt (quick: there it tells whether the step is to blame; repeating every run
-    # was half of the quick run's time)
+    # would double the quick run's dynamics)
     repeat_dt4: str = "every"
     rest_speed: float = 1e-3      # at rest: every node slower than this fraction of the push speed
     nodes_per_side: int = NODES_PER_SIDE  # the lattice (sweeps vary it; the paper's is 5)

@@ -87,6 +87,24 @@ def kind(metric, t):
     return "the deviation from its target"
 
 
+def noise(metric, t, rows):
+    """The smallest change of a deviation the runs can tell: for a comparison with the
+    converged continuum its reference's largest error estimate over the rows
+    (``p2_error_estimate``), for one with FEM P1 on the same tetrahedra the solver's
+    round-off (ROUND_OFF)."""
+    if kind(metric, t).startswith("the total error"):
+        est = [_value(r.get("p2_error_estimate")) for r in rows]
+        return max([ROUND_OFF] + [e for e in est if e is not None])
+    return ROUND_OFF
+
+
+def _floor_text(metric, t, rows):
+    return (f"a change below {fmt(noise(metric, t, rows))} ("
+            + ("the reference's largest error estimate over these runs"
+               if kind(metric, t).startswith("the total error") else "the solver's round-off")
+            + ") is not a trend")
+
+
 def populations(rows, spec):
     """[(label, rows)] of the runs grouped by case and boundary condition where the sweep has
     more than one of them (a patch test is never pooled with a clamped cube); one group,
@@ -111,7 +129,7 @@ def findings(metric, rows, spec, models):
     if t is not None:
         out.append(f"{metric}: {kind(metric, t)}; each model's mean |deviation| from {t[0]} "
                    "per case and boundary condition is in the table, never pooled across "
-                   "them; the runs carry no uncertainty, so the sweep ranks no model.")
+                   f"them; {_floor_text(metric, t, rows)}, and the sweep ranks no model.")
     for label, group in pops:
         said, h, b = _findings(metric, group, spec, models, label, lead=False)
         out += said
@@ -156,7 +174,7 @@ def _findings(metric, rows, spec, models, label, lead=True):
             line += [fmt(at[0]), fmt(at[1])]
             if None not in at:
                 said = f"{m} {fmt(at[0])} -> {fmt(at[1])}"
-                if max(at) < ROUND_OFF:
+                if max(at) < noise(metric, t, rows) or abs(at[1] - at[0]) < noise(metric, t, rows):
                     continue
                 if at[1] > CHANGE * at[0]:
                     trend[a][0].append(said)
@@ -166,7 +184,8 @@ def _findings(metric, rows, spec, models, label, lead=True):
     out = []
     if lead and dev:
         out.append(f"{pre}: {kind(metric, t)}; each model's mean |deviation| from {t[0]} is "
-                   "in the table; the runs carry no uncertainty, so the sweep ranks no model.")
+                   f"in the table; {_floor_text(metric, t, rows)}, and the sweep ranks no "
+                   "model.")
     for a in numeric:
         grows, shrinks = trend[a]
         first, last = map(fmt, ends[a])
@@ -338,8 +357,8 @@ def write(spec, rows, out, registry, table_path):
     doc.p(f"Drawn by `pbcm sweep {spec.source}` from its {len(rows)} runs "
           f"({len(rows) - len(ok)} failed, "
           f"{sum(r['status'] == 'partial' for r in rows)} partial). Every parameter and metric of every run is in "
-          f"[{table_path.name}]({table_path.name}); each run's metrics.json is under "
-          "runs/<run key>/.")
+          f"[{table_path.name}]({table_path.name}); each run's metrics.json is kept beside it "
+          "under runs/<run key>/ where the sweep ran (not committed).")
     doc.h(2, "What was run")
     items = [f"cases: {', '.join(spec.cases)} ({'quick' if spec.quick else 'full'} settings"
              f"{'; static problem only, no dynamics or modes' if spec.static_only else ''})"]

@@ -144,12 +144,11 @@ def mesh_specs(quick=False):
 
 def models_on(spec, models):
     """The models run on a mesh of ``spec``: every one, but on the finest bcc (9009 nodes,
-    49152 tetrahedra: each Newton matrix's factors hold about 5e7 entries, some ten seconds a
-    factorisation, a model some five minutes) the models without a normal-stress term only,
-    and not msm, whose Newton solve on the sliding base stagnates there (50 iterations of a
-    load step unconverged with the push in one and in two steps, some ten seconds a matrix:
-    the splits up to 32 would take hours); there those models read their mirror against the
-    six split alone. A held model is not run on the mirrored five split, where it is its
+    49152 tetrahedra: each Newton matrix's factors hold about 5e7 entries) the models without
+    a normal-stress term only, and not msm, whose Newton solve on the sliding base stagnates
+    there (50 iterations of a load step unconverged with the push in one and in two steps, so
+    the splits up to 32 would each factorise hundreds of such matrices); there those models
+    read their mirror against the six split alone. A held model is not run on the mirrored five split, where it is its
     calibrated reading."""
     kind, n, _ = spec
     # a held model on the mirrored five split is its calibrated reading itself
