@@ -2,6 +2,7 @@
 from pathlib import Path
 
 from model.mesh import SCHEMES, box, read
+from model.units import MM
 from ..library.common import CUBE_MM
 from .common import UsageError, number
 
@@ -27,7 +28,7 @@ def run(args):
                          "mesh file or 'cube'")
     if args.source == "cube":
         # millimetres at the edge, metres inside
-        mesh = box(args.n, args.n, args.n, *(3 * [args.size * 1e-3]), scheme=args.scheme,
+        mesh = box(args.n, args.n, args.n, *(3 * [args.size * MM]), scheme=args.scheme,
                    seed=args.seed)
         title = f"cube n={args.n} size={args.size:g} mm scheme={args.scheme}"
     else:

@@ -6,6 +6,7 @@ import numpy as np
 from model import ModelError
 from model.bc import merge
 from model.mesh import box
+from model.paper_mesh import PAPER_NODES  # noqa: F401 (the paper's lattice, for the cases)
 from ..framework import MM
 from ..reporting.rankings import (best_and_worst, estimate, failures,  # noqa: F401
                                   finite_load, per_run, ranking)

@@ -16,7 +16,7 @@ from ..measuring.error_model import P1_FINITE, Scalar, u_num
 from ..framework import FINDINGS, Case, Knob, MM, Reference, Settings, linear_scale
 from . import common
 
-SIZE_MM, NODES = common.CUBE_MM, 5
+SIZE_MM, NODES = common.CUBE_MM, common.PAPER_NODES
 PUSH_MM, STEPS = 9.6, 6
 LAYERS_MM = tuple(common.layers_mm(NODES, SIZE_MM))
 ENERGY_STEP = 1e-3     # the energy's central difference: this fraction of the push

@@ -10,7 +10,7 @@ from ..measuring.error_model import P1_LINEAR, Norm
 from ..framework import MM, Case, Reference, Settings
 from . import common
 
-SIZE_MM, NODES = common.CUBE_MM, 5
+SIZE_MM, NODES = common.CUBE_MM, common.PAPER_NODES
 N_MODES = transient.N_MODES
 
 

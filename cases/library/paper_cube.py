@@ -14,11 +14,11 @@ from model.mesh import cube
 from ..measuring import metrics as M
 from . import transient
 from ..measuring.error_model import Scalar
-from ..framework import MM, Case, Knob, MESH_FAMILIES, Settings, regimes
+from ..framework import MM, Case, Knob, MESH_FAMILIES, Settings, material_record, regimes
 from . import common
 
 SIZE_MM = common.CUBE_MM
-NODES_PER_SIDE = 5
+NODES_PER_SIDE = common.PAPER_NODES
 PUSH_MM = 1.7
 SPEED_MM_S = 1.7
 BCS = common.CUBE_BCS
@@ -63,7 +63,7 @@ class Config(Settings):
         """The parameters that define the problem the metrics answer (what a bound was
         measured at): material, geometry, loading, damping, step and reference resolution.
         Selections (meshes, models) are not part of it."""
-        return {"E_Pa": self.E, "nu": self.nu, "rho_kg_m3": self.rho, "size_mm": SIZE_MM,
+        return {**material_record(self.E, self.nu, self.rho), "size_mm": SIZE_MM,
                 "nodes_per_side": self.nodes_per_side, "push_mm": self.push_mm,
                 "speed_mm_s": SPEED_MM_S, "layers_mm": common.layers_mm(self.nodes_per_side),
                 "p2_levels": self.p2_levels, "modal_refine": self.modal_refine,

@@ -21,8 +21,9 @@ from model.errors import MeshError, ModelError
 from model.loads import boundary_facets
 from model.material import poisson_problem
 from model.mesh import read_with_sets
+from model.units import MM
 
-LENGTH_UNITS = {"m": 1.0, "cm": 1e-2, "mm": 1e-3, "um": 1e-6, "in": 0.0254}
+LENGTH_UNITS = {"m": 1.0, "cm": 1e-2, "mm": MM, "um": 1e-6, "in": 0.0254}
 AXES = ("x", "y", "z")
 # a case name: the folder reports/problems/NAME and the name metrics.json gates under
 NAME = re.compile(r"[a-z0-9][a-z0-9_-]{0,63}")

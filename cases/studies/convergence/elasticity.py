@@ -8,9 +8,11 @@ from model.homogenize import (anisotropy_index, asymmetry, directional_young,
                               effective_stiffness, engineering_constants, kelvin_moduli,
                               moduli_errors)
 from model.mesh import cube
+from model.units import MM
 from ...library.common import CUBE_MM
 from ...running import stop
 from ...running.runner import FINDINGS
+from ...framework import material_record
 from ...running.store import OFF, key
 
 PATCH_MM = CUBE_MM             # the patch cube: the paper's
@@ -20,7 +22,7 @@ ANGLES_DEG = np.arange(0.0, 360.0 + 1e-9, 5.0)
 
 def patch(family, n):
     """The lattice patch: a cube of ``n`` nodes per side (SI units)."""
-    return cube(n, PATCH_MM * 1e-3, family)
+    return cube(n, PATCH_MM * MM, family)
 
 
 def entry(model_name, family, s):
@@ -56,8 +58,8 @@ def table(s, store=OFF):
     for family in s.meshes:
         for name in s.models:
             stop.checkpoint()
-            k = key(kind="elasticity", model=name, mesh=family, E_Pa=s.E, nu=s.nu,
-                    rho_kg_m3=s.rho, patch_n=s.patch_n)
+            k = key(kind="elasticity", model=name, mesh=family,
+                    **material_record(s.E, s.nu, s.rho), patch_n=s.patch_n)
             found = store.get(k)
             if found is None:
                 try:

@@ -8,6 +8,7 @@ from importlib import resources
 
 from model.material import Material
 from model.errors import ModelError
+from model.units import MM
 from reference import manufactured as mms
 
 SPEC = "verification.toml"
@@ -47,7 +48,7 @@ def spec():
     except TypeError as exc:
         raise ModelError(f"{SPEC}: a [[manufactured]] entry is malformed ({exc}); see the "
                          "fields of cases.studies.convergence.verification.Entry") from None
-    return {"size": data["size_mm"] * 1e-3, "E": float(data["E_Pa"]),
+    return {"size": data["size_mm"] * MM, "E": float(data["E_Pa"]),
             "tolerance": float(data["order_tolerance"]), "manufactured": entries,
             "patch": data["patch"]}
 

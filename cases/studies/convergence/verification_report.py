@@ -1,5 +1,6 @@
 """The convergence report's verification section: the references' manufactured-solution
 ladders and every model's patch test, each sentence computed from the rows it shows."""
+from model.units import MM
 from ...measuring import catalogue
 from ...reporting.document import fmt
 from .steps import DIVISORS, REFERENCE, ROUNDOFF
@@ -47,7 +48,7 @@ def manufactured_section(doc, data):
               for r in rows if not r["passed"]))
     entries = {e.name: e for e in s["manufactured"]}
     doc.p("The field is a sum of three plane waves with phases (no component a polynomial) on "
-          f"the cube of side {s['size'] * 1e3:g} mm, E = {s['E']:g} Pa; prescribed on the faces "
+          f"the cube of side {s['size'] / MM:g} mm, E = {s['E']:g} Pa; prescribed on the faces "
           "listed (x: the face x = 0, X: x = side), its traction on the others, its body force "
           "inside (reference.manufactured, the divergence checked against finite differences). "
           + " ".join(f"{e.name}: nu = {e.nu:g}, amplitude {e.amplitude:g} x side, faces "
