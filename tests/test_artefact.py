@@ -764,7 +764,9 @@ def test_the_reading_is_decided_only_where_no_other_could_match_as_many():
                                    50.0, ["a+n"], spans)
     v = analysis.reading_verdict(table, 50.0)
     assert not v["decided"] and v["model"] is None and v["margin"] == 0
-    assert v["sure"] == "not decided" and v["text"].startswith("Not decided: ")
+    assert v["sure"] == "not decided" and v["text"].startswith(
+        "Plainly: a, b miss the paper's cost (Figure 2). Not decided: ")
+    assert v["plain"] == "a, b miss the paper's cost (Figure 2)"
     assert not v["none_reproduces"] and v["none_reproduces_timed"]
     assert v["cost_miss"] == ["a", "b"] and v["untimed"] == ["a-literal"]
     assert v["stable"] == ["a", "a-literal"] and v["stability_depends"] == ["b"]
@@ -1173,3 +1175,20 @@ def test_the_index_picks_a_mesh_from_the_full_artefact_run_only(tmp_path):
         assert picked == ([] if quick else [
             "- Meshing a cube lattice for a particle model (the bulge/neck pattern; "
             "[artefact study](artefact/report.md)): six or bcc."])
+
+
+def test_the_open_mirror_reads_are_counted_by_their_reason():
+    """A part whose mirror read is not decided is counted under its reason (constants fitted
+    per split, a failed control, no control resolved, the ratio at the threshold), none lost."""
+    rows = [{"mirror_why": "its constants are fitted per split (shear_c 0.1 on ...)"},
+            {"mirror_why": "its constants are fitted per split (shear_c 0.2 on ...)"},
+            {"mirror_why": "the ratio's lower bound 1.2, below 3, its upper bound unbounded "
+                           "(no control part resolved)"},
+            {"mirror_why": "the ratio at the threshold"},
+            {"mirror_why": "a control failed; the ratio on those that ran is 3 or more"}]
+    said = analysis._open_reasons(rows)
+    assert said.startswith("constants fitted per split (no control holds the mirrored "
+                           "split's) 2")
+    for part in ("no control part resolved from 0 1", "the ratio at the threshold 1",
+                 "a control failed 1"):
+        assert part in said

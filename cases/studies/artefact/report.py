@@ -773,6 +773,11 @@ def cells_document(doc, s):
         "dropped it there, the model is its reading). "
         f"Definitions: [glossary](../{GLOSSARY}).")
     combos = [(bc, load) for bc in s.bcs for load in s.loads]
+    # the models run at each size on any split: one missing on a mesh of that size is a hole
+    # of the design, shown as its row of 'not run', never left out
+    at_size = {}
+    for x in doc["cells"]:
+        at_size.setdefault(x["nodes_per_side"], {})[x["model"]] = None
     for mesh in s.meshes:
         rows = {}
         for x in doc["cells"]:
@@ -781,12 +786,17 @@ def cells_document(doc, s):
         if not rows:
             continue
         first = next(iter(rows.values()))
+        size = next(iter(first.values()))["nodes_per_side"]
+        absent = [m for m in at_size.get(size, {}) if m not in rows]
         c.h(2, f"{mesh} ({next(iter(first.values()))['tets']} tetrahedra)")
         c.table(["model"] + [f"{bc}/{load}" for bc, load in combos] + ["constants"],
                 [["reference, mean lateral [mm]"] + [_scale(first.get(k)) for k in combos]
                  + [""]]
                 + [[short(m)] + [_cell(r.get(k)) for k in combos] + [_constants(r)]
-                   for m, r in rows.items()])
+                   for m, r in rows.items()]
+                + [[short(m)] + ["not run"] * len(combos) + ["not run on this mesh by the "
+                                                            "study's design"]
+                   for m in absent])
     return c
 
 
