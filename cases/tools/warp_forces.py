@@ -8,7 +8,7 @@ one after the other into one force array. The laws are pbcm's own (model/terms/)
 * ``fem_linear``: small-strain constant-strain tetrahedra (``fem.linear_forces``);
 * ``volume``: p = -K (V - V0) / V, f_i = p dV/dx_i (``volume.volume_forces``);
 * ``springs``: van Gelder's edge springs of msm (``springs.spring_forces``);
-* ``normal_edge``: the per-corner edge-strain deviation (``normal.normal_block``);
+* ``normal_edge``: the per-corner edge-strain deviation (``normal_edge.normal_block``);
 * ``shear``: the three readings, written from the per-tetrahedron maths that
   ``model/terms/_shear_codegen.py`` writes for numba, translated line by line into a Warp
   kernel, so the two cannot drift apart.

@@ -24,7 +24,7 @@ and counted; the driver then reports the first one (:func:`first_flat`).
 
 Numba's cache keys a compiled kernel on its own file only: after editing this one, run
 ``python model/terms/_shear_codegen.py`` (the generated file records this file's hash) and
-clear ``model/terms/__pycache__`` for the other kernels that use it (``fem``, ``normal``).
+clear ``model/terms/__pycache__`` for the other kernels that use it (``fem``, ``normal_edge``).
 """
 import numpy as np
 from numba import njit
