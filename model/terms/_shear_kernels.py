@@ -3,7 +3,7 @@
 Each reading's derivation is in the docstring of its writer there.
 
 _kernels.py sha256 1ec64e200bb30940
-_blocks.py sha256 44c594ef72c14a5b
+_blocks.py sha256 a0a01f096ad04838
 """
 import numpy as np
 from numba import njit
