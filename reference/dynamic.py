@@ -72,9 +72,9 @@ def solve(mesh, material, dirichlet_of_t, t_end, dt=None, damping=0.0, element="
         (:func:`modal_ramp`); no step, so no step error and no cost growing with the mesh's
         smallest tetrahedron.
     """
+    material = as_material(material, "reference.dynamic.solve")
     if method not in ("newmark", "modal"):
         raise ModelError(f"method must be 'newmark' or 'modal', got {method!r}")
-    material = as_material(material, "reference.dynamic.solve")
     lam, mu, rho = *material.lame, material.rho
     if mass not in ("consistent", "lumped"):
         raise ModelError(f"mass must be 'consistent' or 'lumped', got {mass!r}")

@@ -140,7 +140,8 @@ class Discretisation:
 def solve(mesh, material, dirichlet, body_force=None, element="P1", refine=0, dirichlet_fn=None,
           load_steps=1, rtol=1e-10, max_iter=30, on_step=None, mixed=False, traction=None,
           keep_steps=(), start=None):
-    """Neo-Hookean equilibrium on ``mesh`` (a model.mesh.TetMesh) refined ``refine`` times.
+    """Neo-Hookean equilibrium on ``mesh`` (a model.mesh.TetMesh) refined ``refine`` times, of
+    ``material`` (the model.material.Material: E [Pa], nu; rho is not read).
 
     Newton in ``load_steps`` equal increments (or at the load fractions it lists, as
     ``model.bc.load_fractions`` reads them) of the prescribed displacement, body force and
@@ -374,13 +375,14 @@ def forcing(rn, rn_last, floor):
 
 
 def uniaxial(stretch, material):
-    """The law in homogeneous uniaxial stretch with free lateral faces: (lateral stretch l,
-    nominal axial stress P [Pa]). The lateral faces are free when mu (l - 1/l) +
+    """The law of ``material`` (the model.material.Material: E [Pa], nu) in homogeneous
+    uniaxial ``stretch`` [-] with free lateral faces: (lateral stretch l, nominal axial stress
+    P [Pa]). The lateral faces are free when mu (l - 1/l) +
     lam ln(J) / l = 0 with J = stretch l^2; then P = mu (stretch - 1/stretch) +
     lam ln(J) / stretch (negative in compression)."""
+    lam, mu = as_material(material, "reference.hyperelastic.uniaxial").lame
     if not (np.isfinite(stretch) and stretch > 0):
         raise ModelError(f"a stretch must be a finite number > 0, got {stretch!r}")
-    lam, mu = as_material(material, "reference.hyperelastic.uniaxial").lame
     lat = brentq(lambda t: mu * (t - 1 / t) + lam * np.log(stretch * t * t) / t,
                  stretch ** -0.5 * 1e-3, stretch ** -0.5 * 1e3)
     return float(lat), float(mu * (stretch - 1 / stretch)

@@ -233,7 +233,9 @@ def estimate(sols, h=None):
 
 
 def converged(mesh, material, dirichlet, levels=2, **kw):
-    """Solve with P2 on ``mesh`` refined 0..levels times and estimate the error of the finest."""
+    """Solve with P2 on ``mesh`` refined 0..levels times and estimate the error of the finest;
+    ``material`` the model.material.Material, ``kw`` as :func:`solve` takes them."""
+    material = as_material(material, "reference.linear.converged")
     if levels < 1:
         raise ModelError(f"converged needs levels >= 1 to estimate its error, got {levels}")
     return converged_from([solve(mesh, material, dirichlet, element="P2", refine=k, **kw)

@@ -120,9 +120,9 @@ class Manufactured:
 def manufactured(field, law, material):
     """The problem of ``field`` for the law ``law`` ("linear" or "neo-Hookean") of the
     Material ``material``."""
+    material = as_material(material, "reference.manufactured.manufactured")
     if law not in MATERIALS:
         raise ModelError(f"unknown law {law!r}: choose one of {sorted(MATERIALS)}")
-    material = as_material(material, "reference.manufactured.manufactured")
     return Manufactured(field, MATERIALS[law](*material.lame), material)
 
 

@@ -50,8 +50,9 @@ def lumped(M):
 
 
 def frequencies(mesh, material, dirichlet, k=6, mass="consistent", element="P2", refine=0):
-    """The ``k`` lowest eigenfrequencies of the structure clamped by ``dirichlet`` (values
-    must be zero there; ``{}`` for free-free, whose six rigid modes come first at 0 Hz)."""
+    """The ``k`` lowest eigenfrequencies [Hz] of the structure of ``material`` (the
+    model.material.Material: E [Pa], nu, rho [kg/m^3]) clamped by ``dirichlet`` (values must be
+    zero there; ``{}`` for free-free, whose six rigid modes come first at 0 Hz)."""
     material = as_material(material, "reference.modal.frequencies")
     lam, mu, rho = *material.lame, material.rho
     if mass not in ("consistent", "lumped"):

@@ -6,6 +6,7 @@ import pytest
 
 from model import PRESETS
 from model.errors import MeshError
+from model.material import Material
 from model.geometry import displacement_gradients
 from model.mesh import cube, perturbed
 from cases.studies.convergence import patch
@@ -20,7 +21,7 @@ LATTICES = ("five", "six", "bcc", "unstructured")
 def table():
     s = spec()
     return {(r["mesh"], r["model"]): r for r in patch.table(
-        ("FEM P1",) + tuple(PRESETS), LATTICES, 10e3, 0.45)}, s["patch"]
+        ("FEM P1",) + tuple(PRESETS), LATTICES, Material(10e3, 0.45))}, s["patch"]
 
 
 def test_gradients_of_an_affine_field_are_exact_on_any_mesh():

@@ -9,8 +9,9 @@ The irregular families are the unstructured one and each lattice with its interi
 at random (``model.mesh.perturbed``)."""
 import numpy as np
 
-from model import Material, build
+from model import build
 from model.geometry import displacement_gradients
+from model.material import as_material
 from model.mesh import cube, perturbed
 from reference import linear
 from ...running import stop
@@ -91,21 +92,22 @@ def run_model(model, family, spec, material, size, rtol, store=OFF):
     return store.put(k, row)
 
 
-def units(models, lattices, E, nu, store=OFF):
+def units(models, lattices, material, store=OFF):
     """The table's rows as work units ``(run_model, args, cost)``: every one of ``models``
     ("FEM P1" for the scikit-fem reference) on every patch family of ``lattices``, as the
-    spec's [patch] declares the test, on the spec's cube (cost: one each)."""
+    spec's [patch] declares the test, on the spec's cube, of ``material`` (the study's
+    model.material.Material; cost: one each)."""
+    material = as_material(material, "cases.studies.convergence.patch.units")
     s = verification_spec()
     spec = dict(s["patch"])
     rtol = spec.pop("rtol")
-    material = Material(E=E, nu=nu)
     return [(run_model, (m, fam, spec, material, s["size"], rtol, store), 1.0)
             for fam in families(lattices) for m in models]
 
 
-def table(models, lattices, E, nu, store=OFF):
+def table(models, lattices, material, store=OFF):
     """The rows of :func:`units`, computed here."""
-    return [fn(*args) for fn, args, _ in units(models, lattices, E, nu, store)]
+    return [fn(*args) for fn, args, _ in units(models, lattices, material, store)]
 
 
 __all__ = ["unit_strains", "families", "patch_mesh", "strain_error", "solve", "run_model",

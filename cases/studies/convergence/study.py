@@ -422,7 +422,7 @@ def run(s, workers=None, log=True, bench=None, store=OFF):
         track.advance(elastic_weight, "effective elasticity")
         tables = {} if not s.verification else {
             "manufactured": manufactured_units(s.meshes, s.quick, store),
-            "patch": patch_units((FEM_P1,) + tuple(s.models), s.meshes, s.E, s.nu, store),
+            "patch": patch_units((FEM_P1,) + tuple(s.models), s.meshes, s.material, store),
             # quick: the first family only (a minute a family for every model)
             "steps": steps_units(s.models, s.meshes[:1] if s.quick else s.meshes, s.E, s.nu,
                                  s.rho, store)}

@@ -3,7 +3,7 @@ compressed through the three measured states in one static solve, its displaceme
 measured rest bead positions (P1 on its mesh) against the measured one; the references (the
 neo-Hookean mixed P2/P1 continuum with its estimate, linear P2) at the beads by their own
 basis; the travel that best fits the measured axial displacements."""
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
@@ -118,7 +118,8 @@ def reference_mesh():
 def _nh_solves(plates, travels, nu, s, levels):
     m = reference_mesh()
     fractions, at = schedule(travels, REF_STEP_STRAIN)
-    return [hyperelastic.solve(m, Material(s.E, nu), plate_dirichlet(m, plates, travels[-1]),
+    material = replace(s.material, nu=nu)        # the study's, at the spec's nu
+    return [hyperelastic.solve(m, material, plate_dirichlet(m, plates, travels[-1]),
                                element="P2",
                                mixed=True, refine=k, load_steps=fractions, keep_steps=at)
             for k in levels], at
@@ -148,7 +149,7 @@ def linear_reference(plates, travels, nu, s, beads):
     :func:`continuum` gives the neo-Hookean one."""
     m = reference_mesh()
     bc = plate_dirichlet(m, plates, travels[-1])
-    sols = [linear.solve(m, Material(s.E, nu), bc, element="P2", refine=k)
+    sols = [linear.solve(m, replace(s.material, nu=nu), bc, element="P2", refine=k)
             for k in range(s.ref_levels + 1)]
     conv = converged_from(sols)
     u = sols[-1].at(beads)
@@ -183,7 +184,7 @@ def bead_displacements(model, mesh, spec, travels, beads, s):
     located = mesh.locate(beads)
     kept = {}
     try:
-        pm = build(model, mesh, Material(E=s.E, nu=nu, rho=1000.0))
+        pm = build(model, mesh, replace(s.material, nu=nu))
         pm.solve_static(plate_dirichlet(mesh, plates, travels[-1]), load_steps=fractions,
                         rtol=STATIC_RTOL,
                         on_step=lambda step, x: kept.__setitem__(step, x - mesh.points))
