@@ -196,7 +196,7 @@ def test_rankings_tie_models_within_u_num_of_a_groups_first():
     the caveat appears where u_num exceeds a fifth of the smallest error; a model below five
     times u_num is not judged, so the line names no closest among them and the table shares
     their rank; against a closed form there are no ties."""
-    from cases.library import common
+    from cases.library.narratives import sentences as common
     runs = [{"model": m, "mesh": "five", "bc": "clamped", "err": e, "p2_error_estimate": 0.01}
             for m, e in (("a", 0.10), ("b", 0.105), ("c", 0.115), ("d", 0.30))]
     (table,) = common.ranking(runs, "err", "error")

@@ -1,6 +1,5 @@
-"""What the library's cases share: bars meshed at a spacing, their end faces, and sentences
-that compare FEM with a closed form; the rankings (``cases.reporting.rankings``) are the harness's,
-named here for the cases."""
+"""What the library's cases share: the paper's cube and lattice, bars meshed at a spacing and
+their end faces."""
 import numpy as np
 
 from model import ModelError
@@ -8,8 +7,6 @@ from model.bc import merge
 from model.mesh import box
 from model.paper_mesh import PAPER_NODES  # noqa: F401 (the paper's lattice, for the cases)
 from ..framework import MM
-from ..reporting.rankings import (best_and_worst, estimate, failures,  # noqa: F401
-                                  finite_load, per_run, ranking)
 
 CUBE_BCS = ("clamped", "sliding")    # the compressed cube's bases
 CUBE_MM = 32.0                        # the paper's cube: its side, every cube case's
@@ -50,15 +47,3 @@ def bar(family, length_mm, height_mm, width_mm, spacing_mm):
 def face(mesh, x):
     """The nodes of the end face at x [m]."""
     return mesh.nodes_on_plane("x", x)
-
-
-def vs_closed_form(name, runs, key, closed, unit):
-    """'FEM P2 gives ... against the closed form ...' for the first run of each mesh."""
-    out = []
-    for mesh in dict.fromkeys(r["mesh"] for r in runs):
-        r = next(r for r in runs if r["mesh"] == mesh)
-        fem = r[key]
-        out.append(f"{mesh}: FEM P2 {name} {fem:.4g} {unit}, closed form {closed:.4g} {unit} "
-                   f"(FEM / closed form {fem / closed:.3f}; P2 error estimate "
-                   f"{r['p2_error_estimate']:.2g}).")
-    return out

@@ -1,6 +1,6 @@
 """The cantilever's report prose: what was run, its opening and findings, computed
 from the runs."""
-from .. import common
+from . import sentences
 from ...framework import Narrative
 from ..cantilever import LENGTH_MM, HEIGHT_MM, WIDTH_MM
 
@@ -18,7 +18,7 @@ class CantileverNarrative(Narrative):
     def conclusion(self, s, runs):
         cf = self.case.closed_form(s, "clamped")["tip_deflection_mm"]
         solved = [r for r in runs if r.get("tip_deflection_mm") is not None]
-        out = [common.best_and_worst(runs, "tip_deflection_rel_err", "Tip deflection")]
+        out = [sentences.best_and_worst(runs, "tip_deflection_rel_err", "Tip deflection")]
         if solved:
             fem = solved[0]["tip_deflection_fem_mm"]
             out.append(f"FEM P2 deflects {fem:.4g} mm ({solved[0]['mesh']}), the closed form "
@@ -26,13 +26,13 @@ class CantileverNarrative(Narrative):
             soft = sorted({r["model"] for r in solved
                            if r["tip_deflection_mm"] > r["tip_deflection_fem_mm"]})
             out.append("Softer than FEM in bending: " + (", ".join(soft) or "none") + ". "
-                       + common.failures(runs))
+                       + sentences.failures(runs))
         return out
 
     def findings(self, s, runs):
         cf = self.case.closed_form(s, "clamped")["tip_deflection_mm"]
-        return {"Bending stiffness": common.ranking(runs, "tip_deflection_rel_err",
+        return {"Bending stiffness": sentences.ranking(runs, "tip_deflection_rel_err",
                                                     "tip deflection error"),
-                "Reference against the closed form": common.vs_closed_form(
+                "Reference against the closed form": sentences.vs_closed_form(
                     "tip deflection", runs, "tip_deflection_fem_mm", cf, "mm"),
-                "Failures": [common.failures(runs)]}
+                "Failures": [sentences.failures(runs)]}

@@ -1,6 +1,6 @@
 """The indentation case's report prose: what was run, its opening, findings and
 figures, computed from the runs."""
-from .. import common
+from . import sentences
 from ..indentation import SIZE_MM, PATCH_MM, DEPTH_MM, RIM_MM, DEVIATES, centre_line
 from ...framework import MM, Narrative
 
@@ -23,19 +23,19 @@ class IndentationNarrative(Narrative):
                 "references' every boundary point of every refinement."]
 
     def conclusion(self, s, runs):
-        return [common.best_and_worst(runs, "reaction_rel_err", "Punch force"),
-                common.best_and_worst(runs, "profile_rel_err", "Surface profile"),
+        return [sentences.best_and_worst(runs, "reaction_rel_err", "Punch force"),
+                sentences.best_and_worst(runs, "profile_rel_err", "Surface profile"),
                 "The shear under the edge of the punch's face is not bounded in the continuum "
                 "(it grows as the mesh is refined): its values are in the tables, never "
-                "ranked. " + common.failures(runs)]
+                "ranked. " + sentences.failures(runs)]
 
     def findings(self, s, runs):
-        stiff = common.per_run(runs, lambda r: None if r.get("reaction_ratio") is None
+        stiff = sentences.per_run(runs, lambda r: None if r.get("reaction_ratio") is None
                                else r["reaction_ratio"] > 1, "Stiffer than FEM under the punch")
-        return {"Punch force": common.ranking(runs, "reaction_rel_err", "force error")
+        return {"Punch force": sentences.ranking(runs, "reaction_rel_err", "force error")
                 + [stiff],
-                "Surface profile": common.ranking(runs, "profile_rel_err", "profile error"),
-                "Failures": [common.failures(runs)]}
+                "Surface profile": sentences.ranking(runs, "profile_rel_err", "profile error"),
+                "Failures": [sentences.failures(runs)]}
 
     def sections(self, doc, s, runs, fields, out):
         from ...reporting import figures

@@ -1,7 +1,7 @@
 """The large-compression case's report prose: what was run, its opening, findings
 and figures, computed from the runs."""
 import numpy as np
-from .. import common
+from . import sentences
 from ...reporting import figures
 from ..large_compression import SIZE_MM, NODES, pushes
 from ...framework import MM, Narrative
@@ -50,20 +50,20 @@ class LargeCompressionNarrative(Narrative):
                    "locked, not closer to the law, and the model-form error here ranks "
                    "closeness to a locked mesh." if twin else None)
         return ([locking] if locking else []) + [
-            common.best_and_worst(runs, "force_rel_err_max", "Force-strain curve",
+            sentences.best_and_worst(runs, "force_rel_err_max", "Force-strain curve",
                                   estimate_key=nh),
-            common.best_and_worst(runs, "lateral_rel_err_max", "Lateral expansion",
+            sentences.best_and_worst(runs, "lateral_rel_err_max", "Lateral expansion",
                                   estimate_key=nh),
-            " ".join(filter(None, (line, self.case._agreement(runs), common.failures(runs),
+            " ".join(filter(None, (line, self.case._agreement(runs), sentences.failures(runs),
                                    self.case._homogeneous_failures(runs))))]
 
     def findings(self, s, runs):
         nh = "nh_error_estimate"
-        return {"Force-strain curve": common.ranking(runs, "force_rel_err_max",
+        return {"Force-strain curve": sentences.ranking(runs, "force_rel_err_max",
                                                      "largest force error", estimate_key=nh),
-                "Lateral expansion": common.ranking(runs, "lateral_rel_err_max",
+                "Lateral expansion": sentences.ranking(runs, "lateral_rel_err_max",
                                                     "largest lateral error", estimate_key=nh),
-                "Failures": list(filter(None, [common.failures(runs),
+                "Failures": list(filter(None, [sentences.failures(runs),
                                                self.case._homogeneous_failures(runs)]))}
 
     def sections(self, doc, s, runs, fields, out):

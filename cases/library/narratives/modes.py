@@ -1,7 +1,7 @@
 """The modes case's report prose: what was run, its opening, findings, table cells and
 figures, computed from the runs."""
 import numpy as np
-from .. import common
+from . import sentences
 from ...framework import Narrative
 from ...reporting.document import fmt
 from ..modes import SIZE_MM, NODES, N_MODES
@@ -29,7 +29,7 @@ class ModesNarrative(Narrative):
                 "and stress metrics are n/a."]
 
     def conclusion(self, s, runs):
-        out = [common.best_and_worst([r for r in runs if r["bc"] == bc], "modal_rel_err",
+        out = [sentences.best_and_worst([r for r in runs if r["bc"] == bc], "modal_rel_err",
                                      f"{bc}: first 10 frequencies", lost_key="modes_unpaired")
                for bc in s.bcs]
         odd = [f"{r['model']} on {r['mesh']}/{r['bc']} ({r['rigid_modes']})" for r in runs
@@ -39,7 +39,7 @@ class ModesNarrative(Narrative):
         return out
 
     def findings(self, s, runs):
-        return {f"{bc}": common.ranking([r for r in runs if r["bc"] == bc], "modal_rel_err",
+        return {f"{bc}": sentences.ranking([r for r in runs if r["bc"] == bc], "modal_rel_err",
                                         "largest frequency error", lost_key="modes_unpaired")
                 for bc in s.bcs}
 

@@ -1,6 +1,6 @@
 """The self-weight case's report prose: what was run, its opening and findings,
 computed from the runs."""
-from .. import common
+from . import sentences
 from ...framework import Narrative
 from ..self_weight import SIZE_MM
 
@@ -18,7 +18,7 @@ class SelfWeightNarrative(Narrative):
 
     def conclusion(self, s, runs):
         slide = [r for r in runs if r["bc"] == "sliding"]
-        out = [common.best_and_worst(runs, "top_settlement_rel_err", "Top settlement",
+        out = [sentences.best_and_worst(runs, "top_settlement_rel_err", "Top settlement",
                                      per_mesh=self.case.per_mesh_continuum)]
         # the closed form is read at each mesh's own top nodes: one pair per mesh
         pairs = {r["mesh"]: (r["top_settlement_fem_mm"], r["top_settlement_cf_mm"])
@@ -28,13 +28,13 @@ class SelfWeightNarrative(Narrative):
             out.append("Sliding base, FEM P2 against the closed form read at the mesh's own top "
                        "nodes: " + "; ".join(f"{mesh} {fem:.6g} and {cf:.6g} mm"
                                              for mesh, (fem, cf) in pairs.items()) + "; "
-                       + common.best_and_worst(slide, "top_settlement_cf_rel_err",
+                       + sentences.best_and_worst(slide, "top_settlement_cf_rel_err",
                                                "against the closed form", exact=True))
-        out.append(common.failures(runs))
+        out.append(sentences.failures(runs))
         return out
 
     def findings(self, s, runs):
-        return {bc: common.ranking([r for r in runs if r["bc"] == bc],
+        return {bc: sentences.ranking([r for r in runs if r["bc"] == bc],
                                    "top_settlement_rel_err", "settlement error",
                                    per_mesh=self.case.per_mesh_continuum)
-                for bc in s.bcs} | {"Failures": [common.failures(runs)]}
+                for bc in s.bcs} | {"Failures": [sentences.failures(runs)]}

@@ -1,6 +1,6 @@
 """The torsion case's report prose: what was run, its opening and findings, computed
 from the runs."""
-from .. import common
+from . import sentences
 from ...framework import Narrative
 from ..torsion import LENGTH_MM, SIDE_MM
 
@@ -22,8 +22,8 @@ class TorsionNarrative(Narrative):
 
     def conclusion(self, s, runs):
         cf = self.case.closed_form(s, "clamped")["torque_nm"]
-        out = [common.best_and_worst(runs, "torque_rel_err", "Torque"),
-               common.best_and_worst(runs, "warping_rel_err", "End-face warping")]
+        out = [sentences.best_and_worst(runs, "torque_rel_err", "Torque"),
+               sentences.best_and_worst(runs, "warping_rel_err", "End-face warping")]
         ok = [r for r in runs if r.get("torque_fem_nm") is not None]
         if ok:
             ratio = ok[0]["torque_fem_nm"] / cf
@@ -31,17 +31,17 @@ class TorsionNarrative(Narrative):
                    if ratio > 1.02 else "within 2 % of Saint-Venant")
             out.append(f"FEM P2 needs {ok[0]['torque_fem_nm']:.4g} N m ({ok[0]['mesh']}), "
                        f"Saint-Venant {cf:.4g} N m (ratio {ratio:.3f}: {why}). "
-                       + common.failures(runs))
+                       + sentences.failures(runs))
         return out
 
     def findings(self, s, runs):
         cf = self.case.closed_form(s, "clamped")["torque_nm"]
-        stiff = common.per_run(runs, lambda r: None if r.get("torque_nm") is None
+        stiff = sentences.per_run(runs, lambda r: None if r.get("torque_nm") is None
                                else r["torque_nm"] > r["torque_fem_nm"],
                                "Stiffer than FEM in torsion")
-        return {"Torsional stiffness": common.ranking(runs, "torque_rel_err", "torque error")
+        return {"Torsional stiffness": sentences.ranking(runs, "torque_rel_err", "torque error")
                 + [stiff],
-                "Warping": common.ranking(runs, "warping_rel_err", "warping error"),
-                "Reference against Saint-Venant": common.vs_closed_form(
+                "Warping": sentences.ranking(runs, "warping_rel_err", "warping error"),
+                "Reference against Saint-Venant": sentences.vs_closed_form(
                     "torque", runs, "torque_fem_nm", cf, "N m"),
-                "Failures": [common.failures(runs)]}
+                "Failures": [sentences.failures(runs)]}

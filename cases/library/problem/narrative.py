@@ -1,7 +1,7 @@
 """A user's problem's report prose: its mesh, selections and loads as the TOML gave them, its
 measures' notes, an opening and findings per measure, and each profile's figure, computed
 from the runs."""
-from .. import common
+from ..narratives import sentences
 from ...framework import MM, Narrative
 from ...measuring.catalogue import err_name, ref_name
 from ...reporting import figures
@@ -37,13 +37,13 @@ class ProblemNarrative(Narrative):
 
     def conclusion(self, s, runs):
         first = self.case.spec.measures[0]
-        return [common.best_and_worst(runs, err_name(first.key), first.name),
-                common.failures(runs)]
+        return [sentences.best_and_worst(runs, err_name(first.key), first.name),
+                sentences.failures(runs)]
 
     def findings(self, s, runs):
-        out = {m.name: common.ranking(runs, err_name(m.key), f"{m.name} error")
+        out = {m.name: sentences.ranking(runs, err_name(m.key), f"{m.name} error")
                for m in self.case.spec.measures}
-        return out | {"Failures": [common.failures(runs)]}
+        return out | {"Failures": [sentences.failures(runs)]}
 
     def sections(self, doc, s, runs, fields, out):
         for m in (m for m in self.case.spec.measures if not m.scalar):
