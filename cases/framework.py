@@ -53,15 +53,31 @@ def material_record(E, nu, rho):
 
 
 @dataclass
-class Settings:
-    """What one run of a case does: the material (defaults E = 10 kPa, nu = 0.45,
-    rho = 1000 kg/m^3), the selection (meshes, boundary conditions, models) and the
-    resolution of the references. A case subclasses it to add its own fields (geometry, load,
-    steps) and names them in ``problem()``."""
+class MaterialSettings:
+    """The material a case or study runs: E [Pa], nu, rho [kg/m^3] as the command line gives
+    them (defaults the paper cube's), and the one ``Material`` made from them, checked there,
+    that the models and every reference take."""
 
     E: float = DEFAULT_E
     nu: float = DEFAULT_NU
     rho: float = DEFAULT_RHO
+    material: Material = field(init=False, repr=False, compare=False)
+
+    def __post_init__(self):
+        self.material = Material(E=self.E, nu=self.nu, rho=self.rho)
+
+    def material_record(self):
+        """The material as a metrics document records it."""
+        return material_record(self.E, self.nu, self.rho)
+
+
+@dataclass
+class Settings(MaterialSettings):
+    """What one run of a case does: the material (``MaterialSettings``), the selection
+    (meshes, boundary conditions, models) and the resolution of the references. A case
+    subclasses it to add its own fields (geometry, load, steps) and names them in
+    ``problem()``."""
+
     meshes: tuple = ()
     bcs: tuple = ()
     models: tuple = ()
@@ -73,15 +89,11 @@ class Settings:
     # neo-Hookean reference and the case's extra reference work and metrics (reference_extra,
     # reference_entries, run_extra: dynamics, modes) are skipped
     static_only: bool = False
-    material: Material = field(init=False, repr=False, compare=False)
-
-    def __post_init__(self):
-        self.material = Material(E=self.E, nu=self.nu, rho=self.rho)
 
     def problem(self):
         """The parameters that define the problem the metrics answer (what a bound was
         measured at). Subclasses add their geometry and loads."""
-        return {**material_record(self.E, self.nu, self.rho),
+        return {**self.material_record(),
                 "p2_levels": self.p2_levels, **regimes(self)}
 
     @property

@@ -14,7 +14,7 @@ from model.mesh import cube
 from ..measuring import metrics as M
 from . import transient
 from ..measuring.error_model import Scalar
-from ..framework import MM, Case, Knob, MESH_FAMILIES, Settings, material_record, regimes
+from ..framework import MM, Case, Knob, MESH_FAMILIES, Settings, regimes
 from . import common
 
 SIZE_MM = common.CUBE_MM
@@ -63,7 +63,7 @@ class Config(Settings):
         """The parameters that define the problem the metrics answer (what a bound was
         measured at): material, geometry, loading, damping, step and reference resolution.
         Selections (meshes, models) are not part of it."""
-        return {**material_record(self.E, self.nu, self.rho), "size_mm": SIZE_MM,
+        return {**self.material_record(), "size_mm": SIZE_MM,
                 "nodes_per_side": self.nodes_per_side, "push_mm": self.push_mm,
                 "speed_mm_s": SPEED_MM_S, "layers_mm": common.layers_mm(self.nodes_per_side),
                 "p2_levels": self.p2_levels, "modal_refine": self.modal_refine,

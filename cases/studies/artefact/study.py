@@ -2,19 +2,19 @@
 profile and alternation against the continuum's, and per (mesh, model) the linearised growth
 rate of the paper's clamped RK4 run."""
 import functools
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
 import numpy as np
 
-from model import CalibrationDroppedError, Material, build
+from model import CalibrationDroppedError, build
 from model.candidates import NORMAL_FORMS
 from model.compose import label
 from model.mesh import cube
 from model.paper_mesh import unmatched_faces
 from reference import hyperelastic, linear
 from ...measuring import metrics as M
-from ...framework import (DEFAULT_E, DEFAULT_NU, DEFAULT_RHO, FINDINGS, LOAD_SPLITS,
-                          material_record, solve_split)
+from ...framework import (MaterialSettings, FINDINGS, LOAD_SPLITS,
+                          solve_split)
 from ...library import paper_cube as P
 from ...library.common import layers_mm
 from ...running.progress import Progress
@@ -180,20 +180,16 @@ def mesh_factors(name, spec, mesh):
 
 
 @dataclass
-class ArtefactSettings:
+class ArtefactSettings(MaterialSettings):
     """Material (the paper cube's), the factors and the mode."""
 
-    E: float = DEFAULT_E
-    nu: float = DEFAULT_NU
-    rho: float = DEFAULT_RHO
     quick: bool = False
     bcs: tuple = P.BCS
     loads: tuple = ("paper", "linear")
     damping: float = 50.0     # the paper cube's mass damping [1/s]: what flutter must beat
-    material: Material = field(init=False, repr=False, compare=False)
 
     def __post_init__(self):
-        self.material = Material(E=self.E, nu=self.nu, rho=self.rho)
+        super().__post_init__()
 
     @property
     def ref_levels(self):
@@ -208,7 +204,7 @@ class ArtefactSettings:
         return mesh_specs(self.quick)
 
     def problem(self):
-        return {**material_record(self.E, self.nu, self.rho), "size_mm": P.SIZE_MM,
+        return {**self.material_record(), "size_mm": P.SIZE_MM,
                 "push_mm": P.PUSH_MM, "linear_scale": LINEAR_SCALE, "damping_1_s": self.damping,
                 "reference": {"element": "P2", "mesh": f"{REF_MESH[0]} {REF_MESH[1]}^3",
                               "refinements": self.ref_levels}}

@@ -12,7 +12,6 @@ from model.units import MM
 from ...library.common import CUBE_MM
 from ...running import stop
 from ...running.runner import FINDINGS
-from ...framework import material_record
 from ...running.store import OFF, key
 
 PATCH_MM = CUBE_MM             # the patch cube: the paper's
@@ -59,7 +58,7 @@ def table(s, store=OFF):
         for name in s.models:
             stop.checkpoint()
             k = key(kind="elasticity", model=name, mesh=family,
-                    **material_record(s.E, s.nu, s.rho), patch_n=s.patch_n)
+                    **s.material_record(), patch_n=s.patch_n)
             found = store.get(k)
             if found is None:
                 try:

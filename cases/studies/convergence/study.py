@@ -3,18 +3,18 @@ paper cube (clamped and sliding), the cantilever and the torsion bar, against on
 reference per problem; then the fits, the effective elasticity of every model on every lattice
 and the accuracy per cost.
 """
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from types import SimpleNamespace
 
 import numpy as np
 
-from model import PRESETS, Material, build
+from model import PRESETS, build
 from reference import linear
 from ...measuring import metrics as M
 from ...running import stop
 from ...running.progress import Progress
 from ...running.store import OFF, key
-from ...framework import DEFAULT_E, DEFAULT_NU, DEFAULT_RHO, MESH_FAMILIES, material_record
+from ...framework import MaterialSettings, MESH_FAMILIES
 from ...running.runner import FINDINGS, free_components, jsonable
 from ...running.workers import dearest_first, one_blas_thread
 from .cost import accuracy_per_cost
@@ -36,13 +36,10 @@ SELF_SIMILAR = ("five", "six", "bcc")
 
 
 @dataclass
-class ConvergenceSettings:
+class ConvergenceSettings(MaterialSettings):
     """What the study runs: material, problems, mesh families, models, the mesh sizes h [mm],
     the load scale (linear regime) and the lattice patch of the effective elasticity."""
 
-    E: float = DEFAULT_E
-    nu: float = DEFAULT_NU
-    rho: float = DEFAULT_RHO
     problems: tuple = tuple(PROBLEMS)
     meshes: tuple = MESH_FAMILIES
     models: tuple = tuple(PRESETS)
@@ -57,14 +54,13 @@ class ConvergenceSettings:
     # the verification ladder (manufactured solutions, patch tests, step ladders): the
     # extensions study, which reads the fits and the elasticity alone, runs without it
     verification: bool = True
-    material: Material = field(init=False, repr=False, compare=False)
 
     def __post_init__(self):
-        self.material = Material(E=self.E, nu=self.nu, rho=self.rho)
+        super().__post_init__()
 
     def problem(self):
         """What the gate compares: the problem the metrics answer."""
-        return {**material_record(self.E, self.nu, self.rho),
+        return {**self.material_record(),
                 "h_mm": [round(h, 6) for h in self.h_mm], "load_scale": self.load_scale,
                 "ref_ladders_mm": {p: list(self.ladder(p)) for p in self.problems},
                 "max_nodes": MAX_NODES, "patch_n": self.patch_n}

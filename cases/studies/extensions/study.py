@@ -1,10 +1,9 @@
 """The extensions study's runs: the library's cases and the convergence study with the
 candidate models, reduced to what the rankings read."""
-from dataclasses import dataclass, field, replace
+from dataclasses import dataclass, replace
 
-from model import Material
 from model.candidates import BASE, CANDIDATES, NORMAL_FORMS, short  # noqa: F401 (the study's names)
-from ...framework import DEFAULT_E, DEFAULT_NU, DEFAULT_RHO, material_record
+from ...framework import MaterialSettings
 from ...measuring.catalogue import STATIC, err_name
 from ...reporting.costs import step_cost_us
 from ...measuring.error_model import decomposed
@@ -18,21 +17,17 @@ TWIN = "pbcm-variational+normal"   # the preset whose terms are +normal_edge's
 
 
 @dataclass
-class ExtensionSettings:
+class ExtensionSettings(MaterialSettings):
     """Material, the models (the paper's model, the candidates and the FEM yardstick) and the
     mode; each case and the convergence study run with their own quick or full settings."""
 
-    E: float = DEFAULT_E
-    nu: float = DEFAULT_NU
-    rho: float = DEFAULT_RHO
     models: tuple = (BASE, *CANDIDATES, YARDSTICK)
     quick: bool = False
     cases: tuple = None        # library cases (None: every one)
     problems: tuple = None     # convergence problems (None: the study's own)
-    material: Material = field(init=False, repr=False, compare=False)
 
     def __post_init__(self):
-        self.material = Material(E=self.E, nu=self.nu, rho=self.rho)
+        super().__post_init__()
         if BASE not in self.models:
             from model.errors import ModelError
             raise ModelError(f"the extensions study ranks models against the paper's model: "
@@ -51,7 +46,7 @@ class ExtensionSettings:
 
     def problem(self):
         """What the gate compares: each case's problem and the convergence study's."""
-        return {**material_record(self.E, self.nu, self.rho),
+        return {**self.material_record(),
                 "cases": {n: c.problem() for n, c in self.case_settings().items()},
                 "convergence": self.convergence_settings().problem()}
 

@@ -3,11 +3,11 @@ compressed through the three measured states in one static solve, its displaceme
 measured rest bead positions (P1 on its mesh) against the measured one; the references (the
 neo-Hookean mixed P2/P1 continuum with its estimate, linear P2) at the beads by their own
 basis; the travel that best fits the measured axial displacements."""
-from dataclasses import dataclass, field, replace
+from dataclasses import dataclass, replace
 
 import numpy as np
 
-from model import Material, build
+from model import build
 from model.errors import ModelError
 from model.mesh import cube
 from model.presets import PRESETS
@@ -15,7 +15,7 @@ from reference import hyperelastic, linear
 from reference.linear import converged_from
 from reference import truthcube as T
 from ...running import stop
-from ...framework import FINDINGS
+from ...framework import MaterialSettings, FINDINGS
 from ...running.progress import Progress
 from ...running.runner import jsonable
 from ...running.store import OFF, key
@@ -55,7 +55,7 @@ def variants(nu=NU):
 
 
 @dataclass
-class TruthCubeSettings:
+class TruthCubeSettings(MaterialSettings):
     """The material, the meshes, the variants and the models."""
 
     E: float = E
@@ -64,7 +64,6 @@ class TruthCubeSettings:
     models: tuple = tuple(PRESETS)
     spacings_mm: tuple = SPACINGS_MM
     ref_levels: int = REF_LEVELS
-    material: Material = field(init=False, repr=False, compare=False)
 
     def __post_init__(self):
         if not 0.45 <= self.nu < 0.5:
@@ -73,7 +72,7 @@ class TruthCubeSettings:
                              "Cube's silicone: 0.49 to 0.4999)")
         if self.quick:
             self.spacings_mm = self.spacings_mm[:1]
-        self.material = Material(E=self.E, nu=self.nu, rho=1000.0)
+        super().__post_init__()
 
     @property
     def units(self):
