@@ -291,14 +291,9 @@ class Case(abc.ABC):
         (imported on first use, so that the prose may import the case's constants); None:
         the default narrative, which says what every case's report says.
     fem_solver : the linear FEM solver ("auto", "direct", "amg").
-    draws_stress, magnify : whether the case draws its own stress panels; the magnification
-        of the standard ones.
     static : whether the case has a static displacement problem (what ``pbcm fit`` fits).
     resolution, load : the Settings fields a sweep's ``resolution`` and ``load`` axes turn
         (a Knob each), or None where the case has none.
-    up : the vertical axis ("x", "y" or "z") the report's figures stand on.
-    material_from : where the report says the material comes from (the options that change
-        it).
     """
 
     name: ClassVar[str]
@@ -324,14 +319,9 @@ class Case(abc.ABC):
     quantity_compared: ClassVar[tuple] = ()   # the names quantity_metrics returns
     narrative: ClassVar[object] = None   # its Narrative subclass, or "module:Class"
     fem_solver: ClassVar[str] = "auto"    # the linear FEM solver (reference.solvers.linear_solve)
-    draws_stress: ClassVar[bool] = False   # True: the case draws its own max |tau| panels
-    magnify: ClassVar[float] = 5.0         # displacement magnification of the panels
     static: ClassVar[bool] = True          # False: no static displacement (modes)
     resolution: ClassVar[Knob] = None      # what a sweep's resolution axis turns
     load: ClassVar[Knob] = None            # what a sweep's load axis turns
-    up: ClassVar[str] = "y"                # the vertical axis of the figures
-    glossary: ClassVar[str] = "../glossary.md"   # the glossary's path from the case's report
-    material_from: ClassVar[str] = "override with --E, --nu, --rho"
 
     def __init_subclass__(cls, **kw):
         """A declaration error shows when the case is imported, not in its report."""
@@ -459,11 +449,6 @@ class Case(abc.ABC):
         """Case-specific metrics of one run; ``st`` is None when the static solve failed."""
         return {}
 
-    # ------------------------------------------------------------------ report
-    def command(self):
-        """The command that runs this case, as a report tells its reader."""
-        return f"pbcm run {self.name}"
-
     def story(self):
         """The case's :class:`Narrative` (``narrative``, or the default one)."""
         told = self.narrative or Narrative
@@ -483,9 +468,20 @@ class Narrative:
     ----------
     notes : report lines on how the case is set up; the metrics' definitions come from the
         catalogue.
+    draws_stress, magnify : whether the narrative draws its own stress panels; the
+        displacement magnification of the standard ones.
+    up : the vertical axis ("x", "y" or "z") the report's figures stand on.
+    glossary : the glossary's path from the case's report.
+    material_from : where the report says the material comes from (the options that change
+        it).
     """
 
     notes: ClassVar[tuple] = ()
+    draws_stress: ClassVar[bool] = False
+    magnify: ClassVar[float] = 5.0
+    up: ClassVar[str] = "y"
+    glossary: ClassVar[str] = "../glossary.md"
+    material_from: ClassVar[str] = "override with --E, --nu, --rho"
 
     def __init__(self, case):
         self.case = case
@@ -495,6 +491,10 @@ class Narrative:
         if not isinstance(cls.notes, tuple):
             raise TypeError(f"{cls.__name__}.notes must be a tuple (a one-element tuple needs "
                             "its trailing comma)")
+
+    def command(self):
+        """The command that runs the case, as its report tells its reader."""
+        return f"pbcm run {self.case.name}"
 
     def notes_for(self, s):
         """The report's notes for settings ``s``: ``notes`` unless the setup notes depend on

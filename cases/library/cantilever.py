@@ -39,7 +39,6 @@ class Cantilever(Case):
     qoi_errors = ("tip_deflection_mm",)
     gated = ("tip_deflection_rel_err",)
     columns = ("tip_deflection_mm", "tip_deflection_fem_mm", "tip_deflection_rel_err")
-    magnify = 3.0
 
     def mesh(self, family, s):
         return common.bar(family, LENGTH_MM, HEIGHT_MM, WIDTH_MM, s.spacing_mm)

@@ -121,7 +121,6 @@ class Indentation(Case):
     gated = ("edge_shear_pa", "profile_rel_err")
     columns = ("reaction_n", "reaction_fem_p2_n", "profile_rel_err", "edge_shear_pa",
                "edge_shear_fem_pa")
-    magnify = 2.0
 
     def mesh(self, family, s):
         n = int(round(SIZE_MM / s.spacing_mm)) + 1

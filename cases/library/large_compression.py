@@ -113,7 +113,6 @@ class LargeCompression(Case):
     gated = ("force_rel_err_max", "lateral_rel_err_max")
     columns = ("reaction_fem_nh_n", "force_rel_err_max", "lateral_rel_err_max",
                "linear_force_rel_err_max", "homogeneous_force_dev_max")
-    magnify = 1.0
 
     def mesh(self, family, s):
         return cube(NODES, SIZE_MM * MM, family)

@@ -211,7 +211,6 @@ class PaperCube(Case):
     gated = ("alternation_rel", "reaction_time_rel_l2", "disp_end_push_rel_l2", "rest_time_s",
              "modal_rel_err", "modal_rel_err_free", "rigid_modes_free", "modes_unpaired")
     columns = COLUMNS
-    draws_stress = True
     quantity_compared = ("alternation_mm", "alternation_rel")
 
     def mesh(self, family, s):

@@ -52,7 +52,6 @@ class SelfWeight(Case):
     gated = ("top_settlement_rel_err", "top_settlement_cf_rel_err")
     columns = ("top_settlement_mm", "top_settlement_fem_mm", "top_settlement_cf_mm",
                "top_settlement_rel_err", "top_settlement_cf_rel_err")
-    magnify = 10.0
 
     def mesh(self, family, s):
         return cube(int(round(SIZE_MM / s.spacing_mm)) + 1, SIZE_MM * MM, family)

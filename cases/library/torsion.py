@@ -56,7 +56,6 @@ class Torsion(Case):
     gated = ("torque_rel_err", "warping_rel_err")
     columns = ("torque_nm", "torque_fem_nm", "torque_rel_err", "warping_mm", "warping_fem_mm",
                "warping_rel_err")
-    magnify = 1.0
 
     def mesh(self, family, s):
         return common.bar(family, LENGTH_MM, SIDE_MM, SIDE_MM, s.spacing_mm)

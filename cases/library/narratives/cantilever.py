@@ -6,6 +6,7 @@ from ..cantilever import LENGTH_MM, HEIGHT_MM, WIDTH_MM
 
 
 class CantileverNarrative(Narrative):
+    magnify = 3.0
     notes = (
         "The load reaches the particle model as consistent nodal forces (a third of traction x "
         "area of each face triangle to its vertices), FEM integrates the traction itself.",)

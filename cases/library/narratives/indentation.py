@@ -6,6 +6,7 @@ from ...framework import MM, Narrative
 
 
 class IndentationNarrative(Narrative):
+    magnify = 2.0
     notes = (
         "The punch force is the reaction on the top face along y (the punch's: the rest of "
         "the top is free).",

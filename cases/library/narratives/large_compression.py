@@ -9,6 +9,7 @@ from ...measuring.error_model import u_num
 
 
 class LargeCompressionNarrative(Narrative):
+    magnify = 1.0
     notes = (
         "At the case's load the reference is neo-Hookean (compressible, the law of "
         "reference.hyperelastic): the mixed P2/P1 (u, p) solution on the mesh refined, its "

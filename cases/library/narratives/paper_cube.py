@@ -442,6 +442,7 @@ def sections(doc, cfg, runs, fields, out):
 
 
 class PaperCubeNarrative(Narrative):
+    draws_stress = True
     notes = NOTES
 
     def notes_for(self, s):

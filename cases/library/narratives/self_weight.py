@@ -6,6 +6,7 @@ from ..self_weight import SIZE_MM
 
 
 class SelfWeightNarrative(Narrative):
+    magnify = 10.0
     notes = (
         "Gravity reaches the particle model as consistent nodal forces, a quarter of rho g V0 "
         "of each tetrahedron at each of its vertices.",)

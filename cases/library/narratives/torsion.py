@@ -6,6 +6,7 @@ from ..torsion import LENGTH_MM, SIDE_MM
 
 
 class TorsionNarrative(Narrative):
+    magnify = 1.0
     notes = (
         "The torque's arms are rest positions: the frame of linear FEM's equilibrium. "
         "Saint-Venant's free warping of a square is not zero; the clamped root restrains it.",

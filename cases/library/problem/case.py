@@ -121,16 +121,11 @@ class ProblemCase(Case):
     meshes = quick_meshes = ("mesh",)
     bcs = (BC,)
     quick = {"p2_levels": 1}
-    material_from = "the problem's [material]"
-    glossary = "glossary.md"      # written into the problem's own folder: it lives anywhere
     narrative = "cases.library.problem.narrative:ProblemNarrative"
 
     def __reduce__(self):
         """Pickled as the TOML it was read from (a worker process reads it again)."""
         return (_rebuilt, (str(self.spec.path),))
-
-    def command(self):
-        return f"pbcm run --problem {self.spec.path}"
 
     # ------------------------------------------------------------------ settings
     def settings(self, quick=False, **kw):
@@ -251,7 +246,7 @@ def case_of(spec):
     profiles = [err_name(m.key) for m in spec.measures if not m.scalar]
     reaction = any(m.kind == "reaction" for m in spec.measures)
     attrs = {
-        "name": spec.name, "spec": spec, "models": spec.models, "up": AXES[spec.up],
+        "name": spec.name, "spec": spec, "models": spec.models,
         "meshes": (_mesh_name(spec),), "quick_meshes": (_mesh_name(spec),),
         "title": spec.title or (f"The problem {spec.name}: {spec.mesh_file.name} under the "
                                 f"boundary conditions of {spec.path.name}"),

@@ -9,6 +9,16 @@ from .spec import AXES, nodes_said
 
 
 class ProblemNarrative(Narrative):
+    material_from = "the problem's [material]"
+    glossary = "glossary.md"      # written into the problem's own folder: it lives anywhere
+
+    @property
+    def up(self):
+        return AXES[self.case.spec.up]
+
+    def command(self):
+        return f"pbcm run --problem {self.case.spec.path}"
+
     def references_line(self, s):
         line = super().references_line(s)
         if self.case.spec.neohookean:
