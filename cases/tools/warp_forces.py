@@ -39,7 +39,7 @@ from model.integrate import total_forces
 from model.mesh import cube
 from model.terms.volume import FLAT
 
-from ..framework import MM
+from ..framework import DEFAULT_E, DEFAULT_NU, DEFAULT_RHO, MM
 from ..library.common import CUBE_MM
 
 wp.config.quiet = True
@@ -365,8 +365,9 @@ class WarpForces:
 
 
 def deformed(mesh, seed=0, amplitude=0.03):
-    """Positions of ``mesh`` stretched, sheared and randomly perturbed by ``amplitude`` of the
-    mean edge length (a fixed seed): a general state at which every term has forces."""
+    """Positions of ``mesh`` stretched, sheared and randomly perturbed by ``amplitude`` of
+    its tetrahedra's length scale (the side of a cube of six times their mean volume; a fixed
+    seed): a general state at which every term has forces."""
     rng = np.random.default_rng(seed)
     h = np.cbrt(6.0 * mesh.volumes.mean())
     A = np.array([[1.03, 0.02, 0.0], [0.0, 0.98, 0.015], [0.01, 0.0, 1.01]])
@@ -488,7 +489,7 @@ def main(argv=None):
               f"{', '.join(COVERED)}", file=sys.stderr)
         return 2
     from model import Material, build
-    mat = Material(10e3, 0.45, 1000.0)
+    mat = Material(DEFAULT_E, DEFAULT_NU, DEFAULT_RHO)
     rows = []
     head = f"{'model':26s} {'tets':>9s} {'dtype':8s} {'ns/tet':>9s} {'numba ns/tet':>13s} " \
            f"{'max rel diff':>13s}"
