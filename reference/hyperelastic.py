@@ -16,7 +16,7 @@ from skfem import Basis, ElementTetP1, FacetBasis
 
 from model.bc import bc_arrays, load_fractions
 from model.errors import ConvergenceError, ModelError
-from model.material import as_material
+from model.material import as_material, neohookean_stress
 from ._neohookean import neohookean
 from .assembly import scalar_gradients
 from .discretisation import (INTORDER, dirichlet_dofs, element_basis, parent_of, probe,
@@ -130,11 +130,13 @@ class Discretisation:
         w = self.ub.interpolate(x[:self.ub.N])
         F = w.grad + np.eye(3)[:, :, None, None]
         J = np.linalg.det(np.moveaxis(F, (0, 1), (-2, -1)))
-        p = (self.pb.interpolate(x[self.ub.N:]).value if self.mixed
-             else self.lam * np.log(J))
+        # sigma = P F^T / J = (a F F^T + b I) / J of the law's P = a F + b F^-T; the mixed
+        # form's pressure p takes the place of lam ln J in b
+        a, b = neohookean_stress(np.log(J), self.lam, self.mu)
+        if self.mixed:
+            b = self.pb.interpolate(x[self.ub.N:]).value - self.mu
         FFt = np.einsum("ik...,jk...->ij...", F, F)
-        return (self.mu * (FFt - np.eye(3)[:, :, None, None])
-                + p * np.eye(3)[:, :, None, None]) / J
+        return (a * FFt + b * np.eye(3)[:, :, None, None]) / J
 
 
 def solve(mesh, material, dirichlet, body_force=None, element="P1", refine=0, dirichlet_fn=None,
@@ -383,10 +385,14 @@ def uniaxial(stretch, material):
     lam, mu = as_material(material, "reference.hyperelastic.uniaxial").lame
     if not (np.isfinite(stretch) and stretch > 0):
         raise ModelError(f"a stretch must be a finite number > 0, got {stretch!r}")
-    lat = brentq(lambda t: mu * (t - 1 / t) + lam * np.log(stretch * t * t) / t,
-                 stretch ** -0.5 * 1e-3, stretch ** -0.5 * 1e3)
-    return float(lat), float(mu * (stretch - 1 / stretch)
-                             + lam * np.log(stretch * lat * lat) / stretch)
+    def nominal(along, lateral):
+        """The law's nominal stress P = a F + b F^-T on the diagonal entry of stretch
+        ``along``, the lateral stretches ``lateral``."""
+        a, b = neohookean_stress(np.log(stretch * lateral * lateral), lam, mu)
+        return a * along + b / along
+
+    lat = brentq(lambda t: nominal(t, t), stretch ** -0.5 * 1e-3, stretch ** -0.5 * 1e3)
+    return float(lat), float(nominal(stretch, lat))
 
 
 def converged(mesh, material, dirichlet, levels=1, element="P2", mixed=True, **kw):

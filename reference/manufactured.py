@@ -18,7 +18,7 @@ import numpy as np
 from skfem import Basis, Functional
 
 from model.errors import ModelError
-from model.material import Material, as_material
+from model.material import Material, as_material, neohookean_stress
 
 
 @dataclass(frozen=True)
@@ -83,15 +83,18 @@ class NeoHookean:
 
     def stress(self, g):
         F, Fi, lnJ = self._kinematics(g)
-        return self.mu * F + (self.lam * lnJ - self.mu)[..., None, None] * np.swapaxes(Fi, -1, -2)
+        a, b = neohookean_stress(lnJ, self.lam, self.mu)     # P = a F + b F^-T, the one law
+        return a * F + np.asarray(b)[..., None, None] * np.swapaxes(Fi, -1, -2)
 
     def divergence(self, g, H):
         _, Fi, lnJ = self._kinematics(g)
+        a, b = neohookean_stress(lnJ, self.lam, self.mu)
         dlnJ = np.einsum("...ba,...abJ->...J", Fi, H)
         dFiT = -np.einsum("...Ja,...abJ,...bi->...i", Fi, H, Fi)
-        return (self.mu * np.einsum("...iJJ->...i", H)
+        # d(a F)/dX with a constant, d(b F^-T)/dX with db = lam dlnJ
+        return (a * np.einsum("...iJJ->...i", H)
                 + self.lam * np.einsum("...J,...Ji->...i", dlnJ, Fi)
-                + (self.lam * lnJ - self.mu)[..., None] * dFiT)
+                + np.asarray(b)[..., None] * dFiT)
 
 
 MATERIALS = {"linear": LinearElastic, "neo-Hookean": NeoHookean}
