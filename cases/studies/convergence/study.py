@@ -27,8 +27,8 @@ from .patch import units as patch_units
 from .steps import units as steps_units
 
 FEM_P1 = "FEM P1"              # the yardstick: scikit-fem P1 on the model's own mesh
-MAX_NODES = 10_000             # a level is run where its mesh fits: Newton's sparse LU on a
-#                                bcc cube of 29 449 nodes took 5 min per model here
+MAX_NODES = 10_000             # a level is run where its mesh fits: Newton's sparse LU grows
+#                                faster than the nodes (fill-in), so finer levels cost hours
 STATIC_RTOL = 1e-12            # the static residual, relative to E h^2: far below the errors
 # families whose levels are one lattice at smaller h (an expansion in h holds: extrapolate);
 # the unstructured meshes are perturbed at random anew at each h

@@ -33,7 +33,7 @@ SPACINGS_MM = (10.0, 5.0)
 STATIC_RTOL = 1e-10
 # the continuum on the six split of 20 mm refined REF_LEVELS times, P2/P1, the estimate from
 # the change between the levels: its beads move 0.025-0.12 mm RMS over the refinement, under
-# the measurement's floor (0.30-0.35 mm); one more refinement costs about 10 minutes a solve
+# the measurement's floor (0.30-0.35 mm); one more refinement multiplies the unknowns by 8
 REF_MESH, REF_LEVELS = ("six", 5), 1
 NH = "neo-Hookean P2/P1"         # the references' names in the tables
 LINEAR = "linear P2"
