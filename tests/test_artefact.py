@@ -1147,13 +1147,13 @@ def test_the_mesh_pick_names_the_mirrored_split_only_where_a_part_is_the_mirrors
     median node-level ratio over the larger control; where a part is on every split, or none
     is the mirror's, it names no split."""
     row = {"resolved": "above", "rms": 2e-3, "controls": {SIX: (1e-5, 1e-6), BCC: (2e-5, 1e-6)},
-           "mirror_vs": "above"}
+           "mirror_vs": "above", "mirror_lo": 90.0}
     nodes = {"units": [{"n": 17, "bc": "sliding", "rows": [row]}], "slopes": {}}
     layer = "4 of 10 resolved parts with the paper's sign the mirror's"
     said = analysis.mesh_pick(layer, 4, 0, ["17 clamped"], nodes)
     assert said.startswith("a conforming split without the mirror (six or bcc), not the "
                            "mirrored five: at the side nodes the mirrored split's period-2 "
-                           "part over its larger control's is 17 sliding 100 [100-100]")
+                           "part over its larger control's is at least 17 sliding 90 [90-90]")
     assert "1 of 1 resolved parts (a model on a configuration each) the mirror's" in said and f"in the layer mean {layer}" in said
     assert "FEM P1's own on 17 clamped" in said
     assert analysis.mesh_pick(layer, 4, 1, ["17 clamped"], nodes) is None

@@ -129,7 +129,9 @@ def findings(metric, rows, spec, models):
     if t is not None:
         out.append(f"{metric}: {kind(metric, t)}; each model's mean |deviation| from {t[0]} "
                    "per case and boundary condition is in the table, never pooled across "
-                   f"them; {_floor_text(metric, t, rows)}, and the sweep ranks no model.")
+                   "them; in each, a change below the reference's largest error estimate "
+                   "there (a total error) or the solver's round-off (a model-form error) is "
+                   "not a trend, and the sweep ranks no model.")
     for label, group in pops:
         said, h, b = _findings(metric, group, spec, models, label, lead=False)
         out += said
