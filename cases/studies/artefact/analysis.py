@@ -1495,6 +1495,12 @@ def verdict_lines(sign_rows, nodes, ns, cs, fem_units):
     evidence follows in the full text."""
     out = []
     node_bits = []
+    strains = [(p - 1, q) for o in nodes["slopes"].values() for p, q in o["orders"].values()]
+    strain_span = max((abs(x) for x, _ in strains), default=0.0)
+    # beyond its u (the parts' u through the slope) a strain grows (exponent < 0) or falls
+    sizes = next((o["sizes"] for o in nodes["slopes"].values()), (None, None))
+    grows = sum(x < -q for x, q in strains)
+    falls = sum(x > q for x, q in strains)
     for bc, o in sorted(nodes["slopes"].items()):
         fine = next((x for x in nodes["units"] if (x["n"], x["bc"]) == (o["sizes"][1], bc)),
                     None)
@@ -1528,8 +1534,12 @@ def verdict_lines(sign_rows, nodes, ns, cs, fem_units):
     if node_bits or layer:
         out.append(
             "(a) Mirror symmetry: the mirrored five split carries a period-2 pattern of its "
-            "own at the side nodes (less FEM P1's on the same tetrahedra) that refinement does "
-            "not remove (a strain exponent near 0); whether the mirror alone causes it is "
+            "own at the side nodes (less FEM P1's on the same tetrahedra) whose strain goes "
+            f"as h^e from {sizes[0]} to {sizes[1]} nodes with |e| at most "
+            f"{fmt(strain_span, 2)} ("
+            f"beyond its u growing for {grows}, falling for {falls} and neither for "
+            f"{len(strains) - grows - falls} model-base pairs; two sizes: not an order); "
+            "whether the mirror alone causes it is "
             "decided model by model, against each model's own parts on six and bcc: "
             + "; ".join(node_bits)
             + (". In the layer mean, which averages it across each face (model cells at the "
