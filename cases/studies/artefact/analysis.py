@@ -1540,7 +1540,8 @@ def verdict_lines(sign_rows, nodes, ns, cs, fem_units):
             f"beyond its u growing for {grows}, falling for {falls} and neither for "
             f"{len(strains) - grows - falls} model-base pairs; two sizes: not an order); "
             "whether the mirror alone causes it is "
-            "decided model by model, against each model's own parts on six and bcc: "
+            "decided model by model, against each model's own parts on the conforming splits "
+            "it ran (six, and bcc where run: cells.md shows each hole): "
             + "; ".join(node_bits)
             + (". In the layer mean, which averages it across each face (model cells at the "
                "push, 9 and 17 nodes, both bases, each configuration one mesh pair): "
