@@ -2226,10 +2226,12 @@ def reading_verdict(table, damping, spread=None, figure=None):
     if figure:
         names = {r["name"] for r in readings}
         fig = (" Figure 1 (the pattern on the paper's 5 layers, its own view: shown, never "
-               "scored): " + "; ".join(
-                   f"on the {b} base reproduced (visibly, within its u) by the readings "
+               "scored: a match on 5 layers decides nothing, the metric's check of that "
+               "view in the evidence says why): " + "; ".join(
+                   f"on the {b} base the paper's pattern shows (visibly, within its u) for the "
+                   "readings "
                    + _names([n for n, ok, _, _ in figure[b] if ok is True and n in names])
-                   + (f" and by {_names(other)}" if (other := [
+                   + (f" and for {_names(other)}" if (other := [
                        n for n, ok, _, _ in figure[b] if ok is True and n not in names]) else "")
                    for b in figure) + ".")
     plain = "; ".join(x for x in (
