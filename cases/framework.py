@@ -555,6 +555,8 @@ class Study(abc.ABC):
     quick: ClassVar[dict] = {}
     takes: ClassVar[tuple] = None
     recorded_keys: ClassVar[tuple] = ()
+    # lists of records kept beside metrics.json, each as KEY.json (too large to sit in it)
+    record_files: ClassVar[tuple] = ()
 
     def settings(self, quick=False, **kw):
         """The study's settings: full by default, the ``quick`` overrides, then ``kw`` (None

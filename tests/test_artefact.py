@@ -9,6 +9,8 @@ import numpy as np
 import pytest
 
 from cases.measuring import metrics as M
+from cases.reporting.report import read_study
+from cases.studies.artefact import STUDY
 from cases.studies.artefact import analysis
 from cases.studies.artefact.study import HELD, SPLITS, _free_layers, held
 
@@ -786,7 +788,7 @@ def test_the_quick_study_holds_its_gold_and_its_controls(quick_artefact, capsys)
     status = main(["check", "--metrics", str(quick_artefact.parent), "--gold",
                    str(ROOT / "gold"), "--allow-new"])
     assert status == 0, capsys.readouterr().out
-    doc = json.loads((quick_artefact / "metrics.json").read_text())
+    doc = read_study(quick_artefact, STUDY)
     cells = doc["cells"]
     fem = [c for c in cells if c["model"] == "fem-neohookean" and not c["unmatched_faces"]
            and c["alternation_rel"] is not None]
@@ -1167,6 +1169,8 @@ def test_the_index_picks_a_mesh_from_the_full_artefact_run_only(tmp_path):
     from cases.reporting.answers import recommendation
     folder = tmp_path / "artefact"
     folder.mkdir()
+    for k in STUDY.record_files:
+        (folder / f"{k}.json").write_text("[]")
     for quick in (False, True):
         (folder / "metrics.json").write_text(json.dumps(
             {"parameters": {"quick": quick}, "answer": {"mesh_pick": "six or bcc"}}))
@@ -1192,3 +1196,40 @@ def test_the_open_mirror_reads_are_counted_by_their_reason():
     for part in ("no control part resolved from 0 1", "the ratio at the threshold 1",
                  "a control failed 1"):
         assert part in said
+
+
+def test_the_line_signatures_are_recorded_apart_and_read_back_whole(tmp_path):
+    """The record keeps the line signatures in a file of their own, to a stated precision,
+    the continuum's on FEM P1's cells alone; read back they sit row for row with the cells,
+    and a record whose rows disagree with its cells is refused."""
+    from cases.reporting.report import write_study
+    from cases.studies.artefact.study import (LINE_DIGITS, YARDSTICK, lines_apart,
+                                              lines_joined, recorded_lines)
+    line = [0.1234567890123, -2.0e-7 / 3]
+    cells = [{"mesh": "five-9", "model": m, "bc": "clamped", "load": "paper",
+              "line_alternation_mm": line, "line_alternation_fem_mm": line, "x": 1.0}
+             for m in (YARDSTICK, "msm")]
+    got = recorded_lines(cells)
+    assert got[0]["line_alternation_fem_mm"] == [float(f"{v:.{LINE_DIGITS}g}") for v in line]
+    assert got[1]["line_alternation_fem_mm"] is None
+    assert recorded_lines(got) == got
+    assert got[0]["line_alternation_mm"][0] == pytest.approx(line[0], rel=10.0 ** -LINE_DIGITS)
+
+    kept, rows = lines_apart(got)
+    assert all("line_alternation_mm" not in c for c in kept)
+    assert lines_joined(kept, rows) == got
+    with pytest.raises(KeyError):
+        lines_joined(kept, rows[::-1])
+
+    class Study:
+        record_files = ("cells", "lines")
+
+    class Doc:
+        def write(self, folder):
+            (folder / "report.md").write_text("x\n")
+    write_study(tmp_path, {"case": "t", "cells": kept, "lines": rows}, lambda f: Doc(),
+                apart=Study.record_files)
+    assert "cells" not in json.loads((tmp_path / "metrics.json").read_text())
+    assert len((tmp_path / "cells.json").read_text().splitlines()) == len(kept) + 2
+    back = read_study(tmp_path, Study)
+    assert lines_joined(back["cells"], back["lines"]) == got

@@ -9,11 +9,12 @@ import pytest
 from cases.measuring import catalogue
 from cases.measuring.catalogue import CATALOGUE, DESCRIPTORS, err_name, metric, ref_name
 from cases.registry import CASES, studies
+from cases.reporting.report import read_study
 
 ROOT = Path(__file__).resolve().parents[1]
 # the sections of a metrics.json whose rows carry metrics
-ROW_SECTIONS = ("runs", "gate_runs", "case_runs", "fits", "elasticity", "cells", "rows",
-                "references", "manufactured", "patch", "steps")
+ROW_SECTIONS = ("runs", "gate_runs", "case_runs", "fits", "elasticity", "cells", "lines",
+                "rows", "references", "manufactured", "patch", "steps")
 
 
 def _rows(data):
@@ -33,7 +34,10 @@ def undeclared(data):
 @pytest.mark.parametrize("path", sorted(ROOT.glob("reports/*/metrics.json")),
                          ids=lambda p: p.parent.name)
 def test_every_committed_metric_is_declared(path):
-    data = json.loads(path.read_text())
+    """Every key of a committed record's rows (its metrics.json and the files beside it) is a
+    declared metric or a descriptor, and each gated metric has its declared direction."""
+    study = studies().get(path.parent.name)
+    data = read_study(path.parent, study) if study else json.loads(path.read_text())
     assert undeclared(data) == []
     for name, direction in data.get("gated", {}).items():
         assert metric(name).direction == direction, name

@@ -87,6 +87,16 @@ def test_the_committed_gold_is_compact():
     assert not (ROOT / "thresholds.toml").exists()
 
 
+def test_every_committed_report_file_stays_under_two_mebibytes():
+    """No file the reports commit (Markdown, PNG, JSON) is over 2 MiB: a record that grows
+    past it keeps its bulk in a file of its own."""
+    kept = {".md", ".png", ".json", ".jsonl", ".csv"}
+    big = [str(p.relative_to(ROOT)) for p in (ROOT / "reports").rglob("*")
+           if p.is_file() and p.suffix in kept and "runs" not in p.parts
+           and p.stat().st_size > 2 * 2 ** 20]
+    assert not big
+
+
 def test_worse_model_fails_and_names_the_metric(blessed, tmp_path, capsys, monkeypatch):
     """Every shear term at half its stiffness (in this process: one mesh, no workers)."""
     from cases.framework import Case

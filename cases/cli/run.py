@@ -116,13 +116,13 @@ def _write_glossary(folder):
 
 def _rewrite_study(study, folder):
     """Draw a study's report again from the runs its metrics.json recorded."""
-    import json
+    from ..reporting.report import read_study
     path = folder / "metrics.json"
     try:
-        metrics = json.loads(path.read_text())
+        metrics = read_study(folder, study)
     except (OSError, ValueError) as exc:
-        raise UsageError(f"--rewrite reads the {study.name} study's {path}: {exc}; run the "
-                         "study first") from None
+        raise UsageError(f"--rewrite reads the {study.name} study's record in {folder}: "
+                         f"{exc}; run the study first") from None
     try:
         got = study.recorded(metrics)
         if got is None:

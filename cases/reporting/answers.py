@@ -26,6 +26,14 @@ def _load(root, *parts):
     return json.loads(path.read_text()) if path.is_file() else None
 
 
+def _record(root, study):
+    """A study's record (its metrics.json and the files beside it), or None where not run."""
+    from ..registry import studies
+    from .report import read_study
+    folder = Path(root) / study
+    return read_study(folder, studies()[study]) if (folder / "metrics.json").is_file() else None
+
+
 LIMITED = ("exact", "converges", "floor")   # fit verdicts whose e_inf is a limit
 
 
@@ -222,7 +230,7 @@ def _bead(measured, model, u_val=None):
 
 def lines(root, models, pops=(), quick=False):
     """The answers, each a short paragraph, the last what to pick."""
-    art = _load(root, "artefact", "metrics.json")
+    art = _record(root, "artefact")
     conv = _load(root, "convergence", "metrics.json")
     bench = _load(root, BENCH_FOLDER, BENCH_FILE)
     out = []
@@ -711,7 +719,7 @@ def recommendation(root, models, pops, quick, bench_rows):
                      + (f", with {lin[cheapest][2]} failed runs (no number, or a mode "
                         "unpaired)" if lin[cheapest][2] else ""))
         out.append(line + ".")
-    art = _load(root, "artefact", "metrics.json")
+    art = _record(root, "artefact")
     pick = None if not art or art["parameters"]["quick"] else art["answer"].get("mesh_pick")
     if pick:
         out.append("- Meshing a cube lattice for a particle model (the bulge/neck pattern; "

@@ -198,6 +198,7 @@ def index_documents(root, cases, studies=(), missing=()):
     table first, then the studies, the scorecard and its conclusion; ``missing``, the
     library's cases without a folder, named first (every answer is over the cases found)."""
     from . import answers
+    from .report import read_study
     from ..registry import studies as declared
     root = Path(root)
     pops, data = populations(root, cases)
@@ -249,8 +250,8 @@ def index_documents(root, cases, studies=(), missing=()):
                         + [Cell(cells[m][0], BANDS[cells[m][1]][1]) if m in cells else ""
                            for m in models])
     doc.table(["case/bc", "error", "FEM P1 vs continuum", "u_val"] + models, rows, keys=4)
-    recorded = {n: (json.loads((root / n / "metrics.json").read_text()),
-                    declared()[n].runs_recorded) for n in shown}
+    recorded = {n: (read_study(root / n, declared()[n]), declared()[n].runs_recorded)
+                for n in shown}
     for line in conclusion(pops, models, quick) + [failed_checks(data, recorded)]:
         doc.p(line)
     doc.p("Each case folder holds metrics.json, report.md, report.html and the figures; "

@@ -45,12 +45,33 @@ def provenance(runs):
                          **{k: r[k] for k in TIMING_KEYS if k in r}} for r in runs]}
 
 
-def write_study(out, metrics, make_document):
-    """A study's folder ``out``: ``metrics`` as metrics.json, run.json (the commit and the
-    date; no timings) and the report ``make_document(out)`` draws (its figures into ``out``)."""
+def rows_json(rows):
+    """A list of records as JSON, one compact record per line: a large record stays small
+    and a change to one row is one changed line."""
+    return "[\n" + ",\n".join(json.dumps(r, separators=(",", ":")) for r in rows) + "\n]\n"
+
+
+def read_study(folder, study):
+    """A study's record in ``folder``: its metrics.json with each of its ``record_files``
+    read back under its key."""
+    folder = Path(folder)
+    metrics = json.loads((folder / "metrics.json").read_text())
+    for k in study.record_files:
+        metrics[k] = json.loads((folder / f"{k}.json").read_text())
+    return metrics
+
+
+def write_study(out, metrics, make_document, apart=()):
+    """A study's folder ``out``: ``metrics`` as metrics.json, less each list it keeps
+    ``apart`` (written as KEY.json, one record per line: the study's ``record_files``),
+    run.json (the commit and the date; no timings) and the report ``make_document(out)``
+    draws (its figures into ``out``)."""
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
-    (out / "metrics.json").write_text(json.dumps(metrics, indent=1) + "\n")
+    for k in apart:
+        (out / f"{k}.json").write_text(rows_json(metrics[k]))
+    kept = {k: v for k, v in metrics.items() if k not in apart}
+    (out / "metrics.json").write_text(json.dumps(kept, indent=1) + "\n")
     prov = provenance([])
     prov.pop("timings")
     (out / "run.json").write_text(json.dumps(prov, indent=1) + "\n")

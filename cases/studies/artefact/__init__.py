@@ -8,7 +8,7 @@ switch the pattern on and off, and the answers computed from them.
 from ...framework import Study
 from ...running.store import OFF
 from . import report
-from .study import ArtefactSettings, bench_costs, run
+from .study import ArtefactSettings, bench_costs, lines_joined, recorded_lines, run
 
 
 class Artefact(Study):
@@ -21,6 +21,7 @@ class Artefact(Study):
     settings_class = ArtefactSettings
     takes = ()                # the material alone
     recorded_keys = ("cells", "references", "step_vs_msm")
+    record_files = ("cells", "lines")
 
     def definitions(self):
         from .analysis import CLEAR, DECIDING_LEAK, GROWS, LEAK_SHARE
@@ -51,6 +52,7 @@ class Artefact(Study):
         # the cost is the checkout's bench at the paper's size, the number every other report
         # prints; the recorded one only where the checkout has no bench
         from ...reporting.costs import load
+        data["cells"] = recorded_lines(lines_joined(data["cells"], metrics["lines"]))
         bench = load()
         if bench:
             data.update(bench_costs(bench, list(s.models)))

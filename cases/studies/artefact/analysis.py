@@ -2180,7 +2180,7 @@ def reading_verdict(table, damping, spread=None, figure=None):
         "the clamped base only: the paper fixes its nodes at y = 0 (yet reports that layer "
         "bulging, which a fixed base cannot), so every stability call "
         "here holds for the clamped base alone (the sliding base's rates, linearised alike, "
-        "are in metrics.json, not read); on this "
+        "are in cells.json, not read); on this "
         "study's own cells of each conforming split of the paper's lattice at 5 nodes "
         f"per side: {', '.join(meshes) or 'none'} (the mirrored five has 320 tetrahedra; the "
         "paper's own 374-tetrahedron mesh and the paper-cube case's unstructured mesh are not "

@@ -1,5 +1,5 @@
-"""The artefact study's files: metrics.json (the cells, the answers and the rows
-the gate reads), report.md/.html (the answers, the metric's check, the decomposition per
+"""The artefact study's files: metrics.json (the answers and the rows the gate reads),
+cells.json (the cells) and lines.json (each cell's side-line signatures), report.md/.html (the answers, the metric's check, the decomposition per
 hypothesis, the reading table, figures) and cells.md/.html (every cell's signature beside the
 reference's scale). Every sentence is computed from the cells it is written with."""
 from pathlib import Path
@@ -20,7 +20,8 @@ from .analysis import (CLEAR, COARSE, DECAYS, SHARP_DECAYS, DECIDING_LEAK, END_L
                        paper_figure, paper_figure_text,
                        reading_table, reading_verdict, signature_own, times)
 from .study import (DECISIVE, FIXED_NORMAL_C, HELD_SUFFIX, LINEAR_SCALE, LITERAL_NORMAL,
-                    READINGS, SPLITS, SPLITS_TRIED, YARDSTICK, _free_layers, short)
+                    READINGS, SPLITS, SPLITS_TRIED, YARDSTICK, _free_layers, lines_apart,
+                    short)
 
 GATED = catalogue.gated("alternation_rel", "disp_rel_l2")
 PAPER_TETS = 374        # the paper's own cube, as it reports it
@@ -59,7 +60,9 @@ def write(out, study, s, data):
                     "problem": s.problem(), "gated": GATED, "environment": environment(),
                     "names": {m: short(m) for m in s.models},
                     **data, **found, "gate_runs": gate_rows(data["cells"])})
-    return write_study(out, doc, lambda folder: build(folder, study, s, doc))
+    cells, lines = lines_apart(doc["cells"])
+    return write_study(out, {**doc, "cells": cells, "lines": lines},
+                       lambda folder: build(folder, study, s, doc), apart=study.record_files)
 
 
 def conclusion(doc):
@@ -562,7 +565,7 @@ def _reading(d, s, doc):
         "the forces); for a "
         "model with a normal-stress term not decided: its added cost is this implementation's "
         "term) and stability (the largest growth rate of the undamped model linearised at "
-        "rest, read on the clamped base only (the sliding base's rates are in metrics.json, not "
+        "rest, read on the clamped base only (the sliding base's rates are in cells.json, not "
         "read; the paper fixes its nodes at y = 0), on each conforming split of the lattice, this study's own cells: "
         "not an RK4 run and not the paper's mesh; one definition, the glossary's: a mode "
         f"flutters where its rate is above {GROWS:g} 1/s, and grows beyond the damping we "
