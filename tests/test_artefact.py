@@ -670,7 +670,8 @@ def test_a_reading_stable_on_one_mesh_and_growing_on_another_is_not_stable():
     assert by["a"]["growth_apart"] == {"five-unmirrored": 73.5}
     assert by["a"]["stable_why"] == ("depends on the damping: flutters, damped out by the "
                                      "damping we assume (50 1/s) on five (0.27 1/s), six "
-                                     "(8 1/s), bcc (6 1/s)")
+                                     "(8 1/s), bcc (6 1/s); damped out on every mesh by "
+                                     "mass damping above 16 1/s (twice its largest rate)")
     mixed = analysis.mesh_stability([("five", 0.0), ("six", 8.0)], 50.0)
     assert mixed[0] is None and mixed[1].startswith("depends on the mesh: stable (rate 0)")
     assert by["a"]["growth_max_1_s"] == 8.0 and by["a"]["flutters_below_damping"] == 16.0

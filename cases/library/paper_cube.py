@@ -172,10 +172,15 @@ def dynamic_metrics(dyn, mesh, st, fem):
             "dyn_reaction_n": M.finite("dyn_reaction", dyn["reaction_y"]).tolist()}
 
 
+# a growth rate below this fraction of the model's largest frequency is the eigensolver's
+# round-off: read as 0
+RATE_ROUND_OFF = 1e-7
+
+
 def growth_rate(pm, mesh, bc):
     """Largest exponential growth rate [1/s] of the undamped model linearised at rest with the
     case's constraints: max Re sqrt(lambda) over the eigenvalues lambda of M^-1 df/dx on the
-    free components. Zero (to rounding) for a conservative model; positive means flutter, which
+    free components. Zero (below RATE_ROUND_OFF of the largest frequency) for a conservative model; positive means flutter, which
     mass damping zeta only suppresses when zeta / 2 exceeds it."""
     mask, _ = bc_arrays(static_bc(mesh, bc), mesh.n_nodes)
     free = ~mask.ravel()
@@ -183,7 +188,7 @@ def growth_rate(pm, mesh, bc):
     lam = np.linalg.eigvals(A).astype(complex)
     rate = float(np.sqrt(lam).real.max())
     scale = float(np.sqrt(np.abs(lam).max()))
-    return rate if rate > 1e-7 * scale else 0.0
+    return rate if rate > RATE_ROUND_OFF * scale else 0.0
 
 
 class PaperCube(Case):

@@ -6,6 +6,7 @@ the base and the load, each cell's alternation against the continuum's; the fact
 switch the pattern on and off, and the answers computed from them.
 """
 from ...framework import Study
+from ...library import paper_cube as P
 from ...running.store import OFF
 from . import report
 from .study import ArtefactSettings, bench_costs, lines_joined, recorded_lines, run
@@ -38,7 +39,8 @@ class Artefact(Study):
             f"{CLEAR:g} ({DECIDING_LEAK:g}).",
             "stable, flutter (artefact study): one definition, the glossary's growth: a mode "
             f"flutters where its growth rate at rest is above {GROWS:g} 1/s; stable means rate "
-            "0; a flutter grows beyond the mass damping we assume where its rate exceeds half "
+            f"0 (a rate below {P.RATE_ROUND_OFF:g} of the model's largest frequency is the "
+            "eigensolver's round-off, read as 0); a flutter grows beyond the mass damping we assume where its rate exceeds half "
             "of it; linearised at rest with each base's constraints, and read on the clamped "
             "base only (the paper fixes its base nodes)."]
 

@@ -1728,9 +1728,11 @@ def answer(cells, models=None, estimates=None):
              + (f"; FEM P1 itself, the continuum's law on the same tetrahedra, has a resolved "
                 f"period-2 signature on the mirrored split and not on the conforming ones on "
                 f"{', '.join(fem_units)}" if fem_units else "")
-             + "; its u holds the metric's leaks and the solver's tolerance; the reference "
-             "cancels from every part (the model and FEM P1 are read against one profile) but "
-             "for the mean it is divided by" + (
+             + "; its u holds the metric's leaks and the solver's tolerance; what the model "
+             "and FEM P1 share, the reference's values among it, cancels from every part (both "
+             "are read with one reference's weights, and the signature is linear in the "
+             "profile); the reference enters a part only through the smooth shape its weights "
+             "ignore and the mean the part is divided by" + (
                  f", whose error estimate (at most {fmt(ref_est, 2)} at the push) moves a part "
                  "by that fraction" if ref_est is not None else "")] if a_holds else []) + (
         [lead_nodes] if lead_nodes else []) + (
@@ -2038,6 +2040,10 @@ def mesh_stability(rates, damping):
     by = "; ".join(f"{STABLE_WORDS[k]}" + (f" ({damping:g} 1/s)" if k in ("damping", False)
                                             else "") + " on " + ", ".join(
         f"{m} ({fmt(r, 3)} 1/s)" for m, r, kk in kinds if kk == k) for k in order)
+    top = max(r for _, r, _ in kinds)
+    if top > GROWS:       # the damping each model needs: the paper states none
+        by += (f"; damped out on every mesh by mass damping above {fmt(2 * top, 3)} 1/s "
+               "(twice its largest rate)")
     if len(order) > 1:
         return None, "depends on the mesh: " + by
     k = order[0]
@@ -2188,7 +2194,8 @@ def reading_verdict(table, damping, spread=None, figure=None):
         "the model on a mesh, so a reading is stable only where it is stable on every one): "
         f"one definition, the glossary's: a mode flutters where its rate is above {GROWS:g} "
         f"1/s, and it grows beyond the mass damping we assume ({damping:g} 1/s; the paper "
-        f"states none) where its rate exceeds {damping / 2:g} 1/s; stable means rate 0. "
+        f"states none) where its rate exceeds {damping / 2:g} 1/s; stable means rate 0 (below "
+        f"{P.RATE_ROUND_OFF:g} of the model's largest frequency: the eigensolver's round-off). "
         + "; ".join(f"{r['name']}: {r['stable_why']}" for r in rated) + ". "
         + "The paper states no damping and its mesh is none of these: stability (clamped "
         f"base) is decided (rate 0 on every mesh) for {_names(stable)}"
@@ -2234,8 +2241,11 @@ def reading_verdict(table, damping, spread=None, figure=None):
                    + (f" and for {_names(other)}" if (other := [
                        n for n, ok, _, _ in figure[b] if ok is True and n not in names]) else "")
                    for b in figure) + ".")
+    kernels = len({m.replace("-literal", "") for m in cost_miss})
     plain = "; ".join(x for x in (
-        f"{_names(cost_miss)} miss the paper's cost (Figure 2)" if cost_miss else "",
+        f"{_names(cost_miss)} miss the paper's cost (Figure 2"
+        + (f"; {kernels} kernels timed: a literal reading runs its calibrated reading's"
+           if kernels < len(cost_miss) else "") + ")" if cost_miss else "",
         f"the cost is not decided for {_names(cost_open)}" if cost_open else "") if x)
     text = ((f"Plainly: {plain}. " if plain else "")
             + (f"Not decided: {why}. " if not decided else f"{why}. ")
