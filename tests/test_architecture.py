@@ -101,21 +101,31 @@ def layer(name):
 
 
 def test_the_circle_finder_finds_a_circle():
+    """The circle finder reports a three-module import cycle as one sorted component, leaves out a
+    module that only imports into the cycle, and reports no circle for an acyclic graph."""
     g = {"a": {"b"}, "b": {"c"}, "c": {"a"}, "d": {"a"}}
     assert circles(g) == [["a", "b", "c"]]
     assert circles({"a": {"b"}, "b": set()}) == []
 
 
 def test_the_graph_sees_deferred_and_relative_imports():
+    """The import graph turns relative imports into edges to the named package modules: the report
+    imports the costs module, the convergence study's cost module imports it from three levels
+    up, and the paper-cube case imports the common geometry module; an import inside a
+    function (the index's of the answers module) is an edge too."""
     g = graph()
     # cases.registry imports nothing of the package statically; cases.reporting.report imports costs
     assert "cases.reporting.costs" in g["cases.reporting.report"]
     # `from ...costs import SOURCE` three levels up, in a subpackage
     assert "cases.reporting.costs" in g["cases.studies.convergence.cost"]
     assert "cases.library.common" in g["cases.library.paper_cube"]
+    # `from . import answers` inside the index's build function only
+    assert "cases.reporting.answers" in g["cases.reporting.index"]
 
 
 def test_no_import_circle_anywhere():
+    """The import graph of model, reference and cases, counting imports inside functions too,
+    contains no circle of two or more modules."""
     assert circles(graph()) == []
 
 
@@ -126,6 +136,9 @@ def test_no_import_circle_anywhere():
                                        ("tool", "study"), ("tool", "cli"), ("study", "tool"),
                                        ("study", "cli"), ("model", "reference")])
 def test_layer_never_imports_a_higher_one(low, high):
+    """No module of the lower layer of each pair imports a module of the higher one: model and
+    reference never import cases, the harness never imports a case, study, tool or command, and
+    model never imports reference."""
     g = graph()
     bad = sorted((a, b) for a, bs in g.items() for b in bs
                  if layer(a) == low and (b == high or layer(b) == high))
@@ -133,6 +146,9 @@ def test_layer_never_imports_a_higher_one(low, high):
 
 
 def test_no_case_imports_another():
+    """No case module imports another case; a case's helper modules import no case except a
+    narrative importing its own case, and every narrative module belongs to a case or is the
+    shared sentences module."""
     g = graph()
     cases = set(MODULES.values())
     bad = sorted((a, b) for a, bs in g.items() for b in bs if a in cases and b in cases)
@@ -147,6 +163,7 @@ def test_no_case_imports_another():
 
 
 def test_no_study_imports_another_studys_modules():
+    """No module of one study under cases/studies imports a module of another study."""
     g = graph()
 
     def study_of(m):
@@ -297,3 +314,16 @@ def test_no_issue_number_or_commit_hash_in_the_readme_docs_docstrings_or_comment
     bad = [(str(p.relative_to(ROOT)), m.group(0)) for p, t in _prose_and_comments()
            for m in (*issue.finditer(t), *commit.finditer(t))]
     assert bad == []
+
+
+def test_every_test_states_the_requirement_it_checks():
+    """Every test function in tests/ has a docstring: the requirement it checks."""
+    import ast
+    bare = []
+    for p in sorted((ROOT / "tests").glob("*.py")):
+        for n in ast.walk(ast.parse(p.read_text())):
+            if isinstance(n, (ast.FunctionDef, ast.AsyncFunctionDef)) and n.name.startswith(
+                    "test"):
+                if not ast.get_docstring(n):
+                    bare.append(f"{p.name}::{n.name}")
+    assert bare == []

@@ -12,6 +12,12 @@ from cases.cli import main
 
 
 def test_bench_writes_table_figure_and_in_round_ratios(tmp_path):
+    """`pbcm bench` writes bench.json, bench.md and the step-time figure on the five cubes nearest
+    the sizes asked; every row has finite positive timings, memory and in-round ratios (a model
+    against itself exactly 1, each median inside its rounds' range), calibration time only for
+    the calibrated model, a two-thread speed-up only for the shear reading with two numba
+    threads, and each optional engine timed or reported as not installed. A rerun replaces the
+    folder's rows."""
     out = tmp_path / "bench"
     assert main(["bench", "--sizes", "100", "700", "--rounds", "3", "--models", "msm",
                  "pbcm-variational", "fem-linear", "--out", str(out)]) == 0
@@ -79,6 +85,9 @@ def test_merge_adds_a_composed_model_and_keeps_every_other_row(tmp_path):
 
 
 def test_cost_rows_come_from_the_nearest_bench_size():
+    """A case's cost table comes from the bench size nearest its own on a log scale (1080 tetrahedra
+    for 500) and gives the step ratios to msm and fem-linear, the own stable step and the CPU
+    seconds per simulated second, also over msm's; with no bench it says to run `pbcm bench`."""
     data = {"rows": [{"model": m, "tets": t, "rounds": 5, "step_vs_msm": r,
                       "step_vs_fem-linear": r / 2, "cpu_s_per_simulated_s": 2 * r,
                       "stable_dt_us": 100.0}
@@ -91,6 +100,8 @@ def test_cost_rows_come_from_the_nearest_bench_size():
 
 
 def test_bench_mesh_is_the_closest_five_cube():
+    """The bench mesh for a requested size is the five-scheme cube with the nearest tetrahedron
+    count: 1080 for 1000 and 135 for 100."""
     assert bench.bench_mesh(1e3).n_tets == 1080 and bench.bench_mesh(1e2).n_tets == 135
 
 
@@ -151,6 +162,6 @@ def test_bench_refuses_a_device_it_cannot_time_on_before_timing(tmp_path, capsys
     out = tmp_path / "bench"
     assert main(["bench", "--device", "nonsense", "--sizes", "100", "--rounds", "1",
                  "--models", "msm", "--out", str(out)]) == 2
-    err = capsys.readouterr().err
-    assert "--device nonsense" in err and "bench:" not in capsys.readouterr().out
+    said = capsys.readouterr()
+    assert "--device nonsense" in said.err and "bench:" not in said.out
     assert not out.exists()

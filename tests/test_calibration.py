@@ -18,6 +18,9 @@ READINGS = ("corner", "balanced", "variational")
 
 
 def test_kelvin_moduli_of_isotropic_and_cubic_tensors_worked_by_hand():
+    """The Kelvin moduli of an isotropic tensor are K and 2G five times, and of a cubic tensor K =
+    (C11 + 2 C12) / 3 with C11 - C12 twice and 2 C44 three times; against the isotropic target K
+    = 3, G = 0.7 that cubic tensor has zero bulk error and a largest error of 3 / 1.4 - 1."""
     E, nu = 10e3, 0.45
     K, mu = kelvin_moduli(isotropic_stiffness(E, nu))
     assert K == pytest.approx(E / (3 * (1 - 2 * nu)), rel=1e-14)

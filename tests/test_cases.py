@@ -27,6 +27,10 @@ KEYS = ["mesh", "bc", "model", "disp_rel_l2_p1", "disp_rel_l2_p2", "disp_max_rel
 
 
 def test_quick_run_writes_every_file_with_finite_metrics(quick):
+    """The quick paper-cube run writes every report, figure and data file; metrics.json holds
+    one run per mesh, base and model (each preset and the literal reading) with every
+    expected key, only finite numbers, and no timings, commit or date. Those go to run.json,
+    and one .vtu file is written per run plus FEM P2 per mesh and base."""
     for f in FILES:
         assert (quick / f).is_file(), f
     data = json.loads((quick / "metrics.json").read_text())
@@ -43,7 +47,8 @@ def test_quick_run_writes_every_file_with_finite_metrics(quick):
         # the sliding base poses no modal problem (two held corner nodes): not compared
         assert (r["modal_rel_err"] is None) == (r["bc"] == "sliding")
         if not r["dyn_failed"] and r["bc"] != "sliding":   # sliding: not scored
-            assert r["reaction_time_rel_l2"] > 0 and (r["rest_time_s"] or 2.0) > 1.0
+            assert r["reaction_time_rel_l2"] > 0 and (r["rest_time_s"] is None
+                                                           or r["rest_time_s"] > 1.0)
         # quick mode repeats at dt/4 only the runs that blew up at dt
         assert (r["verdict_changes_dt4"] is None) == (r["dyn_failed"] is None)
     md = (quick / "report.md").read_text()
@@ -75,6 +80,9 @@ def test_the_full_setting_repeats_every_dynamic_run_at_a_quarter_of_the_step():
 
 
 def test_html_parses_and_every_figure_exists(quick):
+    """report.html parses and holds at least one image per PNG file, each embedded as base64
+    with a data-src naming an existing file; every image report.md links exists and report.md
+    has a Findings section."""
     class Images(HTMLParser):
         def __init__(self):
             super().__init__()
@@ -113,6 +121,10 @@ def test_same_command_gives_the_same_metrics(quick, tmp_path):
 
 
 def test_fem_against_itself_has_zero_error_and_alternation():
+    """Linear P2 FEM compared with itself on the five mesh gives zero displacement errors and
+    no alternation on either base (none readable on the clamped base, below 1e-12 on the
+    sliding base), and the sliding base's layer profile is the uniform lateral expansion
+    0.45 x 1.7e-3 / 2 m."""
     mesh = make_mesh("five")
     L = SIZE_MM * 1e-3
     layers = [y * 1e-3 for y in LAYERS_MM]
@@ -133,6 +145,8 @@ def test_fem_against_itself_has_zero_error_and_alternation():
 
 
 def test_paper_pattern_is_the_sign_pattern_of_the_second_differences():
+    """paper_pattern holds for an alternating five-layer profile and not for a barrel, a
+    uniform profile, or a uniform profile carrying rounding noise of 1e-14."""
     alternating = np.array([1.0, 0.4, 1.0, 0.4, 1.0])
     barrel = np.sin(np.pi * np.linspace(0, 1, 5)) + 0.2
     assert M.paper_pattern(alternating) and not M.paper_pattern(barrel)
@@ -142,6 +156,8 @@ def test_paper_pattern_is_the_sign_pattern_of_the_second_differences():
 
 
 def test_metrics_refuse_nan_and_zero_references():
+    """rel_l2 raises MetricError for a non-finite value and for a zero reference, and
+    correlation raises it for a constant input, each message naming the cause."""
     with pytest.raises(M.MetricError, match="not finite"):
         M.rel_l2(np.array([[np.nan, 0, 0]]), np.ones((1, 3)))
     with pytest.raises(M.MetricError, match="reference is zero"):
@@ -155,12 +171,16 @@ def test_metrics_refuse_nan_and_zero_references():
                                        (["run", "paper-cube", "--meshes", "hex"], "mesh"),
                                        (["run", "paper-cube", "--bcs", "glued"], "boundary condition")])
 def test_bad_names_exit_2_listing_valid_ones(argv, word, capsys):
+    """`pbcm run` with an unknown case, model, mesh or boundary condition exits 2 with a
+    single stderr line saying 'unknown <kind>' and listing the valid names."""
     assert main(argv) == 2
     err = capsys.readouterr().err.strip()
     assert len(err.splitlines()) == 1 and f"unknown {word}" in err and "valid:" in err
 
 
 def test_list(capsys):
+    """`pbcm list` exits 0 and its output names the paper-cube case, the
+    pbcm-variational+normal model and the unstructured mesh family."""
     assert main(["list"]) == 0
     out = capsys.readouterr().out
     assert "paper-cube" in out and "pbcm-variational+normal" in out and "unstructured" in out
@@ -392,6 +412,9 @@ def test_the_sliding_cube_is_a_patch_test_passed_by_fem_alone(quick):
 
 
 def test_a_wide_table_is_split_and_each_part_keeps_the_row_names():
+    """A table wider than MAX_COLUMNS is split into parts of at most MAX_COLUMNS columns that
+    each repeat the row-naming columns (one by default, two with keys=2); _inline_html
+    renders bold, links report.md as report.html and escapes angle brackets."""
     from cases.reporting.document import MAX_COLUMNS, Document, _inline_html
     d = Document("t")
     d.table(["model"] + [f"m{k}" for k in range(20)], [["a"] + list(range(20))])

@@ -44,6 +44,8 @@ def test_every_committed_metric_is_declared(path):
 
 
 def test_an_undeclared_key_is_caught():
+    """A row key that is neither a catalogue metric nor a descriptor is reported as undeclared, and
+    looking it up as a metric raises a KeyError that says to declare it in the catalogue."""
     data = {"runs": [{"mesh": "five", "model": "x", "disp_rel_l2_p2": 0.1,
                       "wobble_index": 3.0}], "gated": {"disp_rel_l2_p2": "max"}}
     assert undeclared(data) == ["wobble_index"]
@@ -68,6 +70,9 @@ def test_a_metric_name_carries_the_suffix_of_its_declared_unit():
 
 
 def test_twins_and_errors_are_derived_from_a_quantity():
+    """A quantity's FEM twin name puts _fem before the unit suffix and its error name replaces the
+    unit suffix with _rel_err; the twin keeps the unit and has no gate direction, and the error
+    is dimensionless and gated from above (max)."""
     assert ref_name("bulge_profile_mm") == "bulge_profile_fem_mm"
     assert ref_name("paper_pattern") == "paper_pattern_fem"
     assert err_name("tip_deflection_mm") == "tip_deflection_rel_err"
@@ -79,6 +84,9 @@ def test_twins_and_errors_are_derived_from_a_quantity():
 
 
 def test_every_declaration_is_complete():
+    """Every catalogue entry carries its own name, a unit, a label, a definition ending in a full
+    stop and a direction among None, max, min and signed, and is no descriptor; an unknown
+    direction, a differing second declaration and gating a metric with no direction are refused."""
     for name, m in CATALOGUE.items():
         assert m.name == name and m.unit and m.label and m.definition.endswith("."), name
         assert m.direction in (None, "max", "min", "signed")
@@ -92,13 +100,18 @@ def test_every_declaration_is_complete():
 
 
 def test_correlations_are_gated_from_below_and_errors_from_above():
-    # the one metric gated from below: a correlation falls when the model gets worse
+    """In the standard gated set exactly the stress correlations (stress_corr, stress_force_corr)
+    are gated from below (min), and every other metric is gated from above (max)."""
+    # the metrics gated from below: a correlation falls when the model gets worse
     corr = {"stress_corr", "stress_force_corr"}
     assert {n for n, d in catalogue.STANDARD_GATED.items() if d == "min"} == corr
     assert {d for n, d in catalogue.STANDARD_GATED.items() if n not in corr} == {"max"}
 
 
 def test_headers_show_units_where_they_are_not_ratios():
+    """A metric's header shows its display unit unless it is a ratio: a reaction in N is headed and
+    printed in mN, a relative L2 error has no unit, a count prints as an integer and a missing
+    value as n/a."""
     assert metric("reaction_n").header == "reaction [mN]"
     assert metric("reaction_n").cell(0.0123) == "12.3"
     assert metric("disp_rel_l2_p2").header == "disp L2 P2"
@@ -107,6 +120,9 @@ def test_headers_show_units_where_they_are_not_ratios():
 
 
 def test_cases_and_studies_gate_declared_metrics():
+    """Every headline, gated, column and QoI-error metric of every case is declared; the studies are
+    exactly convergence, extensions, artefact and truth-cube, and each metric a study gates has
+    the direction the catalogue declares for it."""
     for case in CASES.values():
         for name in (case.headline, *case.gated, *case.columns, *case.qoi_errors):
             metric(name)

@@ -111,6 +111,10 @@ def test_every_built_in_term_passes_with_a_margin(name):
 
 
 def test_the_claims_are_declared_where_a_term_does_not_make_them():
+    """The corner shear reading claims neither momentum nor angular momentum, the balanced one
+    momentum only, and fem_linear neither rotation invariance nor angular momentum; the corner
+    reading is not checked for zero net force or torque, and its net force is indeed far from
+    zero."""
     mesh, mat, x = probe()
     corner = make_term("shear", mesh, mat, reading="corner", c=0.5)
     balanced = make_term("shear", mesh, mat, reading="balanced", c=0.5)
@@ -126,6 +130,8 @@ def test_the_claims_are_declared_where_a_term_does_not_make_them():
 
 
 def test_a_sound_user_term_passes(term_file):
+    """A user edge-spring term with no bug is made without being refused by the conformance gate and
+    keeps its claim to be conservative."""
     model.terms.load_file(term_file("sound"))
     t = make_term("edge_springs_sound", cube(3, 0.02, "six"),
                   Material(E=10e3, nu=0.3, rho=1000.0))
@@ -134,6 +140,10 @@ def test_a_sound_user_term_passes(term_file):
 
 @pytest.mark.parametrize("bug", BUGS)
 def test_a_broken_user_term_is_refused_with_the_check_and_the_numbers(term_file, bug):
+    """A user term with one bug (a flipped force sign, a wrong energy factor, a NumPy path unlike
+    the kernel, a net force, a force at rest) is refused when made with a ModelError naming the
+    term, the check it fails and its value against the bound, and a later conformance call
+    refuses it again."""
     model.terms.load_file(term_file(bug))
     check = BUGS[bug][1]
     with pytest.raises(ModelError, match=f"edge_springs_{bug}.*refused.*'{check}': [0-9.e+-]+ "
@@ -157,6 +167,8 @@ def test_the_gradient_bound_separates_truncation_from_a_missing_factor(term_file
 
 def test_a_broken_term_file_is_refused_by_the_command_before_computing(term_file, tmp_path,
                                                                      capsys):
+    """`pbcm run --term` with a term whose forces have the wrong sign exits 2 with an error naming
+    the refused energy-gradient check, and writes no metrics.json."""
     from cases.cli import main
     path = term_file("sign")
     out = tmp_path / "out"

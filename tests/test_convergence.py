@@ -24,6 +24,9 @@ ROOT = Path(__file__).resolve().parents[1]
 @pytest.mark.parametrize("e_inf, C, p", [(0.0, 0.3, 1.0), (0.0, 0.05, 2.0), (0.12, 0.4, 1.5),
                                          (0.05, 0.01, 3.0)])
 def test_three_levels_recover_the_limit_and_order_exactly(e_inf, C, p):
+    """On three levels of e_inf + C h^p the observed order and the fit recover p and e_inf
+    exactly, the uncertainty is 1.25 times the Richardson correction, and the verdict is floor or
+    converges accordingly."""
     h = [8.0, 4.0, 2.0]
     e = [e_inf + C * x**p for x in h]
     assert observed_order(h, e) == pytest.approx(p, rel=1e-9)
@@ -36,6 +39,8 @@ def test_three_levels_recover_the_limit_and_order_exactly(e_inf, C, p):
 
 
 def test_four_levels_uneven_ratio_fit_all_of_them():
+    """Four levels at uneven refinement ratios of 0.05 + 0.02 h^1.3 fit to the limit 0.05 and
+    order 1.3 on all four levels, verdict floor."""
     h = [8.0, 4.0, 2.0, 4.0 / 3.0]
     e = [0.05 + 0.02 * x**1.3 for x in h]
     f = fit(h, e)
@@ -44,6 +49,10 @@ def test_four_levels_uneven_ratio_fit_all_of_them():
 
 
 def test_verdicts_of_the_shapes_a_model_shows():
+    """Halving errors converge, nearly flat ones are a floor, doubling ones diverge with no
+    limit, rises after falls are not asymptotic, and round-off-level errors are exact. Two levels
+    assume first order with Roache's factor 3, extrapolate without an asymptotic range keeps the
+    last value, and NaN raises ValueError."""
     assert fit([8, 4, 2], [0.2, 0.1, 0.05]).verdict == "converges"
     assert fit([8, 4, 2], [0.2, 0.19, 0.185]).verdict == "floor"
     assert fit([8, 4, 2], [0.2, 0.4, 0.8]).verdict == "diverges"
@@ -97,6 +106,8 @@ def test_the_referees_sequence_still_falls_so_it_is_no_floor():
 
 @pytest.mark.parametrize("c, C, p", [(0.1, 0.02, 1.0), (0.1, 0.01, 2.0), (0.05, 0.002, 1.5)])
 def test_a_constant_plus_a_decaying_part_is_a_floor_at_the_constant(c, C, p):
+    """A constant plus a decaying power C h^p is a floor at the constant with order p (to 1e-6)
+    and an uncertainty below the constant."""
     f = fit(H4, [c + C * x**p for x in H4])
     assert f.verdict == "floor" and f.e_inf == pytest.approx(c, rel=1e-6)
     assert f.order == pytest.approx(p, rel=1e-6) and f.e_inf_err < c
@@ -170,6 +181,8 @@ def test_the_full_report_follows_the_rulebook():
 
 
 def test_pareto_front_keeps_only_the_points_no_one_beats():
+    """The Pareto front holds, in increasing cost, the points no other beats in both cost and
+    error, and with a tolerance an error gain no larger than it does not join the front."""
     pts = [(1.0, 0.5), (2.0, 0.2), (2.0, 0.3), (3.0, 0.25), (4.0, 0.1), (0.5, 0.9)]
     assert pareto(pts) == [5, 0, 1, 4]
     # a gain within what the reference resolves beats nothing: 0.2 after 0.5 does, 0.1 after
@@ -187,6 +200,8 @@ def test_a_target_the_reference_cannot_judge_has_no_cheapest_run():
 
 
 def test_step_cost_interpolates_the_bench_in_log_log():
+    """The step cost of a model between bench sizes is interpolated in log-log, outside them it
+    takes the nearest size, and a model the bench lacks has no cost."""
     bench = {"rows": [
         {"model": "fem-linear", "tets": 100, "us_per_step": 10.0, "step_vs_fem-linear": 1.0},
         {"model": "fem-linear", "tets": 10000, "us_per_step": 1000.0, "step_vs_fem-linear": 1.0},
@@ -217,6 +232,9 @@ def study(quick_convergence):
 
 
 def test_quick_study_writes_its_report_and_the_rows_asked_for(study):
+    """The quick study writes its report and figures, a row per run and per fit with their
+    columns over the four (case, bc), the 8 and 4 mm levels and both meshes, only finite numbers,
+    and references converged below 0.01."""
     data = json.loads((study / "metrics.json").read_text())
     for f in ("report.md", "report.html", "pareto.png", "directional_young.png",
               "convergence_paper-cube_clamped.png", "convergence_torsion_clamped.png"):
@@ -241,6 +259,8 @@ def test_quick_study_writes_its_report_and_the_rows_asked_for(study):
 
 
 def test_fem_linear_statics_are_fem_p1(study):
+    """In the quick study the fem-linear model's static error equals FEM P1's at every case, bc,
+    mesh and level, to 1e-6 relative."""
     runs = json.loads((study / "metrics.json").read_text())["runs"]
     p1 = {(r["case"], r["bc"], r["mesh"], r["h_mm"]): r["disp_rel_l2"] for r in runs
           if r["model"] == "FEM P1"}
@@ -264,6 +284,7 @@ def test_sliding_cube_reaction_ratio_is_the_lattice_young_modulus(study):
 
 
 def test_quick_study_passes_the_committed_bounds(study, capsys):
+    """The quick study's metrics pass `pbcm check` against the committed gold (new rows allowed)."""
     status = main(["check", "--metrics", str(study), "--gold",
                    str(ROOT / "gold"), "--allow-new"])
     assert status == 0, capsys.readouterr().out[-3000:]
@@ -285,7 +306,14 @@ def test_progress_says_the_time_left_on_a_log(capsys):
     assert capsys.readouterr().err == ""
 
 
-def test_study_refuses_bcs_before_computing(capsys):
+def test_study_refuses_bcs_before_computing(capsys, monkeypatch):
+    """`pbcm run convergence --bcs` exits 2 saying --bcs does not apply to the convergence
+    study, before it starts computing."""
+    from cases.studies.convergence import Convergence
+
+    def refuse(self, *a, **k):
+        raise AssertionError("the study started computing")
+    monkeypatch.setattr(Convergence, "run", refuse)
     assert main(["run", "convergence", "--bcs", "clamped"]) == 2
     assert "--bcs does not apply to the convergence study" in capsys.readouterr().err
 
@@ -345,6 +373,8 @@ def test_index_opens_with_the_answers_and_lists_the_study(study, tmp_path, capsy
 
 
 def test_study_bad_arguments_fail_before_computing(tmp_path, capsys, monkeypatch):
+    """An --out on a file, nu = 0.5, an unknown mesh and an unknown model each make the quick
+    study exit 2 with one error line, before it starts computing."""
     from cases.studies.convergence import Convergence
 
     def refuse(self, *a, **k):
@@ -386,6 +416,8 @@ def test_fits_that_cannot_lie():
 
 
 def test_a_cancelling_series_is_never_on_the_cost_front():
+    """A run of a cancelling series is marked as such and kept off the cost front, even with the
+    lower error at the same cost; the other run makes the front."""
     from cases.studies.convergence.cost import accuracy_per_cost
     runs = [{"case": "c", "bc": "b", "mesh": "six", "model": m, "h_mm": 4.0, "tets": 100,
              "disp_rel_l2": e} for m, e in (("lucky", 0.001), ("honest", 0.01))]

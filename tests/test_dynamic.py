@@ -55,6 +55,9 @@ def test_fixed_free_bar_period_is_4L_over_c(bar, element, method):
 
 @pytest.mark.parametrize("method,tol", [("newmark", 1e-6), ("modal", 1e-11)])
 def test_undamped_energy_is_constant(bar, method, tol):
+    """Without damping, the released bar exchanges kinetic and strain energy (kinetic zero at
+    release, later above half the total) while the total stays constant to 1e-6 with Newmark
+    and to 1e-11 with the modal method."""
     r, _ = released(bar, "P1", method=method)
     e = r.kinetic + r.strain
     assert r.kinetic[0] == 0 and r.kinetic.max() > 0.5 * e[0]    # energy is exchanged
@@ -96,6 +99,9 @@ def test_slow_push_then_rest_gives_the_static_reaction(element, mass, method):
 
 
 def test_bad_input():
+    """dynamic.solve refuses a negative rho, t_end = 0, a negative dt, negative damping, an
+    unknown mass and a u0 of the wrong shape, each error naming the argument, and a boundary
+    condition whose prescribed components change during the run."""
     mesh = cube(3, 0.032, "six")
     held = {0: (0.0, 0.0, 0.0)}
     for kw, word in [(dict(rho=-1.0), "rho"), (dict(t_end=0.0), "t_end"),
@@ -216,6 +222,9 @@ def test_free_response_is_the_damped_oscillator(w2):
 
 
 def test_modal_method_names_what_it_needs():
+    """dynamic.solve with method="modal" raises ModelError naming what is wrong: a boundary
+    condition that is not a Ramp, a dt given, or supports that leave rigid motions; an
+    unknown method name is refused too."""
     mesh = cube(3, 0.032, "six")
     held = {int(i): (0.0, 0.0, 0.0) for i in mesh.nodes_on_plane("y", 0.0)}
     ramp = Ramp(mesh.nodes_on_plane("y", 0.032), (0.0, -1e-4, 0.0), 0.01, held=held)
@@ -228,6 +237,9 @@ def test_modal_method_names_what_it_needs():
 
 
 def test_mac_of_shapes_and_spaces_worked_by_hand():
+    """mac is 1 for a shape against itself, 0 against an orthogonal one, 0.5 for a shape at
+    45 degrees to a single vector and 1 for a shape in the span of two vectors; a complex
+    shape is compared by its modulus."""
     from cases.measuring.metrics import mac
     e = np.eye(5)
     assert mac(e[0], e[:1].T) == pytest.approx(1.0)
@@ -239,6 +251,9 @@ def test_mac_of_shapes_and_spaces_worked_by_hand():
 
 
 def test_pairing_by_shape_skips_a_spurious_mode_and_spans_degenerate_pairs():
+    """pair_modes pairs by shape: a rotated degenerate pair matches the reference pair and a
+    spurious model mode is skipped, so the worst frequency error is 0.1 rather than the 0.25
+    of pairing by rank; reference modes no model mode spans stay unpaired."""
     from cases.measuring.metrics import pair_modes
     e = np.eye(6)
     f_ref, v_ref = [1.0, 1.0, 2.0, 3.0], e[[0, 1, 2, 3]]
@@ -259,6 +274,9 @@ def _orthonormal(n, k, seed=0):
 
 
 def test_a_model_equal_to_the_reference_pairs_every_mode_with_itself():
+    """A model equal to the reference (its frequencies and shapes, with a nodal mass) pairs
+    every mode with itself, and so does the same model with a degenerate pair given in a
+    non-orthogonal basis."""
     from cases.measuring.metrics import pair_modes
     f, v = [1.0, 1.0, 1.3, 2.0, 2.0, 2.0, 2.5], _orthonormal(30, 7)
     mass = np.random.default_rng(1).uniform(0.5, 2.0, 10)
@@ -273,6 +291,8 @@ def test_a_model_equal_to_the_reference_pairs_every_mode_with_itself():
 
 
 def test_a_spurious_mode_stays_unpaired_and_does_not_shift_the_later_pairs():
+    """A model mode whose shape no reference mode has stays unpaired, and the model modes
+    after it still pair with their own reference modes."""
     from cases.measuring.metrics import pair_modes
     e = _orthonormal(30, 7)
     f_ref, v_ref = [1.0, 1.2, 1.5, 2.0, 2.4, 3.0], e[:6]

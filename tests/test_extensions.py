@@ -18,6 +18,9 @@ TET = CANDIDATES[1]
 
 
 def test_candidates_are_the_paper_model_plus_one_normal_form_each():
+    """The candidates are the paper model plus exactly one normal-stress form each (edge, tet,
+    corotated, sbd), and the tet candidate is variational shear plus volume plus normal_tet, with
+    automatic constants."""
     assert [short(c) for c in CANDIDATES] == ["+normal_edge", "+normal_tet",
                                               "+normal_corotated", "+normal_sbd"]
     assert TET == "shear(reading=variational, c=auto) + volume + normal_tet(c=auto)"
@@ -39,6 +42,10 @@ def _doc(case_errors, alternation, tensors, discretisation=None):
 
 
 def test_rankings_failures_and_verdicts_worked_by_hand():
+    """On a hand-worked document the geometric means of the error ratios to the paper model are 0.5
+    for m1 and 1 for m2; the paper model fails on one case error, one floor and one C_eff (never
+    on the alternation); and each candidate is judged to fix, worsen or not change each failure.
+    The conclusion names no best, since the leave-one-population-out ranges overlap."""
     errs = {"paper-cube": {BASE: 0.2, "m1": 0.05, "m2": 0.4, YARDSTICK: 0.1},
             "cantilever": {BASE: 0.1, "m1": 0.1, "m2": 0.05, YARDSTICK: 0.1}}
     tensors = {BASE: {"six": 0.04}, "m1": {"six": 0.035}, "m2": {"six": 0.005},
@@ -84,6 +91,9 @@ def test_candidates_whose_ranges_overlap_share_a_rank():
 
 
 def test_headline_says_when_no_candidate_beats_the_paper_model():
+    """With a single population, where no leave-one-out range exists, the conclusion names no best
+    candidate and says that m1 (ratio 2) is farther from FEM P1 than the paper model whichever
+    population is taken."""
     errs = {"torsion": {BASE: 0.1, "m1": 0.2, "m2": 0.4, YARDSTICK: 0.1}}
     models, data = _doc(errs, {}, {})
     doc = {"parameters": {"models": models}, "rankings": R.rankings(data, models)}
@@ -146,6 +156,11 @@ def small_study(tmp_path_factory):
 
 
 def test_small_study_writes_rankings_and_gate_rows(small_study):
+    """A quick extensions study on the cantilever writes its Markdown and HTML reports and both
+    figures, ranks the paper model's overall ratio at 1.0, takes step costs from the bench (the
+    candidate above the paper model, both above fem-linear) and records gate rows for the case
+    median and for C_eff on six; the candidate's C_eff error on five is below 1e-6, the paper
+    model's above."""
     doc = json.loads((small_study / "metrics.json").read_text())
     for f in ("report.md", "report.html", "case_errors.png", "ceff_moduli.png"):
         assert (small_study / f).is_file()
@@ -163,6 +178,9 @@ def test_small_study_writes_rankings_and_gate_rows(small_study):
 
 
 def test_rewrite_draws_the_same_report_from_the_recorded_runs(small_study, tmp_path, capsys):
+    """`--rewrite` redraws report.md, metrics.json and both figures byte for byte from the recorded
+    runs; a record made at other problem parameters (another nu) is refused with exit 2 and a
+    message that they changed, and so is rewriting the record as the cantilever case."""
     import shutil
     copy = tmp_path / "copy"
     shutil.copytree(small_study, copy)
@@ -176,6 +194,7 @@ def test_rewrite_draws_the_same_report_from_the_recorded_runs(small_study, tmp_p
     assert main(["run", "extensions", "--rewrite", "--out", str(copy)]) == 2
     assert "problem parameters have changed" in capsys.readouterr().err
     assert main(["run", "cantilever", "--rewrite", "--out", str(copy)]) == 2
+    assert "--rewrite applies to a study" in capsys.readouterr().err
 
 
 def test_its_fits_are_the_convergence_studys_rule_on_its_recorded_runs(small_study, tmp_path):
@@ -227,6 +246,9 @@ def test_fit_recovers_the_closed_form_stiffness_scale(tmp_path):
     (["msm", "--cases", "nope"], "unknown case nope"),
 ])
 def test_fit_refuses_before_computing(args, said, tmp_path, capsys):
+    """`pbcm fit` exits 2, saying why and creating no output folder, when the model has no constant
+    to fit, the case has no static displacement, a case is both fitted on and left out, or the
+    case is unknown."""
     assert main(["fit", *args, "--quick", "--out", str(tmp_path / "f")]) == 2
     assert said in capsys.readouterr().err
     assert not (tmp_path / "f").exists()

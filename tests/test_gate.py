@@ -50,6 +50,9 @@ def edit_gold(src, dst, model, metric, change):
 
 
 def test_bless_then_check_passes(blessed, capsys):
+    """A run checked against the gold blessed from it passes; the gold folder holds only
+    paper-cube.quick.jsonl and policy.toml, whose header names the case, the quick mode, the
+    problem's nu and gated columns such as stress_corr and disp_rel_l2_p2."""
     assert check(blessed / "good", blessed / "g") == 0
     assert sorted(p.name for p in (blessed / "g").iterdir()) == ["paper-cube.quick.jsonl",
                                                                 "policy.toml"]
@@ -81,9 +84,10 @@ def test_gold_values_carry_six_digits_and_a_rebless_of_the_last_digits_changes_n
 
 
 def test_the_committed_gold_is_compact():
-    """All the gate's files together: under 5 % of the 79 741 lines thresholds.toml had."""
+    """The gate's files together hold under 4 000 lines (one line per gated row, not one
+    threshold per metric), and no per-metric thresholds file exists."""
     lines = sum(len(p.read_text().splitlines()) for p in (ROOT / "gold").iterdir())
-    assert lines < 0.05 * 79741
+    assert lines < 4000
     assert not (ROOT / "thresholds.toml").exists()
 
 
@@ -129,6 +133,8 @@ def test_beside_a_regression_an_improvement_is_said_to_have_moved_with_it(blesse
 
 
 def test_hand_tightened_gold_fails(blessed, tmp_path, capsys):
+    """A gold error value halved by hand makes the check exit 1 with a FAIL line for that
+    metric."""
     edit_gold(blessed / "g", tmp_path / "g", "pbcm-variational", "disp_rel_l2_p2",
               lambda v: v / 2)
     assert check(blessed / "good", tmp_path / "g") == 1
@@ -157,6 +163,9 @@ def test_a_null_that_becomes_a_number_fails_and_says_what_changed(blessed, tmp_p
 
 
 def test_missing_gold_row_exits_2(blessed, tmp_path, capsys):
+    """A model with no gold rows at all is listed as NEW and the check exits 3; a gold
+    missing one row of a model that has gold makes the check exit 2 saying the gold has no
+    row."""
     shutil.copytree(blessed / "g", tmp_path / "g")
     f = tmp_path / "g" / "paper-cube.quick.jsonl"
     lines = [l for l in f.read_text().splitlines() if '"msm"' not in l]
@@ -174,6 +183,8 @@ def test_missing_gold_row_exits_2(blessed, tmp_path, capsys):
 
 
 def test_missing_metrics_file_exits_2(blessed, tmp_path, capsys):
+    """The check exits 2 when the metrics folder does not exist or holds no metrics.json,
+    saying which."""
     assert check(tmp_path / "absent", blessed / "g") == 2
     assert "absent does not exist" in capsys.readouterr().err
     (tmp_path / "empty").mkdir()
@@ -182,6 +193,8 @@ def test_missing_metrics_file_exits_2(blessed, tmp_path, capsys):
 
 
 def test_nan_metric_exits_2(blessed, tmp_path, capsys):
+    """A NaN metric in the run makes the check exit 2, naming the metric and saying it is not
+    a finite number."""
     shutil.copytree(blessed / "good", tmp_path / "nan")
     f = tmp_path / "nan" / "paper-cube" / "metrics.json"
     data = json.loads(f.read_text())
@@ -200,6 +213,9 @@ def test_nan_metric_exits_2(blessed, tmp_path, capsys):
     ("paper-cube.quick.jsonl", None, "no gold value"),
     ("policy.toml", None, "has no policy.toml")])
 def test_malformed_or_missing_gold_exits_2(blessed, tmp_path, name, text, word, capsys):
+    """A malformed or missing gold file (an empty or negative rtol, an unknown policy key, a
+    line that is not JSON, a deleted policy.toml or gold file) makes the check exit 2 with an
+    error naming the problem, and so does a gold folder that does not exist."""
     shutil.copytree(blessed / "g", tmp_path / "g")
     if text is None:
         (tmp_path / "g" / name).unlink()
@@ -211,6 +227,10 @@ def test_malformed_or_missing_gold_exits_2(blessed, tmp_path, name, text, word, 
 
 
 def test_the_band_is_two_sided_for_either_sign():
+    """A Bound's band is the gold value +- (rtol |value| + atol) for either sign and
+    direction: the value passes with margin 1 and values 0.07 away fail. An error (max) is
+    worse above and better below, a correlation (min) the reverse, and a signed metric that
+    moves is 'changed', never better."""
     from cases.running.gate import Bound
     for value in (-0.6, 0.6):
         for direction in ("min", "max"):

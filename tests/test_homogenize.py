@@ -21,6 +21,9 @@ def cubic(c11, c12, c44):
 
 
 def test_isotropic_tensor_gives_back_its_constants():
+    """The isotropic stiffness for E and nu has C11 = lambda + 2 mu, C12 = lambda and C44 = mu,
+    gives back E, nu and G as its engineering constants, and has anisotropy index zero and
+    Young's modulus E in every direction."""
     E, nu = 7.0e3, 0.3
     C = isotropic_stiffness(E, nu)
     # sigma_xx under a unit uniaxial strain is lambda + 2 mu
@@ -39,6 +42,9 @@ def test_isotropic_tensor_gives_back_its_constants():
 
 
 def test_cubic_crystal_against_the_closed_forms():
+    """For a cubic crystal (copper's constants) the Voigt and Reuss bulk and shear moduli, the
+    anisotropy index 5 G_V / G_R - 5, Young's modulus along [100], [110] and [111] and the
+    Poisson ratio nu_xy equal their closed forms."""
     c11, c12, c44 = 168.4, 121.4, 75.4           # copper, GPa (Hill's classic example)
     C = cubic(c11, c12, c44)
     K_V, G_V, K_R, G_R = voigt_reuss(C)
@@ -59,6 +65,8 @@ def test_cubic_crystal_against_the_closed_forms():
 
 @pytest.mark.parametrize("family", ["five", "six", "bcc", "unstructured"])
 def test_constant_strain_fem_patch_answers_with_the_target(family):
+    """On every mesh family the effective stiffness of linear FEM equals its material's isotropic
+    tensor to a largest relative modulus error below 1e-8, and is symmetric to 1e-8."""
     mat = Material(E=10e3, nu=0.45)
     C = effective_stiffness(build("fem-linear", cube(4, 0.032, family), mat))
     assert moduli_errors(C, mat.E, mat.nu)["largest"] < 1e-8

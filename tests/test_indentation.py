@@ -24,6 +24,9 @@ def punch_force(family, dirichlet_fn):
 
 
 def test_the_punch_is_its_face_and_a_rim_sloping_to_the_free_surface():
+    """The punch field presses top-face points inside the patch to the full depth, falls linearly
+    over the rim to zero at its outer edge, leaves points beyond the rim or below the top free
+    (NaN), and holds the base at zero."""
     c, top = SIZE_MM / 2 * MM, SIZE_MM * MM
     half = PATCH_MM / 2 * MM
     pts = np.array([[c, top, c], [c + half, top, c - half],
@@ -42,6 +45,10 @@ def test_the_punch_is_its_face_and_a_rim_sloping_to_the_free_surface():
 
 
 def test_the_models_prescribe_the_references_field_at_their_nodes():
+    """The references are given a Region wrapping the punch field, and on the five and unstructured
+    meshes the models' prescribed nodes are exactly those where the punch field is defined, with
+    its values; on the unstructured mesh some top nodes lie on the rim and are pressed part-way
+    down."""
     s = CASE.settings()
     given = CASE.dirichlet_fn(None, "clamped", s)
     assert isinstance(given, Region) and given.fn is punch
@@ -58,6 +65,8 @@ def test_the_models_prescribe_the_references_field_at_their_nodes():
 
 
 def test_every_mesh_poses_the_same_punch():
+    """The converged linear reference's punch reactions on the five, six, bcc and unstructured
+    meshes agree pairwise to within the sum of their error estimates."""
     forces = {f: punch_force(f, CASE.dirichlet_fn(None, "clamped", None))
               for f in ("five", "six", "bcc", "unstructured")}
     for a, (fa, ea) in forces.items():
@@ -75,6 +84,9 @@ def _face_only(points):
 
 
 def test_a_region_decides_new_boundary_points_by_where_they_lie():
+    """In a P2 solve a Region holds every vertical dof under the punch face at the full depth, also
+    those of facets whose other vertices are free, whereas a plain dirichlet function leaves some
+    of them unheld; there are more such dofs than mesh nodes under the face."""
     # P2 dofs on the top face inside the face are held, though their facets' other vertices
     # are free: what a plain dirichlet_fn (the facet rule) does not do
     s = CASE.settings(spacing_mm=SPACING)

@@ -15,6 +15,9 @@ CASE = CASES["large-compression"]
 
 
 def test_the_law_in_closed_form_is_the_hand_formula():
+    """At stretch 0.7 with E = 10 kPa and nu = 0.45 the closed-form uniaxial law gives a lateral
+    stretch of 1.17085 and a force of 4.4435 N on the 32 mm cube, the case's last law force; at
+    stretch 1 it gives (1, 0), and a negative stretch is refused."""
     # lateral stretch and nominal stress at stretch 0.7, E = 10 kPa, nu = 0.45, worked by hand
     # in tests/test_hyperelastic.py: 1.17085 and 4.4435 N on the 32 mm cube
     lt, P = uniaxial(0.7, Material(10e3, 0.45))
@@ -36,6 +39,11 @@ def bonded():
 
 
 def test_bonded_reference_is_a_barrel_with_an_estimate(bonded):
+    """The bonded reference is the refined mixed neo-Hookean solution: its force rises at every step
+    and exceeds the homogeneous law by over 5 %, the mid layer bulges out the most while the
+    bonded layers do not move sideways, and its error estimate lies in (0, 0.1) and bounds the
+    last refinement's change. Its reaction is the last step's force, and its linear-regime scale
+    brings the nominal strain to between 3e-5 and 1e-4."""
     s, mesh, ref = bonded
     nh = ref.nonlinear
     assert nh.result.info["mixed"] and nh.result.info["refine"] == s.nh_levels >= 1
@@ -70,6 +78,8 @@ def test_homogeneous_check_of_fem_neohookean_is_the_law():
 
 
 def test_a_non_conservative_reading_has_no_energy_curve():
+    """For a non-conservative model (pbcm-corner) the homogeneous compression gives a positive force
+    at each step and no force curve derived from an energy."""
     s = CASE.settings(steps=2)
     mesh = CASE.mesh("five", s)
     force, from_energy = lc.homogeneous_curve(build("pbcm-corner", mesh, s.material), mesh, s)

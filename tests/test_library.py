@@ -23,6 +23,10 @@ LIBRARY = [name for name in CASES if name != "paper-cube"]   # the paper cube: `
 
 
 def test_every_case_declares_the_contract():
+    """Every registered case is a Case named by its registry key, with a Settings class, an
+    error (direction max) as headline, a Narrative of its own, tuples of gated metrics,
+    columns and string notes that the catalogue knows, quick settings within its meshes, and
+    gated directions among max, min and signed."""
     for name, case in CASES.items():
         assert isinstance(case, Case) and case.name == name
         assert issubclass(case.settings_class, Settings)
@@ -64,6 +68,11 @@ def test_a_case_declares_physics_and_its_narrative_holds_the_prose():
 
 @pytest.mark.parametrize("name", LIBRARY)
 def test_quick_case_writes_report_and_finite_metrics(library, name):
+    """Each library case's quick run writes metrics.json, report.md, report.html and
+    errors.png; its metrics record the case, quick mode, E = 10 kPa and nu = 0.45, one run
+    per declared model with every gated key, only finite numbers and some headline value. The
+    report opens with two to five lines including the glossary link, has grouped findings and
+    no Definitions section, and every image it links exists."""
     out = library / name
     for f in ("metrics.json", "report.md", "report.html", "errors.png"):
         assert (out / f).is_file(), f
@@ -91,6 +100,8 @@ def test_quick_case_writes_report_and_finite_metrics(library, name):
 
 
 def test_quick_library_passes_the_committed_bounds(library, capsys):
+    """The quick runs of the whole library pass `pbcm check` against the committed gold,
+    models without gold counting as new."""
     # --allow-new: a preset or term added since the bounds were blessed is new, not failed
     status = main(["check", "--metrics", str(library), "--gold",
                    str(ROOT / "gold"), "--allow-new"])
@@ -114,6 +125,8 @@ def test_traction_becomes_consistent_nodal_forces():
 
 
 def test_body_force_becomes_a_quarter_of_each_tetrahedron():
+    """A uniform body force gives nodal forces summing to the force density times the cube's
+    volume, and node 0 receives a quarter of the force on each tetrahedron it belongs to."""
     mesh = cube(3, 0.032, "five")
     f = body_forces(mesh, (0.0, -9810.0, 0.0))
     assert f[:, 1].sum() == pytest.approx(-9810.0 * 0.032**3, rel=1e-12)
@@ -133,7 +146,11 @@ def test_self_weight_fem_is_the_closed_form_and_torsion_is_saint_venant_order(li
     assert 0.98 < fem / tor["closed_form"]["torque_nm"] < 1.05
 
 
-def test_cantilever_metrics_carry_the_issue_fields(library):
+def test_cantilever_metrics_carry_its_problem_and_closed_form(library):
+    """The cantilever's metrics record its geometry, load and material (1 mN on a 64 mm
+    beam), a closed-form tip deflection equal to the Timoshenko formula worked by hand, a FEM
+    tip deflection 85-100 % of it (the clamped root is stiffer), and per run the tip
+    deflection, P2 displacement error and stress correlation."""
     d = json.loads((library / "cantilever" / "metrics.json").read_text())
     assert {"length_mm", "height_mm", "width_mm", "load_N", "E_Pa", "nu"} <= set(d["params"])
     assert d["params"]["load_N"] == 1e-3 and d["params"]["length_mm"] == 64.0
@@ -148,6 +165,9 @@ def test_cantilever_metrics_carry_the_issue_fields(library):
 
 
 def test_scorecard_index(library):
+    """The scorecard index opens with the 'Which reading?' section listing every paper-cube
+    model above the scorecard, links each case's report, marks quick mode, and colours the
+    HTML cells."""
     from cases.reporting.index import index_documents
     md, html = index_documents(library, list(CASES))
     assert md.split("\n\n")[1].startswith("**Which reading?**")
@@ -184,6 +204,9 @@ class Broken(Case):
 
 
 def test_a_failed_mesh_is_recorded_and_the_case_goes_on(tmp_path):
+    """A case whose six mesh cannot be built records those runs as failed with the mesh
+    error, while the five-mesh run completes with positive metrics and the report lists the
+    runs that could not start."""
     from cases.reporting.report import write_case
     from cases.running.runner import run
     case = Broken()

@@ -28,6 +28,9 @@ def _fd_divergence(stress, x, h):
 
 @pytest.mark.parametrize("material,amplitude", [("linear", 1e-3), ("neo-Hookean", 0.05)])
 def test_body_force_is_minus_the_divergence_of_the_stress(material, amplitude):
+    """For the linear and the neo-Hookean law the manufactured body force equals minus the finite-
+    difference divergence of the stress to within 1e-7 of its largest value, and the traction on
+    a face is the stress applied to the face's normal."""
     p = manufactured(waves(L, amplitude), material, Material(E, NU))
     x = np.random.default_rng(0).uniform(0, L, (20, 3))
     b = p.body_force(x)
@@ -37,6 +40,8 @@ def test_body_force_is_minus_the_divergence_of_the_stress(material, amplitude):
 
 
 def test_hessian_is_the_gradient_of_the_gradient():
+    """The manufactured wave field's Hessian matches the central finite difference of its gradient
+    to within 1e-8 of the largest entry."""
     f = waves(L)
     x = np.random.default_rng(1).uniform(0, L, (10, 3))
     h = 1e-5 * L
@@ -62,6 +67,8 @@ def test_the_two_stresses_in_closed_form():
 
 
 def test_l2_error_of_a_constant_offset_is_its_norm_times_root_volume():
+    """The L2 error of a zero P2 solution against a constant field c on a cube of side L is |c|
+    times L^1.5 (the root of the volume), and the returned norm of the exact field equals it."""
     m = cube(3, L, "five")
     bc = {i: (0.0, 0.0, 0.0) for i in range(m.n_nodes)}
     r = linear.solve(m, Material(E, NU), bc, element="P2")
@@ -72,10 +79,14 @@ def test_l2_error_of_a_constant_offset_is_its_norm_times_root_volume():
 
 
 def test_orders_of_a_power_law_are_its_exponent():
+    """Errors that fall as the square of the cell size over the ladder 4, 8, 16 give an observed
+    order of 2 for each consecutive pair."""
     assert orders([4, 8, 16], [1.0, 0.25, 0.0625]) == pytest.approx([2.0, 2.0])
 
 
 def test_bad_problems_are_refused():
+    """An unknown material law, prescribed faces on which no mesh node lies, and a mixed form asked
+    of the linear reference are each refused with a ModelError naming the cause."""
     with pytest.raises(ModelError, match="unknown law"):
         manufactured(waves(L), "rubber", Material(E, NU))
     p = manufactured(waves(L), "linear", Material(E, NU))
@@ -92,6 +103,10 @@ LADDERS = [(e, fam) for e in SPEC["manufactured"] for fam in e.cells]
 @pytest.mark.parametrize("entry,family", LADDERS,
                          ids=[f"{e.name}-{f}" for e, f in LADDERS])
 def test_observed_order_is_the_formal_order(entry, family):
+    """On every ladder and mesh family of the verification spec the observed L2 order of the finest
+    pair is at least the formal order minus the tolerance and, unless the spec declares the
+    family faster, at most the formal order plus it. The finest relative error is under the
+    ladder's bound, the row is marked passed, and the errors fall strictly from level to level."""
     row = run_entry(entry, family, SPEC["size"], SPEC["E"], SPEC["tolerance"])
     order, formal, tol = row["mms_order"], entry.formal_order, SPEC["tolerance"]
     assert order >= formal - tol, row

@@ -18,12 +18,17 @@ def boundary_faces(mesh):
 @pytest.mark.parametrize("scheme,nodes,tets", [("five", 125, 320), ("six", 125, 384),
                                                ("bcc", 189, 768)])
 def test_cube_counts(scheme, nodes, tets):
+    """A cube of 5 nodes per side has 125 nodes and 320 tetrahedra with the five split, 125
+    and 384 with the six split, and 189 and 768 with the bcc lattice."""
     m = cube(5, L, scheme)
     assert (m.n_nodes, m.n_tets) == (nodes, tets)
 
 
 @pytest.mark.parametrize("scheme", SCHEMES)
 def test_cube_is_a_conforming_cube(scheme):
+    """Every generated cube scheme gives positive tetrahedron volumes summing to L^3 to
+    round-off, and its boundary faces (faces of one tetrahedron only) all lie on the cube's
+    surface with a total area of 6 L^2, so the mesh conforms."""
     m = cube(5, L, scheme)
     assert m.volumes.min() > 0
     assert m.volumes.sum() == pytest.approx(L**3, rel=1e-12)
@@ -39,6 +44,9 @@ def test_cube_is_a_conforming_cube(scheme):
 
 
 def test_unstructured_has_no_slivers_and_planar_layers():
+    """The unstructured cube has a smallest radius ratio of at least 0.1, its nodes lie on
+    five planar y-layers evenly spaced over [0, L], and a second call gives the same node
+    coordinates."""
     m = cube(5, L, "unstructured")
     q = m.quality()
     assert q["radius_ratio_min"] >= 0.1
@@ -47,6 +55,9 @@ def test_unstructured_has_no_slivers_and_planar_layers():
 
 
 def test_box_and_node_sets():
+    """A 6 x 3 x 2 box has 36 nodes; nodes_on_plane selects the 6 nodes on x = 0 and the 12
+    on y = 0.02 by axis name or index, nodes_where the 18 with x > 0.05, and an unknown axis
+    raises MeshError naming the axis."""
     m = box(6, 3, 2, 0.1, 0.02, 0.01, "six")
     assert m.n_nodes == 36
     assert len(m.nodes_on_plane("x", 0.0)) == 6
@@ -57,6 +68,8 @@ def test_box_and_node_sets():
 
 
 def test_reorients_negative_tetrahedra():
+    """A negatively oriented tetrahedron is re-oriented on construction: reoriented counts 1
+    and its volume is +1/6."""
     pts = np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0], [0, 0, 1.0]])
     m = TetMesh(pts, np.array([[0, 2, 1, 3]]))
     assert m.reoriented == 1 and m.volumes[0] == pytest.approx(1 / 6)
@@ -73,11 +86,16 @@ def test_reorients_negative_tetrahedra():
     ([[0, 0], [1, 0]], [[0, 1, 0, 1]], "shape"),
 ])
 def test_bad_meshes_are_named(points, tets, match):
+    """TetMesh refuses each malformed input with a MeshError naming the defect: non-finite
+    coordinates, node indices outside the points, zero volume, a node repeated in a
+    tetrahedron, a node in no tetrahedron, duplicate nodes, and points that are not 3-D."""
     with pytest.raises(MeshError, match=match):
         TetMesh(np.array(points, dtype=float), np.array(tets))
 
 
 def test_generator_arguments_are_checked():
+    """cube raises MeshError for an unknown scheme, for fewer than 2 nodes per side and for a
+    negative length, each message naming the bad argument."""
     with pytest.raises(MeshError, match="unknown mesh scheme"):
         cube(3, L, "seven")
     with pytest.raises(MeshError, match=r"nodes along x \(nx\) must be an integer >= 2"):
@@ -87,6 +105,9 @@ def test_generator_arguments_are_checked():
 
 
 def test_gmsh_file_with_mixed_blocks(tmp_path):
+    """read keeps only the tetrahedra of a Gmsh file that also holds vertex, line and
+    triangle blocks and two tetra blocks, drops the node no tetrahedron uses, and returns the
+    original node and tetrahedron counts with volume L^3."""
     m = cube(3, L, "six")
     tri = np.sort(m.tets[:, [0, 1, 2]], axis=1)[:5]
     extra = np.vstack([m.points, [[1.0, 1.0, 1.0]]])  # a geometry point no tetrahedron uses
@@ -101,6 +122,8 @@ def test_gmsh_file_with_mixed_blocks(tmp_path):
 
 
 def test_file_without_tetrahedra(tmp_path):
+    """Reading a mesh file that holds only triangles raises MeshError saying it has no
+    tetrahedra."""
     path = tmp_path / "surface.msh"
     meshio.write(path, meshio.Mesh(np.eye(3), [("triangle", np.array([[0, 1, 2]]))]),
                  file_format="gmsh22", binary=False)
@@ -109,6 +132,8 @@ def test_file_without_tetrahedra(tmp_path):
 
 
 def test_write_roundtrip_with_data(tmp_path):
+    """write stores per-node and per-tetrahedron arrays in a .vtu file from which meshio
+    reads them back unchanged."""
     m = cube(3, L, "five")
     path = tmp_path / "m.vtu"
     write(path, m, point_data={"u": m.points * 0.1}, cell_data={"p": m.volumes})
@@ -132,6 +157,9 @@ def test_a_cube_has_74_triangulations_two_of_five_tetrahedra_each_filling_it():
 
 
 def test_the_delaunay_reconstruction_gives_374_tetrahedra_for_seeds_7_15_25_and_is_non_conforming():
+    """Of seeds 0 to 25, exactly 7, 15 and 25 give a 374-tetrahedron Delaunay lattice of 5
+    nodes a side; seed 7's mesh has 125 nodes and volume size^3 but unmatched interior faces,
+    while the five and six cubes have none."""
     from model.paper_mesh import delaunay_lattice, unmatched_faces
     size = 0.032
     counts = {s: delaunay_lattice(5, size, s).n_tets for s in range(26)}
@@ -144,6 +172,10 @@ def test_the_delaunay_reconstruction_gives_374_tetrahedra_for_seeds_7_15_25_and_
 
 
 def test_the_mixed_split_is_conforming_with_ten_cells_in_five():
+    """mixed_split with 10 five-tetrahedron cells gives a conforming cube of 125 nodes and
+    374 tetrahedra of volume size^3, with 10 cells of five and 54 of six, and another seed
+    gives another split. paper_size_meshes refuses a Delaunay seed that does not give 374
+    tetrahedra, and mixed_split refuses more five-cells than the 64 cells."""
     from model.paper_mesh import mixed_split, paper_size_meshes, unmatched_faces
     size = 0.032
     m = mixed_split(5, size, 10, seed=0)

@@ -25,6 +25,8 @@ def table():
 
 
 def test_gradients_of_an_affine_field_are_exact_on_any_mesh():
+    """The per-tetrahedron displacement gradients of an affine field u = A x + b equal A to within
+    1e-15 on a perturbed six lattice."""
     m = perturbed(cube(4, 0.02, "six"), 0.3, 1)
     A = np.array([[1e-3, 2e-4, -3e-4], [5e-4, -1e-3, 0.0], [0.0, 7e-4, 2e-3]])
     g = displacement_gradients(m.points, m.tets, m.points @ A.T + 1e-3)
@@ -32,6 +34,8 @@ def test_gradients_of_an_affine_field_are_exact_on_any_mesh():
 
 
 def test_strain_error_of_a_doubled_strain_is_one_and_of_the_strain_zero():
+    """On a perturbed bcc mesh the patch strain error is zero for the field of the target strain,
+    still zero with a small rotation added, and exactly 1 (relative) for twice the target strain."""
     m = perturbed(cube(4, 0.02, "bcc"), 0.2, 0)
     eps = np.array([[0.0, 1e-4, 0.0], [1e-4, 0.0, 0.0], [0.0, 0.0, 0.0]])
     assert patch.strain_error(m, m.points @ eps.T, eps) < 1e-12
@@ -42,12 +46,17 @@ def test_strain_error_of_a_doubled_strain_is_one_and_of_the_strain_zero():
 
 
 def test_the_six_unit_strains_are_a_basis_of_the_symmetric_tensors():
+    """The six unit strains are symmetric, have largest entry 1 in magnitude and span the six-
+    dimensional space of symmetric 3x3 tensors."""
     e = np.array([u.ravel() for u in patch.unit_strains()])
     assert np.linalg.matrix_rank(e) == 6
     assert all(np.allclose(u, u.T) and np.abs(u).max() == 1.0 for u in patch.unit_strains())
 
 
 def test_perturbed_keeps_the_boundary_and_moves_the_interior_within_bounds():
+    """Perturbing a mesh moves every interior node and no boundary node, each coordinate by at most
+    the amplitude times the node spacing, the same way for the same seed, keeping the lattice and
+    the tetrahedra; an amplitude of 0.5 is refused with a MeshError."""
     m = cube(5, 0.02, "five")
     p = perturbed(m, 0.2, 3)
     moved = np.linalg.norm(p.points - m.points, axis=1) > 0
@@ -61,11 +70,16 @@ def test_perturbed_keeps_the_boundary_and_moves_the_interior_within_bounds():
 
 
 def test_families_add_each_lattice_perturbed():
+    """The patch-test families are the given lattices followed by the perturbed five, six and bcc
+    lattices (the unstructured mesh gets no perturbed family)."""
     assert patch.families(LATTICES) == list(LATTICES) + [
         "five-perturbed", "six-perturbed", "bcc-perturbed"]
 
 
 def test_fem_baselines_pass_the_patch_test_on_every_family(table):
+    """Every FEM baseline (FEM P1, fem-linear, fem-corotated, fem-neohookean) completes the patch
+    test on every family, regular and perturbed, with a strain error below the spec's exactness
+    bound."""
     rows, p = table
     for fam in patch.families(LATTICES):
         for m in FEM:

@@ -72,6 +72,8 @@ def test_corner_and_balanced_forces_on_one_tetrahedron_by_hand(reading):
 
 
 def test_lumped_mass_is_a_quarter_of_each_tetrahedron():
+    """The lumped mass gives each node of a single tetrahedron a quarter of its mass rho V, and the
+    nodal masses of a meshed cube sum to the cube's mass rho L^3."""
     one = build("msm", TetMesh(X, np.array([[0, 1, 2, 3]])), MAT)
     volume = 0.01**3 / 6
     assert np.allclose(one.mass, MAT.rho * volume / 4, rtol=1e-12)

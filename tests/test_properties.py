@@ -64,6 +64,9 @@ def test_the_conservative_presets_are_the_expected_ones(small_mesh):
        seed=st.integers(0, 2**32 - 1))
 def test_random_valid_meshes_give_finite_forces_that_conserve_momentum(mesh, nu, E, preset,
                                                                         strain, seed):
+    """For every conservative particle preset on any random valid mesh (perturbed, renumbered,
+    tetrahedra and vertices reordered) at a random small deformation, the forces are finite and
+    non-zero, their sum and net torque vanish to round-off, and the forces at rest vanish."""
     try:
         pm = build(preset, mesh, Material(E=E, nu=nu))
     except ModelError as exc:   # e.g. one cell: the normal term adds nothing to fit
@@ -94,6 +97,10 @@ CORRUPTIONS = ("nan", "inf", "degenerate", "repeated-node", "duplicate-node", "u
        seed=st.integers(0, 2**32 - 1))
 def test_random_invalid_meshes_raise_mesh_error_and_nothing_else(n, scheme, size, corruption,
                                                                  seed):
+    """Each corruption of a valid box mesh (a NaN or infinite coordinate, a degenerate, repeated-
+    node or duplicate tetrahedron, a duplicated or unused node, an out-of-range, negative or
+    fractional index, 2-D points, no tetrahedra) makes TetMesh raise MeshError and no other
+    exception."""
     rng = np.random.default_rng(seed)
     base = box(n, n, n, size, size, size, scheme=scheme)
     pts, tets = base.points.copy(), base.tets.copy()

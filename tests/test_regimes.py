@@ -20,6 +20,9 @@ E, NU = 10e3, 0.45
 
 
 def test_the_scale_brings_the_largest_principal_strain_to_the_regime():
+    """The linear-regime scale brings the largest principal strain of a stress field to
+    LINEAR_STRAIN, leaves a field already below it unscaled (scale 1.0), and refuses a field with
+    no strain with a ModelError."""
     # a uniaxial stress sigma: strains sigma / E axially and -nu sigma / E laterally
     sigma = np.zeros((2, 3, 3))
     sigma[0, 1, 1] = 1e-3 * E           # strain 1e-3: the largest
@@ -42,6 +45,9 @@ def sliding():
 
 
 def test_the_sliding_cube_references_are_the_closed_forms(sliding):
+    """For the sliding paper cube the linear-regime scale is LINEAR_STRAIN over the axial push
+    strain, and the neo-Hookean reference displacement is the homogeneous uniaxial closed form to
+    1e-9 of the push."""
     s, mesh, ref = sliding
     strain = PUSH_MM / SIZE_MM
     # homogeneous: the largest strain is the axial one
@@ -64,6 +70,9 @@ def runs(sliding, model):
 
 
 def test_fem_neohookean_is_exact_at_the_load_and_linear_in_the_regime(sliding):
+    """On the sliding cube fem-neohookean matches the neo-Hookean reference at the case's load to a
+    relative L2 error below 1e-7, and linear P2 in the linear regime to within three times the
+    regime's strain."""
     r = runs(sliding, "fem-neohookean")
     # the same law on a field P1 represents exactly
     assert r["disp_rel_l2_nh"] < 1e-7
@@ -73,6 +82,10 @@ def test_fem_neohookean_is_exact_at_the_load_and_linear_in_the_regime(sliding):
 
 
 def test_fem_linear_at_the_load_is_off_by_its_linearisation_error(sliding):
+    """On the sliding cube fem-linear matches linear P2 in the linear regime to 1e-8, and at the
+    case's load its relative L2 error against the neo-Hookean field equals the hand-worked
+    distance of the linear from the neo-Hookean homogeneous field over the free components (above
+    0.005)."""
     s, mesh, _ = sliding
     r = runs(sliding, "fem-linear")
     assert r["disp_rel_l2_p2"] < 1e-8              # the patch test, exact

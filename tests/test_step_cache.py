@@ -44,6 +44,9 @@ def _push(model, mat, step):
 
 @pytest.mark.parametrize("model", ["pbcm-variational"])   # two kernels
 def test_the_generated_step_is_the_first_class_step_to_the_bit(steps, mat, model):
+    """For pbcm-variational (two kernels) 300 RK4 steps of the generated, disk-cached step module
+    end with the same successful status and bit-identical positions and velocities as the first-
+    class step, and exactly one step module is written."""
     status_g, x_g, v_g = _push(model, mat, lambda k: step_cache.step_for(k, rk4_ramp))
     status_f, x_f, v_f = _push(model, mat, lambda k: (rk4_ramp, k))
     assert status_g == status_f and status_g[0] == 0
@@ -52,6 +55,9 @@ def test_the_generated_step_is_the_first_class_step_to_the_bit(steps, mat, model
 
 
 def test_a_new_process_loads_the_step_without_compiling(steps):
+    """A second process asking for the same composition's step loads the module the first process
+    compiled and wrote: the same pbcm_step_ module name, one cache hit and no miss, where the
+    first process had one miss and no hit."""
     code = ("import json; from model import build, Material, step_cache;"
             "from cases.library import paper_cube as pc;"
             "m = pc.make_mesh('five', 3); pm = build('msm', m, Material(1e4, 0.45, 1e3));"
@@ -70,6 +76,8 @@ def test_a_new_process_loads_the_step_without_compiling(steps):
 
 
 def test_a_changed_kernel_file_makes_a_new_module(steps, tmp_path, monkeypatch):
+    """The generated step module changes when a kernel's source file changes, and is the first one
+    again once the file's content is restored."""
     from model.terms import springs
     names = ((springs.__name__, "x", str(tmp_path / "k.py")),)
     (tmp_path / "k.py").write_text("a = 1\n")
@@ -87,6 +95,9 @@ def test_a_changed_kernel_file_makes_a_new_module(steps, tmp_path, monkeypatch):
 
 
 def test_a_kernel_no_module_names_keeps_the_first_class_step(steps):
+    """A kernel that no importable module names (a function jitted inside a function, a builtin)
+    keeps the first-class step with its kernels unchanged, and nothing is written to the step
+    folder."""
     def made_here(x, out):
         return -1
     local = njit(made_here)

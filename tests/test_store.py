@@ -39,6 +39,9 @@ def _refuse(*args, **kw):
 
 def test_a_second_run_computes_nothing_and_writes_the_same_files(cache, tmp_path,
                                                                  monkeypatch):
+    """A second run of a case on an unchanged checkout takes every result from the store and
+    computes nothing, and its metrics.json, report.md and errors.png are byte-identical to those
+    of the first run and of a fresh run with the store off."""
     assert main(["run", CASE, *SMALL, "--out", str(tmp_path / "first")]) == 0
     assert any(cache.iterdir())
     with monkeypatch.context() as m:
@@ -56,6 +59,9 @@ def test_a_second_run_computes_nothing_and_writes_the_same_files(cache, tmp_path
 
 
 def test_no_cache_neither_reads_nor_fills_the_store(cache, tmp_path, monkeypatch):
+    """A run with --no-cache leaves the store empty, and a store that is switched off serves none of
+    the entries another run kept, so the run computes afresh. A first run into an enabled store
+    keeps three entries (the run, its reference fields, its references) and finds none."""
     assert main(["run", CASE, *SMALL, "--out", str(tmp_path / "a"), "--no-cache"]) == 0
     assert not cache.exists() or not any(cache.iterdir())
     s = CASES[CASE].settings(quick=True, meshes=("five",), bcs=("clamped",),
@@ -72,6 +78,9 @@ def test_no_cache_neither_reads_nor_fills_the_store(cache, tmp_path, monkeypatch
 
 def test_a_static_only_run_reuses_the_full_runs_and_computes_only_the_new_model(
         cache, monkeypatch):
+    """A static-only run with reuse_full takes the stored full run's row and references unchanged
+    and computes only the model not yet stored, whose row equals that of a fresh static-only run;
+    without reuse_full a static-only run does not take the full run's row and computes it again."""
     case = CASES[CASE]
     full = case.settings(quick=True, meshes=("five",), bcs=("clamped",),
                          models=("pbcm-variational",))
@@ -108,7 +117,9 @@ def _tree(tmp_path):
 
 @pytest.mark.parametrize("edited", ["model/terms/shear.py", "reference/linear.py",
                                     "cases/running/runner.py", "cases/cli/sweeps/nu.toml"])
-def test_a_change_to_any_source_file_misses_every_entry(tmp_path, edited):
+def test_a_change_to_any_source_file_changes_the_source_hash(tmp_path, edited):
+    """Appending a line to any source file of the packages (a term, a reference solver, the runner,
+    a sweep file) changes the source hash, and restoring the file's bytes restores the hash."""
     root = _tree(tmp_path)
     before = S.source_hash(root)
     path = root / edited
@@ -158,6 +169,8 @@ def test_an_entry_point_packages_source_is_in_the_key(tmp_path, monkeypatch):
 
 
 def test_keys_depend_on_what_determines_a_result():
+    """A store key is the same for the same inputs and differs when any one of the mesh, boundary
+    condition, model, Young's modulus or entry kind changes."""
     base = dict(kind="run", case="cantilever", mesh="five", bc="clamped", model="msm",
                 E_Pa=10e3)
     k = S.key(**base)
@@ -183,6 +196,9 @@ KILLED = textwrap.dedent("""
 
 
 def test_a_run_killed_while_writing_leaves_no_entry(cache):
+    """A process killed after writing an entry's value file but before committing the entry leaves
+    no entry that a later store returns; that store stays enabled and the same key can then be
+    written and read back."""
     folder = cache
     env = {k: v for k, v in os.environ.items() if k != S.ENV_OFF}
     env["PYTHONPATH"] = str(ROOT)
@@ -203,6 +219,8 @@ def test_a_run_killed_while_writing_leaves_no_entry(cache):
 
 
 def test_the_store_folder_follows_the_environment(monkeypatch, tmp_path):
+    """The store folder is $PBCM_CACHE when that is set and a per-user folder for pbcm otherwise,
+    and a store opened with $PBCM_NO_CACHE set is disabled."""
     monkeypatch.setenv(S.ENV, str(tmp_path / "here"))
     assert S.default_folder() == tmp_path / "here"
     monkeypatch.delenv(S.ENV)

@@ -13,6 +13,9 @@ CASE = CASES["torsion"]
 
 
 def test_the_linearised_rotation_is_the_small_angle_limit_of_the_exact_one():
+    """At a tiny angle the exact end-face rotation equals its linearisation to 1e-5 relative; at 10
+    degrees the exact rotation moves each point radially by cos(theta) - 1 of its radius, and the
+    linearised one has no radial part."""
     p = np.array([[0.0, 0.003, 0.011], [0.0, 0.016, 0.0]])
     c = (0.008, 0.008)
     small = 1e-6
@@ -27,6 +30,9 @@ def test_the_linearised_rotation_is_the_small_angle_limit_of_the_exact_one():
 
 
 def test_converged_linear_torque_is_at_or_above_saint_venant():
+    """The converged linear torque of the clamped bar under the linearised end rotation lies between
+    Saint-Venant's beta G a^4 theta / L and 2 % above it, and the torque of the exact rotation
+    read as a small strain is lower by the factor sin(theta) / theta to 1e-3."""
     s = CASE.settings(spacing_mm=8.0)
     mesh = CASE.mesh("five", s)
     bc = CASE.dirichlet_linear(mesh, "clamped", s)

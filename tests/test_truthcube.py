@@ -34,12 +34,17 @@ def _by_hand():
 
 
 def test_the_data_travels_with_its_attribution():
+    """The data folder's README credits Kerdok et al. in Medical Image Analysis and names the
+    OpenSurgSim source and its Apache licence."""
     readme = (T.DATA.parent / "README.md").read_text()
     assert "Kerdok" in readme and "Medical Image Analysis" in readme
     assert "opensurgsim" in readme.lower() and "Apache" in readme
 
 
 def test_loader_reads_343_beads_at_4_states_in_metres(tc):
+    """The loader reads 343 beads at the four nominal strains (0, 5, 12.5, 18.25 %), every
+    position equal to the csv file's millimetres converted to metres, the first bead (1, 1, 1) at
+    its known coordinates."""
     assert tc.index.shape == (343, 3) and tc.positions.shape == (4, 343, 3)
     assert tc.strains == (0.0, 0.05, 0.125, 0.1825)
     raw = _by_hand()
@@ -55,6 +60,9 @@ def test_loader_reads_343_beads_at_4_states_in_metres(tc):
 
 
 def test_layer_means_worked_from_the_file(tc):
+    """The mean z displacement at 18.25 % of layers k = 7 and k = 1, worked from the csv by hand
+    (15.02 and 1.47 mm), is the loader's, and layer 7 moves 4.34, 10.16 and 15.02 mm at the three
+    compressed states."""
     raw = _by_hand()
     # by hand: the k = 7 and k = 1 layers' mean z displacement at 18.25 %, from the csv
     k7 = np.mean([v[11] - v[2] for ijk, v in raw.items() if ijk[2] == 7])
@@ -69,6 +77,8 @@ def test_layer_means_worked_from_the_file(tc):
 
 
 def test_bad_files_and_states_are_refused(tmp_path, tc):
+    """A missing data file, a file cut short of 343 rows and a displacement asked for state 0
+    each raise ModelError saying which."""
     with pytest.raises(ModelError, match="not found"):
         T.load(tmp_path / "missing.csv")
     short = tmp_path / "short.csv"
@@ -80,6 +90,8 @@ def test_bad_files_and_states_are_refused(tmp_path, tc):
 
 
 def test_model_frame_puts_the_beads_inside_the_cube_and_the_moving_plate_at_z0(tc):
+    """In the model's frame every bead lies within 5 to 75 mm, layer k = 7 sits about 10 mm and
+    layer k = 1 about 70 mm above z = 0, and over 95 % of the beads move toward +z at 18.25 %."""
     X = tc.in_model_frame(tc.rest)
     assert X.min() > 0.005 and X.max() < 0.075
     # the k = 7 layer (next to the moving plate) about 10 mm above z = 0, k = 1 below 80 mm
@@ -98,6 +110,8 @@ def _rotate(points, theta, t, c):
 
 
 def test_rigid_inplane_motion_recovered_exactly():
+    """A known in-plane rotation (0.02 rad) and translation of random points are recovered
+    exactly, and removing them restores the rest x, y positions while keeping the axial shift."""
     rng = np.random.default_rng(3)
     rest = rng.uniform(-0.03, 0.03, (50, 3))
     c = rest[:, :2].mean(axis=0)
@@ -112,6 +126,8 @@ def test_rigid_inplane_motion_recovered_exactly():
 
 
 def test_a_symmetric_barrel_has_no_rigid_part():
+    """A barrel deformation symmetric about the axis has zero rigid in-plane translation and
+    rotation (below 1e-15)."""
     g = np.linspace(-0.03, 0.03, 7)
     rest = np.array(np.meshgrid(g, g, g, indexing="ij")).reshape(3, -1).T
     barrel = rest.copy()
@@ -121,6 +137,8 @@ def test_a_symmetric_barrel_has_no_rigid_part():
 
 
 def test_quantisation_step_found_on_a_grid_and_not_in_noise(tc):
+    """Values on a 0.625 mm grid give that step with full coherence, uniform random values give
+    no step, and the data's y coordinates at 18.25 % are quantised in 0.625 mm steps."""
     rng = np.random.default_rng(0)
     q, c = T.quantisation_step(0.625e-3 * rng.integers(-60, 60, 300) + 0.0002)
     assert q == pytest.approx(0.625e-3, rel=2e-3) and c == pytest.approx(1.0)
@@ -130,6 +148,8 @@ def test_quantisation_step_found_on_a_grid_and_not_in_noise(tc):
 
 
 def test_noise_of_a_smooth_field_plus_scatter_is_the_scatter():
+    """The measured noise of a smooth polynomial displacement field is zero, and with Gaussian
+    scatter added it is that scatter's standard deviation per component, within 15 %."""
     rng = np.random.default_rng(1)
     rest = rng.uniform(-0.03, 0.03, (343, 3))
     x, y, z = rest.T / 0.04
@@ -141,6 +161,10 @@ def test_noise_of_a_smooth_field_plus_scatter_is_the_scatter():
 
 
 def test_bead_errors_against_closed_forms(tc):
+    """The bead errors are zero for the measurement itself, 1 mm axial and 0 lateral for a 1 mm
+    shift along z, and 0.5 mm lateral for a (0.3, 0.4) mm shift; the excess over the floor is
+    sqrt(rms^2 - floor^2), within holds up to sqrt(2) floors, and a non-finite field raises
+    ModelError."""
     m = B.Measured(tc)
     u = m.u(3)
     scale = m.scale(3)
@@ -159,6 +183,9 @@ def test_bead_errors_against_closed_forms(tc):
 
 
 def test_floor_and_layer_profiles_from_the_data(tc):
+    """At 18.25 % the y noise lies between 0.2 and 0.4 mm, the axial floor is below the lateral
+    one and the total is their norm; the raw lateral bulge of the middle layer exceeds both end
+    layers', and layer 7 moves 15.0165 mm axially."""
     m = B.Measured(tc)
     f = m.floor(3)
     # the y quantisation alone (0.625 mm on rest and deformed) gives 0.255 mm
@@ -172,6 +199,8 @@ def test_floor_and_layer_profiles_from_the_data(tc):
 
 
 def test_located_points_interpolate_affine_fields_exactly(tc):
+    """The beads located in the 10 mm mesh get non-negative barycentric weights summing to 1 that
+    interpolate an affine field exactly (1e-15), and a point outside the mesh raises MeshError."""
     mesh = P.mesh(10.0)
     X = B.Measured(tc).beads
     loc = mesh.locate(X)
@@ -184,6 +213,9 @@ def test_located_points_interpolate_affine_fields_exactly(tc):
 
 
 def test_load_fractions_and_schedule():
+    """load_fractions gives k / n or the given increasing fractions ending at 1 and refuses
+    anything else; the schedule reaches the 4, 10 and 14.6 mm travels exactly at steps 4, 10 and
+    15, no step above the mesh's step strain."""
     assert load_fractions(4).tolist() == [0.25, 0.5, 0.75, 1.0]
     assert load_fractions([0.3, 1.0]).tolist() == [0.3, 1.0]
     for bad in (0, [0.5, 0.4, 1.0], [0.5, 0.9], [], [0.0, 1.0], "x"):
@@ -224,6 +256,9 @@ def test_frictionless_continuum_is_the_uniaxial_closed_form():
 
 
 def test_bonded_plates_hold_both_faces_and_frictionless_only_pins_rigid_motion():
+    """Bonded plates prescribe all three components of the 50 plate nodes; frictionless plates
+    prescribe only u_z there except two fixed-plate nodes that pin the rigid in-plane motion, and
+    an unknown plate condition raises ModelError."""
     m = cube(5, T.SIDE, "five")
     bonded = P.dirichlet(m, "bonded", 1e-3)
     assert len(bonded) == 50 and all(None not in v for v in bonded.values())
@@ -235,6 +270,8 @@ def test_bonded_plates_hold_both_faces_and_frictionless_only_pins_rigid_motion()
 
 
 def test_static_solve_stops_at_the_given_fractions(mat):
+    """A static solve with load fractions 0.25 and 1.0 calls on_step once per fraction and ends
+    at the one-step solution, to 1e-9 of the largest displacement."""
     m = cube(3, 0.032, "six")
     pm = build("fem-linear", m, mat)
     bc = P.dirichlet(cube(3, T.SIDE, "six"), "bonded", 1e-3)
@@ -264,6 +301,8 @@ def test_bead_field_does_not_depend_on_E(tc, model):
 
 
 def test_settings_refuse_a_compressible_silicone(tmp_path):
+    """The study's settings refuse nu = 0.3 with a ModelError, and `pbcm run truth-cube --nu 0.3`
+    exits 2 without creating its output folder."""
     from cases.studies.truthcube.study import TruthCubeSettings
     with pytest.raises(ModelError, match="nearly incompressible"):
         TruthCubeSettings(nu=0.3)
@@ -274,6 +313,10 @@ def test_settings_refuse_a_compressible_silicone(tmp_path):
 
 
 def test_the_quick_study_holds_its_gold_and_its_controls(quick_truthcube, capsys):
+    """The quick study passes `pbcm check` and holds one row per model and state on the 10 mm
+    bonded mesh, each a finite RMS or a stated failure. The neo-Hookean continuum's axial layer
+    profile rises toward the moving plate, and linear elasticity's gap to it grows with strain
+    from below the floor at 5 %."""
     from cases.cli import main
     status = main(["check", "--metrics", str(quick_truthcube.parent), "--gold",
                    str(ROOT / "gold"), "--allow-new"])

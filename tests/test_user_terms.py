@@ -34,6 +34,9 @@ def example():
 
 
 def test_example_term_is_a_conservative_momentum_conserving_term(example, small_mesh, mat):
+    """The example user term's forces equal its NumPy forces and minus the central finite-difference
+    gradient of its energy, and sum to zero over the nodes; being a small-strain term, it exerts
+    forces under a finite rotation of the rest shape."""
     t = example(small_mesh, mat, c=0.4)
     x = perturbed(small_mesh, 0.05, seed=4)
     f = t.forces(x)
@@ -53,6 +56,9 @@ def test_example_term_is_a_conservative_momentum_conserving_term(example, small_
 
 
 def test_example_composes_and_calibrates(example, small_mesh, mat):
+    """A model composed of variational shear, the example normal_axis term and volume builds under
+    its own label with positive automatic constants for shear and normal_axis, and normal_axis's
+    calibrated constant equals normal_sbd's in the same composition to 1e-6."""
     pm = build(COMPOSED, small_mesh, mat)
     assert pm.name == COMPOSED and pm.info["normal_axis_c"] > 0 and pm.info["shear_c"] > 0
     # linearised, it is the material-axis normal strain: the same quadratic form as normal_sbd
@@ -105,6 +111,10 @@ def test_entry_point_group_registers_an_installed_package(tmp_path):
 
 
 def test_composition_grammar():
+    """The composition grammar expands presets into their terms, normalises spacing in labels and
+    reads numeric parameters; it refuses with a ModelError an unknown parameter or model,
+    unbalanced brackets, a repeated term, a parameter with no value, an empty model and an
+    unreadable value."""
     assert parse("pbcm-variational + normal_tet(c=0.1)") == [
         ("shear", {"reading": "variational", "c": "auto"}), ("volume", {}),
         ("normal_tet", {"c": 0.1})]
@@ -126,6 +136,9 @@ def test_composition_grammar():
     (["--models", "normal_axis(c=auto) + volume"], "unknown model 'normal_axis'"),
 ])
 def test_bad_models_and_term_files_fail_before_computing(args, said, tmp_path, capsys):
+    """A run whose model has an unknown parameter, whose term file does not exist, or which names a
+    user term that no loaded file registers exits 2 with a message saying so and creates no
+    output folder."""
     env = os.environ.pop("PBCM_TERMS", None)
     saved = dict(model.terms.TERMS)
     model.terms.TERMS.pop("normal_axis", None)
@@ -140,6 +153,8 @@ def test_bad_models_and_term_files_fail_before_computing(args, said, tmp_path, c
 
 
 def test_term_file_that_registers_nothing_or_fails(tmp_path):
+    """Loading a term file that registers no term, or one that raises while it is imported, fails
+    with a ModelError saying so, naming the raised error in the second case."""
     (tmp_path / "empty.py").write_text("x = 1\n")
     (tmp_path / "broken.py").write_text("raise RuntimeError('boom')\n")
     for f, said in [("empty.py", "registers no term"), ("broken.py", "RuntimeError: boom")]:
@@ -148,6 +163,8 @@ def test_term_file_that_registers_nothing_or_fails(tmp_path):
 
 
 def test_pbcm_list_names_the_terms_with_their_parameters(capsys):
+    """`pbcm list --term FILE` exits 0 and lists the built-in terms and the file's term, each with
+    its parameters and their defaults, and the studies."""
     assert main(["list", "--term", str(EXAMPLE)]) == 0
     out = capsys.readouterr().out
     for line in ("normal_tet(c=auto):", "shear(reading=variational, c=auto):", "volume():",

@@ -25,6 +25,8 @@ def one_process(tmp_path_factory):
 
 
 def test_workers_write_the_metrics_of_one_process(tmp_path, one_process):
+    """Running the units on two worker processes writes a metrics.json byte-identical to the
+    one-process run, with the meshes in their declared order (five before six)."""
     assert main(["run", *UNITS, "--workers", "2",
                  "--out", str(tmp_path / "2")]) == 0
     one, two = ((p / "metrics.json").read_bytes() for p in (one_process, tmp_path / "2"))
@@ -44,6 +46,8 @@ def test_a_dask_cluster_writes_the_metrics_of_one_process(tmp_path, one_process)
 
 
 def test_scheduler_and_workers_together_are_refused_before_computing(capsys, tmp_path):
+    """`pbcm run` given both --scheduler and --workers exits 2, tells the user to drop
+    --workers, and creates no output folder."""
     assert main(["run", "cantilever", "--scheduler", "tcp://127.0.0.1:1", "--workers", "2",
                  "--out", str(tmp_path / "c")]) == 2
     assert "drop --workers" in capsys.readouterr().err
@@ -51,6 +55,8 @@ def test_scheduler_and_workers_together_are_refused_before_computing(capsys, tmp
 
 
 def test_an_unreachable_scheduler_is_one_line(capsys, tmp_path, monkeypatch):
+    """A --scheduler address where no Dask scheduler answers makes `pbcm run` exit 2 with a
+    single stderr line saying so."""
     from cases.running import workers
     monkeypatch.setattr(workers, "CONNECT_TIMEOUT_S", 1)     # nothing answers port 9
     assert main(["run", "cantilever", "--quick", "--scheduler", "tcp://127.0.0.1:9",
@@ -73,6 +79,8 @@ def die_always(item):
 
 
 def test_a_killed_local_workers_unit_runs_again(tmp_path):
+    """A unit whose local worker process is killed the first time it runs is given out again,
+    so every unit's result comes back."""
     items = [(None, 1), (str(tmp_path / "killed"), 2), (None, 3)]
     with Workers(2) as pool:
         got = sorted(pool.unordered(die_once, items))
@@ -80,6 +88,8 @@ def test_a_killed_local_workers_unit_runs_again(tmp_path):
 
 
 def test_a_unit_that_kills_every_worker_is_lost_after_the_retries():
+    """A unit that kills its worker every time it runs comes back as a WorkerLost error with
+    no result, saying it died RETRIES + 1 times."""
     with Workers(1) as pool:
         outcomes = list(pool.outcomes(die_always, [0]))
     [(i, error, result)] = outcomes
@@ -88,6 +98,8 @@ def test_a_unit_that_kills_every_worker_is_lost_after_the_retries():
 
 
 def test_the_cluster_executor_is_the_same_interface():
+    """The Dask Cluster executor (here a one-process LocalCluster) returns every unit's
+    result through the same unordered interface as Workers and has a dashboard link."""
     with Cluster(None, 1) as cluster:
         assert sorted(cluster.unordered(die_once, [(None, 4), (None, 5)])) == [40, 50]
         assert cluster.dashboard
@@ -95,11 +107,15 @@ def test_the_cluster_executor_is_the_same_interface():
 
 @pytest.mark.parametrize("n", [0, -1, 1.5, "2"])
 def test_workers_refuse_a_count_that_is_not_a_positive_integer(n):
+    """Workers refuses a count of 0, -1, 1.5 or the string '2' with a ValueError asking for
+    an integer >= 1."""
     with pytest.raises(ValueError, match="integer >= 1"):
         Workers(n)
 
 
 def test_workers_flag_is_checked_before_computing(capsys, tmp_path):
+    """`pbcm run --workers 0` exits 2, names --workers in its error, and creates no output
+    folder."""
     assert main(["run", "cantilever", "--workers", "0", "--out", str(tmp_path / "c")]) == 2
     assert "--workers" in capsys.readouterr().err
     assert not (tmp_path / "c").exists()

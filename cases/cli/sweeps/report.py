@@ -68,8 +68,14 @@ def _where(r, axes):
     return ", ".join(f"{a} {fmt(r[a])}" if a in NUMERIC_AXES else str(r[a]) for a in axes)
 
 
-def _mean(xs):
-    return float(np.mean(xs)) if xs else None
+def _stat(xs):
+    """(median, smallest, largest) of ``xs``, or None: one population's spread, never
+    averaged away."""
+    return (float(np.median(xs)), float(min(xs)), float(max(xs))) if xs else None
+
+
+def _spread(st):
+    return "n/a" if st is None else f"{fmt(st[0])} [{fmt(st[1])}-{fmt(st[2])}]"
 
 
 POPULATION = ("case", "bc")   # runs of one kind: one case under one boundary condition
@@ -123,21 +129,39 @@ def findings(metric, rows, spec, models):
     and sentences per population (case and boundary condition), none pooled."""
     pops = populations(rows, spec)
     if len(pops) == 1:
-        return _findings(metric, rows, spec, models, "")
+        said, header, body = _findings(metric, rows, spec, models, "")
+        return _patch_test(metric, rows) + said, header, body
     out, header, body = [], None, []
     t = target(metric, rows)
     if t is not None:
-        out.append(f"{metric}: {kind(metric, t)}; each model's mean |deviation| from {t[0]} "
-                   "per case and boundary condition is in the table, never pooled across "
-                   "them; in each, a change below the reference's largest error estimate "
-                   "there (a total error) or the solver's round-off (a model-form error) is "
-                   "not a trend, and the sweep ranks no model.")
+        out.append(f"{metric}: {kind(metric, t)}; each model's |deviation| from {t[0]} per "
+                   f"case and boundary condition, {SPREAD}, is in the table, never pooled "
+                   "across them; in each, a change below the reference's largest error "
+                   "estimate there (a total error) or the solver's round-off (a model-form "
+                   f"error), or within {OVERLAP}, is not a trend, and the sweep ranks no "
+                   "model.")
     for label, group in pops:
         said, h, b = _findings(metric, group, spec, models, label, lead=False)
-        out += said
+        out += _patch_test(f"{metric} on {label}", group) + said
         header = ["population"] + h
         body += [[label] + line for line in b]
     return out, header, body
+
+
+def _patch_test(pre, rows):
+    """A sentence where every run of a population is its case's patch test (a field every
+    FEM element reproduces): FEM's rows there check, they do not measure accuracy."""
+    from ...registry import CASES
+    if not rows or not all(r.get("bc") in getattr(CASES.get(r["case"]), "patch_tests", ())
+                           for r in rows):
+        return []
+    return [f"{pre}: a patch test (a homogeneous field that FEM reproduces on any mesh): the "
+            "FEM models' rows there are a check, not accuracy; a particle model's row is its "
+            "consistency."]
+
+
+SPREAD = "median [smallest-largest] over its runs there (meshes and other axes), n of N runs"
+OVERLAP = "the spread over the meshes at both ends (the two ranges overlap)"
 
 
 def _findings(metric, rows, spec, models, label, lead=True):
@@ -160,43 +184,50 @@ def _findings(metric, rows, spec, models, label, lead=True):
     dev = deviations(metric, rows)
     numeric = [a for a in spec.swept() if a in NUMERIC_AXES]
     ends = {a: _ends(a, rows, spec) for a in numeric}
-    header = ["model", "runs", f"mean abs dev from {t[0]}", "worst", "at"]
+    header = ["model", "n of N", f"abs dev from {t[0]}: median [min-max]", "worst", "at"]
     for a in numeric:
-        header += [f"mean abs dev at {a} = {fmt(ends[a][0])}",
-                   f"mean abs dev at {a} = {fmt(ends[a][1])}"]
+        header += [f"at {a} = {fmt(ends[a][0])}", f"at {a} = {fmt(ends[a][1])}"]
     body, trend = [], {a: ([], []) for a in numeric}
+    floor = noise(metric, t, rows)
     for m in models:
         d = dev.get(m)
         if not d:
             continue
+        planned = sum(r["model"] == m for r in rows)
         worst = max(d, key=lambda p: p[0])
-        line = [m, len(d), fmt(_mean([x for x, _ in d])), fmt(worst[0]), _where(worst[1], axes)]
+        line = [m, f"{len(d)} of {planned}", _spread(_stat([x for x, _ in d])),
+                fmt(worst[0]), _where(worst[1], axes)]
         for a in numeric:
-            at = [_mean([x for x, r in d if r[a] == v]) for v in ends[a]]
-            line += [fmt(at[0]), fmt(at[1])]
-            if None not in at:
-                said = f"{m} {fmt(at[0])} -> {fmt(at[1])}"
-                if max(at) < noise(metric, t, rows) or abs(at[1] - at[0]) < noise(metric, t, rows):
-                    continue
-                if at[1] > CHANGE * at[0]:
-                    trend[a][0].append(said)
-                elif at[1] * CHANGE < at[0]:
-                    trend[a][1].append(said)
+            at = [_stat([x for x, r in d if r[a] == v]) for v in ends[a]]
+            line += [_spread(at[0]), _spread(at[1])]
+            if None in at:
+                continue
+            (m0, lo0, hi0), (m1, lo1, hi1) = at
+            if (max(m0, m1) < floor or abs(m1 - m0) < floor
+                    or (lo1 <= hi0 and lo0 <= hi1)):
+                continue               # below the floor, or within the spread: no trend
+            said = f"{m} {_spread(at[0])} -> {_spread(at[1])}"
+            if m1 > CHANGE * m0:
+                trend[a][0].append(said)
+            elif m1 * CHANGE < m0:
+                trend[a][1].append(said)
         body.append(line)
     out = []
     if lead and dev:
-        out.append(f"{pre}: {kind(metric, t)}; each model's mean |deviation| from {t[0]} is "
-                   f"in the table; {_floor_text(metric, t, rows)}, and the sweep ranks no "
-                   "model.")
+        out.append(f"{pre}: {kind(metric, t)}; each model's |deviation| from {t[0]}, "
+                   f"{SPREAD}, is in the table; {_floor_text(metric, t, rows)}, nor is a "
+                   f"change within {OVERLAP}, and the sweep ranks no model.")
     for a in numeric:
         grows, shrinks = trend[a]
         first, last = map(fmt, ends[a])
         if grows:
-            out.append(f"{pre}: the mean |deviation| grows by more than {CHANGE:g}x from "
-                       f"{a} = {first} to {a} = {last}: " + ", ".join(grows) + ".")
+            out.append(f"{pre}: the median |deviation| grows by more than {CHANGE:g}x from "
+                       f"{a} = {first} to {a} = {last}, beyond the spread over the meshes: "
+                       + ", ".join(grows) + ".")
         if shrinks:
             out.append(f"{pre}: it shrinks by more than {CHANGE:g}x from {a} = {first} to "
-                       f"{a} = {last}: " + ", ".join(shrinks) + ".")
+                       f"{a} = {last}, beyond the spread over the meshes: "
+                       + ", ".join(shrinks) + ".")
     if t[0] == "FEM P2":
         fem = ref_name(metric)
         out += [f"{pre}: {m} {text}" for m in models
