@@ -168,8 +168,8 @@ def table(root, models, pops=(), quick=False):
     spread = {f: scorecard.spread(pops, models, f) for f in (False, True)}
     header = ["model", "model-form error, linear regime", "model-form error, finite load",
               "consistency limit (largest, +- fit)", "worst isotropy error",
-              "alternation on the mirrored five split, 5-layer view (signed, the larger over "
-              "the bases; decides nothing)", "RK4 run",
+              "alternation on the mirrored five split, 5-layer view, linear regime (signed, the "
+              "larger over the bases; decides nothing)", "RK4 run",
               "s per simulated s", "Truth Cube bead RMS [mm]"]
     rows = []
     for m in models:

@@ -644,6 +644,7 @@ def units(cells, models=None):
                     "fem_clear": fem_clear,
                     "fem_controls": fem_all, "floor": floor, "identity": identity,
                     "fem_ratio": None if fem_five is None else abs(fem_five) / floor,
+                    "ref_scale_mm": None if ref is None else float(np.abs(ref).mean()),
                     "rows": rows,
                     "distinct": len(distinct), "run": len(rows)})
     return out
@@ -670,10 +671,11 @@ def two_point_order(coarse, u_coarse, fine, u_fine):
 
 
 def orders(us):
-    """Per base: each distinct model's order in h of its own part from the smallest to the
-    next size (h halved) where both configurations read and the part is resolved at both with
-    one sign: log2 of the ratio, with its uncertainty (``two_point_order``); with how many of
-    the models at both sizes it covers."""
+    """Per base: each distinct model's order in h of its own part [mm] (the relative part times
+    its reference's mean, which moves with the size on the clamped base) from the smallest to
+    the next size (h halved) where both configurations read and the part is resolved at both
+    with one sign: log2 of the ratio, with its uncertainty (``two_point_order``); with how
+    many of the models at both sizes it covers."""
     by = {(u["n"], u["bc"]): u for u in us}
     out = {}
     for (n, bc), u in by.items():
@@ -693,8 +695,9 @@ def orders(us):
             f = fr[r["model"]]
             if r.get("part_vs_u") == "above" and f.get("part_vs_u") == "above" \
                     and np.sign(r["part"]) == np.sign(f["part"]):
-                got[r["name"]], u_[r["name"]] = two_point_order(r["part"], r["u"], f["part"],
-                                                                f["u"])
+                sc, sf = u["ref_scale_mm"], fine["ref_scale_mm"]
+                got[r["name"]], u_[r["name"]] = two_point_order(
+                    r["part"] * sc, r["u"] * sc, f["part"] * sf, f["u"] * sf)
         out[bc] = {"orders": got, "u": u_, "of": len(both), "sizes": (n, fine["n"]),
                    "why": None}
     return out
@@ -1488,25 +1491,66 @@ def _open_reasons(rows):
     return ", ".join(f"{k} {v}" for k, v in sorted(kinds.items(), key=lambda kv: -kv[1]))
 
 
-def verdict_lines(sign_rows, nodes, ns, cs, fem_units):
-    """The answer in one sentence per hypothesis, with the counts and ranges that decide it:
-    (a) at the side nodes (the largest size per base) and in the layer mean, by sign, with the
-    parts the runs leave open and why; (b) the normal-stress pairs; (c) consistency. The
-    evidence follows in the full text."""
-    out = []
+def size_line(layer_orders, below, largest, units_):
+    """The first sentence: how large the pattern the paper drew (the layer mean) is at the
+    finest size, and how its own part falls under refinement, per base; with FEM P1's own
+    signature on the mirrored split where it is resolved."""
+    falls = []
+    for bc, o in sorted(layer_orders.items()):
+        v = sorted(o["orders"].values())
+        if v:
+            falls.append(f"as h^{np.median(v):.2f} on the {bc} base (median; "
+                         f"{v[0]:.2f} to {v[-1]:.2f} over {len(v)} of {o['of']} models "
+                         f"resolved at {o['sizes'][0]} and {o['sizes'][1]} nodes)")
+    if below is None:
+        seen = "not decided (no configuration's leak is below the deciding level)"
+    else:
+        top = [(w, v) for w, v in (largest or {}).items() if v and w.startswith(f"{below['n']} ")]
+        seen = below["head"] + (" (largest: " + ", ".join(
+            f"{v[0]} {fmt(abs(v[1]), 2)} over its own mean on {w}" for w, v in top) + ")"
+            if top else "")
+    fem = [f"{fmt(abs(u['fem_mm']), 2)} mm on {_where((u['n'], u['bc']))}" for u in units_
+           if u["reads"] and u.get("fem_vs") == "above" and u.get("fem_mm") is not None]
+    return ("Size (the paper's Figure 1 draws the layer mean): " + seen
+            + (". The layer mean's own part (less FEM P1's) falls " + "; ".join(falls)
+               + " (two sizes: not an order): refinement removes the pattern from the layer "
+               "mean, while at the side nodes a period-2 pattern of about constant strain "
+               "stays on the mirrored split ((a))" if falls else "")
+            + (f". FEM P1's own layer signature on the mirrored split: {', '.join(fem)}"
+               if fem else "") + ".")
+
+
+def distinct_pairs(pairs):
+    """The normal-stress pairs with those of one configuration, one base model and the same
+    part with and without the term (to SAME) counted once: two terms that move the part alike
+    are one observation."""
+    kept = []
+    for p in pairs:
+        if not any((q["n"], q["bc"], q["base"]) == (p["n"], p["bc"], p["base"])
+                   and same(q["with"], p["with"], SAME) and same(q["without"], p["without"], SAME)
+                   for q in kept):
+            kept.append(p)
+    return kept
+
+
+def verdict_lines(sign_rows, nodes, ns, cs, fem_units, size=None):
+    """The answer in one sentence per hypothesis, with the counts and ranges that decide it,
+    after ``size`` (``size_line``): (a) at the side nodes (the largest size per base) and in
+    the layer mean, by sign, with the parts the runs leave open and why; (b) the
+    normal-stress pairs; (c) consistency. The evidence follows in the full text."""
+    out = [size] if size else []
     node_bits = []
-    strains = [(p - 1, q) for o in nodes["slopes"].values() for p, q in o["orders"].values()]
-    strain_span = max((abs(x) for x, _ in strains), default=0.0)
-    # beyond its u (the parts' u through the slope) a strain grows (exponent < 0) or falls
     sizes = next((o["sizes"] for o in nodes["slopes"].values()), (None, None))
-    grows = sum(x < -q for x, q in strains)
-    falls = sum(x > q for x, q in strains)
     for bc, o in sorted(nodes["slopes"].items()):
         fine = next((x for x in nodes["units"] if (x["n"], x["bc"]) == (o["sizes"][1], bc)),
                     None)
         v = sorted(p - 1 for p, _ in o["orders"].values())
         if fine is None or not v:
             continue
+        # beyond its u (the parts' u through the slope, which holds neither the fitted
+        # constants nor a spread over meshes) a strain grows (exponent < 0) or falls
+        grows = sum(p - 1 < -q for p, q in o["orders"].values())
+        falls = sum(p - 1 > q for p, q in o["orders"].values())
         res = [r for r in fine["rows"] if r["resolved"] == "above"]
         mir = [r for r in res if r.get("mirror_vs") == "above"]
         # the ratio's lower bound (a control below its u may be 0: the point value overstates)
@@ -1520,7 +1564,8 @@ def verdict_lines(sign_rows, nodes, ns, cs, fem_units):
                f"(median of the lower bounds; {times(ratios[0])}-{times(ratios[-1])})"
                if ratios else "")
             + f"; its strain goes as h^{np.median(v):.2f} from {o['sizes'][0]} to "
-            f"{o['sizes'][1]} nodes ({v[0]:.2f} to {v[-1]:.2f} over {len(v)} models)")
+            f"{o['sizes'][1]} nodes ({v[0]:.2f} to {v[-1]:.2f} over {len(v)} models; beyond "
+            f"its u growing for {grows}, falling for {falls})")
     layer = []
     for s_, word in (("+", "the paper's sign"), ("-", "the reversed sign")):
         rows = [r for _, r in sign_rows[s_]]
@@ -1535,10 +1580,8 @@ def verdict_lines(sign_rows, nodes, ns, cs, fem_units):
         out.append(
             "(a) Mirror symmetry: the mirrored five split carries a period-2 pattern of its "
             "own at the side nodes (less FEM P1's on the same tetrahedra) whose strain goes "
-            f"as h^e from {sizes[0]} to {sizes[1]} nodes with |e| at most "
-            f"{fmt(strain_span, 2)} ("
-            f"beyond its u growing for {grows}, falling for {falls} and neither for "
-            f"{len(strains) - grows - falls} model-base pairs; two sizes: not an order); "
+            f"as h^e from {sizes[0]} to {sizes[1]} nodes, per base below (two sizes: not an "
+            "order; the u of e holds neither the fitted constants nor a spread over meshes); "
             "whether the mirror alone causes it is "
             "decided model by model, against each model's own parts on the conforming splits "
             "it ran (six, and bcc where run: cells.md shows each hole): "
@@ -1549,21 +1592,26 @@ def verdict_lines(sign_rows, nodes, ns, cs, fem_units):
             + (f". FEM P1 itself has a resolved mirrored pattern on {', '.join(fem_units)}"
                if fem_units else "") + ".")
     if ns.get("pairs"):
-        ps = ns["pairs"]
-        flat = [p for p in ps if same(abs(p["with"]), abs(p["without"]), 0.02)]
+        ps = distinct_pairs(ns["pairs"])
         open_ = [p for p in ps if p["reduced"] == "at"]
-        decisive = [p for p in ps if p["reduced"] != "at" and p not in flat]
-        red = sum(p["reduced"] == "above" for p in decisive)
+        decided = [p for p in ps if p["reduced"] != "at"]
+        flat = [p for p in decided if same(abs(p["with"]), abs(p["without"]), 0.02)]
+        red = sum(p["reduced"] == "above" for p in decided)
+        per = {}
+        for p in decided:
+            per.setdefault(_where((p["n"], p["bc"])), []).append(p["reduced"] == "above")
         out.append(
-            f"(b) Normal stress: {red} of {len(decisive)} decisive pairs (a resolved part with "
-            f"and without the term, the split and the shear held) reduced {RATIO:g}-fold"
-            + (f", |with| / |without| {fmt(min(p['ratio'] for p in decisive), 2)}-"
-               f"{fmt(max(p['ratio'] for p in decisive), 2)}" if decisive else "")
+            f"(b) Normal stress: {red} of {len(decided)} decided pairs (a resolved part with "
+            f"and without the term, the split held; distinct pairs, each configuration one "
+            f"mesh pair: " + ", ".join(f"{w} {sum(v)} of {len(v)}" for w, v in per.items())
+            + f") reduced {RATIO:g}-fold"
+            + (f", |with| / |without| {fmt(min(p['ratio'] for p in decided), 2)}-"
+               f"{fmt(max(p['ratio'] for p in decided), 2)}" if decided else "")
+            + (f" (in {len(flat)} of them the term moves the part by under 2 %: a null, "
+               "the term changes the pattern by nothing)" if flat else "")
             + (f"; {len(open_)} not decided (the part with the term not resolved from 0: "
                + _names(sorted({f"{p['model']} ({_where((p['n'], p['bc']))})"
                                 for p in open_})) + ")" if open_ else "")
-            + (f"; {len(flat)} uninformative (the term fitted so small that the part moves by "
-               "under 2 %)" if flat else "")
             + (": the missing normal stress is not shown to be the cause." if red == 0 else
                "."))
     else:
@@ -1664,7 +1712,7 @@ def answer(cells, models=None, estimates=None):
               + ". Each configuration is one mesh pair (n = 1) that its models share; the "
               "classes are in the artefact report's tables")
     def b_sign(s_):
-        ps = [p for p in ns["pairs"] if p["sign"] == s_]
+        ps = [p for p in distinct_pairs(ns["pairs"]) if p["sign"] == s_]
         if not ps:
             return f"{word[s_]} ({s_}): not tested" + (
                 f" (beside {_names(ns['inactive_other_sign'])} every fitted term changes "
@@ -1769,7 +1817,8 @@ def answer(cells, models=None, estimates=None):
         top = max(rows, key=lambda r: abs(r["own"]), default=None)
         largest[_where((u["n"], u["bc"]))] = None if top is None else [top["name"],
                                                                       top["own"]]
-    verdicts = verdict_lines(sign_rows, nodes, ns, cs, fem_units)
+    verdicts = verdict_lines(sign_rows, nodes, ns, cs, fem_units,
+                             size_line(m["orders"], below, largest, dec))
     return {**base, "decided": bool(causes), "cause": lead, "text": text, "numbers": text,
             "verdicts": verdicts,
             "clear": any(r["clear"] == "above" for u in seen_at for r in u["rows"]
@@ -2241,11 +2290,13 @@ def reading_verdict(table, damping, spread=None, figure=None):
                    + (f" and for {_names(other)}" if (other := [
                        n for n, ok, _, _ in figure[b] if ok is True and n not in names]) else "")
                    for b in figure) + ".")
-    kernels = len({m.replace("-literal", "") for m in cost_miss})
+    literal = any(m.endswith("-literal") for m in cost_miss)
     plain = "; ".join(x for x in (
-        f"{_names(cost_miss)} miss the paper's cost (Figure 2"
-        + (f"; {kernels} kernels timed: a literal reading runs its calibrated reading's"
-           if kernels < len(cost_miss) else "") + ")" if cost_miss else "",
+        f"{_names(cost_miss)} miss the paper's cost (Figure 2's measure: the time of one "
+        f"step over msm's, at the paper's size, with this implementation's kernels"
+        + ("; a literal reading is timed as its calibrated one, the same kernel"
+           if literal else "") + "; per simulated second, at each model's own stable step, "
+        "the index's cost line gives other ratios)" if cost_miss else "",
         f"the cost is not decided for {_names(cost_open)}" if cost_open else "") if x)
     text = ((f"Plainly: {plain}. " if plain else "")
             + (f"Not decided: {why}. " if not decided else f"{why}. ")

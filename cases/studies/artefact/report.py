@@ -17,7 +17,7 @@ from ...library import paper_cube as P
 from .analysis import (CLEAR, COARSE, DECAYS, SHARP_DECAYS, DECIDING_LEAK, END_LAYERS, GROWS, LEAK_SHARE,
                        MIN_RESOLVED, NEAR, PAPER_BULGES_MM, PAPER_COST, PAPER_NECKS_MM, RATIO,
                        SAME, TRACKS, WIDTHS, _compress, answer, classes, failure, how_sure,
-                       paper_figure, paper_figure_text,
+                       distinct_pairs, paper_figure, paper_figure_text,
                        reading_table, reading_verdict, signature_own, times)
 from .study import (DECISIVE, FIXED_NORMAL_C, HELD_SUFFIX, LINEAR_SCALE, LITERAL_NORMAL,
                     READINGS, SPLITS, SPLITS_TRIED, YARDSTICK, _free_layers, lines_apart,
@@ -112,10 +112,15 @@ def _lateral(x, est):
 CLEAR_WORDS = {"above": "clear", "below": "below", "at": "not decided"}
 
 
-def _clear(r):
-    """The clear call of a row with each normalisation's where they differ."""
+def _clear(r, decides=True):
+    """The clear call of a row with each normalisation's where they differ; on a
+    configuration that does not decide (the paper's 5-layer view), the level it reaches
+    alone, deciding nothing."""
     if r.get("clear") is None:
         return "n/a"
+    if not decides:
+        return {"above": f"above {CLEAR:g}", "below": f"below {CLEAR:g}",
+                "at": f"near {CLEAR:g}"}[r["clear"]] + " (decides nothing here)"
     by = r.get("clear_by") or {}
     word = CLEAR_WORDS[r["clear"]]
     if r["clear"] == "at":
@@ -187,10 +192,10 @@ def _what_was_run(d, s, doc):
         "it in the split alone), msm, msm with the variational shear "
         f"at c = 1, and {YARDSTICK} (FEM P1: constant-strain FEM with the continuum's own "
         "neo-Hookean law on the same tetrahedra, the control). On the finest bcc (9009 nodes) "
-        "the models without a normal-stress term only, and not msm (the cost of its Newton "
-        "matrices; msm's solve on the sliding base there stagnates, 50 iterations of a load "
-        "step unconverged with the push in one and in two steps): those models' mirror is "
-        "read against the six split alone. Each cell also keeps each "
+        "the models without a normal-stress term only, not msm (the study's design, for the "
+        "cost of those solves; no msm run there is in this record, and cells.md shows the "
+        "hole): the other models' mirror is read against the six split alone. Each cell also "
+        "keeps each "
         "vertical line of side-face nodes' own signature (the layer profile's weights applied "
         "to that line; the lines' mean is the layer profile's): the node-level pattern the "
         "layer mean averages over a face. The "
@@ -314,11 +319,11 @@ def _metric_check(d, doc):
     if view.get("unit") is not None or view.get("of"):
         d.p(f"The paper's own view (mirrored five, {view['n']} layers, sliding base): "
             f"{len(view['shows'])} of {view['of']} distinct models ({view['run']} run) have "
-            "the paper's sign clear on both normalisations"
+            f"the paper's sign above {CLEAR:g} on both normalisations"
             + (f" ({', '.join(view['shows'])})" if view["shows"] else "")
-            + (f"; reversed and clear: {', '.join(view['reversed'])}"
+            + (f"; the reversed sign above it: {', '.join(view['reversed'])}"
                if view.get("reversed") else "")
-            + (f"; not decided: {', '.join(view['at'])}" if view["at"] else "")
+            + (f"; near it: {', '.join(view['at'])}" if view["at"] else "")
             + ". It decides nothing: on 5 layers the weights have one direction left to reduce "
             "the leak along, and smooth "
             f"fields leak up to {fmt(view['check'].get('worst'), 2)} of their height. "
@@ -396,7 +401,7 @@ def _mirror(d, doc):
             same_ = [x["name"] for x in u["rows"] if x["same_as"] == r["name"]]
             cps = r.get("control_parts") or {}
             rows.append([r["name"] + (f" (= {_compress(same_)})" if same_ else ""), _unit(u),
-                         _pm(r["five"], r.get("u_sig")), f"{fmt(r['own'], 3)}: {_clear(r)}",
+                         _pm(r["five"], r.get("u_sig")), f"{fmt(r['own'], 3)}: {_clear(r, u['decides'])}",
                          _lateral(r["lateral"], est.get(f"{u['bc']}/paper")),
                          _pm(r.get("part"), r.get("u")),
                          ("held: " if r.get("controls_held") else "") + (
@@ -490,11 +495,14 @@ def _normal(d, ns):
                      if len(ns["signs"]) == 1 else "") + "."
                   if ns["decided"] else "none qualifies, so (b) is not tested."))
     if ns["pairs"]:
+        counted = distinct_pairs(ns["pairs"])
         d.table(["configuration", "term", "reading", "its sign", "part without", "part with",
-                 "|with| / |without|", f"reduced {RATIO:g}-fold"],
+                 "|with| / |without|", f"reduced {RATIO:g}-fold", "counted"],
                 [[f"{p['n']} {p['bc']}", p["term"], p["base"], p["sign"], _sig(p["without"]),
                   _sig(p["with"]), fmt(p["ratio"], 3),
-                  {"above": "yes", "below": "no", "at": "not decided"}[p["reduced"]]]
+                  {"above": "yes", "below": "no", "at": "not decided"}[p["reduced"]],
+                  "yes" if any(p is q for q in counted) else
+                  "no: one observation with another term's pair above"]
                  for p in ns["pairs"]])
     why = {}
     for x in ns["untested"]:
