@@ -1270,3 +1270,15 @@ def test_the_size_line_gives_the_layer_mean_at_the_finest_size_and_its_fall_per_
     assert "(largest: a 0.004 over its own mean on 17 clamped)" in said
     assert "falls as h^2.50 on the clamped base (median; 2.00 to 3.00 over 3 of 4 models" in said
     assert "sliding" not in said.split("falls")[1]
+
+
+def test_a_model_that_barely_expands_on_a_control_split_is_named_against_the_mesh_pick():
+    """At the largest size, a model keeping 3 times less of the continuum's lateral motion on
+    a conforming control than on the mirrored split is named with both lateral errors; one
+    that keeps as much is not."""
+    cells = [cell("five-9", analysis.MIRRORED, "m", 0.0, n=9, scale=0.4),
+             cell("six-9", analysis.CONFORMING_CONTROLS[0], "m", 0.0, n=9, scale=0.01),
+             cell("five-9", analysis.MIRRORED, "k", 0.0, n=9, scale=0.4),
+             cell("six-9", analysis.CONFORMING_CONTROLS[0], "k", 0.0, n=9, scale=0.3)]
+    said = analysis.stiffer_on_controls(cells)
+    assert said == ["m (six -0.99 against -0.6 on the mirrored five, 9 sliding)"]

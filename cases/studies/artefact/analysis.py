@@ -1374,7 +1374,37 @@ def node_text(nodes):
                                   "decided)" if slopes else ""))
 
 
-def mesh_pick(resolved, mirrors, against_, fem_units, nodes):
+def stiffer_on_controls(cells):
+    """'msm (six -0.997 against -0.59 on the mirrored five, 17 sliding)': per model at the
+    largest size, where on a conforming control split the model keeps RATIO times less of the
+    continuum's lateral motion (1 + its lateral displacement error) than on the mirrored
+    split, of the same sign (it barely expands laterally there): a cost of the pick that the
+    pattern does not show."""
+    at = _index(cells)
+    top = max((c["nodes_per_side"] for c in cells), default=0)
+    out = []
+    for m in dict.fromkeys(c["model"] for c in cells if c["family"] != CONTROL
+                           and c["nodes_per_side"] == top):
+        worst = None
+        for bc in ("clamped", "sliding"):
+            five = at.get((m, MIRRORED, top, bc, "paper"))
+            e5 = None if five is None or five.get("failed") else lateral_error(five)
+            for x in CONFORMING_CONTROLS:
+                c = at.get((m, x, top, bc, "paper"))
+                e = None if c is None or c.get("failed") else lateral_error(c)
+                if e5 is None or e is None or e5 <= -1.0 or e <= -1.0:
+                    continue
+                kept = (1.0 + e) / (1.0 + e5)
+                if kept * RATIO < 1.0 and (worst is None or kept < worst[0]):
+                    worst = (kept, x, e, e5, bc)
+        if worst:
+            _, x, e, e5, bc = worst
+            out.append(f"{short(m)} ({x.split(' ')[0]} {fmt(e, 3)} against {fmt(e5, 2)} on the "
+                       f"mirrored five, {top} {bc})")
+    return out
+
+
+def mesh_pick(resolved, mirrors, against_, fem_units, nodes, stiffer=()):
     """What to mesh a lattice with, given the bulge/neck pattern: from the layer-level parts
     (``resolved`` their counts by sign in words, ``mirrors`` the mirror's, ``against_`` on
     every split), FEM P1's own
@@ -1405,7 +1435,10 @@ def mesh_pick(resolved, mirrors, against_, fem_units, nodes):
             f"the layer mean {resolved}"
             + (f"; FEM P1's own on {', '.join(fem_units)}" if fem_units else "")
             + " (one mesh per split and size: no spread over meshes; chosen on the pattern "
-            "alone: each mesh family's model-form error is in the scorecard)")
+            "alone: each mesh family's model-form error is in the scorecard)"
+            + (f"; not for a model that keeps {RATIO:g} times less of the continuum's lateral "
+               "motion there than on the mirrored split (its lateral displacement error, at "
+               "the largest size): " + ", ".join(stiffer) if stiffer else ""))
 
 
 def _period_text(dec):
@@ -1574,8 +1607,13 @@ def verdict_lines(sign_rows, nodes, ns, cs, fem_units, size=None):
         mir = sum(r.get("mirror_vs") == "above" for r in rows)
         every = sum(r.get("mirror_vs") == "below" for r in rows)
         open_ = [r for r in rows if r.get("mirror_vs") not in ("above", "below")]
-        layer.append(f"{word}: {mir} of {len(rows)} the mirror's, {every} on every split"
-                     + (f", {len(open_)} not decided: {_open_reasons(open_)}" if open_ else ""))
+        per = {}                   # each configuration one mesh pair: the unit
+        for w, r in sign_rows[s_]:
+            per.setdefault(w, []).append(r.get("mirror_vs") == "above")
+        layer.append(f"{word}: the mirror's on " + ", ".join(
+            f"{w} {sum(v)} of {len(v)}" for w, v in per.items())
+            + f" (in all {mir} of {len(rows)} parts), {every} on every split"
+            + (f", {len(open_)} not decided: {_open_reasons(open_)}" if open_ else ""))
     if node_bits or layer:
         out.append(
             "(a) Mirror symmetry: the mirrored five split carries a period-2 pattern of its "
@@ -1668,7 +1706,8 @@ def answer(cells, models=None, estimates=None):
                                f"with {w_} the mirror's" for s_, w_ in (
                                    ("+", "the paper's sign"), ("-", "the reversed sign"))
                                if sign_rows[s_]),
-                     sum(len(v) for v in mirrored.values()), against_, fem_units, nodes)
+                     sum(len(v) for v in mirrored.values()), against_, fem_units, nodes,
+                     stiffer_on_controls(cells))
     across = consistency_across(every)
     across_said = across_text(across)
     nodes_said, lead_nodes = node_text(nodes), node_lead(nodes)
