@@ -48,9 +48,15 @@ DEFAULT_E, DEFAULT_NU = 10e3, 0.45
 DEFAULT_RHO = next(f.default for f in fields(Material) if f.name == "rho")   # the model's
 
 
-def material_record(E, nu, rho):
-    """The material as a metrics document records it (SI, units in the keys)."""
-    return {"E_Pa": E, "nu": nu, "rho_kg_m3": rho}
+# each material field and its key in a metrics document (SI, the unit in the key)
+MATERIAL_KEYS = {"E": "E_Pa", "nu": "nu", "rho": "rho_kg_m3"}
+
+
+def material_record(E, nu, rho=None):
+    """The material as a metrics document records it (SI, units in the keys); without the
+    density where it is None (a static problem, where it plays no part)."""
+    got = {"E": E, "nu": nu, "rho": rho}
+    return {k: got[f] for f, k in MATERIAL_KEYS.items() if got[f] is not None}
 
 
 @dataclass
@@ -67,9 +73,10 @@ class MaterialSettings:
     def __post_init__(self):
         self.material = Material(E=self.E, nu=self.nu, rho=self.rho)
 
-    def material_record(self):
-        """The material as a metrics document records it."""
-        return material_record(self.E, self.nu, self.rho)
+    def material_record(self, static=False):
+        """The material as a metrics document records it (``static``: without the density,
+        which a static problem does not use)."""
+        return material_record(self.E, self.nu, None if static else self.rho)
 
 
 @dataclass
@@ -605,10 +612,9 @@ class Study(abc.ABC):
     def recorded_settings(self, parameters):
         """The settings fields a run recorded in its ``parameters``: each under its own name or,
         for the material, its record's (``material_record``)."""
-        names = {"E": "E_Pa", "rho": "rho_kg_m3"}
         out = {}
         for f in fields(self.settings_class):
-            key = f.name if f.name in parameters else names.get(f.name)
+            key = f.name if f.name in parameters else MATERIAL_KEYS.get(f.name)
             if f.init and f.name != "quick" and key in parameters:
                 v = parameters[key]
                 out[f.name] = tuple(v) if isinstance(v, list) else v

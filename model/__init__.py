@@ -11,10 +11,21 @@ True
 from .material import Material
 from .errors import (PbcmError, MeshError, MaterialError, ModelError, DegenerateTetError,
                      BlowUpError, ConvergenceError, CalibrationDroppedError)
-from .presets import PRESETS
-from .system import ParticleModel
 
 __version__ = "0.1.0"
+
+
+def __getattr__(name):
+    # the physics loads on first use, so that importing the material or the mesh (what the
+    # references take from the model) loads none of it
+    if name == "ParticleModel":
+        from .system import ParticleModel
+        return ParticleModel
+    if name == "PRESETS":
+        from .presets import PRESETS
+        return PRESETS
+    raise AttributeError(f"module 'model' has no attribute {name!r}")
+
 
 def build(model, mesh, material, threads=1, **term_params):
     """A :class:`ParticleModel` from a preset name, a composed spec such as
@@ -36,6 +47,7 @@ def build(model, mesh, material, threads=1, **term_params):
         raise ModelError(f"parameters given for term(s) {', '.join(sorted(unknown))} that "
                          f"model {name!r} does not have ({', '.join(t for t, _ in terms)})")
     terms = [(t, {**p, **term_params.get(t, {})}) for t, p in terms]
+    from .system import ParticleModel
     return ParticleModel(mesh, material, terms, name=name, threads=threads)
 
 

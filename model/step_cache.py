@@ -86,7 +86,7 @@ def source(names, step):
               "    term, bad = -1, -1"]
     for i in range(len(names)):
         lines += [f"    b = k{i}(x, *kernels[{i}], out)",
-                  f"    if b >= 0 and term < 0:", f"        term, bad = {i}, b"]
+                  "    if b >= 0 and term < 0:", f"        term, bad = {i}, b"]
     lines += ["    return term, bad", "", ""]
     return "\n".join(lines) + body.replace("@njit\n", "@njit(cache=True)\n", 1)
 

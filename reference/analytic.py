@@ -5,9 +5,11 @@ import numpy as np
 from model.material import as_material
 
 
-def uniaxial_sliding(points, strain, nu, axis=1):
-    """Homogeneous uniaxial strain ``strain`` along ``axis`` with free lateral faces and sliding
-    ends, origin fixed: u_axis = strain x_axis, u_other = -nu strain x_other."""
+def uniaxial_sliding(points, strain, material, axis=1):
+    """Homogeneous uniaxial strain ``strain`` along ``axis`` of ``material`` (a
+    model.material.Material; nu read) with free lateral faces and sliding ends, origin fixed:
+    u_axis = strain x_axis, u_other = -nu strain x_other."""
+    nu = as_material(material, "reference.analytic.uniaxial_sliding").nu
     u = -nu * strain * np.asarray(points, dtype=float)
     u[:, axis] = strain * points[:, axis]
     return u
@@ -31,7 +33,10 @@ def self_weight(points, material, g, height, axis=1):
     return u
 
 
-def self_weight_stress(points, rho, g, height, axis=1):
+def self_weight_stress(points, material, g, height, axis=1):
+    """The stress [Pa] of :func:`self_weight` at ``points``: sigma_aa = rho g (x_a - height),
+    rho the ``material``'s density."""
+    rho = as_material(material, "reference.analytic.self_weight_stress").rho
     s = np.zeros((len(points), 3, 3))
     s[:, axis, axis] = rho * g * (np.asarray(points)[:, axis] - height)
     return s

@@ -195,6 +195,20 @@ def test_reference_takes_the_mesh_from_model_never_its_physics():
     assert used <= allowed, used - allowed
 
 
+def test_importing_every_reference_loads_none_of_the_models_physics():
+    """At run time too: a fresh interpreter that imports every reference module has loaded no
+    model module beyond those the doc lists (the model package loads its physics lazily)."""
+    import subprocess
+    import sys
+    mods = sorted(p.stem for p in (ROOT / "reference").glob("*.py") if p.stem != "__init__")
+    code = ("import importlib, sys\n"
+            + "".join(f"importlib.import_module('reference.{m}')\n" for m in mods)
+            + "print(' '.join(m for m in sys.modules if m.startswith('model.')))")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                         cwd=ROOT, check=True).stdout.split()
+    assert set(out) <= _reference_may_take(), set(out) - _reference_may_take()
+
+
 def test_nothing_points_outside_the_repository():
     """A clone has no ../shared: neither the README nor the code nor docs send the reader
     there."""
@@ -271,6 +285,19 @@ def test_the_rooms_import_as_the_doc_says():
         bad = sorted((a, b) for a, bs in g.items() if a.startswith(src + ".") for b in bs
                      if any(b == x or b.startswith(x + ".") for x in bans))
         assert bad == [], (room, bad)
+
+
+def test_a_tool_imports_no_study_and_no_case():
+    """The doc's rule for the tools holds on the import graph: no tool imports a study, and of
+    the library of cases only its shared geometry."""
+    text = " ".join(DOC.read_text().split())
+    assert ("a tool imports no study and no case (of the library only its shared geometry, "
+            "`cases.library.common`)") in text
+    g = graph()
+    bad = sorted((a, b) for a, bs in g.items() if a.startswith("cases.tools.") for b in bs
+                 if b.startswith("cases.studies")
+                 or (b.startswith("cases.library") and b != "cases.library.common"))
+    assert bad == []
 
 
 def test_model_and_reference_never_import_each_others_physics():

@@ -490,8 +490,8 @@ def test_the_progress_bar_keeps_its_numbers_at_80_columns(monkeypatch):
         file=io.StringIO(), width=80, force_terminal=True))
     p = progress.Progress("paper-cube", 10, width=56)
     assert p.width == 80 - progress.NUMBERS
-    assert progress.fit("x" * 60, p.width) == "x" * (p.width - 1) + "\u2026"
-    assert progress.fit("short", p.width) == "short"
+    assert progress.shorten("x" * 60, p.width) == "x" * (p.width - 1) + "\u2026"
+    assert progress.shorten("short", p.width) == "short"
 
 
 def test_a_stress_panels_scale_is_robust_to_one_slivers_spike(tmp_path, monkeypatch):

@@ -16,7 +16,7 @@ from model.mesh import cube
 from reference import hyperelastic
 from reference import truthcube as T
 from cases.studies.truthcube import beads as B
-from cases.studies.truthcube import problem as P
+from cases.studies.truthcube import specimen as P
 
 ROOT = Path(__file__).resolve().parents[1]
 

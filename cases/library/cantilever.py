@@ -9,7 +9,7 @@ from ..measuring.error_model import Scalar
 from ..framework import Case, Knob, Loads, MM, Settings, Traction
 from . import common
 
-LENGTH_MM, HEIGHT_MM, WIDTH_MM = 64.0, 16.0, 16.0
+LENGTH_MM, HEIGHT_MM, WIDTH_MM = common.BAR_MM
 LOAD_N = 1e-3
 
 
@@ -61,6 +61,7 @@ class Cantilever(Case):
 
     def params(self, s):
         return {"length_mm": LENGTH_MM, "height_mm": HEIGHT_MM, "width_mm": WIDTH_MM,
-                "load_N": s.load_N, "E_Pa": s.E, "nu": s.nu, "spacing_mm": s.spacing_mm}
+                "load_N": s.load_N, **s.material_record(static=True),
+                "spacing_mm": s.spacing_mm}
 
 CASE = Cantilever()

@@ -10,12 +10,16 @@ from ..framework import MM
 
 CUBE_BCS = ("clamped", "sliding")    # the compressed cube's bases
 CUBE_MM = 32.0                        # the paper's cube: its side, every cube case's
+BAR_MM = (64.0, 16.0, 16.0)           # the bars (bending, torsion): length along x, section
 
 
 def layers_mm(nodes_per_side, size_mm=CUBE_MM):
     """The y-layers of a cube's layer profile [mm]: its lattice's node planes (the paper's five
     at 0, 8, 16, 24, 32 mm on its 5 x 5 x 5 lattice)."""
     return np.linspace(0.0, size_mm, nodes_per_side).tolist()
+
+
+PAPER_LAYERS_MM = tuple(layers_mm(PAPER_NODES))   # the paper's own five layers
 
 
 def cube_boundary_sets(mesh, bc, size):

@@ -17,7 +17,7 @@ from . import common
 
 SIZE_MM, NODES = common.CUBE_MM, common.PAPER_NODES
 PUSH_MM, STEPS = 9.6, 6
-LAYERS_MM = tuple(common.layers_mm(NODES, SIZE_MM))
+LAYERS_MM = common.PAPER_LAYERS_MM
 ENERGY_STEP = 1e-3     # the energy's central difference: this fraction of the push
 
 

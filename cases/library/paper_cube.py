@@ -81,7 +81,6 @@ def make_mesh(name, nodes_per_side=NODES_PER_SIDE):
     return cube(nodes_per_side, SIZE_MM * MM, name)
 
 
-LAYERS_MM = tuple(common.layers_mm(NODES_PER_SIDE))     # the paper's own five layers
 
 
 def apparent_poisson(profile, push_mm):

@@ -9,7 +9,7 @@ from ..measuring.error_model import Scalar
 from ..framework import Case, Knob, MM, Settings
 from . import common
 
-LENGTH_MM, SIDE_MM = 64.0, 16.0
+LENGTH_MM, SIDE_MM, _ = common.BAR_MM
 ANGLE_DEG = 10.0
 BETA_SQUARE = 0.1406   # Saint-Venant torsion constant of a square, J = beta a^4
 

@@ -26,6 +26,8 @@ from .names import load_name, ref_name
 # and where it stops differs from one processor to the next): printed as such, and never the
 # difference that decides a tie or a rank
 ROUND_OFF = 10 * RTOL
+# a reference judges an error only where its own estimate is at most a fifth of it
+JUDGES = 5
 P1_LINEAR = "fem-linear"          # FEM P1 with the linear law: the twin in the linear regime
 P1_FINITE = "fem-neohookean"      # FEM P1 with the reference's law: the twin at finite load
 

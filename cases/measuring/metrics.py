@@ -11,7 +11,7 @@ PATTERN_TOL = 1e-6  # second differences below this fraction of the profile coun
 ALTERNATION_CLEAR = 0.01   # an alternation below 1 % of the mean lateral displacement is not clear
 # a patch test passes below this displacement error: the linear regime (strains of 1e-4)
 # leaves a geometrically nonlinear model about 5e-5 off the linear field (fem-neohookean), a
-# consistency error is 1e-3 and above (pbcm-variational on five: 0.0018)
+# consistency error is 1e-3 and above
 PATCH_TOL = 1e-3
 RANK_TOL = 1e-8     # singular values below this (unit columns) count as zero: rounding, not shape
 

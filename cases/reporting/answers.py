@@ -10,12 +10,11 @@ from pathlib import Path
 
 import numpy as np
 
-from .costs import FILE as BENCH_FILE, FOLDER as BENCH_FOLDER
+from .costs import COST_TETS, FILE as BENCH_FILE, FOLDER as BENCH_FOLDER
 from .document import fmt, rel, rel_range
-from ..measuring.error_model import P1_LINEAR, ROUND_OFF, input_spread
+from ..measuring.error_model import JUDGES, P1_LINEAR, ROUND_OFF, input_spread
 from ..measuring.metrics import PATCH_TOL
 
-COST_TETS = 1e4          # the mesh size of the cost column (tetrahedra)
 CONSISTENCY = ("paper-cube", "sliding")     # the patch test whose converged limit is the error
 FINITE = "large-compression"                 # the finite-strain case (neo-Hookean reference)
 MEASURED = "truth-cube"                      # the study against measured beads
@@ -795,7 +794,7 @@ def _discretisation(pops, finite):
         meds.append((float(np.median(d)), f"[{rel_range(min(d), max(d))} over the meshes]",
                      p.label + (", beyond what its reference judges: the continuum's u_num "
                                 "exceeds a "
-                                "fifth of it" if p.u_continuum > np.median(d) / 5 else "")))
+                                "fifth of it" if p.u_continuum > np.median(d) / JUDGES else "")))
     if not meds:
         return ""
     (lo, lo_range, a), (hi, hi_range, b) = min(meds), max(meds)

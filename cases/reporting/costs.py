@@ -18,6 +18,7 @@ FILE = "bench.json"
 FOLDER = "bench"                 # beside the case folders: reports/bench/bench.json
 SOURCE = f"reports/{FOLDER}/{FILE}"
 BASE = "fem-linear"              # the baseline every ratio is taken against
+COST_TETS = 1e4                  # the mesh size at which costs are compared (tetrahedra)
 CHECKOUT = Path(__file__).resolve().parents[2] / "reports" / FOLDER / FILE
 
 

@@ -9,7 +9,7 @@ import numpy as np
 
 from ..measuring.catalogue import err_name, ref_name
 from .document import Table, rel, rel_range
-from ..measuring.error_model import P1_FINITE, P1_LINEAR, standings, u_num
+from ..measuring.error_model import JUDGES, P1_FINITE, P1_LINEAR, standings, u_num
 
 # what a ranking by a case's own metric measures: the total error, the mesh's own included
 # (the model-form ranking is the error model's, cases.reporting.scorecard)
@@ -50,10 +50,6 @@ def _labelled(runs, line_of):
         return [line_of(next(iter(pops.values())))]
     return [f"[{bc}] {line_of(rs)}" for bc, rs in pops.items()]
 
-
-# a reference judges errors above this many times its own u_num, and orders none below
-# (a fifth of the smallest error ranked)
-JUDGES = 5
 
 # the continuum's value behind a relative error whose quantity is not named after it
 CONTINUUM_OF = {"reaction_rel_err": "reaction_fem_p2_n",

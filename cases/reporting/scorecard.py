@@ -497,7 +497,7 @@ def case_findings(name, quantities, runs, patch_tests=(), estimate_key="p2_error
             line += (f". FEM P1 itself is {rel(np.median(disc))} "
                      f"[{rel_range(min(disc), max(disc))}] from the continuum on these meshes "
                      "(discretisation error)")
-        elif disc and p.u_continuum > np.median(disc) / 5:
+        elif disc and p.u_continuum > np.median(disc) / E.JUDGES:
             # the continuum's u_num exceeds a fifth of P1's own error: nothing is judged closer
             line += (f". FEM P1 itself is {rel(np.median(disc))} "
                      f"[{rel_range(min(disc), max(disc))}] from the continuum on these meshes "

@@ -15,7 +15,7 @@ LOG_STEPS = 10     # lines a log gets over the whole work
 NUMBERS = 40       # the columns the bar's numbers (percentage, elapsed, time left) need
 
 
-def fit(text, width):
+def shorten(text, width):
     """``text`` cut to ``width`` characters, an ellipsis marking the cut."""
     return text if len(text) <= width else text[:width - 1] + "\u2026"
 
@@ -49,7 +49,7 @@ class Progress:
         """``work`` more done; ``text`` what is being done now."""
         self.done += work
         self._bar.update(self._task, completed=self.done,
-                         description=fit(text if text is not None else self.title, self.width))
+                         description=shorten(text if text is not None else self.title, self.width))
         step = int(LOG_STEPS * self.done / self.total)
         if self.log and not self.tty and work and step > self._said:
             self._said = step

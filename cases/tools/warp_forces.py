@@ -374,13 +374,6 @@ def deformed(mesh, seed=0, amplitude=0.03):
     return mesh.points @ A.T + amplitude * h * rng.uniform(-1.0, 1.0, mesh.points.shape)
 
 
-def max_rel_diff(pm, x, device="cpu", dtype="float64", ours=None):
-    """max |f_warp - f_numba| / max |f_numba| at positions ``x``."""
-    ours = pm.forces(x) if ours is None else ours
-    theirs = WarpForces(pm, x, device, dtype).forces()
-    return float(np.abs(theirs - ours).max() / np.abs(ours).max())
-
-
 def check_device(device):
     """The Warp device ``device`` (a name such as ``cpu``, ``cuda``, ``cuda:0``); a ValueError
     naming the devices there are where it does not exist."""

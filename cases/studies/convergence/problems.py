@@ -109,11 +109,11 @@ class Problem:
 PROBLEMS = {
     "paper-cube": Problem("paper-cube", (common.CUBE_MM,) * 3, ("clamped", "sliding"), "driven",
                           label="top force"),
-    "cantilever": Problem("cantilever", (64.0, 16.0, 16.0), ("clamped",), "tip_deflection_mm",
+    "cantilever": Problem("cantilever", common.BAR_MM, ("clamped",), "tip_deflection_mm",
                           compliance=True, label="load / tip deflection"),
     # P2 converges at order 1 here (the clamped root restrains the warping): a fourth level,
     # solved by AMG-CG (the direct solver's fill at that size needs several GB)
-    "torsion": Problem("torsion", (64.0, 16.0, 16.0), ("clamped",), "torque_nm",
+    "torsion": Problem("torsion", common.BAR_MM, ("clamped",), "torque_nm",
                        label="torque", ref_ladder_mm=(8.0, 4.0, 2.0, 4.0 / 3.0),
                        ref_fine_solver="amg",
                        # checked by the tests on the five lattice at 8 mm: FEM P1's solution

@@ -3,6 +3,7 @@ accuracy per cost, and the rows the gate reads), report.md/.html and the figures
 sentence is computed from the data it is written with."""
 
 from ...measuring import catalogue
+from ...measuring.error_model import JUDGES
 from ...reporting.document import Document, fmt, rel
 from ...reporting.report import environment, write_study
 from ...running.runner import jsonable
@@ -24,7 +25,7 @@ GATED = catalogue.gated("disp_rel_l2", "reaction_rel_err", "e_inf", "moduli_rel_
 BUDGETS = (0.1, 0.02)   # error targets of the cost table: the cheapest run reaching each
 # a reference whose estimate is more than a fifth of an error cannot judge it: the errors below
 # this many times its estimate are "not resolved"
-REF_MARGIN = 5.0
+REF_MARGIN = float(JUDGES)     # the error model's: a reference judges five times its estimate
 STIFFNESS_TOL = 0.01     # a stiffness error this far from 0 past its +- is said (C_eff's tolerance)
 ISOTROPIC_TOL = 0.01    # every C_eff modulus within this of the target's: the lattice is it
 

@@ -5,14 +5,13 @@ from dataclasses import dataclass, replace
 from model.candidates import BASE, CANDIDATES, NORMAL_FORMS, short  # noqa: F401 (the study's names)
 from ...framework import MaterialSettings
 from ...measuring.catalogue import STATIC, err_name
-from ...reporting.costs import step_cost_us
+from ...reporting.costs import COST_TETS, step_cost_us
 from ...measuring.error_model import decomposed
 from ...running.store import OFF
 from ...registry import studies
 from ...running.runner import jsonable, run as run_case
 
 YARDSTICK = "fem-linear"     # what the same tetrahedra give as constant-strain FEM
-COST_TETS = 1e4              # the mesh size at which costs are compared
 TWIN = "pbcm-variational+normal"   # the preset whose terms are +normal_edge's
 
 

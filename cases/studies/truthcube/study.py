@@ -20,7 +20,7 @@ from ...running.progress import Progress
 from ...running.runner import jsonable
 from ...running.store import OFF, key
 from ...running.workers import dearest_first
-from .problem import (FAMILY, STEP_OF_SPACING, dirichlet as plate_dirichlet,
+from .specimen import (FAMILY, STEP_OF_SPACING, dirichlet as plate_dirichlet,
                       mesh as spacing_mesh, nominal_travels, schedule, step_strain)
 from .beads import Measured, errors, layer_axial, layer_lateral
 from model.units import MM
@@ -94,7 +94,7 @@ class TruthCubeSettings(MaterialSettings):
                                                       for h in self.spacings_mm[1:]]
 
     def problem(self):
-        return {"E_Pa": self.E, "nu": self.nu, "side_mm": T.SIDE / MM,
+        return {**self.material_record(static=True), "side_mm": T.SIDE / MM,
                 "strains": list(T.STRAINS[1:]), "family": FAMILY,
                 "step_of_spacing": STEP_OF_SPACING, "static_rtol": STATIC_RTOL,
                 "reference": {"element": "P2/P1 mixed", "mesh": f"{REF_MESH[0]} "
