@@ -7,8 +7,9 @@ from . import CalibratedTerm
 from ._kernels import deformation_gradients_numpy, rest_shape_inverse
 
 
-class ConstantStrainTerm(CalibratedTerm):
-    """A CalibratedTerm with ``Dinv`` (m, 3, 3) and ``F(x, rows)``."""
+class RestShape:
+    """What every term written on F shares, calibrated or not (the FEM baselines too): ``Dinv``
+    (m, 3, 3) at rest and ``F(x, rows)``; its kernels check flattening."""
 
     checks_inversion = True
 
@@ -20,3 +21,7 @@ class ConstantStrainTerm(CalibratedTerm):
         """F (r, 3, 3) of the tetrahedra ``rows`` at positions ``x``."""
         return deformation_gradients_numpy(np.asarray(x, dtype=float), self.mesh.tets[rows],
                                            self.Dinv[rows])
+
+
+class ConstantStrainTerm(RestShape, CalibratedTerm):
+    """A CalibratedTerm with ``Dinv`` (m, 3, 3) and ``F(x, rows)``."""

@@ -22,9 +22,10 @@ from . import Term, register
 from ..material import neohookean_energy, neohookean_stress
 from ._blocks import B, FLAG, OPTIONS, OUT, SCRATCH, blocked, blocked_tets, first_flat, gather, \
     scatter
+from ._constant_strain import RestShape
 from ._kernels import (add_piola_forces, cofactor, cross, deformation_gradient,
-                       deformation_gradients_numpy, dot, lin, piola_forces_numpy,
-                       rest_shape_inverse, sub)
+                       dot, lin, piola_forces_numpy,
+                       sub)
 from .volume import FLAT
 
 
@@ -185,25 +186,20 @@ def neohookean_forces(x, tets, Dinv, vol0, lam, mu, out):
     return -1
 
 
-class _ConstantStrain(Term):
-    """What the three baselines share: Dm^-1, V0 and the Lame constants."""
+class _ConstantStrain(RestShape, Term):
+    """What the three baselines share: Dm^-1 and F (``RestShape``), V0 and the Lame
+    constants."""
 
     conservative = True
-    checks_inversion = True
     _kernel = None
 
     def __init__(self, mesh, material, scale=1.0, **params):
         super().__init__(mesh, material, scale, **params)
-        self.Dinv = np.ascontiguousarray(rest_shape_inverse(mesh.points, mesh.tets))
         self.vol0 = mesh.volumes
         self.lam, self.mu = self.scale * material.lam, self.scale * material.G
 
     def kernel(self):
         return type(self)._kernel, (self.mesh.tets, self.Dinv, self.vol0, self.lam, self.mu)
-
-    def F(self, x):
-        return deformation_gradients_numpy(np.asarray(x, dtype=float), self.mesh.tets,
-                                           self.Dinv)
 
     def forces_numpy(self, x):
         return piola_forces_numpy(self.piola(self.F(x)), self.Dinv, self.vol0, self.mesh.tets,
