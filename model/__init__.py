@@ -47,8 +47,10 @@ def build(model, mesh, material, threads=1, **term_params):
         raise ModelError(f"parameters given for term(s) {', '.join(sorted(unknown))} that "
                          f"model {name!r} does not have ({', '.join(t for t, _ in terms)})")
     terms = [(t, {**p, **term_params.get(t, {})}) for t, p in terms]
+    from .presets import IMPLICIT_STEP
     from .system import ParticleModel
-    return ParticleModel(mesh, material, terms, name=name, threads=threads)
+    return ParticleModel(mesh, material, terms, name=name, threads=threads,
+                         implicit_dt=IMPLICIT_STEP.get(name))
 
 
 __all__ = ["Material", "build", "PRESETS", "ParticleModel", "PbcmError", "MeshError",

@@ -21,8 +21,7 @@ from .errors import BlowUpError, ConvergenceError, ModelError
 from .geometry import min_signed_volume
 from .integrate import Trajectory
 
-FRAME_S = 1.0 / 60.0        # a rendered frame's step
-HAPTIC_S = 1e-3             # a haptic loop's step
+from .presets import FRAME_S, HAPTIC_S  # noqa: F401 (the steps simulators run at)
 NEWTON_RTOL = 1e-8          # |R| over the step's inertial force scale at which Newton stops
 CG_RTOL = 1e-10             # each Newton system's relative residual
 MAX_NEWTON = 20

@@ -23,7 +23,14 @@ PRESETS = {
 LITERAL = {f"pbcm-{reading}-literal": [("shear", {"reading": reading, "c": 1.0}), ("volume", {})]
            for reading in ("corner", "balanced", "variational")}
 
-# every name a model spec may use
-NAMED = {**PRESETS, **LITERAL}
+# corotated FEM integrated by backward Euler (model.implicit) at a fixed step, as surgical
+# simulators run it: a rendered frame's (1/60 s) and a haptic loop's (1 ms); run where asked for
+FRAME_S, HAPTIC_S = 1.0 / 60.0, 1e-3
+IMPLICIT_STEP = {"fem-corotated-implicit-frame": FRAME_S,
+                 "fem-corotated-implicit-haptic": HAPTIC_S}
+IMPLICIT = {name: PRESETS["fem-corotated"] for name in IMPLICIT_STEP}
 
-__all__ = ["PRESETS", "LITERAL", "NAMED"]
+# every name a model spec may use
+NAMED = {**PRESETS, **LITERAL, **IMPLICIT}
+
+__all__ = ["PRESETS", "LITERAL", "IMPLICIT", "IMPLICIT_STEP", "NAMED"]

@@ -19,8 +19,10 @@ class ParticleModel:
     their parameters and calibration constants (``shear_c``, ``normal_edge_c``).
     """
 
-    def __init__(self, mesh, material, terms, name="custom", threads=1):
+    def __init__(self, mesh, material, terms, name="custom", threads=1, implicit_dt=None):
         self.mesh, self.material, self.name = mesh, material, name
+        # None: RK4 at the stable step; a step [s]: backward Euler at it (model.implicit)
+        self.implicit_dt = implicit_dt
         if not (isinstance(threads, int) and 1 <= threads <= numba.config.NUMBA_NUM_THREADS):
             raise ModelError(f"threads must be an integer from 1 to {numba.config.NUMBA_NUM_THREADS}"
                              f" (numba's threads on this machine), got {threads!r}")
@@ -134,7 +136,10 @@ class ParticleModel:
                                     / max((np.linalg.norm(r, axis=1) * fs).sum(), 1e-300))}
 
     def stable_dt(self, safety=0.5):
-        """safety * min_T h_T / c_p, with h_T the smallest height and c_p the P-wave speed."""
+        """safety * min_T h_T / c_p, with h_T the smallest height and c_p the P-wave speed;
+        for a model integrated by backward Euler its own fixed step (stable at any step)."""
+        if self.implicit_dt is not None:
+            return self.implicit_dt
         return safety * float(smallest_heights(self.mesh.points, self.mesh.tets).min()) \
             / self.material.p_wave_speed
 
@@ -152,6 +157,12 @@ class ParticleModel:
 
     def simulate(self, bc_of_t, t_end, dt=None, damping=0.0, f_ext=None, frames=101, safety=0.5,
                  x0=None, v0=None, t0=0.0):
-        """Classical RK4 dynamics (see model.integrate.simulate)."""
+        """Classical RK4 dynamics (see model.integrate.simulate), or backward Euler at the
+        model's own step (``implicit_dt``, or ``dt`` where given; see model.implicit)."""
+        if self.implicit_dt is not None:
+            from .implicit import backward_euler
+            return backward_euler(self, bc_of_t, t_end, self.implicit_dt if dt is None else dt,
+                                  damping=damping, f_ext=f_ext, frames=frames, x0=x0, v0=v0,
+                                  t0=t0)
         return rk4_simulate(self, bc_of_t, t_end, dt=dt, damping=damping, f_ext=f_ext,
                                   frames=frames, safety=safety, x0=x0, v0=v0, t0=t0)
