@@ -38,25 +38,6 @@ def deviatoric_basis():
     return np.array(b)
 
 
-def quadratic_form(energy, points, basis, delta=1e-4):
-    """Q with energy(X + delta eps X) = delta^2 a^T Q a + O(delta^4) (symmetric differences)
-    from whole energies: slower than :func:`strain_quadratic_form`, the tests' check of it."""
-    centred = points - points.mean(axis=0)
-
-    def w(eps):
-        return 0.5 * (energy(points + centred @ eps.T) + energy(points - centred @ eps.T))
-
-    nb = len(basis)
-    Q = np.empty((nb, nb))
-    for k in range(nb):
-        Q[k, k] = w(delta * basis[k]) / delta**2
-    for k in range(nb):
-        for l in range(k + 1, nb):
-            Q[k, l] = Q[l, k] = 0.5 * (w(delta * (basis[k] + basis[l])) / delta**2
-                                       - Q[k, k] - Q[l, l])
-    return Q
-
-
 def strain_quadratic_form(term, points, basis, delta=1e-4, chunk=1 << 16):
     """Q (p, p) of ``term``'s unit energy, from its strain measures by central differences,
     a chunk of tetrahedra at a time (memory stays at about chunk x 24 x p doubles)."""

@@ -863,8 +863,8 @@ def test_the_cost_is_the_benchs_at_the_papers_size_alone():
     pooled over sizes: rows at 135 and 1080 tetrahedra with wider ranges change nothing; a
     literal reading takes its calibrated reading's row; a model the bench lacks at 320 has
     none."""
-    from cases.studies.artefact.study import PAPER_TETS, bench_costs
-    assert PAPER_TETS == 320
+    from cases.studies.artefact.study import FIVE_TETS, bench_costs
+    assert FIVE_TETS == 320
 
     def row(model, tets, r, span):
         return {"model": model, "tets": tets, "step_vs_msm": r, "step_vs_msm_range": span,

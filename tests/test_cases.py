@@ -9,7 +9,8 @@ from conftest import floats_in
 
 from cases.measuring import metrics as M
 from cases.cli import main
-from cases.library.paper_cube import LAYERS_MM, SIZE_MM, make_mesh, static_bc
+from cases.library.common import PAPER_LAYERS_MM as LAYERS_MM
+from cases.library.paper_cube import SIZE_MM, make_mesh, static_bc
 from cases.reporting.report import TIMING_KEYS
 from model.material import Material
 from model import PRESETS, ModelError

@@ -315,11 +315,30 @@ def test_scale_survives_calibration(small_mesh, mat):
     assert half.energy(x) == pytest.approx(0.5 * full.energy(x), rel=1e-12)
 
 
+def quadratic_form(energy, points, basis, delta=1e-4):
+    """Q with energy(X + delta eps X) = delta^2 a^T Q a + O(delta^4) (symmetric differences)
+    from whole energies: slower than the calibration's strain_quadratic_form, and its check."""
+    centred = points - points.mean(axis=0)
+
+    def w(eps):
+        return 0.5 * (energy(points + centred @ eps.T) + energy(points - centred @ eps.T))
+
+    nb = len(basis)
+    Q = np.empty((nb, nb))
+    for k in range(nb):
+        Q[k, k] = w(delta * basis[k]) / delta**2
+    for k in range(nb):
+        for l in range(k + 1, nb):
+            Q[k, l] = Q[l, k] = 0.5 * (w(delta * (basis[k] + basis[l])) / delta**2
+                                       - Q[k, k] - Q[l, l])
+    return Q
+
+
 @pytest.mark.parametrize("preset", ["pbcm-variational", "pbcm-variational+normal"])
 def test_fast_calibration_form_equals_the_energy_form(preset, mat):
     """The quadratic form calibration fits, from the strain measures chunk by chunk, equals
     the one taken from second differences of whole energies (an independent route)."""
-    from model.calibrate import deviatoric_basis, quadratic_form, strain_quadratic_form
+    from model.calibrate import deviatoric_basis, strain_quadratic_form
     m = cube(4, 0.032, "bcc")
     pm = build(preset, m, mat)
     for t in pm.terms:

@@ -192,7 +192,8 @@ def add_selection(p):
                         "variational, c=auto) + normal_edge(c=auto) + volume\" (default: "
                         "every preset)")
     add_term_files(p)
-    p.add_argument("--meshes", nargs="+", help="meshes (default: all; --quick: five six)")
+    p.add_argument("--meshes", nargs="+", help="meshes (default: all; --quick: the case's quick meshes, five for most, "
+                        "five and six for the paper cube)")
     p.add_argument("--bcs", nargs="+", help="boundary conditions (default: all)")
     p.add_argument("--quick", action="store_true",
                    help="each case's quick settings (fewer meshes, coarser references; "

@@ -28,8 +28,9 @@ class Cantilever(Case):
     name = "cantilever"
     resolution = Knob("spacing_mm", "lattice spacing [mm]")
     load = Knob("load_N", "end load [N]")
-    title = ("Cantilever 64 x 16 x 16 mm, clamped at x = 0, 1 mN end load in -y (bending; "
-             "closed form Euler-Bernoulli + Timoshenko)")
+    title = (f"Cantilever {LENGTH_MM:g} x {HEIGHT_MM:g} x {WIDTH_MM:g} mm, clamped at x = 0, "
+             f"{LOAD_N * 1e3:g} mN end load in -y (bending; closed form Euler-Bernoulli + "
+             "Timoshenko)")
     settings_class = CantileverSettings
     bcs = ("clamped",)
     fem_solver = "direct"   # AMG-CG stagnates on this slender beam

@@ -108,9 +108,10 @@ class Indentation(Case):
     narrative = "cases.library.narratives.indentation:IndentationNarrative"
     name = "indentation"
     resolution = Knob("spacing_mm", "lattice spacing [mm]")
-    title = ("Indentation of a 32 mm cube on a clamped base by a rigid punch, an 8 x 8 mm flat "
-             "face with a 4 mm sloping rim, pressed 2 mm (punch force, surface profile, shear "
-             "under the edge of the punch's face)")
+    title = (f"Indentation of a {SIZE_MM:g} mm cube on a clamped base by a rigid punch, an "
+             f"{PATCH_MM:g} x {PATCH_MM:g} mm flat face with a {RIM_MM:g} mm sloping rim, pressed "
+             f"{DEPTH_MM:g} mm (punch force, surface profile, shear under the edge of the punch's "
+             "face)")
     settings_class = IndentationSettings
     bcs = ("clamped",)
     headline = "reaction_rel_err"

@@ -98,8 +98,9 @@ class LargeCompression(Case):
     narrative = "cases.library.narratives.large_compression:LargeCompressionNarrative"
     name = "large-compression"
     load = Knob("push_mm", "push [mm]")
-    title = ("The paper's cube bonded to base and top plate, pushed to 30 % (9.6 mm) in 6 "
-             "steps, against converged neo-Hookean FEM (linear FEM shown beside it)")
+    title = (f"The paper's cube bonded to base and top plate, pushed to "
+             f"{100 * PUSH_MM / SIZE_MM:.0f} % ({PUSH_MM:g} mm) in {STEPS} steps, against "
+             "converged neo-Hookean FEM (linear FEM shown beside it)")
     settings_class = LargeCompressionSettings
     meshes = ("five", "six", "bcc", "unstructured")
     bcs = ("clamped",)

@@ -26,8 +26,8 @@ class ModesSettings(Settings):
 class Modes(Case):
     narrative = "cases.library.narratives.modes:ModesNarrative"
     name = "modes"
-    title = ("The first 10 frequencies of the 32 mm cube, free-free and with a clamped base, "
-             "of every model linearised at rest, against FEM P2")
+    title = (f"The first {N_MODES} frequencies of the {SIZE_MM:g} mm cube, free-free and with a "
+             "clamped base, of every model linearised at rest, against FEM P2")
     settings_class = ModesSettings
     static = False
     bcs = ("free", "clamped")

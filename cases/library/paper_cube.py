@@ -197,7 +197,8 @@ class PaperCube(Case):
 
     narrative = "cases.library.narratives.paper_cube:PaperCubeNarrative"
     name = "paper-cube"
-    title = "The paper's cube pushed down 1.7 mm (5.3 %), clamped or sliding base"
+    title = (f"The paper's cube pushed down {PUSH_MM:g} mm ({100 * PUSH_MM / SIZE_MM:.1f} %), "
+             "clamped or sliding base")
     settings_class = Config
     resolution = Knob("nodes_per_side", "nodes per side")
     load = Knob("push_mm", "push [mm]")

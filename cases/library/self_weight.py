@@ -35,8 +35,8 @@ class SelfWeight(Case):
     name = "self-weight"
     resolution = Knob("spacing_mm", "lattice spacing [mm]")
     load = Knob("g", "gravity [m/s^2]")
-    title = ("A 32 mm block settling under its own weight, base sliding (closed form) or "
-             "clamped (FEM)")
+    title = (f"A {SIZE_MM:g} mm block settling under its own weight, base sliding (closed form) "
+             "or clamped (FEM)")
     settings_class = SelfWeightSettings
     bcs = ("sliding", "clamped")
     # sliding: the closed form read at each mesh's own top nodes (its lateral term depends on

@@ -44,8 +44,9 @@ class Torsion(Case):
     name = "torsion"
     resolution = Knob("spacing_mm", "lattice spacing [mm]")
     load = Knob("angle_deg", "end rotation [deg]")
-    title = ("Torsion of a 16 x 16 x 64 mm bar, x = 0 clamped, the end face turned 10 degrees "
-             "(torque against FEM and Saint-Venant; end-face warping)")
+    title = (f"Torsion of a {SIDE_MM:g} x {SIDE_MM:g} x {LENGTH_MM:g} mm bar, x = 0 clamped, "
+             f"the end face turned {ANGLE_DEG:g} degrees (torque against FEM and Saint-Venant; "
+             "end-face warping)")
     settings_class = TorsionSettings
     bcs = ("clamped",)
     fem_solver = "direct"   # a slender bar, as the cantilever: AMG-CG stagnates

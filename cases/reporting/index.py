@@ -9,6 +9,7 @@ import numpy as np
 
 from . import scorecard
 from .document import GLOSSARY, Cell, Document, Link, rel, rel_range
+from ..measuring.error_model import JUDGES
 from ..running.output import SWEEP_MARK
 
 # headline error bands of the scorecard: within 5 %, within 20 %, beyond
@@ -320,7 +321,7 @@ TERMS = {
     "unless the two compared directly (the geometric mean over the cases of their paired "
     "population errors' ratio) keep that order whatever is left out; or a "
     "value below what its uncertainty resolves (a convergence fit whose finest error is below "
-    "five times its reference's estimate; an artefact part within its u of 0). A reference "
+    f"{JUDGES} times its reference's estimate; an artefact part within its u of 0). A reference "
     "too coarse to judge a case's differences is said as such, not with this word.",
     "failed run": "a run that gave no number (no equilibrium, a metric undefined, a run that "
     "could not start): it counts against its model, as infinitely wrong, in every ranking, "

@@ -36,11 +36,10 @@ import warp as wp
 from numba import njit
 
 from model.integrate import total_forces
-from model.mesh import cube
 from model.terms.volume import FLAT
 
-from ..framework import DEFAULT_E, DEFAULT_NU, DEFAULT_RHO, MM
-from ..library.common import CUBE_MM
+from ..framework import DEFAULT_E, DEFAULT_NU, DEFAULT_RHO
+from .bench import bench_mesh
 
 wp.config.quiet = True
 if hasattr(wp.config, "log_level"):      # newer Warp logs its start-up and module loads at INFO
@@ -424,13 +423,6 @@ def numba_seconds_per_evaluation(pm, x, min_s=0.2):
     t0 = time.perf_counter()
     _force_loop(kern, x, out, reps)
     return (time.perf_counter() - t0) / reps
-
-
-def bench_mesh(target):
-    """The bench's mesh (cases.tools.bench.bench_mesh, which imports this module): the 'five'
-    cube of the paper's side whose tetrahedron count is closest to ``target``."""
-    k = max(1, round((target / 5.0) ** (1.0 / 3.0)))
-    return cube(k + 1, CUBE_MM * MM, "five")
 
 
 def time_model(pm, device, dtypes=DTYPES, seed=0, min_s=0.2):

@@ -12,7 +12,7 @@ from ...reporting.document import Table, fmt
 from ...framework import Narrative
 from ..paper_cube import SPEED_MM_S
 
-PAPER_TETS = 374     # the paper's mesh (section 4), unpublished
+from model.paper_mesh import PAPER_TETS     # the paper's mesh (section 4), unpublished
 CAUCHY_TOL = 0.02    # an apparent Poisson ratio this close to 1/4 does not show anisotropy
 
 # the notes beside the catalogue's definitions

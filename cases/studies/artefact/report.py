@@ -6,6 +6,7 @@ from pathlib import Path
 
 import numpy as np
 
+from model.paper_mesh import PAPER_TETS     # the paper's own cube, as it reports it
 from model.static import SHORTEST_STEP
 from ...measuring import catalogue
 from ...measuring.metrics import EXACT_DEGREE, SMOOTH_DECAYS, SMOOTH_WIDTHS
@@ -24,7 +25,6 @@ from .study import (DECISIVE, FIXED_NORMAL_C, HELD_SUFFIX, LINEAR_SCALE, LITERAL
                     short)
 
 GATED = catalogue.gated("alternation_rel", "disp_rel_l2")
-PAPER_TETS = 374        # the paper's own cube, as it reports it
 
 
 def readings(models):

@@ -424,30 +424,30 @@ def lines_joined(cells, rows):
     return [{**c, **{k: r[k] for k in LINES}} for c, r in zip(cells, rows)]
 
 
-PAPER_TETS = 5 * (P.NODES_PER_SIDE - 1) ** 3     # the mirrored five cube: 320 tetrahedra
+FIVE_TETS = 5 * (P.NODES_PER_SIDE - 1) ** 3     # the mirrored five cube: 320 tetrahedra
 
 
 def bench_costs(bench, models):
     """What the study takes from the bench document ``bench``: each model's step over msm's
     on the paper's cube (``step_costs``) and its spread over the bench's rounds at that size
     (``step_ranges``), with the size and rounds that spread covers."""
-    rows = [r for r in (bench or {}).get("rows", []) if r["tets"] == PAPER_TETS]
+    rows = [r for r in (bench or {}).get("rows", []) if r["tets"] == FIVE_TETS]
     return {"step_vs_msm": step_costs(bench, models),
             "step_vs_msm_range": step_ranges(bench, models),
             "bench_spread": None if not rows else {
-                "tets": [PAPER_TETS],
+                "tets": [FIVE_TETS],
                 "rounds": max([r.get("rounds") or 0 for r in rows], default=0)}}
 
 
 def _paper_row(bench, model):
-    """The bench's row of ``model`` at the paper's size (PAPER_TETS), or None."""
+    """The bench's row of ``model`` at the paper's size (FIVE_TETS), or None."""
     return next((r for r in (bench or {}).get("rows", []) if r["model"] == model
-                 and r["tets"] == PAPER_TETS and r.get("step_vs_msm") is not None), None)
+                 and r["tets"] == FIVE_TETS and r.get("step_vs_msm") is not None), None)
 
 
 def step_ranges(bench, models):
     """{model: [smallest, largest]} of its RK4 step over msm's over the bench's rounds at the
-    paper's size (PAPER_TETS: one population, never pooled with other sizes); a literal
+    paper's size (FIVE_TETS: one population, never pooled with other sizes); a literal
     reading's is its calibrated reading's (the same kernel); None where the bench lacks the
     model at that size or its range."""
     out = {}
