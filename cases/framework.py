@@ -46,6 +46,7 @@ def scaled(dirichlet, k):
 # metrics document: one place for both
 DEFAULT_E, DEFAULT_NU = 10e3, 0.45
 DEFAULT_RHO = next(f.default for f in fields(Material) if f.name == "rho")   # the model's
+DEFAULT_MATERIAL = Material(DEFAULT_E, DEFAULT_NU, DEFAULT_RHO)   # the paper cube's
 
 
 # each material field and its key in a metrics document (SI, the unit in the key)

@@ -25,8 +25,10 @@ def add(sub):
     ft.add_argument("--bcs", nargs="+", help="boundary conditions of every case (default: "
                                              "each case's own)")
     ft.add_argument("--out", help="output folder (default reports/fit/MODEL)")
-    ft.add_argument("--E", type=number("--E", "Young's modulus in Pa, a number > 0", low=0))
-    ft.add_argument("--nu", type=poisson)
+    ft.add_argument("--E", type=number("--E", "Young's modulus in Pa, a number > 0", low=0),
+                    help="Young's modulus [Pa] (default: each case's)")
+    ft.add_argument("--nu", type=poisson, help="Poisson's ratio, -1 < nu < 0.5 (default: each "
+                    "case's)")
     add_term_files(ft)
     ft.set_defaults(func=run)
 

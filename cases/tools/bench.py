@@ -18,14 +18,14 @@ import numpy as np
 import numba
 from numba import njit
 
-from model import Material, PRESETS, build
+from model import PRESETS, build
 from model.bc import Ramp
 from model.calibrate import calibrate
 from model.integrate import STEP_BUFFERS, rk4_ramp, total_forces
 from model.candidates import CANDIDATES
 from model.mesh import cube
 
-from ..framework import DEFAULT_E, DEFAULT_NU, DEFAULT_RHO, MM
+from ..framework import DEFAULT_MATERIAL, MM
 from ..library.common import CUBE_MM
 from ..reporting import figures
 from ..running import stop
@@ -209,7 +209,7 @@ def run(sizes=SIZES, models=None, rounds=7, progress=print, with_engines=True, d
     if with_engines and any(e.installed() for e in ENGINES.values()) \
             and ENGINE_REFERENCE not in timed_models:
         timed_models.append(ENGINE_REFERENCE)
-    mat = Material(DEFAULT_E, DEFAULT_NU, DEFAULT_RHO)
+    mat = DEFAULT_MATERIAL
     for name in timed_models:   # load every module once, so that memory counts the model only
         build(name, bench_mesh(1), mat)
     rows, engine_rows, engines, device_rows = [], [], {}, []

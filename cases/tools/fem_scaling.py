@@ -10,13 +10,11 @@ import time
 
 import numpy as np
 
-from model.material import Material
 from model.mesh import cube
 from reference import linear
-from ..framework import DEFAULT_E, DEFAULT_NU, DEFAULT_RHO
+from ..framework import DEFAULT_MATERIAL
 
 
-DEFAULT_MATERIAL = Material(DEFAULT_E, DEFAULT_NU, DEFAULT_RHO)   # the suite's own
 
 
 def cube_problem(n):

@@ -38,7 +38,7 @@ from numba import njit
 from model.integrate import total_forces
 from model.terms.volume import FLAT
 
-from ..framework import DEFAULT_E, DEFAULT_NU, DEFAULT_RHO
+from ..framework import DEFAULT_MATERIAL
 from .bench import bench_mesh
 
 wp.config.quiet = True
@@ -473,8 +473,8 @@ def main(argv=None):
         print(f"warp_forces: error: not covered: {', '.join(unknown)}; covered: "
               f"{', '.join(COVERED)}", file=sys.stderr)
         return 2
-    from model import Material, build
-    mat = Material(DEFAULT_E, DEFAULT_NU, DEFAULT_RHO)
+    from model import build
+    mat = DEFAULT_MATERIAL
     rows = []
     head = f"{'model':26s} {'tets':>9s} {'dtype':8s} {'ns/tet':>9s} {'numba ns/tet':>13s} " \
            f"{'max rel diff':>13s}"
