@@ -264,6 +264,14 @@ def _what_was_run(d, s, doc):
 def _metric_check(d, doc):
     us = doc["answer"]["hypotheses"]["mirror"]["units"]
     d.h(2, "The metric's check")
+    d.p("What the check can and cannot show: the signature scores 0, to round-off, on the "
+        "continuum and on every polynomial up to degree 2 (a parabolic barrel), and a pure "
+        "(-1)^k pattern at its amplitude; on any other smooth field (a Gaussian bulge, an end "
+        "layer) a finite set of layers leaves it a small score, the leak, which no weights "
+        "remove for every width at once. A score of exactly 0 on every smooth profile is "
+        "therefore not what is claimed: each smooth field's leak is measured here, and the "
+        "worst of them is carried in every u, so that no part a leak could make is called "
+        "resolved.")
     d.p("The signature's weights on test fields of each (size, base), the layers it reads "
         "(centred an eighth of a spacing off the weights' quarter-layer design grid; the "
         "widths 2 and 3, the decay 2 and, on the clamped base, the barrel are among the "
