@@ -154,3 +154,30 @@ def test_corotated_kernel_equals_its_reference_far_from_rest(family):
     want = forces(t.reference_kernel(), x, np.zeros_like(x))
     got = forces(t.kernel(), x, np.zeros_like(x))
     assert np.abs(got - want).max() <= 1e-12 * np.abs(want).max()
+
+
+@pytest.mark.skipif(numba.config.NUMBA_NUM_THREADS < 2, reason="one thread")
+@pytest.mark.parametrize("name", ["fem_linear", "fem_corotated", "fem_neohookean"])
+@pytest.mark.parametrize("family", MESHES)
+def test_every_fem_baseline_has_a_two_thread_mode_equal_to_serial_bit_for_bit(name, family):
+    """Each FEM baseline's two-thread kernel adds, into a non-zero output, the serial
+    kernel's forces bit for bit on every mesh family, and reports the same first flattened
+    tetrahedron where one corner is moved onto another."""
+    mesh = mesh_of(family)
+    t = make_term(name, mesh, MAT)
+    x = perturbed(mesh, 0.02, seed=5)
+    start = np.full_like(x, 0.25)
+    was = numba.get_num_threads()
+    numba.set_num_threads(2)
+    try:
+        two = forces(t.threaded_kernel(), x, start)
+        fn, args = t.threaded_kernel()
+        bad = x.copy()
+        a, b = mesh.tets[len(mesh.tets) // 2, :2]
+        bad[a] = bad[b]          # two corners of one tetrahedron on one point: it is flat
+        got = fn(bad, *args, np.zeros_like(x))
+    finally:
+        numba.set_num_threads(was)
+    assert np.array_equal(two, forces(t.kernel(), x, start))
+    serial, sargs = t.kernel()
+    assert got >= 0 and got == serial(bad, *sargs, np.zeros_like(x))

@@ -120,6 +120,19 @@ def add_piola_forces(P, Dinv, vol0, tets, t, out):
     add_to(out, tets[t, 0], f0)
 
 
+@njit(cache=True, inline="always")
+def put_piola_forces(P, Dinv, vol0, t, ft):
+    """:func:`add_piola_forces`'s four corner forces of tetrahedron t stored into ft[t]
+    (m, 4, 3) instead of added into the nodes: the same values, bit for bit."""
+    f0 = (0.0, 0.0, 0.0)
+    for c in range(3):
+        r = vec(Dinv[t], c)
+        f = (-vol0[t] * dot(P[0], r), -vol0[t] * dot(P[1], r), -vol0[t] * dot(P[2], r))
+        ft[t, c + 1, 0], ft[t, c + 1, 1], ft[t, c + 1, 2] = f
+        f0 = sub(f0, f)
+    ft[t, 0, 0], ft[t, 0, 1], ft[t, 0, 2] = f0
+
+
 def deformation_gradients_numpy(x, tets, Dinv):
     """F (m, 3, 3) for every tetrahedron, vectorised."""
     X = x[tets]

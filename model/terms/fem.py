@@ -21,12 +21,22 @@ from numba import njit
 from . import Term, register
 from ..material import neohookean_energy, neohookean_stress
 from ._blocks import B, FLAG, OPTIONS, OUT, SCRATCH, blocked, blocked_tets, first_flat, gather, \
-    scatter
+    put, scatter
 from ._constant_strain import RestShape
 from ._kernels import (add_piola_forces, cofactor, cross, deformation_gradient,
-                       dot, lin, piola_forces_numpy,
+                       dot, lin, piola_forces_numpy, put_piola_forces,
                        sub)
+from ._threads import TwoThreads
 from .volume import FLAT
+
+
+@njit(cache=True, inline="always")
+def linear_piola(F, lam, mu):
+    """P = 2 mu eps + lam tr(eps) I, eps = sym(F) - I."""
+    s = lam * (F[0][0] + F[1][1] + F[2][2] - 3.0) - 2.0 * mu
+    return ((2.0 * mu * F[0][0] + s, mu * (F[0][1] + F[1][0]), mu * (F[0][2] + F[2][0])),
+            (mu * (F[1][0] + F[0][1]), 2.0 * mu * F[1][1] + s, mu * (F[1][2] + F[2][1])),
+            (mu * (F[2][0] + F[0][2]), mu * (F[2][1] + F[1][2]), 2.0 * mu * F[2][2] + s))
 
 
 @njit(cache=True, fastmath=True)
@@ -36,12 +46,23 @@ def linear_forces(x, tets, Dinv, vol0, lam, mu, out):
         F, J = deformation_gradient(x, tets, t, Dinv)
         if J <= FLAT:
             return t
-        s = lam * (F[0][0] + F[1][1] + F[2][2] - 3.0) - 2.0 * mu   # P = 2 mu eps + lam tr(eps) I
-        P = ((2.0 * mu * F[0][0] + s, mu * (F[0][1] + F[1][0]), mu * (F[0][2] + F[2][0])),
-             (mu * (F[1][0] + F[0][1]), 2.0 * mu * F[1][1] + s, mu * (F[1][2] + F[2][1])),
-             (mu * (F[2][0] + F[0][2]), mu * (F[2][1] + F[1][2]), 2.0 * mu * F[2][2] + s))
-        add_piola_forces(P, Dinv, vol0, tets, t, out)
+        add_piola_forces(linear_piola(F, lam, mu), Dinv, vol0, tets, t, out)
     return -1
+
+
+@njit(cache=True, fastmath=True)
+def linear_tets(x, tets, Dinv, vol0, lam, mu, ft, flat, first, stop):
+    """linear_forces for the tetrahedra [first, stop) into ft (m, 4, 3); flattened ones
+    flagged in flat (the two-thread mode's twin: the same forces, bit for bit)."""
+    n_flat = 0
+    for t in range(first, stop):
+        F, J = deformation_gradient(x, tets, t, Dinv)
+        if J <= FLAT:
+            flat[t] = 1
+            n_flat += 1
+            continue
+        put_piola_forces(linear_piola(F, lam, mu), Dinv, vol0, t, ft)
+    return n_flat
 
 
 @njit(cache=True, inline="always")
@@ -152,6 +173,20 @@ def corotated_forces(x, tb, m, data, lam, mu, out):
     return -1
 
 
+@njit(**OPTIONS)
+def corotated_tets(x, tb, m, data, lam, mu, ft, flat, first, stop):
+    """corotated_forces for the tetrahedra [first, stop) into ft (m, 4, 3); flattened ones
+    flagged in flat (the two-thread mode's twin: the same forces, bit for bit)."""
+    s = np.empty(SCRATCH)
+    r = np.empty(POLAR)
+    n_flat = 0
+    for blk in range(first // B, (stop + B - 1) // B):
+        gather(x, tb, blk, s)
+        corotated_block(s, r, blk, data, lam, mu)
+        n_flat += put(ft, flat, blk, first, stop, s)
+    return n_flat
+
+
 @njit(cache=True, fastmath=True)
 def corotated_forces_reference(x, tets, Dinv, vol0, lam, mu, out):
     """Co-rotated constant-strain tetrahedra; returns the first flattened one, or -1.
@@ -170,6 +205,15 @@ def corotated_forces_reference(x, tets, Dinv, vol0, lam, mu, out):
     return -1
 
 
+@njit(cache=True, inline="always")
+def neohookean_piola(F, J, lam, mu):
+    """P = m F + b F^-T of the compressible neo-Hookean law (F^-T = cof(F) / J)."""
+    m, b = neohookean_stress(np.log(J), lam, mu)
+    a = b / J
+    C = cofactor(F)
+    return (lin(m, F[0], a, C[0]), lin(m, F[1], a, C[1]), lin(m, F[2], a, C[2]))
+
+
 @njit(cache=True, fastmath=True)
 def neohookean_forces(x, tets, Dinv, vol0, lam, mu, out):
     """Compressible neo-Hookean constant-strain tetrahedra; returns the first one with
@@ -178,12 +222,23 @@ def neohookean_forces(x, tets, Dinv, vol0, lam, mu, out):
         F, J = deformation_gradient(x, tets, t, Dinv)
         if J <= FLAT:
             return t
-        m, b = neohookean_stress(np.log(J), lam, mu)
-        a = b / J                        # P = m F + b F^-T, F^-T = cof(F) / J
-        C = cofactor(F)
-        P = (lin(m, F[0], a, C[0]), lin(m, F[1], a, C[1]), lin(m, F[2], a, C[2]))
-        add_piola_forces(P, Dinv, vol0, tets, t, out)
+        add_piola_forces(neohookean_piola(F, J, lam, mu), Dinv, vol0, tets, t, out)
     return -1
+
+
+@njit(cache=True, fastmath=True)
+def neohookean_tets(x, tets, Dinv, vol0, lam, mu, ft, flat, first, stop):
+    """neohookean_forces for the tetrahedra [first, stop) into ft (m, 4, 3); flattened ones
+    flagged in flat (the two-thread mode's twin: the same forces, bit for bit)."""
+    n_flat = 0
+    for t in range(first, stop):
+        F, J = deformation_gradient(x, tets, t, Dinv)
+        if J <= FLAT:
+            flat[t] = 1
+            n_flat += 1
+            continue
+        put_piola_forces(neohookean_piola(F, J, lam, mu), Dinv, vol0, t, ft)
+    return n_flat
 
 
 class _ConstantStrain(RestShape, Term):
@@ -192,14 +247,21 @@ class _ConstantStrain(RestShape, Term):
 
     conservative = True
     _kernel = None
+    _per_tet = None       # the two-thread mode's per-tetrahedron twin of _kernel
 
     def __init__(self, mesh, material, scale=1.0, **params):
         super().__init__(mesh, material, scale, **params)
         self.vol0 = mesh.volumes
         self.lam, self.mu = self.scale * material.lam, self.scale * material.G
+        self._threads = None
 
     def kernel(self):
         return type(self)._kernel, (self.mesh.tets, self.Dinv, self.vol0, self.lam, self.mu)
+
+    def threaded_kernel(self):
+        if self._threads is None:
+            self._threads = TwoThreads(self.mesh.tets, self.mesh.n_nodes)
+        return self._threads.kernel(type(self)._per_tet, self.kernel()[1])
 
     def forces_numpy(self, x):
         return piola_forces_numpy(self.piola(self.F(x)), self.Dinv, self.vol0, self.mesh.tets,
@@ -220,6 +282,7 @@ class FemLinear(_ConstantStrain):
     angular_momentum = False
 
     _kernel = staticmethod(linear_forces)
+    _per_tet = staticmethod(linear_tets)
 
     def _eps(self, F):
         return 0.5 * (F + np.transpose(F, (0, 2, 1))) - np.eye(3)
@@ -253,6 +316,8 @@ class FemCorotated(_ConstantStrain):
         self._blocked = (blocked_tets(mesh.tets), mesh.n_tets, blocked(
             np.concatenate([self.Dinv.reshape(-1, 9), self.vol0[:, None]], axis=1)))
 
+    _per_tet = staticmethod(corotated_tets)
+
     def kernel(self):
         return corotated_forces, (*self._blocked, self.lam, self.mu)
 
@@ -278,6 +343,7 @@ class FemNeoHookean(_ConstantStrain):
 
     name = "fem_neohookean"
     _kernel = staticmethod(neohookean_forces)
+    _per_tet = staticmethod(neohookean_tets)
 
     def piola(self, F):
         m, b = neohookean_stress(np.log(np.linalg.det(F)), self.lam, self.mu)
