@@ -5,6 +5,7 @@ import numpy as np
 from model import ModelError
 from model.bc import merge
 from model.mesh import box
+from model.mesh import cube
 from model.paper_mesh import PAPER_NODES  # noqa: F401 (the paper's lattice, for the cases)
 from ..framework import MM
 
@@ -20,6 +21,13 @@ def layers_mm(nodes_per_side, size_mm=CUBE_MM):
 
 
 PAPER_LAYERS_MM = tuple(layers_mm(PAPER_NODES))   # the paper's own five layers
+
+
+def bench_mesh(target):
+    """The 'five' cube of the paper's side whose tetrahedron count is closest to ``target``:
+    the mesh the cost bench times a model on."""
+    k = max(1, round((target / 5.0) ** (1.0 / 3.0)))
+    return cube(k + 1, CUBE_MM * MM, "five")
 
 
 def cube_boundary_sets(mesh, bc, size):

@@ -23,10 +23,9 @@ from model.bc import Ramp
 from model.calibrate import calibrate
 from model.integrate import STEP_BUFFERS, rk4_ramp, total_forces
 from model.candidates import CANDIDATES
-from model.mesh import cube
 
 from ..framework import DEFAULT_MATERIAL, MM
-from ..library.common import CUBE_MM
+from ..library.common import CUBE_MM, bench_mesh
 from ..reporting import figures
 from ..running import stop
 from .engines import ENGINES
@@ -59,12 +58,6 @@ def own_stable_step(pm):
     start = np.random.default_rng(0).standard_normal(A.shape[0])   # the same bits every run
     lam = eigs(A, k=1, which="LM", v0=start, tol=1e-6, return_eigenvectors=False)
     return float(RK4_LIMIT / np.sqrt(np.abs(lam[0])))
-
-
-def bench_mesh(target):
-    """The 'five' cube of the paper's side whose tetrahedron count is closest to ``target``."""
-    k = max(1, round((target / 5.0) ** (1.0 / 3.0)))
-    return cube(k + 1, CUBE_MM * MM, "five")
 
 
 class _Timed:

@@ -39,7 +39,7 @@ from model.integrate import total_forces
 from model.terms.volume import FLAT
 
 from ..framework import DEFAULT_MATERIAL
-from .bench import bench_mesh
+from ..library.common import bench_mesh
 
 wp.config.quiet = True
 if hasattr(wp.config, "log_level"):      # newer Warp logs its start-up and module loads at INFO

@@ -2,7 +2,7 @@
 
 Each reading's derivation is in the docstring of its writer there.
 
-_kernels.py sha256 1ec64e200bb30940
+_kernels.py sha256 9aa3a69f33f8f830
 _blocks.py sha256 a0a01f096ad04838
 """
 import numpy as np
