@@ -1282,3 +1282,25 @@ def test_a_model_that_barely_expands_on_a_control_split_is_named_against_the_mes
              cell("six-9", analysis.CONFORMING_CONTROLS[0], "k", 0.0, n=9, scale=0.3)]
     said = analysis.stiffer_on_controls(cells)
     assert said == ["m (six -0.99 against -0.6 on the mirrored five, 9 sliding)"]
+
+
+def test_consistency_at_the_side_nodes_tracks_a_part_that_grows_with_the_patch_error():
+    """Read at the side nodes (sliding, linear load, each model's node-level part less FEM
+    P1's against its patch-test error): parts that rise with the error track it; parts that
+    fall as it rises do not; parts the continuum's round-off cannot tell from 0 are not
+    testable."""
+    split = analysis.CONFORMING_CONTROLS[0]
+    lines = np.ones(8)
+
+    def world(parts):
+        fem = _with_lines(cell("six-9", split, analysis.YARDSTICK_MODEL, 0.0, n=9,
+                               load="linear", family="fem", disp_rel_l2=0.0), 0 * lines)
+        return [fem] + [_with_lines(cell("six-9", split, f"m{i}", 0.0, n=9, load="linear",
+                                         disp_rel_l2=0.01 * (i + 1)), p * lines)
+                        for i, p in enumerate(parts)]
+    rises = analysis.node_consistency(world([1e-3 * (i + 1) for i in range(12)]))["rows"][0]
+    assert rises["verdict"] == "tracks" and rises["rho"] == pytest.approx(1.0)
+    falls = analysis.node_consistency(world([1e-3 * (12 - i) for i in range(12)]))["rows"][0]
+    assert falls["verdict"] == "does not track"
+    tiny = analysis.node_consistency(world([1e-20 * (i + 1) for i in range(12)]))["rows"][0]
+    assert tiny["verdict"].startswith("not testable: 0 of 12 node-level parts resolved")

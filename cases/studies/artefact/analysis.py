@@ -909,6 +909,50 @@ def consistency(cells):
             "testable": any(not r["verdict"].startswith("not testable") for r in rows)}
 
 
+def node_consistency(cells):
+    """Hypothesis (c) read at the side nodes: per conforming mesh from DECISIVE layers, on the
+    sliding base at the linear load (one regime, a patch test), the rank correlation over the
+    distinct models (the control left out; models agreeing to SAME in both counted once)
+    between the node-level part (``node_part`` rms against FEM P1 on the same tetrahedra)
+    and the patch-test error (disp_rel_l2 at that load), with its 95 % interval; 'not
+    testable' where fewer than MIN_RESOLVED parts are resolved (RATIO times ``node_u``)."""
+    at = _index(cells)
+    rows = []
+    for mesh, n, split in sorted({(c["mesh"], c["nodes_per_side"], c["split"]) for c in cells
+                                  if c["nodes_per_side"] >= DECISIVE and c["split"] != UNMIRRORED
+                                  and c["bc"] == "sliding" and c["load"] == "linear"}):
+        fem = at.get((YARDSTICK_MODEL, split, n, "sliding", "linear"))
+        u = node_u(fem)
+        if u is None:
+            continue
+        pts, resolved = [], []
+        for c in cells:
+            if ((c["mesh"], c["bc"], c["load"]) != (mesh, "sliding", "linear")
+                    or c["family"] == CONTROL or c.get("failed")
+                    or c.get("disp_rel_l2") is None):
+                continue
+            rms, _ = node_part(c, fem)
+            if rms is None:
+                continue
+            if any(same(rms, a, SAME) and same(c["disp_rel_l2"], b, SAME) for a, b in pts):
+                continue        # one observation with a model counted before it
+            pts.append((rms, c["disp_rel_l2"]))
+            if against(rms / u, RATIO) == "above":
+                resolved.append(short(c["model"]))
+        if len(pts) < 3:
+            continue
+        part, err = np.array(pts).T
+        rho = float(spearmanr(part, err).statistic) if np.ptp(part) and np.ptp(err) else None
+        ci = rank_interval(rho, len(pts))
+        verdict = (f"not testable: {len(resolved)} of {len(pts)} node-level parts resolved, "
+                   f"fewer than {MIN_RESOLVED}" if len(resolved) < MIN_RESOLVED
+                   else _track(rho, ci))
+        rows.append({"mesh": mesh, "models": len(pts), "resolved": len(resolved), "u": u,
+                     "rho": rho, "interval": ci, "verdict": verdict})
+    return {"rows": rows,
+            "testable": any(not r["verdict"].startswith("not testable") for r in rows)}
+
+
 def consistency_across(cells):
     """Hypothesis (c) read within one model across the splits: on the sliding base at the
     linear load (a patch test) from DECISIVE layers, per distinct model (its controls its held
@@ -1566,7 +1610,7 @@ def distinct_pairs(pairs):
     return kept
 
 
-def verdict_lines(sign_rows, nodes, ns, cs, fem_units, size=None):
+def verdict_lines(sign_rows, nodes, ns, cs, fem_units, size=None, nc=None):
     """The answer in one sentence per hypothesis, with the counts and ranges that decide it,
     after ``size`` (``size_line``): (a) at the side nodes (the largest size per base) and in
     the layer mean, by sign, with the parts the runs leave open and why; (b) the
@@ -1658,7 +1702,14 @@ def verdict_lines(sign_rows, nodes, ns, cs, fem_units, size=None):
     out.append(f"(c) Consistency: {word}" + (
         f" ({'; '.join(r['mesh'] + ': ' + r['verdict'] for r in cs['rows'])})"
         if cs.get("rows") else "") + "; the linear load, which (c) reads, is run at 9 nodes, "
-        "not at 17.")
+        "not at 17" + (
+            "; at the side nodes (each model's node-level part against its patch-test error, "
+            "both of the same sliding run at the linear load, so partly one measurement): "
+            + "; ".join(f"{r['mesh']}: {r['verdict']}" + (
+                f" (rho {r['rho']:.2f} [{r['interval'][0]:.2f}, {r['interval'][1]:.2f}], "
+                f"{r['models']} distinct models)" if r["rho"] is not None
+                and r.get("interval") else "") for r in nc["rows"])
+            if nc and nc.get("rows") else "") + ".")
     return out
 
 
@@ -1856,8 +1907,10 @@ def answer(cells, models=None, estimates=None):
         top = max(rows, key=lambda r: abs(r["own"]), default=None)
         largest[_where((u["n"], u["bc"]))] = None if top is None else [top["name"],
                                                                       top["own"]]
+    nc = node_consistency(cells)
+    hyp["node_consistency"] = nc
     verdicts = verdict_lines(sign_rows, nodes, ns, cs, fem_units,
-                             size_line(m["orders"], below, largest, dec))
+                             size_line(m["orders"], below, largest, dec), nc)
     return {**base, "decided": bool(causes), "cause": lead, "text": text, "numbers": text,
             "verdicts": verdicts,
             "clear": any(r["clear"] == "above" for u in seen_at for r in u["rows"]
