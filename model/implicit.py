@@ -20,8 +20,8 @@ from .bc import bc_arrays
 from .errors import BlowUpError, ConvergenceError, ModelError
 from .geometry import min_signed_volume
 from .integrate import Trajectory
-
 from .presets import FRAME_S, HAPTIC_S  # noqa: F401 (the steps simulators run at)
+
 NEWTON_RTOL = 1e-8          # |R| over the step's inertial force scale at which Newton stops
 CG_RTOL = 1e-10             # each Newton system's relative residual
 MAX_NEWTON = 20
@@ -67,6 +67,7 @@ def backward_euler(model, bc_of_t, t_end, dt, damping=0.0, f_ext=None, frames=10
     guess = np.zeros(int(free.sum()))
     newton_total = cg_total = 0
     largest = 0.0
+    f_old = model.forces(x)       # the forces at the step's start: the last Newton evaluation
     extent = float(np.ptp(mesh.points, axis=0).max())
 
     def record(k, x):
@@ -84,12 +85,13 @@ def backward_euler(model, bc_of_t, t_end, dt, damping=0.0, f_ext=None, frames=10
         # force on the free nodes, never below a millionth of the largest seen (at rest both
         # vanish and the residual is round-off)
         scale = max(float(np.abs(inertia * (x - x_old).ravel()).max()),
-                    float(np.abs(model.forces(x_old) + f_ext)[~mask].max(initial=0.0)),
+                    float(np.abs(f_old + f_ext)[~mask].max(initial=0.0)),
                     SCALE_FLOOR * largest, 1e-300)
         largest = max(largest, scale)
         for it in range(max_newton + 1):
+            f_old = model.forces(x)
             r = (inertia.reshape(x.shape) * (x - x_old) - m3.reshape(x.shape) / dt * v_old
-                 - model.forces(x) - f_ext).ravel()[free]
+                 - f_old - f_ext).ravel()[free]
             if np.abs(r).max() <= newton_rtol * scale:
                 break
             if it == max_newton:
