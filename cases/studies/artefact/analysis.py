@@ -1462,7 +1462,7 @@ def mesh_pick(resolved, mirrors, against_, fem_units, nodes, stiffer=()):
     for x in nodes["units"]:
         # the ratio's lower bound: a control below its u may be 0
         got = [r["mirror_lo"] for r in x["rows"]
-               if r["resolved"] == "above" and r.get("mirror_lo") is not None]
+               if r.get("mirror_vs") == "above" and r.get("mirror_lo") is not None]
         if got:
             ratios[_where((x["n"], x["bc"]))] = (float(np.median(got)), min(got), max(got))
     if against_ or not (mirrors or node_mirror or fem_units):
@@ -1472,7 +1472,7 @@ def mesh_pick(resolved, mirrors, against_, fem_units, nodes, stiffer=()):
             "least "
             + ", ".join(f"{w} {times(v[0])} [{times(v[1])}-{times(v[2])}]"
                         for w, v in ratios.items())
-            + f" (median [range] over the models of the lower bounds), {len(node_mirror)} of "
+            + f" (median [range] of the lower bounds over the mirror's parts), {len(node_mirror)} of "
             f"{len(node_rows)} "
             "resolved parts (a model on a configuration each) the mirror's, the others not "
             "decided, none on every split; in "
@@ -1631,14 +1631,16 @@ def verdict_lines(sign_rows, nodes, ns, cs, fem_units, size=None, nc=None):
         res = [r for r in fine["rows"] if r["resolved"] == "above"]
         mir = [r for r in res if r.get("mirror_vs") == "above"]
         # the ratio's lower bound (a control below its u may be 0: the point value overstates)
-        ratios = sorted(r["mirror_lo"] for r in res if r.get("mirror_lo") is not None)
+        # over the parts called the mirror's alone (an open part's ratio decides nothing)
+        ratios = sorted(r["mirror_lo"] for r in mir if r.get("mirror_lo") is not None)
         node_bits.append(
             f"{bc} base, {fine['n']} nodes: {len(mir)} of {len(res)} resolved parts the "
             "mirror's" + (f" ({len(res) - len(mir)} not decided: "
                           f"{_open_reasons([r for r in res if r.get('mirror_vs') == 'at'])})"
                           if len(res) > len(mir) else "")
             + (f", mirrored over its larger control at least {times(float(np.median(ratios)))} "
-               f"(median of the lower bounds; {times(ratios[0])}-{times(ratios[-1])})"
+               f"(median of the lower bounds over the mirror's parts; "
+               f"{times(ratios[0])}-{times(ratios[-1])})"
                if ratios else "")
             + f"; its strain goes as h^{np.median(v):.2f} from {o['sizes'][0]} to "
             f"{o['sizes'][1]} nodes ({v[0]:.2f} to {v[-1]:.2f} over {len(v)} models; beyond "
