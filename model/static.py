@@ -184,7 +184,8 @@ def _predicted(x, r, before, last, s, free, residual):
     return x, r
 
 
-def solve(model, bc, f_ext=None, rtol=RTOL, max_iter=50, load_steps=1, on_step=None):
+def solve(model, bc, f_ext=None, rtol=RTOL, max_iter=50, load_steps=1, on_step=None,
+          stall=None):
     """Solve f_int(x) + f_ext = 0 on the free components, prescribed ones set from ``bc``.
 
     Newton in ``load_steps`` equal increments of the prescribed displacement and of ``f_ext``
@@ -196,7 +197,10 @@ def solve(model, bc, f_ext=None, rtol=RTOL, max_iter=50, load_steps=1, on_step=N
     residual by CHORD_GAIN, which saves the finite-difference Jacobian and its factorisation
     in the last iterations. A full Newton step is kept where it raises the residual less than
     GROWTH times, under a watchdog (WATCH); otherwise, and for the rest of a step whose watch
-    failed, the step is halved until the residual falls. Raises ConvergenceError otherwise.
+    failed, the step is halved until the residual falls. Raises ConvergenceError otherwise,
+    and, where ``stall`` is given, as soon as ``stall`` Newton iterations in a row have not
+    halved the load step's residual (a stalled step: on a large mesh each of its iterations
+    factorises a Newton matrix, and a caller splitting the load learns it sooner).
     """
     mesh = model.mesh
     mask, vals = bc_arrays(bc, mesh.n_nodes)
@@ -229,10 +233,19 @@ def solve(model, bc, f_ext=None, rtol=RTOL, max_iter=50, load_steps=1, on_step=N
         if before is not None:
             x, r = _predicted(x, r, before, (s_last, x_last), s, free, residual)
         anchor, watched, monotone = None, 0, False
+        mark, since = np.inf, 0     # the residual last halved to, and iterations since
         for _ in range(max_iter):
             rn = np.abs(r[free]).max(initial=0.0)
             if rn <= tol:
                 break
+            if rn <= 0.5 * mark:
+                mark, since = rn, 0
+            elif stall is not None and since >= stall:
+                raise ConvergenceError(
+                    f"static solve stalled at load step {step}/{load_steps}: {stall} Newton "
+                    f"iterations did not halve the residual {mark:.3e} N (tol {tol:.3e} N); "
+                    "increase load_steps")
+            since += 1
             if anchor is not None:
                 if rn < anchor[2]:
                     anchor = None

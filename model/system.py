@@ -150,10 +150,10 @@ class ParticleModel:
         return jacobian(self.forces, self.mesh, x, self._jacobian_pattern)
 
     def solve_static(self, bc, f_ext=None, rtol=STATIC_RTOL, max_iter=50, load_steps=1,
-                     on_step=None):
+                     on_step=None, stall=None):
         """Equilibrium f_int(x) + f_ext = 0 on the free components (see model.static.solve)."""
         return static_solve(self, bc, f_ext=f_ext, rtol=rtol, max_iter=max_iter,
-                            load_steps=load_steps, on_step=on_step)
+                            load_steps=load_steps, on_step=on_step, stall=stall)
 
     def simulate(self, bc_of_t, t_end, dt=None, damping=0.0, f_ext=None, frames=101, safety=0.5,
                  x0=None, v0=None, t0=0.0):

@@ -1036,19 +1036,45 @@ def test_a_held_shear_constant_is_the_calibrated_readings_fit_on_the_named_mesh(
     of the same size ('five') or on its own mesh ('this mesh'); a model without one is built
     as named."""
     from model import Material, build
-    from cases.studies.artefact.study import MIRRORED_FIVE, SAME_MESH, held_shear, make_mesh
+    from cases.studies.artefact.study import (MIRRORED_FIVE, SAME_MESH, held, held_constants,
+                                              make_mesh)
     s = type("S", (), {"material": Material(E=10e3, nu=0.45)})()
     six = make_mesh("six", ("six", 5, 0))
     five = make_mesh("five", ("five", 5, 0))
     fit = {k: build("pbcm-balanced", m, s.material)
            .info["shear_c"] for k, m in (("five", five), ("six", six))}
-    on_five = held_shear({"reading": "balanced", "shear_c_of": MIRRORED_FIVE},
-                         ("six", 5, 0), six, s)
-    on_six = held_shear({"reading": "balanced", "shear_c_of": SAME_MESH}, ("six", 5, 0), six, s)
-    assert on_five == {"shear": {"c": pytest.approx(fit["five"])}}
-    assert on_six == {"shear": {"c": pytest.approx(fit["six"])}}
+    reading = {"reading": "balanced", "normal": "none"}
+    on_five = held_constants(held("pbcm-balanced"), {**reading, "shear_c_of": MIRRORED_FIVE},
+                             ("six", 5, 0), six, s)
+    on_six = held_constants("pbcm-balanced", {**reading, "shear_c_of": SAME_MESH},
+                            ("six", 5, 0), six, s)
+    assert on_five == ({"shear": {"c": pytest.approx(fit["five"])}}, {})
+    assert on_six == ({"shear": {"c": pytest.approx(fit["six"])}}, {})
     assert fit["five"] != pytest.approx(fit["six"], rel=1e-3)
-    assert held_shear({"reading": "balanced"}, ("six", 5, 0), six, s) == {}
+    assert held_constants("pbcm-balanced", reading, ("six", 5, 0), six, s) == ({}, {})
+
+
+def test_a_held_twin_of_a_fitted_normal_term_takes_every_constant_of_the_mirrored_split():
+    """The held twin of a reading with a fitted normal term is built on a control split with
+    the shear's c and the term's c_n that the model itself fits on the mirrored five split of
+    the same size, so that the two differ in the split alone."""
+    from model import Material
+    from cases.studies.artefact.study import _built, held, make_mesh, model_specs
+    from model.compose import label
+    s = type("S", (), {"material": Material(E=10e3, nu=0.45)})()
+    m = label("pbcm-variational + normal_edge(c=auto)")
+    specs = model_specs()
+    five_spec, six_spec = ("five", 5, 0), ("six", 5, 0)
+    five, six = make_mesh("five", five_spec), make_mesh("six", six_spec)
+    own_five, dropped = _built(m, specs[m], five_spec, five, s)
+    own_six, _ = _built(m, specs[m], six_spec, six, s)
+    twin, twin_dropped = _built(held(m), specs[held(m)], six_spec, six, s)
+    assert not dropped and not twin_dropped
+    for c in ("shear_c", "normal_edge_c"):
+        assert twin.info[c] == pytest.approx(own_five.info[c], rel=1e-12)
+    assert own_six.info["normal_edge_c"] != pytest.approx(own_five.info["normal_edge_c"],
+                                                         rel=1e-3)
+    assert twin.mesh is six
 
 
 def test_a_mirror_read_against_controls_with_other_fitted_constants_is_not_decided(nine_decides):

@@ -115,6 +115,25 @@ def test_static_errors(mat):
         pm.solve_static(bc)
 
 
+def test_a_load_step_whose_residual_does_not_halve_is_called_stalled_only_when_asked(mat):
+    """With ``stall`` given, a load step whose Newton iterations have not halved its residual
+    that many times in a row raises a ConvergenceError naming the stall (here a Jacobian
+    1000 times too stiff makes every step a thousandth of Newton's); without it the same
+    solve runs to max_iter; a solve that converges is the same with and without it."""
+    mesh = cube(3, L, "five")
+    pm = build("pbcm-variational", mesh, mat)
+    _, _, bc = cube_bc(mesh, -0.05 * L)
+    plain = pm.solve_static(bc)
+    guarded = pm.solve_static(bc, stall=3)
+    assert np.array_equal(plain.u, guarded.u) and plain.iterations == guarded.iterations
+    exact = pm.jacobian
+    pm.jacobian = lambda x: 1e3 * exact(x)
+    with pytest.raises(ConvergenceError, match="stalled at load step 1/1: 3 Newton iterations"):
+        pm.solve_static(bc, stall=3)
+    with pytest.raises(ConvergenceError, match="did not converge in 8 Newton iterations"):
+        pm.solve_static(bc, max_iter=8)
+
+
 def test_a_newton_direction_that_inverts_a_tetrahedron_at_every_length_is_a_convergence_error():
     """Where every backtracked Newton step inverts a tetrahedron, the solve raises a
     ConvergenceError (naming the tetrahedron and asking for more load steps), the error a

@@ -31,6 +31,10 @@ STATIC_RTOL = 1e-10
 # the push split into up to 32 equal steps before a cell is called failed: the finest meshes'
 # first failures (an inverted tetrahedron at 8 steps) are told from a load-path problem
 SPLITS_TRIED = LOAD_SPLITS + (16, 32)
+# a load step whose residual 10 Newton iterations in a row have not halved is split more finely
+# (each such iteration factorises a Newton matrix; on the finest bcc about 10 s); a Newton step
+# that converges halves it in one or two
+STALL = 10
 REF_MESH = ("six", 5)         # the reference's own mesh (refined REF_LEVELS times, P2)
 REF_LEVELS = 2               # two refinements: its own period-2 error 1.4e-5 on 17 clamped layers
 QUICK_REF_LEVELS = 1         # a preview's reference (its 9-node meshes decide nothing)
@@ -69,19 +73,20 @@ def model_specs(quick=False):
         out[label(f"pbcm-balanced + {form}(c={FIXED_NORMAL_C:g})")] = {
             "family": "particle", "reading": "balanced", "constant": "calibrated",
             "normal": fixed_normal(form), "shear_c_of": SAME_MESH}
-    # each calibrated reading on the other splits with the shear's c fitted on the mirrored
-    # five split of the same size: the mirror's controls then differ from it in the split alone
-    for r in READINGS:
-        out[held(f"pbcm-{r}")] = {"family": "particle", "reading": r, "constant": HELD,
-                                  "normal": "none", "shear_c_of": MIRRORED_FIVE}
+    # each model whose constants are fitted per mesh, run on the other splits with the
+    # constants fitted on the mirrored five split of the same size (the shear's c, and a fitted
+    # normal term's c_n): the mirror's controls then differ from it in the split alone
+    for m, f in list(out.items()):
+        if f["constant"] == "calibrated":
+            out[held(m)] = {**f, "constant": HELD, "shear_c_of": MIRRORED_FIVE}
     out["msm"] = {"family": "msm", "reading": "none", "constant": "springs", "normal": "edges"}
     out[MSM_SHEAR] = {"family": "msm", "reading": "variational", "constant": "literal",
                       "normal": "edges"}
     out[YARDSTICK] = {"family": "fem", "reading": "none", "constant": "none", "normal": "fem"}
     if quick:
         keep = ("pbcm-balanced", "pbcm-variational", "pbcm-balanced-literal",
-                label("pbcm-balanced + normal_edge(c=auto)"), held("pbcm-balanced"), "msm",
-                YARDSTICK)
+                label("pbcm-balanced + normal_edge(c=auto)"), held("pbcm-balanced"),
+                held(label("pbcm-balanced + normal_edge(c=auto)")), "msm", YARDSTICK)
         out = {m: out[m] for m in keep}
     return out
 
@@ -143,20 +148,10 @@ def mesh_specs(quick=False):
 
 
 def models_on(spec, models):
-    """The models run on a mesh of ``spec``: every one, but on the finest bcc (9009 nodes,
-    49152 tetrahedra: each Newton matrix's factors hold about 5e7 entries) the models without
-    a normal-stress term only, and not msm, whose Newton solve on the sliding base stagnates
-    there (50 iterations of a load step unconverged with the push in one and in two steps, so
-    the splits up to 32 would each factorise hundreds of such matrices); there those models
-    read their mirror against the six split alone. A held model is not run on the mirrored five split, where it is its
-    calibrated reading."""
+    """The models run on a mesh of ``spec``: every one; a held model is not run on the
+    mirrored five split, where it is the model it holds the constants of."""
     kind, n, _ = spec
-    # a held model on the mirrored five split is its calibrated reading itself
-    out = [m for m, f in models.items() if not (kind == "five" and f["constant"] == HELD)]
-    if kind == "bcc" and n == max(SIZES):
-        return [m for m in out if models[m]["normal"] in ("none", "fem", "edges")
-                and m != "msm"]
-    return out
+    return [m for m, f in models.items() if not (kind == "five" and f["constant"] == HELD)]
 
 
 def loads_on(spec, loads):
@@ -266,7 +261,8 @@ def cell(pm, mesh, n, bc, load, u_ref):
     out = {"bulge_profile_fem_mm": ref_profile.tolist(), "failed": None,
            "line_alternation_fem_mm": lines(u_ref)}
     try:
-        st, steps = solve_split(pm, dirichlet, splits=SPLITS_TRIED, rtol=STATIC_RTOL)
+        st, steps = solve_split(pm, dirichlet, splits=SPLITS_TRIED, rtol=STATIC_RTOL,
+                                stall=STALL)
     except FINDINGS as exc:
         return {**out, "failed": str(exc), "bulge_profile_mm": None, "alternation_mm": None,
                 "alternation_rel": None, "disp_rel_l2": None, "load_steps": None,
@@ -314,7 +310,9 @@ def _built(model, factors, spec, mesh, s):
     """``model`` built on ``mesh`` and the constants its fit dropped ({term_c: 0.0}): a normal
     term beside a held shear whose fit comes out c_n = 0 adds nothing on this mesh, so the
     model is its reading with that shear (a finding: the pair is one observation)."""
-    params = held_shear(factors, spec, mesh, s)
+    params, dropped = held_constants(model, factors, spec, mesh, s)
+    if dropped:
+        return build(f"pbcm-{factors['reading']}", mesh, s.material, **params), dropped
     try:
         return build(builds(model), mesh, s.material, **params), {}
     except CalibrationDroppedError:
@@ -324,17 +322,29 @@ def _built(model, factors, spec, mesh, s):
             {f"{factors['normal']}_c": 0.0})
 
 
-def held_shear(factors, spec, mesh, s):
-    """``build``'s term parameters for a model whose shear c is held (``shear_c_of``): the
-    calibrated reading's fit on this mesh or on the mirrored five split of the same size;
-    none for the others."""
+def held_constants(model, factors, spec, mesh, s):
+    """``(build's term parameters, the constants dropped)`` for a model whose constants are
+    held (``shear_c_of``): the calibrated reading's shear c fitted on this mesh ('this mesh');
+    or, held from the mirrored five split of the same size ('five'), every constant ``model``'s
+    calibrated twin fits there (the shear's c, and a fitted normal term's c_n, dropped where
+    that fit gives 0); ``({}, {})`` for the others."""
     where = factors.get("shear_c_of")
     if where is None:
-        return {}
-    on = mesh if where == SAME_MESH else make_mesh(mesh_name("five", spec[1]),
-                                                  ("five", spec[1], spec[2]))
-    fitted = build(f"pbcm-{factors['reading']}", on, s.material).info["shear_c"]
-    return {"shear": {"c": float(fitted)}}
+        return {}, {}
+    if where == SAME_MESH:
+        fitted = build(f"pbcm-{factors['reading']}", mesh, s.material).info["shear_c"]
+        return {"shear": {"c": float(fitted)}}, {}
+    five_spec = ("five", spec[1], spec[2])
+    five = make_mesh(mesh_name(*five_spec[:2]), five_spec)
+    if factors["normal"] not in NORMAL_FORMS:
+        return held_constants(model, {**factors, "shear_c_of": SAME_MESH}, five_spec, five, s)
+    twin, dropped = _built(builds(model), {**factors, "constant": "calibrated",
+                                           "shear_c_of": SAME_MESH}, five_spec, five, s)
+    params = {"shear": {"c": float(twin.info["shear_c"])}}
+    if dropped:
+        return params, dropped
+    form = factors["normal"]
+    return {**params, form: {"c": float(twin.info[f"{form}_c"])}}, {}
 
 
 def _reference_unit(job):
