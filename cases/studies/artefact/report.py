@@ -267,10 +267,12 @@ def _metric_check(d, doc):
         "continuum and on every polynomial up to degree 2 (a parabolic barrel), and a pure "
         "(-1)^k pattern at its amplitude; on any other smooth field (a Gaussian bulge, an end "
         "layer) a finite set of layers leaves it a small score, the leak, which no weights "
-        "remove for every width at once. A score of exactly 0 on every smooth profile is "
-        "therefore not what is claimed: each smooth field's leak is measured here, and the "
-        "worst of them is carried in every u, so that no part a leak could make is called "
-        "resolved.")
+        "remove for every width at once. The requirement the metric was first set, a score "
+        "of 0 (to round-off) on every smooth profile, Gaussian bulges of any width above two "
+        "layers among them, cannot be met by weights on a finite set of layers, and this study "
+        "replaces it: 0 on the continuum and on the polynomials the weights absorb, each "
+        "other smooth field's leak measured here, and the worst of them carried in every u, "
+        "so that no part a leak could make is called resolved.")
     d.p("The signature's weights on test fields of each (size, base), the layers it reads "
         "(centred an eighth of a spacing off the weights' quarter-layer design grid; the "
         "widths 2 and 3, the decay 2 and, on the clamped base, the barrel are among the "
