@@ -2,6 +2,7 @@
 import math
 
 import numpy as np
+import scipy.sparse as sp
 import pytest
 
 from model import Material, build
@@ -318,3 +319,55 @@ def test_node_colours_share_no_neighbour_and_are_the_smallest_free(scheme):
         assert colour[i] not in colour[others]
         earlier = colour[others[others < i]]
         assert set(range(colour[i])) <= set(earlier)
+
+
+def _grid_laplacian(m):
+    """The 7-point Laplacian on an m^3 grid and its unknowns' positions."""
+    T = sp.diags([-1.0, 2.0, -1.0], [-1, 0, 1], shape=(m, m))
+    eye = sp.identity(m)
+    A = (sp.kron(sp.kron(T, eye), eye) + sp.kron(sp.kron(eye, T), eye)
+         + sp.kron(sp.kron(eye, eye), T)).tocsc()
+    g = np.arange(m, dtype=float)
+    return A, np.stack(np.meshgrid(g, g, g, indexing="ij"), -1).reshape(-1, 3)
+
+
+def test_a_nested_dissection_ordering_solves_the_same_system_and_is_kept_only_where_sparser(
+        mat, monkeypatch):
+    """The nested dissection is a permutation of the unknowns; factors in its order solve the
+    Newton system as minimum degree's do (to round-off); a solve keeps it only where its
+    factors hold fewer entries (the 3D Jacobian of msm on the 9-node bcc cube: yes; the
+    7-point grid Laplacian, where minimum degree fills less: no) and never tries it below
+    DISSECT_FROM unknowns; positions that do not match the unknowns are refused."""
+    import model.static as static
+    from model.ordering import nested_dissection
+    mesh = cube(9, L, "bcc")
+    pm = build("msm", mesh, mat)
+    J = pm.jacobian(mesh.points).tocsc()
+    free = np.ones(J.shape[0], bool)
+    free[:3 * 81] = False                  # some fixed nodes: a non-singular matrix
+    A = J[free][:, free].tocsc()
+    xyz = np.repeat(mesh.points, 3, axis=0)[free]
+    order = nested_dissection(A, xyz)
+    assert np.array_equal(np.sort(order), np.arange(A.shape[0]))
+    b = np.sin(np.arange(A.shape[0], dtype=float))
+    plain, dissected = static.factorise(A), static.factorise(A, order)
+    x = plain.solve(b)
+    assert np.abs(dissected.solve(b) - x).max() < 1e-10 * np.abs(x).max()
+    assert A.shape[0] >= static.DISSECT_FROM
+    chooser = static.Factoriser(xyz)
+    kept = chooser(A)
+    assert chooser.order is not None and np.array_equal(chooser.order, order)
+    assert kept.L.nnz + kept.U.nnz < plain.L.nnz + plain.U.nnz
+    assert np.abs(chooser(A).solve(b) - x).max() < 1e-10 * np.abs(x).max()
+    lap, where = _grid_laplacian(16)
+    by_degree = static.Factoriser(where)
+    by_degree(lap)
+    assert by_degree.order is None
+    def never(*a):
+        raise AssertionError("dissected below DISSECT_FROM")
+    monkeypatch.setattr(static, "nested_dissection", never)
+    small = static.Factoriser(xyz[:300])
+    small(A[:300][:, :300])
+    assert small.order is None
+    with pytest.raises(ValueError, match="one per row"):
+        nested_dissection(A, xyz[:10])
