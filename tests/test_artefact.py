@@ -1340,3 +1340,32 @@ def test_consistency_at_the_side_nodes_tracks_a_part_that_grows_with_the_patch_e
     read = analysis.node_consistency(world([1e-3 * (12 - i) for i in range(12)],
                                            [1e-3 * (i + 1) for i in range(12)]))["rows"][0]
     assert read["verdict"] == "does not track"
+
+
+def test_the_short_answer_says_each_hypothesis_with_the_numbers_that_decide_it(nine_decides):
+    """On a world whose pattern is on the mirrored split alone, the opening's plain answer
+    calls (a) the mirror's with the counts of resolved parts, none on every split; (b) not
+    tested where no term is active beside a resolved part; and a row per question."""
+    a = analysis.answer(_world(_mirror_world))
+    rows = {r[0]: r for r in a["short_rows"]}
+    mirror = rows["(a) The mirror symmetry of the five split?"]
+    assert mirror[1].startswith("yes, where decided")
+    assert "6 of 6 with the paper's sign the mirror's, 0 on every split" in mirror[2]
+    assert rows["(b) The missing normal stress?"][1] == "not tested"
+    assert len(a["short"]) == len(a["short_rows"]) == 4
+    assert a["short"][1] == ("(a) The mirror symmetry of the five split? yes, where decided: "
+                             "every decided part is the mirrored split's, none is on every "
+                             "split.")
+
+
+def test_the_reading_line_names_each_observable_a_reading_fails():
+    """The opening's reading sentence says 'Not decided' where no reading is decided, names
+    the readings that miss the cost and those whose stability depends on the mesh or the
+    damping, and says plainly when no reading reproduces every observable."""
+    from cases.studies.artefact.report import reading_line
+    said = reading_line({"decided": False, "cost_miss": ["a"], "cost_open": ["b"],
+                         "unstable": [], "stability_depends": ["a"],
+                         "none_reproduces": True})
+    assert said.startswith("Not decided: a miss the paper's cost")
+    assert "the cost is not decided for b" in said and "stability depends" in said
+    assert "No reading reproduces every observable the paper reports." in said

@@ -1017,9 +1017,10 @@ def _cause_numbers(art):
     if not any(c["nodes_per_side"] >= decisive for c in art.get("cells", [])):
         return (f"Quick: not decided (this run lacks the meshes of {decisive} and more nodes "
                 "per side; `pbcm run artefact` decides) ([artefact study](artefact/report.md)).")
-    # the study's one-sentence verdicts, their evidence and how sure in its report
-    said = " ".join(a.get("verdicts") or []) or a.get("text")
-    return (said + " " if said else "") + ("The evidence and how sure: the [artefact "
+    # the study's plain answer; its numbers, evidence and how sure in its report
+    said = " ".join(a.get("short") or a.get("verdicts") or []) or a.get("text")
+    return (said + " " if said else "") + ("The numbers that decide each answer, the "
+                                          "evidence and how sure: the [artefact "
                                           "study](artefact/report.md).")
 
 

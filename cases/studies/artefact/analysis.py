@@ -1734,6 +1734,73 @@ def verdict_lines(sign_rows, nodes, ns, cs, fem_units, size=None, nc=None):
 
 
 
+def short_answer(below, nodes, sign_rows, ns, cs, nc):
+    """The answer in a few plain sentences and a table, from what ``verdict_lines`` states in
+    full: ``(sentences, rows)``, a row per question (size, each hypothesis): [question,
+    answer, the numbers that decide it]."""
+    rows = []
+    if below is None:
+        rows.append(["Large enough to see (the layer mean the paper drew)?", "not decided",
+                     "no configuration's leak is below the deciding level"])
+    else:
+        rows.append(["Large enough to see (the layer mean the paper drew)?",
+                     f"no, at {below['n']} nodes per side" if below["all_below"] else
+                     f"yes, for some models at {below['n']} nodes per side",
+                     below["head"]])
+    node_said, mirror_any, every_any = [], False, False
+    for bc, o in sorted(nodes["slopes"].items()):
+        fine = next((x for x in nodes["units"] if (x["n"], x["bc"]) == (o["sizes"][1], bc)),
+                    None)
+        if fine is None:
+            continue
+        res = [r for r in fine["rows"] if r["resolved"] == "above"]
+        mir = [r for r in res if r.get("mirror_vs") == "above"]
+        every = [r for r in res if r.get("mirror_vs") == "below"]
+        mirror_any |= bool(mir)
+        every_any |= bool(every)
+        node_said.append(f"{len(mir)} of {len(res)} resolved parts are the mirror's, "
+                         f"{len(every)} on every split ({bc}, {fine['n']} nodes)")
+    layer = []
+    for s_, word in (("+", "the paper's sign"), ("-", "the reversed sign")):
+        rs = [r for _, r in sign_rows[s_]]
+        if rs:
+            mir = sum(r.get("mirror_vs") == "above" for r in rs)
+            every = sum(r.get("mirror_vs") == "below" for r in rs)
+            mirror_any |= bool(mir)
+            every_any |= bool(every)
+            layer.append(f"{mir} of {len(rs)} with {word} the mirror's, {every} on every split")
+    a_answer = ("yes, where decided: every decided part is the mirrored split's, none is on "
+                "every split" if mirror_any and not every_any else
+                "partly: some parts are on every split" if mirror_any else "not shown")
+    evidence = ((["at the side nodes: " + "; ".join(node_said)] if node_said else [])
+                + (["in the layer mean (9 and 17 nodes): " + "; ".join(layer)] if layer
+                   else []))
+    rows.append(["(a) The mirror symmetry of the five split?", a_answer,
+                 "; ".join(evidence) or "no resolved part"])
+    ps = distinct_pairs(ns.get("pairs") or [])
+    decided = [p for p in ps if p["reduced"] != "at"]
+    red = sum(p["reduced"] == "above" for p in decided)
+    rows.append(["(b) The missing normal stress?",
+                 "not tested" if not ps else "no: no term reduces the pattern" if red == 0
+                 else f"for {red} pairs",
+                 f"{red} of {len(decided)} decided pairs (a resolved part with and without "
+                 f"the term, the split held) reduced {RATIO:g}-fold; {len(ps) - len(decided)} "
+                 "not decided" if ps else "no term active beside a resolved part"])
+    node_words = [r["verdict"] for r in (nc or {}).get("rows", [])]
+    c_word = (_tracks_word(cs["rows"]) if cs.get("testable") else "not testable")
+    c_answer = ("no: the pattern does not track the patch-test error"
+                if node_words and all(w == "does not track" for w in node_words)
+                else "not decided")
+    rows.append(["(c) The model's consistency (its patch-test error)?", c_answer,
+                 f"the layer signature: {c_word}; the node-level part against the patch-test "
+                 "error of a separate run: " + (", ".join(
+                     f"{r['mesh']} {r['verdict']}" + (f" (rho {r['rho']:.2f})"
+                                                     if r["rho"] is not None else "")
+                     for r in nc["rows"]) if node_words else "not read")])
+    said = [f"{q} {a}." for q, a, _ in rows]
+    return said, rows
+
+
 def answer(cells, models=None, estimates=None):
     """The paper's question answered hypothesis by hypothesis from the configurations that
     read own parts (DECISIVE or more layers): (a) where a resolved own part is the mirror's,
@@ -1931,11 +1998,12 @@ def answer(cells, models=None, estimates=None):
     hyp["node_consistency"] = nc
     verdicts = verdict_lines(sign_rows, nodes, ns, cs, fem_units,
                              size_line(m["orders"], below, largest, dec), nc)
+    short, short_rows = short_answer(below, nodes, sign_rows, ns, cs, nc)
     if apart(us):
         verdicts.append("Not counted: " + "; ".join(apart(us)) + ": its parts are in the "
                         "tables and the two-point orders in h, not in the counts above.")
     return {**base, "decided": bool(causes), "cause": lead, "text": text, "numbers": text,
-            "verdicts": verdicts,
+            "verdicts": verdicts, "short": short, "short_rows": short_rows,
             "clear": any(r["clear"] == "above" for u in seen_at for r in u["rows"]
                          if r["same_as"] is None),
             "all_below": bool(below and below["all_below"]), "by_reading": tags,

@@ -66,18 +66,42 @@ def write(out, study, s, data):
 
 
 def conclusion(doc):
-    """The study's three lines: the cause, the reading and how sure; a quick run's are a
+    """The study's opening: the cause in plain sentences and the reading in one (the numbers
+    that decide them follow in a table and in 'The answer in full'); a quick run's is a
     preview that decides nothing."""
-    verdicts = " ".join(doc["answer"].get("verdicts") or [])
-    lines = ([f"**What causes the bulge/neck pattern.** {verdicts} The evidence, hypothesis by "
-              "hypothesis, follows."] if verdicts else []) + [
-             f"**The evidence.** {doc['answer']['text']}",
-             f"**Which reading.** {doc['verdict']['text']}", doc["how_sure"]]
     if doc["parameters"].get("quick"):     # the cells below show what it measured
         return ["**Quick: not decided** (`pbcm run artefact` decides, on meshes of 9 and 17 "
                 "nodes per side): the cells and tables below are a preview of its few meshes "
                 "and decide nothing."]
-    return lines
+    short = " ".join(doc["answer"].get("short") or [])
+    return ([f"**What causes the bulge/neck pattern.** {short} The table below gives the "
+             "numbers that decide each answer; 'The answer in full' states them with their "
+             "uncertainty."] if short else []) + [
+            f"**Which reading.** {reading_line(doc['verdict'])}",
+            "**How sure.** Each configuration is one mesh per split (n = 1); every u holds the "
+            "metric's leaks and the solver's tolerance, not the sensitivity to the fitted "
+            "constants nor a spread over meshes, so the answers are provisional on those "
+            "(in full below)."]
+
+
+def reading_line(v):
+    """The reading verdict in one sentence: decided or not, and the observables that fail."""
+    head = (f"{v['model']}, {v['sure']}" if v.get("decided") else "Not decided")
+    bits = []
+    if v.get("cost_miss"):
+        bits.append(f"{', '.join(v['cost_miss'])} miss the paper's cost (a step over 10 times "
+                    "msm's)")
+    if v.get("cost_open"):
+        bits.append(f"the cost is not decided for {', '.join(v['cost_open'])}")
+    if v.get("unstable"):
+        bits.append(f"{', '.join(v['unstable'])} grow beyond the damping we assume")
+    if v.get("stability_depends"):
+        bits.append(f"stability depends on the mesh or the damping for "
+                    f"{', '.join(v['stability_depends'])}")
+    none = (" No reading reproduces every observable the paper reports." if
+            v.get("none_reproduces") else "")
+    return (head + (": " + "; ".join(bits) if bits else "") + "." + none
+            + " The full verdict is in 'Which reading the paper used'.")
 
 
 def _sig(x):
@@ -132,6 +156,13 @@ def build(out, study, s, doc):
     out = Path(out)
     d = Document(f"pbcm report: {study.name}")
     d.opening(conclusion(doc))
+    if not doc["parameters"].get("quick") and doc["answer"].get("short_rows"):
+        d.table(["question", "answer", "the numbers that decide it"],
+                doc["answer"]["short_rows"])
+        d.h(2, "The answer in full")
+        d.ul(["**What causes the bulge/neck pattern.** " + v if i == 0 else v
+              for i, v in enumerate(doc["answer"].get("verdicts") or [])]
+             + [f"**The evidence.** {doc['answer']['text']}", doc["how_sure"]])
     d.p("Every cell's numbers: [cells.md](cells.md). The report is drawn again from the stored "
         "cells with `pbcm run artefact --rewrite`; without `--rewrite` every cell is "
         "computed again.")
@@ -572,6 +603,7 @@ def _reading(d, s, doc):
               if r["paper_push_disp_median"] is not None]
     est = refs.get("clamped/paper")
     ranks = est is not None and finite and est <= min(finite) / 5
+    d.p(f"**Which reading.** {doc['verdict']['text']}")
     d.p("The verdict is the opening's; per model on the paper's lattice (5 nodes per side). "
         "Scored: the cost, the paper's Figure 2 (the time of one step over msm's, more than "
         f"{PAPER_COST:g}: the bench's in-round RK4 step ratio on the 320-tetrahedron five "
