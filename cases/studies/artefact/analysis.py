@@ -1686,7 +1686,7 @@ def verdict_lines(sign_rows, nodes, ns, cs, fem_units, size=None, nc=None):
             "order; the u of e holds neither the fitted constants nor a spread over meshes); "
             "whether the mirror alone causes it is "
             "decided model by model, against each model's own parts on the conforming splits "
-            "it ran (six, and bcc where run: cells.md shows each hole): "
+            "it ran (six and bcc; cells.md shows every failed cell): "
             + "; ".join(node_bits)
             + (". In the layer mean, which averages it across each face (model cells at the "
                "push, 9 and 17 nodes, both bases, each configuration one mesh pair): "
