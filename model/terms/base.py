@@ -32,6 +32,10 @@ class Term:
         to ``kernel()`` (model.terms._threads); None, the default, runs the serial kernel;
     ``forces_numpy(x)``
         the same forces in plain numpy, written from the formula, for the tests;
+    ``tangent(x)``
+        optional: d forces / d x (sparse, 3n x 3n) in closed form; where every term of a
+        model has one, its Newton solves and implicit steps use them instead of a coloured
+        finite difference;
     ``energy(x)``
         for a conservative term;
     ``calibrate``, ``coef``, ``unit_energy(x)`` and ``calibration_residuals(x, rows)``
