@@ -165,3 +165,32 @@ def test_bench_refuses_a_device_it_cannot_time_on_before_timing(tmp_path, capsys
     said = capsys.readouterr()
     assert "--device nonsense" in said.err and "bench:" not in said.out
     assert not out.exists()
+
+
+def test_the_implicit_presets_are_timed_per_simulated_second_beside_the_explicit_ones():
+    """An implicit preset named to the bench is timed a step per round on the bench's push
+    (positive time, at least one Newton iteration and one CG iteration per Newton system) and
+    its CPU time per simulated second is its step's time over its own step; it is not timed
+    as an explicit model."""
+    from cases.tools import bench
+    data = bench.run(sizes=(100,), models=["msm", "fem-corotated-implicit-frame"], rounds=2,
+                     progress=lambda *_: None, with_engines=False)
+    assert {r["model"] for r in data["rows"]} == {"msm"}
+    (row,) = data["implicit_rows"]
+    assert row["model"] == "fem-corotated-implicit-frame" and row["tets"] == 135
+    assert row["us_per_step"] > 0 and row["newton_per_step"] >= 1 and row["cg_per_newton"] >= 1
+    assert row["cpu_s_per_simulated_s"] == pytest.approx(row["us_per_step"] * 1e-6 * 60.0)
+
+
+def test_real_time_is_the_largest_size_measured_at_one_cpu_second_per_simulated_second():
+    """A model runs in real time at a size where its CPU time per simulated second is at most
+    1; its reach is the largest such size measured, None where no size is; a row without a
+    measured cost per simulated second is not read."""
+    from cases.tools import bench
+    data = {"rows": [{"model": "a", "tets": 100, "cpu_s_per_simulated_s": 0.1},
+                     {"model": "a", "tets": 1000, "cpu_s_per_simulated_s": 1.0},
+                     {"model": "a", "tets": 10000, "cpu_s_per_simulated_s": 9.0},
+                     {"model": "a", "tets": 100000},
+                     {"model": "b", "tets": 100, "cpu_s_per_simulated_s": 1.5}],
+            "implicit_rows": [{"model": "c", "tets": 100, "cpu_s_per_simulated_s": 0.5}]}
+    assert bench.real_time_reach(data) == {"a": 1000, "b": None, "c": 100}

@@ -19,6 +19,8 @@ import numba
 from numba import njit
 
 from model import PRESETS, build
+from model.implicit import backward_euler
+from model.presets import IMPLICIT_STEP
 from model.bc import Ramp
 from model.calibrate import calibrate
 from model.integrate import STEP_BUFFERS, rk4_ramp, total_forces
@@ -39,6 +41,11 @@ QUICK_SIZES = (1e2, 1e3)
 BASELINES = ("msm", "fem-linear")
 SAMPLE_S = 0.02          # each timing sample runs at least this long (many calls if need be)
 ENGINE_REFERENCE = "fem-neohookean"   # what the optional engines' forces are compared with
+# the implicit presets' steps are timed up to this size: each solves a Newton system by
+# conjugate gradients whose iterations grow with the mesh
+IMPLICIT_TETS = 2e4
+DAMPING = 50.0           # the push's mass damping [1/s] (the paper cube's)
+REAL_TIME = 1.0          # CPU seconds per simulated second at which a model runs in real time
 
 
 @njit   # not cached: it takes the kernels (see model.integrate)
@@ -80,10 +87,7 @@ class _Timed:
         if any(threaded) and numba.config.NUMBA_NUM_THREADS >= 2:
             numba.set_num_threads(2)
             self.kernels_2 = tuple(k or t.kernel() for k, t in zip(threaded, self.pm.terms))
-        side = CUBE_MM * MM
-        top, bot = mesh.nodes_on_plane("y", side), mesh.nodes_on_plane("y", 0.0)
-        ramp = Ramp(top, (0.0, -0.01 * side, 0.0), 1.0, fixed=bot)   # 1 % in one second
-        mask, start, moving = ramp.parts(mesh.n_nodes)
+        mask, start, moving = _push(mesh).parts(mesh.n_nodes)
         self.x, self.v = mesh.points.copy(), np.zeros_like(mesh.points)
         self.out = np.zeros_like(mesh.points)
         self.step_args = (mesh.points, self.pm.mass, np.zeros_like(mesh.points), 50.0, mask,
@@ -129,6 +133,52 @@ class _Timed:
             _force_loop(self.kernels_2, self.x, self.out, self.reps_force)
             speedup = (w1 - w0) / (time.perf_counter() - w1)
         return (t1 - t0) * 1e-9 / self.reps_force, (t2 - t1) * 1e-9 / self.reps_step, speedup
+
+
+def _push(mesh):
+    """The bench's push: the top moved down 1 % of the side in one second, the base held."""
+    side = CUBE_MM * MM
+    top, bot = mesh.nodes_on_plane("y", side), mesh.nodes_on_plane("y", 0.0)
+    return Ramp(top, (0.0, -0.01 * side, 0.0), 1.0, fixed=bot)
+
+
+class _ImplicitTimed:
+    """An implicit preset (backward Euler at its own step) on the bench's push, timed one
+    step per sample, each sample going on from the last state: thread CPU time per step, and
+    the Newton and conjugate-gradient iterations it took."""
+
+    def __init__(self, name, mesh, mat):
+        self.pm = build(name, mesh, mat)
+        self.dt, self.ramp = IMPLICIT_STEP[name], _push(mesh)
+        self.x, self.v, self.t = mesh.points.copy(), np.zeros_like(mesh.points), 0.0
+        self._step()       # the first step builds the Jacobian's pattern: outside the timings
+
+    def _step(self):
+        stats = {}
+        run = backward_euler(self.pm, self.ramp, self.t + self.dt, self.dt, damping=DAMPING,
+                             frames=2, x0=self.x, v0=self.v, t0=self.t, stats=stats)
+        self.x, self.v, self.t = run.x[-1], run.v, self.t + self.dt
+        return stats
+
+    def sample(self):
+        """(seconds per step, Newton iterations, conjugate-gradient iterations)."""
+        t0 = time.thread_time_ns()
+        stats = self._step()
+        return ((time.thread_time_ns() - t0) * 1e-9, stats["newton_iterations"],
+                stats["cg_iterations"])
+
+
+def implicit_row(name, mesh, samples, rounds):
+    """The bench row of an implicit preset from its samples (seconds, Newton, CG) per round."""
+    own = np.array(samples, dtype=float)
+    dt = IMPLICIT_STEP[name]
+    step = float(np.median(own[:, 0]))
+    return {"model": name, "tets": mesh.n_tets, "nodes": mesh.n_nodes,
+            "us_per_step": step * 1e6, "dt_us": dt * 1e6,
+            "cpu_s_per_simulated_s": step / dt,
+            "newton_per_step": float(np.median(own[:, 1])),
+            "cg_per_newton": float(np.median(own[:, 2] / np.maximum(own[:, 1], 1))),
+            "rounds": rounds}
 
 
 class _EngineTimed:
@@ -194,10 +244,13 @@ def run(sizes=SIZES, models=None, rounds=7, progress=print, with_engines=True, d
     """Measure every model at every size; returns the bench document (plain data). The
     baselines (msm, fem-linear) are always timed, for the ratios; the other engines only with
     ``with_engines``. With a Warp ``device`` (``cpu``, ``cuda``, ``cuda:1`` ...) the Warp
-    kernels of the covered models are timed there too (``device_rows``)."""
+    kernels of the covered models are timed there too (``device_rows``). The implicit
+    presets' steps (every one without ``models``, else those it names) are timed in the same
+    rounds up to IMPLICIT_TETS (``implicit_rows``)."""
     if not models:      # every preset and the normal-stress candidates of `pbcm run extensions`
-        models = [*PRESETS, *CANDIDATES]
-    models = list(models)
+        models = [*PRESETS, *CANDIDATES, *IMPLICIT_STEP]
+    implicit = [m for m in models if m in IMPLICIT_STEP]
+    models = [m for m in models if m not in IMPLICIT_STEP]
     timed_models = models + [b for b in BASELINES if b not in models]
     if with_engines and any(e.installed() for e in ENGINES.values()) \
             and ENGINE_REFERENCE not in timed_models:
@@ -205,7 +258,7 @@ def run(sizes=SIZES, models=None, rounds=7, progress=print, with_engines=True, d
     mat = DEFAULT_MATERIAL
     for name in timed_models:   # load every module once, so that memory counts the model only
         build(name, bench_mesh(1), mat)
-    rows, engine_rows, engines, device_rows = [], [], {}, []
+    rows, engine_rows, engines, device_rows, implicit_rows = [], [], {}, [], []
     for target in sizes:
         mesh = bench_mesh(target)
         progress(f"bench: {mesh.n_tets} tetrahedra, {len(timed_models)} models")
@@ -215,14 +268,21 @@ def run(sizes=SIZES, models=None, rounds=7, progress=print, with_engines=True, d
         for name, line in status.items():
             if line not in engines.setdefault(name, []):
                 engines[name].append(line)
+        stepped = {name: _ImplicitTimed(name, mesh, mat) for name in implicit
+                   if mesh.n_tets <= IMPLICIT_TETS}
         samples = {name: [] for name in timed}
         engine_samples = {name: [] for name in timers}
+        implicit_samples = {name: [] for name in stepped}
         for _ in range(rounds):       # round-robin: one sample of every model per round
             stop.checkpoint()
             for name, t in timed.items():
                 samples[name].append(t.sample())
             for name, t in timers.items():
                 engine_samples[name].append(t.sample())
+            for name, t in stepped.items():
+                implicit_samples[name].append(t.sample())
+        implicit_rows += [implicit_row(name, mesh, got, rounds)
+                          for name, got in implicit_samples.items()]
         for name, own in engine_samples.items():
             own, ref = np.array(own), np.array(samples[ENGINE_REFERENCE])[:, 0]
             engine_rows.append({"engine": name, "tets": mesh.n_tets,
@@ -256,7 +316,7 @@ def run(sizes=SIZES, models=None, rounds=7, progress=print, with_engines=True, d
         del timed, timers
     data = {"machine": _machine(), "sizes": [int(s) for s in sizes], "rows": rows,
             "engines": {k: "; ".join(v) for k, v in engines.items()},
-            "engine_rows": engine_rows}
+            "engine_rows": engine_rows, "implicit_rows": implicit_rows}
     if device is not None:
         from . import warp_forces
         data.update(device=warp_forces.device_name(device), device_rows=device_rows)
@@ -268,10 +328,13 @@ def merge(old, new):
     Each row's ratios were taken in its own process against the baselines timed with it, so
     rows of separate runs stay comparable; the baselines' own rows, and the engines, stay
     ``old``'s, so that costs computed from them elsewhere do not move."""
-    keys = {(r["model"], r["tets"]) for r in new["rows"]}
-    rows = [r for r in old["rows"] if (r["model"], r["tets"]) not in keys] + new["rows"]
+    def merged(key):
+        got = new.get(key, [])
+        keys = {(r["model"], r["tets"]) for r in got}
+        return [r for r in old.get(key, []) if (r["model"], r["tets"]) not in keys] + got
     sizes = sorted(set(old["sizes"]) | set(new["sizes"]))
-    return {**old, "sizes": sizes, "rows": rows}
+    return {**old, "sizes": sizes, "rows": merged("rows"),
+            "implicit_rows": merged("implicit_rows")}
 
 
 def _machine():
@@ -325,6 +388,23 @@ def write(data, out):
                 fmt(r["memory_mb"], 3),
                 "-" if r.get("two_thread_speedup") is None else fmt(r["two_thread_speedup"])]
                for r in rows])
+    per_second = per_simulated_second(data)
+    if per_second:
+        doc.p("One simulated second (the bench's push, 1 % of the side in one second, base "
+              f"held, mass damping {DAMPING:g} 1/s): CPU seconds each model takes on this "
+              f"machine ({m['cpu']}, one core), the explicit models at their own largest "
+              "stable RK4 step (2 sqrt 2 over the largest frequency at rest, measured up to "
+              f"{STABLE_STEP_TETS:g} tetrahedra), the implicit ones (backward Euler, Newton "
+              "with conjugate gradients) at their own step, with the Newton iterations per "
+              f"step and CG iterations per Newton system; at most {REAL_TIME:g}: real time.")
+        doc.table(["model", "tets", "dt [us]", "us per step", "CPU s per simulated s",
+                   "real time", "Newton / step", "CG / Newton"], per_second)
+        fastest = real_time_reach(data)
+        if fastest:
+            doc.p("The largest mesh measured at which each model runs in real time on this "
+                  "machine (serial): " + "; ".join(
+                      f"{m_} {t} tetrahedra" if t else f"{m_} none of the sizes measured"
+                      for m_, t in fastest.items()) + ".")
     doc.p("Optional engines, timed on the same meshes in the same rounds (`pip install "
           "'pbcm[engines]'`), with the ratio of their force evaluation to pbcm's "
           f"{ENGINE_REFERENCE} kernel taken in-round:")
@@ -348,6 +428,36 @@ def write(data, out):
                    for r in data["device_rows"]])
     doc.img("step_time.png", "RK4 step time against tetrahedra, every model")
     doc.write(out, stem="bench")
+
+
+def per_simulated_second(data):
+    """Table rows of every model's CPU time per simulated second, where measured."""
+    out = []
+    for r in data["rows"]:
+        if r.get("cpu_s_per_simulated_s") is not None:
+            c = r["cpu_s_per_simulated_s"]
+            out.append([r["model"], r["tets"], fmt(r["stable_dt_us"]), fmt(r["us_per_step"]),
+                        fmt(c), "yes" if c <= REAL_TIME else "no", "-", "-"])
+    for r in data.get("implicit_rows", []):
+        c = r["cpu_s_per_simulated_s"]
+        out.append([r["model"], r["tets"], fmt(r["dt_us"]), fmt(r["us_per_step"]), fmt(c),
+                    "yes" if c <= REAL_TIME else "no", fmt(r["newton_per_step"], 2),
+                    fmt(r["cg_per_newton"], 3)])
+    return out
+
+
+def real_time_reach(data):
+    """{model: the largest tetrahedron count measured at which it runs in real time, or
+    None}, over the sizes where its cost per simulated second was measured."""
+    reach = {}
+    for r in list(data["rows"]) + list(data.get("implicit_rows", [])):
+        c = r.get("cpu_s_per_simulated_s")
+        if c is None:
+            continue
+        best = reach.setdefault(r["model"], None)
+        if c <= REAL_TIME and (best is None or r["tets"] > best):
+            reach[r["model"]] = r["tets"]
+    return reach
 
 
 def summary(data):
