@@ -17,6 +17,7 @@ STUDY_MODULES = {
     "extensions": "cases.studies.extensions",
     "artefact": "cases.studies.artefact",
     "truth-cube": "cases.studies.truthcube",
+    "realtime": "cases.studies.realtime",
 }
 
 CASES = {name: importlib.import_module(module).CASE for name, module in MODULES.items()}

@@ -584,8 +584,9 @@ ACCURACY = 0.05     # the stated accuracy of the cost recommendation (model-form
 
 
 def recommendation(root, models, pops, quick, bench_rows):
-    """A head and at most five lines: what to pick for each stated use, from the model-form
-    errors, the Truth Cube's comparison, the costs and the artefact study's mesh pick."""
+    """A head and at most six lines: what to pick for each stated use, from the model-form
+    errors, the Truth Cube's comparison, the costs, the real-time study and the artefact
+    study's mesh pick."""
     from . import scorecard
     head = "**What to pick?**"
     if quick:
@@ -718,12 +719,15 @@ def recommendation(root, models, pops, quick, bench_rows):
                      + (f", with {lin[cheapest][2]} failed runs (no number, or a mode "
                         "unpaired)" if lin[cheapest][2] else ""))
         out.append(line + ".")
+    rt = _load(root, "realtime", "metrics.json")
+    if rt and not rt["parameters"]["quick"]:
+        out.append(f"- A real-time budget ([realtime](realtime/report.md)): {rt['answer']}")
     art = _record(root, "artefact")
     pick = None if not art or art["parameters"]["quick"] else art["answer"].get("mesh_pick")
     if pick:
         out.append("- Meshing a cube lattice for a particle model (the bulge/neck pattern; "
                    f"[artefact study](artefact/report.md)): {pick}.")
-    return out[:6] if len(out) > 1 else []
+    return out[:7] if len(out) > 1 else []
 
 
 def _cheaper_contender(best, others, bench_rows, base, conv=None):

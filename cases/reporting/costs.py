@@ -55,6 +55,17 @@ def step_cost_us(bench, model, tets):
     return float(t_base * ratio)
 
 
+def per_simulated_second(bench, model, tets):
+    """CPU seconds ``model`` takes per simulated second on the bench's mesh of ``tets``
+    tetrahedra (its own stable RK4 step, or an implicit preset's own step), as the bench
+    measured it there; None where it did not (another size, a size above the one it measures
+    the stable step or the implicit step to, or no bench)."""
+    for r in list((bench or {}).get("rows", [])) + list((bench or {}).get("implicit_rows", [])):
+        if r["model"] == model and r["tets"] == tets:
+            return r.get("cpu_s_per_simulated_s")
+    return None
+
+
 def cost_items(data, models, tets):
     """What a case report states about cost: a table of each model's RK4 step against msm's
     and fem-linear's, and at its own stable step the cost of one simulated second, from the

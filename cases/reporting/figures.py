@@ -161,6 +161,16 @@ def loglog(path, series, xlabel, ylabel, title):
     _finish(fig, ax, path, xlabel, ylabel, title)
 
 
+def error_against_cost(path, series, budget, xlabel, ylabel, title):
+    """Error against cost on log-log axes, one line per (label, costs, errors), and the
+    budget drawn as a vertical line (what lies left of it fits the budget)."""
+    fig, ax = plt.subplots(figsize=(6, 4.5))
+    for label, x, y in series:
+        ax.loglog(x, y, "-o", ms=3, label=label)
+    ax.axvline(budget, color="k", ls="--", lw=1, label="real time")
+    _finish(fig, ax, path, xlabel, ylabel, title)
+
+
 def measured_layers(path, layers, columns, title, highlight=None):
     """Measured against modelled quantities per bead layer: one column per entry of
     ``columns`` = (column title, rows), each row (ylabel, measured, floor, references,
