@@ -2,6 +2,7 @@
 errors there, the ranking with ties, and the quick run a preview."""
 import json
 
+import pytest
 
 from cases.cli import main
 from cases.studies.realtime import report as R
@@ -24,22 +25,32 @@ def test_the_reach_is_the_largest_size_measured_at_one_cpu_second_per_simulated_
     assert got["pbcm-corner"] is None and got["fem-linear"] is None
 
 
-def test_the_most_accurate_model_at_real_time_is_ranked_with_ties_within_u_val():
-    """Models at their reach are ranked by their distance from the continuum; two closer than
-    u_val (the reference's estimate) share the first rank and both are named in the answer,
-    with the machine; a model closer to the continuum than to FEM P1 by more than u_val is
-    named as cancelling FEM P1's error."""
+def test_the_most_accurate_model_at_real_time_is_ranked_by_its_error_bound_with_ties():
+    """Models at their reach are ranked by their error bound (model-form error plus FEM P1's
+    distance from the continuum on that mesh), never by a distance that cancels FEM P1's
+    error; two bounds closer than u_val (the reference's estimate) share the first rank and
+    both are named in the answer, with the machine; a model closer to the continuum than to
+    FEM P1 by more than u_val is named as cancelling FEM P1's error."""
     data = {"runs": [_run("msm", 1080, 0.5, 0.30, 0.30),
-                     _run("fem-linear", 1080, 0.2, 0.052, 0.015),
-                     _run("pbcm-corner", 1080, 0.6, 0.050, 0.09)],
+                     _run("fem-neohookean", 1080, 0.3, 0.052, 0.0),
+                     _run("fem-linear", 1080, 0.2, 0.054, 0.003),
+                     _run("pbcm-corner", 1080, 0.6, 0.030, 0.09),
+                     _run("fem-corotated", 10985, 0.9, 0.02, 0.012),
+                     _run("fem-neohookean", 10985, 3.0, 0.018, 0.0)],
             "error_estimate": 0.005, "machine": {"cpu": "X", "cores": 2}}
     v = R.verdict(data)
-    assert sorted(v["best"]) == ["fem-linear", "pbcm-corner"]
+    assert v["bounds"]["pbcm-corner"] == pytest.approx(0.142)
+    assert v["bounds"]["fem-corotated"] == pytest.approx(0.030)
+    assert v["best"] == ["fem-corotated"]
     assert v["cancels"] == ["pbcm-corner"]
     said = R.answer_line(data, v, quick=False)
     assert said.startswith("At real time on this machine (X, 2 cores, one used), the most "
-                           "accurate model is")
-    assert "pbcm-corner, with 1080 tetrahedra" in said and "(tied within u_val)" in said
+                           "accurate model is fem-corotated, with 10985 tetrahedra, error bound "
+                           "0.03")
+    tied = {**data, "runs": data["runs"][:3]}
+    v = R.verdict(tied)
+    assert sorted(v["best"]) == ["fem-linear", "fem-neohookean"]
+    assert "(tied within u_val)" in R.answer_line(tied, v, quick=False)
     assert R.answer_line(data, v, quick=True).startswith("Quick: not decided")
 
 
