@@ -34,7 +34,7 @@ def build(model, mesh, material, threads=1, **term_params):
 
     ``term_params`` override parameters per term name, e.g.
     ``build("pbcm-variational", mesh, mat, shear={"scale": 0.5})``. ``threads`` > 1 runs the
-    terms that have a threaded kernel (the shear readings, the FEM baselines) on that many of numba's threads,
+    terms that have a threaded kernel (the shear readings, the volume term, the FEM baselines) on that many of numba's threads,
     with forces equal bit for bit to the serial ones.
     """
     if isinstance(model, str):

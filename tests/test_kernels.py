@@ -157,12 +157,12 @@ def test_corotated_kernel_equals_its_reference_far_from_rest(family):
 
 
 @pytest.mark.skipif(numba.config.NUMBA_NUM_THREADS < 2, reason="one thread")
-@pytest.mark.parametrize("name", ["fem_linear", "fem_corotated", "fem_neohookean"])
+@pytest.mark.parametrize("name", ["fem_linear", "fem_corotated", "fem_neohookean", "volume"])
 @pytest.mark.parametrize("family", MESHES)
 def test_every_fem_baseline_has_a_two_thread_mode_equal_to_serial_bit_for_bit(name, family):
-    """Each FEM baseline's two-thread kernel adds, into a non-zero output, the serial
-    kernel's forces bit for bit on every mesh family, and reports the same first flattened
-    tetrahedron where one corner is moved onto another."""
+    """Each FEM baseline's and the volume term's two-thread kernel adds, into a non-zero
+    output, the serial kernel's forces bit for bit on every mesh family, and reports the same
+    first flattened tetrahedron where one corner is moved onto another."""
     mesh = mesh_of(family)
     t = make_term(name, mesh, MAT)
     x = perturbed(mesh, 0.02, seed=5)

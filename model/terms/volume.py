@@ -7,31 +7,66 @@ import numpy as np
 from numba import njit
 
 from . import Term, register
-from ._kernels import add_to, cross, dot, sub, vec, volume_gradient_numpy
+from ._kernels import add_to, cross, dot, put, sub, vec, volume_gradient_numpy
+from ._threads import TwoThreads
 
 # V / V0 below this is a flattened tetrahedron (the energy's log barrier is meaningless there)
 FLAT = 1e-6
 
 
-@njit(cache=True, fastmath=True)
+@njit(cache=True, inline="always")
+def volume_tet(x, tets, vol0, K, t):
+    """Tetrahedron t's pressure forces on its four nodes (p dV/dx_i, p = -K (V - V0) / V),
+    and whether it is flattened below FLAT V0 (then the forces are not computed)."""
+    n0, n1, n2, n3 = tets[t, 0], tets[t, 1], tets[t, 2], tets[t, 3]
+    x0 = vec(x, n0)
+    d01, d02, d03 = sub(vec(x, n1), x0), sub(vec(x, n2), x0), sub(vec(x, n3), x0)
+    c1, c2, c3 = cross(d02, d03), cross(d03, d01), cross(d01, d02)   # d(6V)/dx_1..3
+    V6 = dot(d01, c1)
+    if V6 <= FLAT * 6.0 * vol0[t]:
+        z = (0.0, 0.0, 0.0)
+        return True, z, z, z, z
+    p6 = -K * (V6 - 6.0 * vol0[t]) / (6.0 * V6)   # p / 6: c_j is d(6V)/dx_j
+    return (False, (-p6 * (c1[0] + c2[0] + c3[0]), -p6 * (c1[1] + c2[1] + c3[1]),
+                    -p6 * (c1[2] + c2[2] + c3[2])),
+            (p6 * c1[0], p6 * c1[1], p6 * c1[2]), (p6 * c2[0], p6 * c2[1], p6 * c2[2]),
+            (p6 * c3[0], p6 * c3[1], p6 * c3[2]))
+
+
+# without fastmath: its contraction of a product into the addition differs between the
+# serial kernel (which adds into the nodes) and its twin (which stores), and the two-thread
+# mode must equal the serial forces bit for bit
+@njit(cache=True)
 def volume_forces(x, tets, vol0, K, out):
     """f_i = p dV/dx_i, p = -K (V - V0) / V, for every tetrahedron; returns the first one
     flattened below FLAT V0, or -1."""
     for t in range(tets.shape[0]):
-        n0, n1, n2, n3 = tets[t, 0], tets[t, 1], tets[t, 2], tets[t, 3]
-        x0 = vec(x, n0)
-        d01, d02, d03 = sub(vec(x, n1), x0), sub(vec(x, n2), x0), sub(vec(x, n3), x0)
-        c1, c2, c3 = cross(d02, d03), cross(d03, d01), cross(d01, d02)   # d(6V)/dx_1..3
-        V6 = dot(d01, c1)
-        if V6 <= FLAT * 6.0 * vol0[t]:
+        flat, f0, f1, f2, f3 = volume_tet(x, tets, vol0, K, t)
+        if flat:
             return t
-        p6 = -K * (V6 - 6.0 * vol0[t]) / (6.0 * V6)   # p / 6: c_j is d(6V)/dx_j
-        add_to(out, n0, (-p6 * (c1[0] + c2[0] + c3[0]), -p6 * (c1[1] + c2[1] + c3[1]),
-                         -p6 * (c1[2] + c2[2] + c3[2])))
-        add_to(out, n1, (p6 * c1[0], p6 * c1[1], p6 * c1[2]))
-        add_to(out, n2, (p6 * c2[0], p6 * c2[1], p6 * c2[2]))
-        add_to(out, n3, (p6 * c3[0], p6 * c3[1], p6 * c3[2]))
+        add_to(out, tets[t, 0], f0)
+        add_to(out, tets[t, 1], f1)
+        add_to(out, tets[t, 2], f2)
+        add_to(out, tets[t, 3], f3)
     return -1
+
+
+@njit(cache=True)
+def volume_tets(x, tets, vol0, K, ft, flat, first, stop):
+    """volume_forces for the tetrahedra [first, stop) into ft (m, 4, 3); flattened ones
+    flagged in flat (the two-thread mode's twin: the same forces, bit for bit)."""
+    n_flat = 0
+    for t in range(first, stop):
+        bad, f0, f1, f2, f3 = volume_tet(x, tets, vol0, K, t)
+        if bad:
+            flat[t] = 1
+            n_flat += 1
+            continue
+        put(ft, t, 0, f0)
+        put(ft, t, 1, f1)
+        put(ft, t, 2, f2)
+        put(ft, t, 3, f3)
+    return n_flat
 
 
 @register
@@ -49,6 +84,11 @@ class Volume(Term):
 
     def kernel(self):
         return volume_forces, (self.mesh.tets, self.vol0, self.K)
+
+    def threaded_kernel(self):
+        if getattr(self, "_threads", None) is None:
+            self._threads = TwoThreads(self.mesh.tets, self.mesh.n_nodes)
+        return self._threads.kernel(volume_tets, self.kernel()[1])
 
     def forces_numpy(self, x):
         V, dV = volume_gradient_numpy(x, self.mesh.tets)
