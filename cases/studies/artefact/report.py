@@ -22,7 +22,7 @@ from .analysis import (CLEAR, COARSE, DECAYS, SHARP_DECAYS, DECIDING_LEAK, END_L
                        reading_table, reading_verdict, signature_own, times)
 from .study import (DECISIVE, FIXED_NORMAL_C, HELD_SUFFIX, LINEAR_SCALE, LITERAL_NORMAL,
                     READINGS, SPLITS, SPLITS_TRIED, YARDSTICK, _free_layers, lines_apart,
-                    short)
+                    models_on, short)
 
 GATED = catalogue.gated("alternation_rel", "disp_rel_l2")
 
@@ -188,6 +188,25 @@ def build(out, study, s, doc):
     return d
 
 
+def recorded_design(s, doc):
+    """Whether the record holds every (mesh, model) the design runs, and which it lacks."""
+    have = {(c["mesh"], c["model"]) for c in doc["cells"]}
+    lacking = {}
+    for mesh, spec in s.meshes.items():
+        for m in models_on(spec, s.models):
+            if (mesh, m) not in have:
+                lacking.setdefault(mesh, []).append(short(m))
+    if not lacking:
+        return ("Every model runs on every mesh; a static solve that fails is a failed cell, "
+                "with its cause.")
+    n = sum(len(v) for v in lacking.values())
+    return (f"The design runs every model on every mesh, but this record lacks {n} (mesh, "
+            "model) pairs of it, which no answer here reads: " + "; ".join(
+                f"{mesh}: {len(v)} ({', '.join(v[:3])}{', ...' if len(v) > 3 else ''})"
+                for mesh, v in lacking.items()) + " (`pbcm run artefact` computes them); a "
+            "static solve that fails is a failed cell, with its cause.")
+
+
 def _what_was_run(d, s, doc):
     d.h(2, "What was run")
     sizes = sorted({spec[1] for spec in s.meshes.values()})
@@ -223,8 +242,8 @@ def _what_was_run(d, s, doc):
         f"the same size ('{HELD_SUFFIX.strip()}': its mirror's controls, which then differ from "
         "it in the split alone), msm, msm with the variational shear "
         f"at c = 1, and {YARDSTICK} (FEM P1: constant-strain FEM with the continuum's own "
-        "neo-Hookean law on the same tetrahedra, the control). Every model runs on every "
-        "mesh; a static solve that fails is a failed cell, with its cause. Each cell also "
+        "neo-Hookean law on the same tetrahedra, the control). " + recorded_design(s, doc)
+        + " Each cell also "
         "keeps each "
         "vertical line of side-face nodes' own signature (the layer profile's weights applied "
         "to that line; the lines' mean is the layer profile's): the node-level pattern the "
