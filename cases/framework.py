@@ -121,6 +121,10 @@ class Settings(MaterialSettings):
 # Newton from rest may stagnate where a split load converges: a solver's limit, not the
 # model's, so a static solve fails only when every split does
 LOAD_SPLITS = (1, 2, 4, 8)
+# a load step whose residual this many Newton iterations in a row have not halved is split
+# more finely (a study passes it as solve_split's stall; a converging Newton step halves it in
+# one or two, and on a large mesh each iteration factorises a Newton matrix)
+STALL = 10
 
 
 def solve_split(pm, dirichlet, f_ext=None, splits=LOAD_SPLITS, **kw):

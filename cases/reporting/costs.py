@@ -19,6 +19,7 @@ FOLDER = "bench"                 # beside the case folders: reports/bench/bench.
 SOURCE = f"reports/{FOLDER}/{FILE}"
 BASE = "fem-linear"              # the baseline every ratio is taken against
 COST_TETS = 1e4                  # the mesh size at which costs are compared (tetrahedra)
+REAL_TIME = 1.0                  # CPU seconds per simulated second at which a model runs in real time
 CHECKOUT = Path(__file__).resolve().parents[2] / "reports" / FOLDER / FILE
 
 

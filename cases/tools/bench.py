@@ -31,7 +31,7 @@ from ..library.common import CUBE_MM, bench_mesh
 from ..reporting import figures
 from ..running import stop
 from .engines import ENGINES
-from ..reporting.costs import FILE
+from ..reporting.costs import FILE, REAL_TIME
 from ..reporting.document import Document, fmt
 
 SIZES = (1e2, 3.2e2, 1e3, 1e4, 1e5, 1e6)   # 3.2e2: the paper's 125-node cube (five split)
@@ -45,7 +45,6 @@ ENGINE_REFERENCE = "fem-neohookean"   # what the optional engines' forces are co
 # conjugate gradients whose iterations grow with the mesh
 IMPLICIT_TETS = 2e5
 DAMPING = 50.0           # the push's mass damping [1/s] (the paper cube's)
-REAL_TIME = 1.0          # CPU seconds per simulated second at which a model runs in real time
 
 
 @njit   # not cached: it takes the kernels (see model.integrate)
@@ -90,7 +89,7 @@ class _Timed:
         mask, start, moving = _push(mesh).parts(mesh.n_nodes)
         self.x, self.v = mesh.points.copy(), np.zeros_like(mesh.points)
         self.out = np.zeros_like(mesh.points)
-        self.step_args = (mesh.points, self.pm.mass, np.zeros_like(mesh.points), 50.0, mask,
+        self.step_args = (mesh.points, self.pm.mass, np.zeros_like(mesh.points), DAMPING, mask,
                           start, moving, 1.0, mesh.tets,
                           not any(t.checks_inversion for t in self.pm.terms),
                           self.pm.material.p_wave_speed, np.empty((STEP_BUFFERS,) + mesh.points.shape))

@@ -2,6 +2,7 @@
 tetrahedron share (``normal_sbd``, ``normal_corotated``): Dm^-1 at rest, F of any positions,
 and the flattening check their kernels make (det F <= FLAT)."""
 import numpy as np
+import scipy.sparse as sp
 
 from . import CalibratedTerm
 from ._kernels import deformation_gradients_numpy, rest_shape_inverse
@@ -42,7 +43,6 @@ class _TangentPattern:
     goes in the CSR pattern of the sum."""
 
     def __init__(self, tets, n_nodes, Dinv):
-        import scipy.sparse as sp
         m = len(tets)
         G = np.concatenate([-Dinv.sum(axis=1)[:, None, :], Dinv], axis=1)    # (m, 4, 3)
         B = np.zeros((m, 3, 3, 4, 3))
@@ -59,12 +59,12 @@ class _TangentPattern:
         self.indices = (uniq % shape[1]).astype(np.int32)
         self.indptr = np.searchsorted(uniq // shape[1], np.arange(shape[0] + 1)).astype(
             np.int32)
-        self.shape, self.sp = shape, sp
+        self.shape = shape
 
     def matrix(self, K):
         """The CSR sum of the element matrices K (m, 12, 12)."""
         data = np.bincount(self.slot, weights=K.ravel(), minlength=len(self.indices))
-        return self.sp.csr_matrix((data, self.indices, self.indptr), shape=self.shape)
+        return sp.csr_matrix((data, self.indices, self.indptr), shape=self.shape)
 
 
 class ConstantStrainTerm(RestShape, CalibratedTerm):

@@ -13,7 +13,7 @@ from model.mesh import cube
 from model.paper_mesh import unmatched_faces
 from reference import hyperelastic, linear
 from ...measuring import metrics as M
-from ...framework import (MaterialSettings, FINDINGS, LOAD_SPLITS,
+from ...framework import (MaterialSettings, FINDINGS, LOAD_SPLITS, STALL,
                           solve_split)
 from ...library import paper_cube as P
 from ...library.common import layers_mm
@@ -31,10 +31,6 @@ STATIC_RTOL = 1e-10
 # the push split into up to 32 equal steps before a cell is called failed: the finest meshes'
 # first failures (an inverted tetrahedron at 8 steps) are told from a load-path problem
 SPLITS_TRIED = LOAD_SPLITS + (16, 32)
-# a load step whose residual 10 Newton iterations in a row have not halved is split more finely
-# (each such iteration factorises a Newton matrix; on the finest bcc about 10 s); a Newton step
-# that converges halves it in one or two
-STALL = 10
 REF_MESH = ("six", 5)         # the reference's own mesh (refined REF_LEVELS times, P2)
 REF_LEVELS = 2               # two refinements: its own period-2 error 1.4e-5 on 17 clamped layers
 QUICK_REF_LEVELS = 1         # a preview's reference (its 9-node meshes decide nothing)

@@ -7,13 +7,13 @@ from pathlib import Path
 from ...measuring import catalogue
 from ...measuring.error_model import standings, u_val
 from ...reporting import figures
+from ...reporting.costs import REAL_TIME
 from ...reporting.document import Document, fmt
 from ...reporting.report import environment, write_study
 from ...running.runner import jsonable
 from .study import ACCURACY_TETS, MODELS, P1, statics_of
 
 GATED = catalogue.gated("disp_rel_l2", "disp_form_rel_l2")
-REAL_TIME = 1.0       # CPU seconds per simulated second: real time
 
 
 def reach(runs):

@@ -11,7 +11,7 @@ import numpy as np
 from model import build
 from model.presets import IMPLICIT_STEP
 from reference import hyperelastic
-from ...framework import FINDINGS, LOAD_SPLITS, MaterialSettings, solve_split
+from ...framework import FINDINGS, LOAD_SPLITS, STALL, MaterialSettings, solve_split
 from ...library import paper_cube as P
 from ...library.common import bench_mesh
 from ...measuring import metrics as M
@@ -32,7 +32,6 @@ MODELS = ("pbcm-corner", "pbcm-balanced", "pbcm-variational", "msm", "fem-linear
 REF_MESH = ("six", 5)           # the continuum: neo-Hookean P2 on this cube, refined
 REF_LEVELS, QUICK_REF_LEVELS = 2, 1
 STATIC_RTOL = 1e-10
-STALL = 10
 
 
 def statics_of(model):
