@@ -1344,18 +1344,29 @@ def test_consistency_at_the_side_nodes_tracks_a_part_that_grows_with_the_patch_e
 
 def test_the_short_answer_says_each_hypothesis_with_the_numbers_that_decide_it(nine_decides):
     """On a world whose pattern is on the mirrored split alone, the opening's plain answer
-    calls (a) the mirror's with the counts of resolved parts, none on every split; (b) not
-    tested where no term is active beside a resolved part; and a row per question."""
+    calls (a) the mirror's where decided, with n = 1 and the counts of resolved parts, none on
+    every split; (b) not tested where no term is active beside a resolved part; (c) not
+    decided unless both of its readings agree; and a row per question."""
     a = analysis.answer(_world(_mirror_world))
     rows = {r[0]: r for r in a["short_rows"]}
     mirror = rows["(a) The mirror symmetry of the five split?"]
-    assert mirror[1].startswith("yes, where decided")
-    assert "6 of 6 with the paper's sign the mirror's, 0 on every split" in mirror[2]
+    assert mirror[1] == ("the mirror's where decided (none on every split; one mesh per split "
+                         "and size, n = 1)")
+    assert "6 of 6 with the paper's sign the mirror's, 0 on every split, 0 not decided" \
+        in mirror[2]
     assert rows["(b) The missing normal stress?"][1] == "not tested"
+    empty = {"slopes": {}, "units": []}, {"+": [], "-": []}, {}
+
+    def c_answer(layer, node):
+        got = analysis.short_answer(None, empty[0], empty[1], empty[2],
+                                    {"testable": True, "rows": [{"verdict": layer}]},
+                                    {"rows": [{"verdict": node, "mesh": "six-9", "rho": 0.1}]})
+        return got[1][-1][1]
+    assert c_answer("does not track", "does not track").startswith("no: neither")
+    assert c_answer("tracks", "tracks").startswith("yes: both")
+    assert c_answer("does not track", "tracks").startswith("not decided")
     assert len(a["short"]) == len(a["short_rows"]) == 4
-    assert a["short"][1] == ("(a) The mirror symmetry of the five split? yes, where decided: "
-                             "every decided part is the mirrored split's, none is on every "
-                             "split.")
+    assert a["short"][1] == ("(a) The mirror symmetry of the five split? " + mirror[1] + ".")
 
 
 def test_the_reading_line_names_each_observable_a_reading_fails():
@@ -1382,5 +1393,6 @@ def test_the_report_says_which_pairs_of_the_design_its_record_lacks():
     assert recorded_design(s, {"cells": every}).startswith("Every model runs on every mesh")
     said = recorded_design(s, {"cells": every[1:]})
     assert said.startswith("The design runs every model on every mesh, but this record lacks "
-                           f"1 (mesh, model) pairs of it, which no answer here reads: "
+                           "1 (mesh, model) pairs of it (each a hole in cells.md; a part whose "
+                           "control is missing is 'not decided', never dropped): "
                            f"{every[0]['mesh']}: 1 (")

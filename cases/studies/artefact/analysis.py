@@ -1734,20 +1734,29 @@ def verdict_lines(sign_rows, nodes, ns, cs, fem_units, size=None, nc=None):
 
 
 
-def short_answer(below, nodes, sign_rows, ns, cs, nc):
+def short_answer(below, nodes, sign_rows, ns, cs, nc, fine_units=()):
     """The answer in a few plain sentences and a table, from what ``verdict_lines`` states in
     full: ``(sentences, rows)``, a row per question (size, each hypothesis): [question,
-    answer, the numbers that decide it]."""
+    answer, the numbers that decide it]. ``fine_units``: the counted configurations at the
+    finest size, whose metric check says what a pattern at the paper's own period reads."""
     rows = []
+    period = [f"{fmt(u['check']['paper_period'], 2)} ({u['bc']})" for u in fine_units
+              if u["check"].get("paper_period") is not None]
     if below is None:
         rows.append(["Large enough to see (the layer mean the paper drew)?", "not decided",
                      "no configuration's leak is below the deciding level"])
     else:
         rows.append(["Large enough to see (the layer mean the paper drew)?",
-                     f"no, at {below['n']} nodes per side" if below["all_below"] else
-                     f"yes, for some models at {below['n']} nodes per side",
-                     below["head"]])
-    node_said, mirror_any, every_any = [], False, False
+                     (f"a period-2 pattern at the mesh's own scale: no, at {below['n']} nodes "
+                      "per side" if below["all_below"] else
+                      f"a period-2 pattern at the mesh's own scale: yes, for some models at "
+                      f"{below['n']} nodes per side")
+                     + ("; one at the paper's own period (bulges 16 mm apart): not decided, "
+                        "these meshes read it as smooth" if period else ""),
+                     below["head"] + (f"; a pattern at the paper's period reads "
+                                      f"{', '.join(period)} of its amplitude there"
+                                      if period else "")])
+    node_said, mirror_any, every_any, open_any = [], False, False, False
     for bc, o in sorted(nodes["slopes"].items()):
         fine = next((x for x in nodes["units"] if (x["n"], x["bc"]) == (o["sizes"][1], bc)),
                     None)
@@ -1758,8 +1767,10 @@ def short_answer(below, nodes, sign_rows, ns, cs, nc):
         every = [r for r in res if r.get("mirror_vs") == "below"]
         mirror_any |= bool(mir)
         every_any |= bool(every)
+        open_any |= len(res) > len(mir) + len(every)
         node_said.append(f"{len(mir)} of {len(res)} resolved parts are the mirror's, "
-                         f"{len(every)} on every split ({bc}, {fine['n']} nodes)")
+                         f"{len(every)} on every split, {len(res) - len(mir) - len(every)} not "
+                         f"decided ({bc}, {fine['n']} nodes; unsigned: rms over the lines)")
     layer = []
     for s_, word in (("+", "the paper's sign"), ("-", "the reversed sign")):
         rs = [r for _, r in sign_rows[s_]]
@@ -1768,32 +1779,47 @@ def short_answer(below, nodes, sign_rows, ns, cs, nc):
             every = sum(r.get("mirror_vs") == "below" for r in rs)
             mirror_any |= bool(mir)
             every_any |= bool(every)
-            layer.append(f"{mir} of {len(rs)} with {word} the mirror's, {every} on every split")
-    a_answer = ("yes, where decided: every decided part is the mirrored split's, none is on "
-                "every split" if mirror_any and not every_any else
+            open_any |= len(rs) > mir + every
+            layer.append(f"{mir} of {len(rs)} with {word} the mirror's, {every} on every "
+                         f"split, {len(rs) - mir - every} not decided")
+    a_answer = ("the mirror's where decided (none on every split; "
+                + ("many parts not decided; " if open_any else "")
+                + "one mesh per split and size, n = 1)" if mirror_any and not every_any else
                 "partly: some parts are on every split" if mirror_any else "not shown")
     evidence = ((["at the side nodes: " + "; ".join(node_said)] if node_said else [])
-                + (["in the layer mean (9 and 17 nodes): " + "; ".join(layer)] if layer
-                   else []))
+                + (["in the layer mean (model parts, counted configurations): "
+                    + "; ".join(layer)] if layer else []))
     rows.append(["(a) The mirror symmetry of the five split?", a_answer,
                  "; ".join(evidence) or "no resolved part"])
     ps = distinct_pairs(ns.get("pairs") or [])
     decided = [p for p in ps if p["reduced"] != "at"]
     red = sum(p["reduced"] == "above" for p in decided)
+    nulls = [p for p in decided if same(abs(p["with"]), abs(p["without"]), 0.02)]
+    spans = {s_: [p["ratio"] for p in decided if p["sign"] == s_] for s_ in ("+", "-")}
     rows.append(["(b) The missing normal stress?",
-                 "not tested" if not ps else "no: no term reduces the pattern" if red == 0
+                 "not tested" if not ps else
+                 f"not shown: no term reduces the pattern {RATIO:g}-fold" if red == 0
                  else f"for {red} pairs",
-                 f"{red} of {len(decided)} decided pairs (a resolved part with and without "
-                 f"the term, the split held) reduced {RATIO:g}-fold; {len(ps) - len(decided)} "
-                 "not decided" if ps else "no term active beside a resolved part"])
+                 (f"{red} of {len(decided)} decided distinct pairs (a resolved part with and "
+                  f"without the term, the split held) reduced {RATIO:g}-fold; "
+                  f"{len(ps) - len(decided)} not decided; {len(nulls)} of them nulls (the "
+                  "term moves the part by under 2 %); |with| / |without| " + ", ".join(
+                      f"{fmt(min(v), 2)}-{fmt(max(v), 2)} with "
+                      + ("the paper's sign" if s_ == "+" else "the reversed sign")
+                      for s_, v in spans.items() if v)) if ps else
+                 "no term active beside a resolved part"])
     node_words = [r["verdict"] for r in (nc or {}).get("rows", [])]
     c_word = (_tracks_word(cs["rows"]) if cs.get("testable") else "not testable")
-    c_answer = ("no: the pattern does not track the patch-test error"
-                if node_words and all(w == "does not track" for w in node_words)
-                else "not decided")
+    node_word = _tracks_word(nc["rows"]) if node_words else "not read"
+    # the two readings must agree: the layer signature at the linear load and the node part
+    # at the push against the patch-test error
+    c_answer = ("no: neither reading tracks the patch-test error" if
+                c_word == node_word == "does not track" else
+                "yes: both readings track the patch-test error" if c_word == node_word ==
+                "tracks" else "not decided: the two readings do not agree")
     rows.append(["(c) The model's consistency (its patch-test error)?", c_answer,
-                 f"the layer signature: {c_word}; the node-level part against the patch-test "
-                 "error of a separate run: " + (", ".join(
+                 f"the layer signature at the linear load: {c_word}; the node-level part at "
+                 "the push against the patch-test error of a separate run: " + (", ".join(
                      f"{r['mesh']} {r['verdict']}" + (f" (rho {r['rho']:.2f})"
                                                      if r["rho"] is not None else "")
                      for r in nc["rows"]) if node_words else "not read")])
@@ -1998,7 +2024,8 @@ def answer(cells, models=None, estimates=None):
     hyp["node_consistency"] = nc
     verdicts = verdict_lines(sign_rows, nodes, ns, cs, fem_units,
                              size_line(m["orders"], below, largest, dec), nc)
-    short, short_rows = short_answer(below, nodes, sign_rows, ns, cs, nc)
+    short, short_rows = short_answer(below, nodes, sign_rows, ns, cs, nc,
+                                     [u for u in seen_at if below and u["n"] == below["n"]])
     if apart(us):
         verdicts.append("Not counted: " + "; ".join(apart(us)) + ": its parts are in the "
                         "tables and the two-point orders in h, not in the counts above.")

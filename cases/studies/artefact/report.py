@@ -201,7 +201,8 @@ def recorded_design(s, doc):
                 "with its cause.")
     n = sum(len(v) for v in lacking.values())
     return (f"The design runs every model on every mesh, but this record lacks {n} (mesh, "
-            "model) pairs of it, which no answer here reads: " + "; ".join(
+            "model) pairs of it (each a hole in cells.md; a part whose control is missing "
+            "is 'not decided', never dropped): " + "; ".join(
                 f"{mesh}: {len(v)} ({', '.join(v[:3])}{', ...' if len(v) > 3 else ''})"
                 for mesh, v in lacking.items()) + " (`pbcm run artefact` computes them); a "
             "static solve that fails is a failed cell, with its cause.")
@@ -859,16 +860,20 @@ def cells_document(doc, s):
             continue
         first = next(iter(rows.values()))
         size = next(iter(first.values()))["nodes_per_side"]
-        absent = [m for m in at_size.get(size, {}) if m not in rows]
+        spec = s.meshes.get(mesh)
+        designed = models_on(spec, s.models) if spec else []
+        # every model the design runs here and this record lacks: a visible hole
+        absent = [m for m in dict.fromkeys(list(at_size.get(size, {})) + designed)
+                  if m not in rows and (not spec or m in designed)]
         c.h(2, f"{mesh} ({next(iter(first.values()))['tets']} tetrahedra)")
         c.table(["model"] + [f"{bc}/{load}" for bc, load in combos] + ["constants"],
                 [["reference, mean lateral [mm]"] + [_scale(first.get(k)) for k in combos]
                  + [""]]
                 + [[short(m)] + [_cell(r.get(k)) for k in combos] + [_constants(r)]
                    for m, r in rows.items()]
-                + [[short(m)] + ["not run"] * len(combos) + ["not run on this mesh by the "
-                                                            "study's design"]
-                   for m in absent])
+                + [[short(m)] + ["not in this record"] * len(combos)
+                   + ["the design runs it here; this record predates it (`pbcm run artefact` "
+                      "computes it)"] for m in absent])
     return c
 
 
