@@ -860,11 +860,11 @@ def test_a_static_solve_splits_the_load_where_newton_from_rest_stagnates():
     assert pm.asked == list(LOAD_SPLITS)
 
 
-def test_the_cost_is_the_benchs_at_the_papers_size_alone():
+def test_the_cost_is_the_benchs_at_the_papers_size_held_at_every_size():
     """The point and its range are the bench's at the paper's 320 tetrahedra, never a range
-    pooled over sizes: rows at 135 and 1080 tetrahedra with wider ranges change nothing; a
-    literal reading takes its calibrated reading's row; a model the bench lacks at 320 has
-    none."""
+    pooled over sizes; a literal reading takes its calibrated reading's row; a model the bench
+    lacks at 320 has none. The call at 320 stands only where each other size's own range
+    reads the same; a size whose range reaches the threshold leaves the cost not decided."""
     from cases.studies.artefact.study import FIVE_TETS, bench_costs
     assert FIVE_TETS == 320
 
@@ -889,7 +889,23 @@ def test_the_cost_is_the_benchs_at_the_papers_size_alone():
     v = analysis.reading_verdict(table, 50.0, got["bench_spread"])
     assert "pbcm-corner 4.72 [4.35-5.07] (missed)" in v["text"]
     assert "pbcm-corner miss the paper's cost: every round below 8" in v["text"]
-    assert "7 rounds at 320 tetrahedra, that size alone" in v["text"]
+    assert "7 rounds at 320 tetrahedra" in v["text"]
+    # each size its own population: a miss at 320 stands only where every size misses
+    sizes = got["step_vs_msm_sizes"]
+    assert sizes["pbcm-corner"] == {135: [3.6, 11.0], 320: [4.35, 5.07], 1080: [5.0, 12.0]}
+    assert sizes["pbcm-corner-literal"] == sizes["pbcm-corner"]
+    table = analysis.reading_table(_reading_cells(rates), got["step_vs_msm"], list(rates),
+                                   50.0, step_range=got["step_vs_msm_range"],
+                                   step_sizes=sizes)
+    assert table[0]["matches"]["cost"] is None
+    assert "not at every size: 135 tetrahedra 3.6-11 reaches 10, 1080 tetrahedra 5-12 " \
+           "reaches 10: not decided" in table[0]["cost_why"]
+    below = {320: [4.35, 5.07], 1080: [5.0, 7.0]}
+    table = analysis.reading_table(_reading_cells(rates), got["step_vs_msm"], list(rates),
+                                   50.0, step_range=got["step_vs_msm_range"],
+                                   step_sizes={"pbcm-corner": below})
+    assert table[0]["matches"]["cost"] is False
+    assert "at every size the bench ran (320, 1080 tetrahedra)" in table[0]["cost_why"]
 
 
 def test_the_studys_definitions_state_the_metrics_leak_one_flutter_and_the_configuration():
@@ -1185,8 +1201,8 @@ def test_a_pattern_that_follows_the_split_and_not_the_patch_error_is_named_so():
 def test_the_mesh_pick_names_the_mirrored_split_only_where_a_part_is_the_mirrors_and_none_on_every_split():
     """The mesh pick avoids the mirrored five split where some resolved part (layer mean, side
     nodes or FEM P1's own) is the mirror's and none is on every split, with the counts and the
-    median node-level ratio over the larger control; where a part is on every split, or none
-    is the mirror's, it names no split."""
+    median node-level ratio over the larger control, from the configurations the answers
+    count alone; where a part is on every split, or none is the mirror's, it names no split."""
     row = {"resolved": "above", "rms": 2e-3, "controls": {SIX: (1e-5, 1e-6), BCC: (2e-5, 1e-6)},
            "mirror_vs": "above", "mirror_lo": 90.0}
     nodes = {"units": [{"n": 17, "bc": "sliding", "rows": [row]}], "slopes": {}}
@@ -1200,6 +1216,11 @@ def test_the_mesh_pick_names_the_mirrored_split_only_where_a_part_is_the_mirrors
     assert analysis.mesh_pick(layer, 4, 1, ["17 clamped"], nodes) is None
     empty = {"units": [], "slopes": {}}
     assert analysis.mesh_pick("", 0, 0, [], empty) is None
+    # a configuration the answers do not count (9 clamped: its smooth fields leak) stays out
+    apart = {"n": 9, "bc": "clamped", "rows": [dict(row, mirror_lo=5.0)]}
+    both = {"units": [apart] + nodes["units"], "slopes": {}}
+    said = analysis.mesh_pick(layer, 4, 0, [], both, counted_at={(17, "sliding")})
+    assert "9 clamped" not in said and "1 of 1 resolved parts" in said
 
 
 def test_the_index_picks_a_mesh_from_the_full_artefact_run_only(tmp_path):

@@ -59,7 +59,8 @@ class Artefact(Study):
         if bench:
             data.update(bench_costs(bench, list(s.models)))
         else:
-            data.update({k: metrics.get(k) for k in ("step_vs_msm_range", "bench_spread")})
+            data.update({k: metrics.get(k) for k in ("step_vs_msm_range", "step_vs_msm_sizes",
+                                                       "bench_spread")})
         for c in data["cells"]:     # the glossary's flutter: a growth rate above 0
             if c.get("growth_rate_1_s") is not None:
                 c["flutter"] = c["growth_rate_1_s"] > 0.0

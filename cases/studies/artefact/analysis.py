@@ -1466,18 +1466,21 @@ def stiffer_on_controls(cells):
     return out
 
 
-def mesh_pick(resolved, mirrors, against_, fem_units, nodes, stiffer=()):
+def mesh_pick(resolved, mirrors, against_, fem_units, nodes, stiffer=(), counted_at=None):
     """What to mesh a lattice with, given the bulge/neck pattern: from the layer-level parts
     (``resolved`` their counts by sign in words, ``mirrors`` the mirror's, ``against_`` on
     every split), FEM P1's own
     (``fem_units``: where it is the mirror's) and the node-level parts (``node_pattern``): the
     median over the models of the mirrored split's node-level part over its larger control's,
-    per configuration. A split is named to avoid only where some part is the mirror's and
-    none is on every split."""
-    node_rows = [r for x in nodes["units"] for r in x["rows"] if r["resolved"] == "above"]
+    per configuration. Only the configurations the answers count (``counted_at``, (n, bc)
+    pairs; every one where None) enter. A split is named to avoid only where some part is the
+    mirror's and none is on every split."""
+    units = [x for x in nodes["units"]
+             if counted_at is None or (x["n"], x["bc"]) in counted_at]
+    node_rows = [r for x in units for r in x["rows"] if r["resolved"] == "above"]
     node_mirror = [r for r in node_rows if r.get("mirror_vs") == "above"]
     ratios = {}
-    for x in nodes["units"]:
+    for x in units:
         # the ratio's lower bound: a control below its u may be 0
         got = [r["mirror_lo"] for r in x["rows"]
                if r.get("mirror_vs") == "above" and r.get("mirror_lo") is not None]
@@ -1492,8 +1495,9 @@ def mesh_pick(resolved, mirrors, against_, fem_units, nodes, stiffer=()):
                         for w, v in ratios.items())
             + f" (median [range] of the lower bounds over the mirror's parts), {len(node_mirror)} of "
             f"{len(node_rows)} "
-            "resolved parts (a model on a configuration each) the mirror's, the others not "
-            "decided, none on every split; in "
+            "resolved parts (a model on a configuration each) the mirror's, "
+            + ("the others not decided, " if len(node_mirror) < len(node_rows) else "")
+            + "none on every split; in "
             f"the layer mean {resolved}"
             + (f"; FEM P1's own on {', '.join(fem_units)}" if fem_units else "")
             + " (one mesh per split and size: no spread over meshes; chosen on the pattern "
@@ -1871,7 +1875,7 @@ def answer(cells, models=None, estimates=None):
                                    ("+", "the paper's sign"), ("-", "the reversed sign"))
                                if sign_rows[s_]),
                      sum(len(v) for v in mirrored.values()), against_, fem_units, nodes,
-                     stiffer_on_controls(cells))
+                     stiffer_on_controls(cells), {(u["n"], u["bc"]) for u in dec})
     across = consistency_across(every)
     across_said = across_text(across)
     nodes_said, lead_nodes = node_text(nodes), node_lead(nodes)
@@ -2330,17 +2334,37 @@ def cost_call(point, span):
                   }[call]
 
 
-def reading_table(cells, step_vs_msm, readings, damping=50.0, extra=(), step_range=None):
+def size_call(call, why, sizes):
+    """(call, why) of the paper-size call held against every bench size (``sizes``
+    {tetrahedra: [smallest, largest]}, each size its own population): the paper's Figure 2
+    reads the cost and its growth with mesh size, so a call stands only where every size
+    reads the same; else not decided, with the sizes that differ."""
+    if call not in ("above", "below") or not sizes:
+        return call, why
+    other = {t: bounded(lo, hi, PAPER_COST) for t, (lo, hi) in sizes.items()}
+    off = {t: c for t, c in other.items() if c != call}
+    if not off:
+        return call, why + f", and at every size the bench ran ({', '.join(map(str, sizes))} tetrahedra)"
+    return "at", (why + "; not at every size: " + ", ".join(
+        f"{t} tetrahedra {fmt(sizes[t][0], 3)}-{fmt(sizes[t][1], 3)} "
+        + ("reaches" if c == "at" else c) + f" {PAPER_COST:g}" for t, c in off.items())
+        + ": not decided")
+
+
+def reading_table(cells, step_vs_msm, readings, damping=50.0, extra=(), step_range=None,
+                  step_sizes=None):
     """One row per reading (``readings``, calibrated and literal) and per model of ``extra``
     (a reading with a normal-stress term, which the paper's equations lack): the paper's
     observables on its own lattice (5 nodes per side) and which of the decidable ones
     (OBSERVABLES) it matches.
 
     Cost: the stored step / msm ratio on the paper's cube read on its spread over the
-    bench's rounds and sizes (``step_range``, ``cost_call``; a literal reading's is its
-    calibrated reading's, the same kernel); None (not decided) where not timed, without a spread,
-    where the range reaches the threshold, or for a model with a normal-stress term (its
-    added cost is this implementation's term, no evidence about the paper's reading).
+    bench's rounds (``step_range``, ``cost_call``; a literal reading's is its calibrated
+    reading's, the same kernel), and held against each size the bench ran (``step_sizes``,
+    ``size_call``); None (not decided) where not timed, without a spread, where the range
+    reaches the threshold or a size reads otherwise, or for a model with a normal-stress
+    term (its added cost is this implementation's term, no evidence about the paper's
+    reading).
     Stability: the largest growth rate of the undamped model linearised at rest (clamped) on
     each conforming split of the lattice (mirrored five, six, bcc; ``mesh_stability``), each
     against half the mass damping we assume (``damping`` / 2) and, without damping, against
@@ -2368,7 +2392,8 @@ def reading_table(cells, step_vs_msm, readings, damping=50.0, extra=(), step_ran
         timed = step_vs_msm.get(model) is not None
         cost = step_vs_msm.get(model) if timed else None
         span = (step_range or {}).get(model) if timed else None
-        cost_vs, cost_why = cost_call(cost, span)
+        cost_vs, cost_why = size_call(*cost_call(cost, span),
+                                      (step_sizes or {}).get(model) if timed else None)
         if not in_paper and cost is not None:
             cost_why += "; not scored (a term the paper lacks)"
         grow = max(by_mesh.values()) if by_mesh else None
@@ -2466,13 +2491,15 @@ def reading_verdict(table, damping, spread=None, figure=None):
                                         for m, v in r["growth_apart"].items())
             for r in rated if r["growth_apart"]) + "." if apart else ""))
     bench = ("" if not spread else f" over the bench's {spread['rounds']} rounds at "
-             + ", ".join(str(t) for t in spread["tets"]) + " tetrahedra, that size alone")
+             + ", ".join(str(t) for t in spread["tets"]) + " tetrahedra")
     ranged = [r for r in timed if r["step_range"]]
     cost = (f"Cost (the paper's Figure 2: the time of one step, more than {PAPER_COST:g} "
             "times msm's; the in-round ratio on the 320-tetrahedron five split of the paper's "
             "125 nodes (the paper's own mesh had 374 tetrahedra) [its range"
             f"{bench}], read on the range: a range that reaches within {NEAR:.0%} of "
-            f"{PAPER_COST:g} is not decided): "
+            f"{PAPER_COST:g} is not decided; the figure reads the cost's growth with mesh "
+            "size, so a call stands only where the range at every size the bench ran, each "
+            "its own population, reads the same): "
             + (", ".join(f"{r['name']} {_span(r)} ({MATCH_WORDS[r['matches']['cost']]})"
                          for r in ranged) if ranged else "no range timed")
             + "".join(f"; {_names(v)} {w}" for v, w in (
@@ -2483,6 +2510,8 @@ def reading_verdict(table, damping, spread=None, figure=None):
                   and r["step_range"][1] < PAPER_COST],
                  f"below {PAPER_COST:g} in every round, the largest within {NEAR:.0%} of it: "
                  "not decided")) if v)
+            + "".join(f"; {r['name']}: {r['cost_why']}" for r in ranged
+                      if "not at every size" in r["cost_why"])
             + (f"; one timing without a spread, not decided: "
                f"{_names([r['name'] for r in timed if not r['step_range']])}"
                if any(not r["step_range"] for r in timed) else "")

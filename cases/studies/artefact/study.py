@@ -440,6 +440,7 @@ def bench_costs(bench, models):
     rows = [r for r in (bench or {}).get("rows", []) if r["tets"] == FIVE_TETS]
     return {"step_vs_msm": step_costs(bench, models),
             "step_vs_msm_range": step_ranges(bench, models),
+            "step_vs_msm_sizes": size_ranges(bench, models),
             "bench_spread": None if not rows else {
                 "tets": [FIVE_TETS],
                 "rounds": max([r.get("rounds") or 0 for r in rows], default=0)}}
@@ -461,6 +462,19 @@ def step_ranges(bench, models):
         r = _paper_row(bench, m.replace("-literal", ""))
         span = None if r is None else r.get("step_vs_msm_range")
         out[m] = [float(span[0]), float(span[1])] if span else None
+    return out
+
+
+def size_ranges(bench, models):
+    """{model: {tetrahedra: [smallest, largest]}}: its RK4 step over msm's over the bench's
+    rounds at each size the bench ran, each size its own population (the paper's Figure 2
+    reads the cost's growth with mesh size); a literal reading's is its calibrated reading's."""
+    out = {}
+    for m in models:
+        got = {int(r["tets"]): [float(v) for v in r["step_vs_msm_range"]]
+               for r in (bench or {}).get("rows", [])
+               if r["model"] == m.replace("-literal", "") and r.get("step_vs_msm_range")}
+        out[m] = dict(sorted(got.items())) or None
     return out
 
 
