@@ -1334,47 +1334,54 @@ def test_a_model_that_barely_expands_on_a_control_split_is_named_against_the_mes
 
 
 def test_consistency_at_the_side_nodes_tracks_a_part_that_grows_with_the_patch_error():
-    """Read at the side nodes (sliding, each model's node-level part at the paper's push less
-    FEM P1's, against its patch-test error from the separate run at the linear load): parts
-    that rise with the error track it; parts that fall as it rises do not; parts the
-    continuum's round-off cannot tell from 0 are not testable; the linear run's own lines are
-    not what is read."""
+    """Read at the side nodes in one run (sliding, the linear load: each model's node-level
+    part less FEM P1's against its patch-test error there): parts that rise with the error
+    track it; parts that fall as it rises do not; parts the continuum's round-off cannot tell
+    from 0 are not testable; the push's lines are not what is read; variants of too few
+    reading families leave it not decided (the interval counts each family once)."""
     split = analysis.CONFORMING_CONTROLS[0]
     lines = np.ones(8)
 
-    def world(parts, linear_parts=None):
+    def world(linear_parts, paper_parts=None, names=None):
         out = []
         for load in ("paper", "linear"):
             out.append(_with_lines(cell("six-9", split, analysis.YARDSTICK_MODEL, 0.0, n=9,
                                         load=load, family="fem", disp_rel_l2=0.0), 0 * lines))
-            at = parts if load == "paper" else (linear_parts or parts)
-            out += [_with_lines(cell("six-9", split, f"m{i}", 0.0, n=9, load=load,
+            at = linear_parts if load == "linear" else (paper_parts or linear_parts)
+            out += [_with_lines(cell("six-9", split, (names or [f"m{i}" for i in range(12)])[i],
+                                     0.0, n=9, load=load,
                                      disp_rel_l2=0.01 * (i + 1) if load == "linear" else 0.5),
                                 p * lines) for i, p in enumerate(at)]
         return out
     rises = analysis.node_consistency(world([1e-3 * (i + 1) for i in range(12)]))["rows"][0]
     assert rises["verdict"] == "tracks" and rises["rho"] == pytest.approx(1.0)
+    assert rises["families"] == 12
     falls = analysis.node_consistency(world([1e-3 * (12 - i) for i in range(12)]))["rows"][0]
     assert falls["verdict"] == "does not track"
     tiny = analysis.node_consistency(world([1e-20 * (i + 1) for i in range(12)]))["rows"][0]
     assert tiny["verdict"].startswith("not testable: 0 of 12 node-level parts resolved")
-    read = analysis.node_consistency(world([1e-3 * (12 - i) for i in range(12)],
-                                           [1e-3 * (i + 1) for i in range(12)]))["rows"][0]
-    assert read["verdict"] == "does not track"
+    read = analysis.node_consistency(world([1e-3 * (i + 1) for i in range(12)],
+                                           [1e-3 * (12 - i) for i in range(12)]))["rows"][0]
+    assert read["verdict"] == "tracks"
+    variants = [f"pbcm-corner +normal_{i}" if i < 6 else f"msm +v{i}" for i in range(12)]
+    two = analysis.node_consistency(world([1e-3 * (i + 1) for i in range(12)],
+                                          names=variants))["rows"][0]
+    assert two["families"] == 2 and two["verdict"].startswith("not decided")
 
 
 def test_the_short_answer_says_each_hypothesis_with_the_numbers_that_decide_it(nine_decides):
     """On a world whose pattern is on the mirrored split alone, the opening's plain answer
     calls (a) the mirror's where decided, with n = 1 and the counts of resolved parts, none on
-    every split; (b) not tested where no term is active beside a resolved part; (c) not
-    decided unless both of its readings agree; and a row per question."""
+    every split, per configuration and sign; (b) not tested where no term is active beside a
+    resolved part; (c) not decided unless both of its views agree, saying which view is open
+    or that they disagree; and a row per question."""
     a = analysis.answer(_world(_mirror_world))
     rows = {r[0]: r for r in a["short_rows"]}
     mirror = rows["(a) The mirror symmetry of the five split?"]
-    assert mirror[1] == ("the mirror's where decided (none on every split; one mesh per split "
-                         "and size, n = 1)")
-    assert "6 of 6 with the paper's sign the mirror's, 0 on every split, 0 not decided" \
-        in mirror[2]
+    assert mirror[1] == ("the mirror's where decided: every resolved part on 9 sliding, "
+                         "17 clamped, 17 sliding; none on every split; one mesh per split and "
+                         "size, n = 1")
+    assert "9 sliding: + 2 of 2; 17 clamped: + 2 of 2; 17 sliding: + 2 of 2" in mirror[2]
     assert rows["(b) The missing normal stress?"][1] == "not tested"
     empty = {"slopes": {}, "units": []}, {"+": [], "-": []}, {}
 
@@ -1385,7 +1392,10 @@ def test_the_short_answer_says_each_hypothesis_with_the_numbers_that_decide_it(n
         return got[1][-1][1]
     assert c_answer("does not track", "does not track").startswith("no: neither")
     assert c_answer("tracks", "tracks").startswith("yes: both")
-    assert c_answer("does not track", "tracks").startswith("not decided")
+    assert c_answer("does not track", "tracks") == ("not decided: the layer view and the node "
+                                                    "view disagree")
+    assert c_answer("not decided (x)", "does not track") == ("not decided: the layer view "
+                                                            "not decided")
     assert len(a["short"]) == len(a["short_rows"]) == 4
     assert a["short"][1] == ("(a) The mirror symmetry of the five split? " + mirror[1] + ".")
 
@@ -1417,3 +1427,59 @@ def test_the_report_says_which_pairs_of_the_design_its_record_lacks():
                            "1 (mesh, model) pairs of it (each a hole in cells.md; a part whose "
                            "control is missing is 'not decided', never dropped): "
                            f"{every[0]['mesh']}: 1 (")
+
+
+def test_the_mesh_pick_names_the_models_a_control_split_makes_flutter_faster():
+    """A model whose growth rate at rest (clamped, the paper's lattice) on a conforming control
+    is 3 times its rate on the mirrored five and above 0 is named, with its rate per split; a
+    model no faster on the controls, or one still at rest there, is not."""
+    def rated(model, split, rate):
+        return {"model": model, "split": split, "family": "particle", "bc": "clamped",
+                "load": "paper", "constant": "literal", "growth_rate_1_s": rate}
+    six, bcc = analysis.CONFORMING_CONTROLS
+    cells = [rated("a", FIVE, 3.5), rated("a", six, 97.0), rated("a", bcc, 5.0),
+             rated("b", FIVE, 3.5), rated("b", six, 4.0), rated("b", bcc, 0.0),
+             rated("c", FIVE, 0.0), rated("c", six, 0.0)]
+    said = analysis.flutter_on_controls(cells)
+    assert said == [f"a (five 3.5, {six} 97, {bcc} 5 1/s)"]
+
+
+def test_the_shear_constants_reach_is_the_largest_calibrated_over_literal_part():
+    """The bound on what the fitted shear constant moves: over the counted configurations,
+    the largest factor either way between a calibrated reading's resolved own part and its
+    literal reading's; a configuration the answers do not count, or an unresolved part,
+    is left out."""
+    def unit(n, bc, rows, decides=True):
+        return {"n": n, "bc": bc, "reads": True, "decides": decides, "rows": rows}
+
+    def row(name, part, sign="+"):
+        return {"name": name, "part": part, "sign": sign}
+    us = [unit(17, "sliding", [row("pbcm-balanced", 2.5e-4), row("pbcm-balanced-literal", 8e-4),
+                               row("pbcm-corner", -1e-3, "-"),
+                               row("pbcm-corner-literal", -1.2e-3, "-")]),
+          unit(9, "clamped", [row("pbcm-corner", 1e-4), row("pbcm-corner-literal", 1e-2)],
+               decides=False),
+          unit(9, "sliding", [row("pbcm-variational", 1e-3),
+                              row("pbcm-variational-literal", 1e-5, None)])]
+    f, name, where = analysis.constant_spread(us)
+    assert f == pytest.approx(3.2) and name == "pbcm-balanced" and where == "17 sliding"
+    assert analysis.constant_spread(us[1:]) is None
+
+
+def test_the_thresholds_tried_move_the_answers_and_leave_the_studys_own_in_place(nine_decides):
+    """Each threshold is tried at a value either side of the study's and the answers that
+    change are listed; the study's thresholds are the same after the trial as before it."""
+    before = (analysis.CLEAR, analysis.RATIO, analysis.TRACKS, analysis.DECIDING_LEAK)
+    moves = analysis.threshold_moves(_world(_mirror_world))
+    assert [(m["threshold"], m["value"]) for m in moves] == [
+        (k, v) for k, vs in analysis.THRESHOLDS_TRIED.items() for v in vs]
+    assert all(m["ours"] == getattr(analysis, m["threshold"]) for m in moves)
+    assert (analysis.CLEAR, analysis.RATIO, analysis.TRACKS, analysis.DECIDING_LEAK) == before
+    # a factor no part reaches: (a) changes, and the trial says to what
+    analysis.THRESHOLDS_TRIED, keep = {"RATIO": (1e9,)}, analysis.THRESHOLDS_TRIED
+    try:
+        (far,) = analysis.threshold_moves(_world(_mirror_world))
+    finally:
+        analysis.THRESHOLDS_TRIED = keep
+    assert ["(a) The mirror symmetry of the five split?", "not shown"] in far["changed"]
+    assert analysis.RATIO == before[1]

@@ -19,7 +19,8 @@ from .analysis import (CLEAR, COARSE, DECAYS, SHARP_DECAYS, DECIDING_LEAK, END_L
                        MIN_RESOLVED, NEAR, PAPER_BULGES_MM, PAPER_COST, PAPER_NECKS_MM, RATIO,
                        SAME, TRACKS, WIDTHS, _compress, answer, classes, failure, how_sure,
                        distinct_pairs, paper_figure, paper_figure_text,
-                       reading_table, reading_verdict, signature_own, times)
+                       reading_table, reading_verdict, signature_own, times, counted,
+                       threshold_moves)
 from .study import (DECISIVE, FIXED_NORMAL_C, HELD_SUFFIX, LINEAR_SCALE, LITERAL_NORMAL,
                     READINGS, SPLITS, SPLITS_TRIED, YARDSTICK, _free_layers, lines_apart,
                     models_on, short)
@@ -52,6 +53,7 @@ def analyse(data, models, damping):
              "verdict": reading_verdict(table, damping, data.get("bench_spread"),
                                         paper_figure(data["cells"], readings(models)))}
     found["how_sure"] = how_sure(found["answer"], found["verdict"])
+    found["thresholds"] = threshold_moves(data["cells"], models, _estimates(data))
     return found
 
 
@@ -164,6 +166,7 @@ def build(out, study, s, doc):
         d.ul(["**What causes the bulge/neck pattern.** " + v if i == 0 else v
               for i, v in enumerate(doc["answer"].get("verdicts") or [])]
              + [f"**The evidence.** {doc['answer']['text']}", doc["how_sure"]])
+        _thresholds(d, doc.get("thresholds") or [])
     d.p("Every cell's numbers: [cells.md](cells.md). The report is drawn again from the stored "
         "cells with `pbcm run artefact --rewrite`; without `--rewrite` every cell is "
         "computed again.")
@@ -187,6 +190,19 @@ def build(out, study, s, doc):
     d.p(f"Environment: {doc['environment']}.")
     cells_document(doc, s).write(out, stem="cells")
     return d
+
+
+def _thresholds(d, moves):
+    """How the short answers move with each threshold this study fixed."""
+    if not moves:
+        return
+    d.h(3, "How the answers move with the thresholds")
+    d.p("The clear level, the dominance factor and the tracking correlation are this study's "
+        "conventions, not the paper's. Each is tried at a value either side of ours, the "
+        "rest held; a question whose answer changes is provisional on that threshold.")
+    d.table(["threshold (ours)", "tried", "answers that change"],
+            [[f"{m['word']} ({m['ours']:g})", f"{m['value']:g}",
+              "; ".join(f"{q} {a}" for q, a in m["changed"]) or "none"] for m in moves])
 
 
 def recorded_design(s, doc):
@@ -321,8 +337,8 @@ def _metric_check(d, doc):
         "layer) a finite set of layers leaves it a small score, the leak, which no weights "
         "remove for every width at once. The requirement the metric was first set, a score "
         "of 0 (to round-off) on every smooth profile, Gaussian bulges of any width above two "
-        "layers among them, cannot be met by weights on a finite set of layers, and this study "
-        "replaces it: 0 on the continuum and on the polynomials the weights absorb, each "
+        "layers among them, cannot be met by weights on a finite set of layers; this study "
+        "departs from that requirement, on purpose and stated here, and replaces it: 0 on the continuum and on the polynomials the weights absorb, each "
         "other smooth field's leak measured here, and the worst of them carried in every u, "
         "so that no part a leak could make is called resolved.")
     d.p("The signature's weights on test fields of each (size, base), the layers it reads "
@@ -498,7 +514,9 @@ def _mirror(d, doc):
             "what its own part rests on: its sign with the number of configurations where it is "
             "resolved, n of N, and where it is the mirror's.")
         d.table(["model"] + [_unit(u) for u in dec] + ["own part", "the mirror's on"],
-                [[name] + [t["units"].get(_unit(u), "not run") for u in dec]
+                [[name] + [t["units"].get(_unit(u), "not run" if counted(u) else
+                                          "not counted (its smooth fields leak)")
+                           for u in dec]
                  + [t["label"], ", ".join(t["mirror"]) or "none"]
                  for name, t in tags.items()])
     for bc, o in m["orders"].items():
@@ -515,8 +533,11 @@ def _mirror(d, doc):
                + fmt(max((o.get("u") or {0: 0.0}).values()), 2) + "), no check that the "
                "sizes are in the asymptotic range"
                + ("; the orders of unrelated models agree within "
-                  f"{max(v) - min(v):.3f}: one common order, not a per-model property (its "
-                  "cause is not identified by these runs)" if len(v) > 2
+                  f"{max(v) - min(v):.3f}: one common order, not a per-model property (a "
+                  "node-level pattern of fixed strain averaged over each layer's side nodes "
+                  "falls as h^"
+                  f"{np.log2(o['sizes'][1] * (o['sizes'][1] - 1) / (o['sizes'][0] * (o['sizes'][0] - 1))):.2f}"
+                  " over these sizes: the layer mean's slope is that averaging's)" if len(v) > 2
                   and max(v) - min(v) < 0.05 else "") + "." if v else
                "no distinct model resolved at both."))
     lin = a.get("linear") or {}
@@ -597,9 +618,9 @@ def _consistency(d, cs, us=()):
                   and u["check"].get("ends") is not None and u["n"] in {
                       int(r["mesh"].rsplit("-", 1)[-1]) for r in cs["rows"]
                       if r["mesh"].rsplit("-", 1)[-1].isdigit()}))
-    d.table(["mesh", "clustered at", "distinct models", "signed: rho [95 %]",
-             "unsigned: rho [95 %]", "resolved signatures", "verdict"],
-            [[r["mesh"], fmt(v["tol"]), f"{v['n']} of {r['of']}",
+    d.table(["mesh", "clustered at", "distinct models (reading families: the interval's n)",
+             "signed: rho [95 %]", "unsigned: rho [95 %]", "resolved signatures", "verdict"],
+            [[r["mesh"], fmt(v["tol"]), f"{v['n']} of {r['of']} ({r.get('families', 'n/a')})",
               _rho(v), _rho(next(w for w in r["variants"] if w["tol"] == v["tol"]
                                  and not w["signed"])),
               f"{r['clear']}" + (f" ({len(r['at'])} at the threshold)" if r["at"] else ""),
@@ -708,7 +729,10 @@ def _figures(d, out, s, doc):
               "gives each model's period-2 signature over the reference's mean and over its "
               "own mean (n/a: the reference and a quadratic span the free layers, no period-2 "
               "component exists there), marked 'clear' where it is clear on both "
-              "normalisations and the configuration decides")
+              "normalisations and the configuration decides"
+              + ("; on the clamped base, the paper's setting, the 3 free layers of its 5 carry "
+                 "no period-2 part, so an alternation like its Figure 1's could show only on "
+                 "the sliding base" if spec[1] == 5 else ""))
     meshes, models = list(s.meshes), list(s.models)
     for bc in s.bcs:
         cell = {(c["model"], c["mesh"]): c for c in cells if c["bc"] == bc
@@ -716,15 +740,20 @@ def _figures(d, out, s, doc):
         if not cell:
             continue
         fig = f"alternation_{bc}.png"
+        counts = {(u["n"], u["bc"]) for u in units if counted(u)}
+        muted = [j for j, x in enumerate(meshes)
+                 if (s.meshes[x][1], bc) not in counts]
         heatmap(out / fig, [short(m) for m in models], meshes,
                 [[cell.get((m, x)) for x in meshes] for m in models],
                 f"signature over the reference's mean / the clear level {CLEAR:g}, {bc} base, "
-                "the paper's push")
+                "the paper's push", muted)
         d.img(fig, f"The signature of every model on every mesh, {bc} base, over the "
               f"reference's mean in units of the clear level {CLEAR:g} (colour linear, "
               "saturating at +-1.5: the clear level is +-1 on the bar; a value near 0 is "
               "white), each cell's value written out; 'failed' on dark grey, 'not run' "
-              "hatched, 'n/a' (no signature) on light grey")
+              "hatched, 'n/a' (no signature) on light grey; a mesh whose configuration "
+              "(size, base) the answers do not count (5 nodes, or a leak above the deciding "
+              "level) is greyed over and marked '(not counted)': its colours decide nothing")
 
 
 def profiles_figure(path, panels, title, decides=None, clear=None):
@@ -789,11 +818,12 @@ def _status(c):
     return None
 
 
-def heatmap(path, rows, cols, cells, title):
+def heatmap(path, rows, cols, cells, title, muted=()):
     """The signature of each (row, column) cell over the clear level, on a linear colour
     scale saturating at +-1.5 (the clear level at +-1, marked on the bar), its value written
     in two significant figures ('<1e-8' below round-off, on white); a failed cell on dark
-    grey, a cell not run hatched, one without a signature on light grey, each with its word."""
+    grey, a cell not run hatched, one without a signature on light grey, each with its word;
+    the ``muted`` columns (decide nothing) greyed over and labelled so."""
     import matplotlib.pyplot as plt
     from matplotlib.colors import Normalize
     from matplotlib.patches import Rectangle
@@ -816,6 +846,10 @@ def heatmap(path, rows, cols, cells, title):
             x = c["alternation_rel"]
             ax.text(j, i, "<1e-8" if abs(x) < 1e-8 else f"{x:.1e}", ha="center", va="center",
                     fontsize=5.2, color="k")
+    for j in muted:
+        ax.add_patch(Rectangle((j - 0.5, -0.5), 1, len(rows), facecolor="0.85", alpha=0.75,
+                               edgecolor="none", zorder=2))
+    cols = [f"{x} (not counted)" if j in muted else x for j, x in enumerate(cols)]
     ax.set_xticks(range(len(cols)), cols, rotation=45, ha="right", fontsize=7)
     ax.set_yticks(range(len(rows)), rows, fontsize=6.5)
     ax.set_title(title, fontsize=8)

@@ -110,7 +110,10 @@ def fixed_normal(form):
 def short(model):
     """The name tables and figures use: 'pbcm-balanced +normal_edge' for a reading with a
     fitted normal term, 'pbcm-balanced +normal_edge (c_n = 1)' with a fixed one, 'msm +shear
-    (c = 1)' for msm with the shear term, else the model."""
+    (c = 1)' for msm with the shear term, else the model; a held twin's is its model's with
+    HELD_SUFFIX."""
+    if model.endswith(HELD_SUFFIX):
+        return short(model[:-len(HELD_SUFFIX)]) + HELD_SUFFIX
     for r in READINGS:
         for form in NORMAL_FORMS:
             if model == label(f"pbcm-{r} + {form}(c=auto)"):
