@@ -360,17 +360,32 @@ def test_generated_shear_kernels_are_current():
 # collection, where it would compile every kernel in each xdist worker before any test runs)
 THREADED = ["volume", "corner", "balanced", "variational", "fem_linear", "fem_corotated",
             "fem_neohookean"]
+EDGE_THREADED = ["springs"]     # its elements are edges: a flattened tetrahedron is no fault
 
 
-def test_the_shear_readings_the_volume_term_and_the_fem_baselines_have_a_threaded_kernel():
-    """Exactly the volume term, the three shear readings (corner, balanced, variational) and
-    the three FEM baselines have a threaded kernel; every other term has none."""
+def test_the_shear_readings_the_volume_term_the_springs_and_the_fem_baselines_have_a_threaded_kernel():
+    """Exactly the volume term, the three shear readings (corner, balanced, variational), the
+    springs and the three FEM baselines have a threaded kernel; every other term has none."""
     mesh, material = cube(2, 0.01, "five"), Material(E=1e4, nu=0.3)
     assert sorted(k for k in TERMS if make_term(*TERMS[k][:1], mesh, material, **TERMS[k][1])
-                  .threaded_kernel() is not None) == sorted(THREADED)
+                  .threaded_kernel() is not None) == sorted(THREADED + EDGE_THREADED)
 
 
-@pytest.mark.parametrize("key", THREADED)
+def test_the_springs_threaded_kernel_reports_the_first_collapsed_edge(mat):
+    """With edges 30 and 5 collapsed to a point, the springs' threaded kernel returns the
+    first one (5), as the serial kernel does."""
+    mesh = cube(4, 0.02, "five")
+    t = term("springs", mesh, mat)
+    x = mesh.points.copy()
+    for e in (30, 5):
+        i, j = t.edge[e]
+        x[j] = x[i]
+    fn, args = t.threaded_kernel()
+    assert fn(x, *args, np.zeros_like(x)) == 5
+    assert t.kernel()[0](x, *t.kernel()[1], np.zeros_like(x)) == 5
+
+
+@pytest.mark.parametrize("key", THREADED + EDGE_THREADED)
 @pytest.mark.parametrize("family", ["five", "six"])
 def test_threaded_kernel_equals_serial_bit_for_bit(key, family, mat):
     """The two-thread mode sums each node's contributions in the serial kernel's order, so

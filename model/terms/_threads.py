@@ -54,10 +54,11 @@ def per_tet_then_gather(x, kernel_tets, args, ft, flat, ptr, slot, out):
 
 
 class TwoThreads:
-    """The buffers of the two-thread mode for one term: ft, the flags and the node CSR."""
+    """The buffers of the two-thread mode for one term: ft, the flags and the node CSR, over
+    its elements (tetrahedra, or a spring term's edges)."""
 
     def __init__(self, tets, n_nodes):
-        self.ft = np.empty((len(tets), 4, 3))
+        self.ft = np.empty((len(tets), tets.shape[1], 3))    # a tetrahedron's 4, an edge's 2
         self.flat = np.zeros(len(tets), dtype=np.int8)
         self.ptr, self.slot = node_slots(tets, n_nodes)
 

@@ -14,6 +14,7 @@ from numba import njit
 
 from . import Term, register
 from ..geometry import edges
+from ._threads import TwoThreads
 
 
 @njit(cache=True, fastmath=True)
@@ -33,6 +34,27 @@ def spring_forces(x, edge, rest, k, out):
         out[j, 1] -= f * d1
         out[j, 2] -= f * d2
     return -1
+
+
+@njit(cache=True, fastmath=True)
+def spring_edges(x, edge, rest, k, fe, flat, first, stop):
+    """spring_forces for the edges [first, stop) into fe (m, 2, 3), collapsed ones flagged in
+    flat (the two-thread mode's twin: node j's force is stored negated, which the gather adds
+    to the same bits as the serial kernel's subtraction)."""
+    n_flat = 0
+    for s in range(first, stop):
+        i, j = edge[s, 0], edge[s, 1]
+        d0, d1, d2 = x[j, 0] - x[i, 0], x[j, 1] - x[i, 1], x[j, 2] - x[i, 2]
+        ln = np.sqrt(d0 * d0 + d1 * d1 + d2 * d2)
+        if ln <= 0.0:
+            flat[s] = 1
+            n_flat += 1
+            continue
+        f = k[s] * (ln - rest[s]) / ln
+        g0, g1, g2 = f * d0, f * d1, f * d2
+        fe[s, 0, 0], fe[s, 0, 1], fe[s, 0, 2] = g0, g1, g2
+        fe[s, 1, 0], fe[s, 1, 1], fe[s, 1, 2] = -g0, -g1, -g2
+    return n_flat
 
 
 def van_gelder_stiffness(mesh):
@@ -62,6 +84,11 @@ class Springs(Term):
 
     def kernel(self):
         return spring_forces, (self.edge, self.rest, self.k)
+
+    def threaded_kernel(self):
+        if getattr(self, "_threads", None) is None:
+            self._threads = TwoThreads(self.edge, self.mesh.n_nodes)
+        return self._threads.kernel(spring_edges, self.kernel()[1])
 
     def degenerate_tets(self, bad):
         """The tetrahedra around the collapsed edge ``bad``."""
