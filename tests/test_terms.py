@@ -358,14 +358,15 @@ def test_generated_shear_kernels_are_current():
 
 # the terms with a two-thread kernel (which the next test finds by making every term: not at
 # collection, where it would compile every kernel in each xdist worker before any test runs)
-THREADED = ["volume", "corner", "balanced", "variational", "fem_linear", "fem_corotated",
-            "fem_neohookean"]
+THREADED = ["volume", "corner", "balanced", "variational", "normal_edge", "fem_linear",
+            "fem_corotated", "fem_neohookean"]
 EDGE_THREADED = ["springs"]     # its elements are edges: a flattened tetrahedron is no fault
 
 
-def test_the_shear_readings_the_volume_term_the_springs_and_the_fem_baselines_have_a_threaded_kernel():
+def test_every_presets_terms_have_a_threaded_kernel():
     """Exactly the volume term, the three shear readings (corner, balanced, variational), the
-    springs and the three FEM baselines have a threaded kernel; every other term has none."""
+    edge normal term (the +normal preset's), the springs and the three FEM baselines have a
+    threaded kernel, so every preset runs wholly on two threads; every other term has none."""
     mesh, material = cube(2, 0.01, "five"), Material(E=1e4, nu=0.3)
     assert sorted(k for k in TERMS if make_term(*TERMS[k][:1], mesh, material, **TERMS[k][1])
                   .threaded_kernel() is not None) == sorted(THREADED + EDGE_THREADED)
@@ -385,6 +386,20 @@ def test_the_springs_threaded_kernel_reports_the_first_collapsed_edge(mat):
     assert t.kernel()[0](x, *t.kernel()[1], np.zeros_like(x)) == 5
 
 
+def test_the_edge_normal_terms_threaded_kernel_reports_the_first_tetrahedron_with_a_collapsed_edge(mat):
+    """With an edge of tetrahedra 40 and 7 collapsed to a point, the edge normal term's
+    threaded kernel returns the first tetrahedron holding a collapsed edge, as the serial
+    kernel does."""
+    mesh = cube(4, 0.02, "five")
+    t = term("normal_edge", mesh, mat)
+    x = mesh.points.copy()
+    for k in (40, 7):
+        x[mesh.tets[k, 1]] = x[mesh.tets[k, 0]]
+    serial = t.kernel()[0](x, *t.kernel()[1], np.zeros_like(x))
+    fn, args = t.threaded_kernel()
+    assert serial >= 0 and fn(x, *args, np.zeros_like(x)) == serial
+
+
 @pytest.mark.parametrize("key", THREADED + EDGE_THREADED)
 @pytest.mark.parametrize("family", ["five", "six"])
 def test_threaded_kernel_equals_serial_bit_for_bit(key, family, mat):
@@ -399,7 +414,7 @@ def test_threaded_kernel_equals_serial_bit_for_bit(key, family, mat):
     assert np.array_equal(out, t.forces(x, np.full_like(x, 0.25)))
 
 
-@pytest.mark.parametrize("key", THREADED)
+@pytest.mark.parametrize("key", [k for k in THREADED if k != "normal_edge"])
 def test_threaded_kernel_reports_the_first_flattened_tetrahedron(key, mat):
     """With tetrahedra 40 and 7 flattened, the threaded kernel returns the same degenerate
     tetrahedron as the serial kernel, the first one, which is the one the serial

@@ -14,7 +14,8 @@ from numba import njit
 
 from . import CalibratedTerm, register
 from ._blocks import (B, FLAG, OPTIONS, OUT, SCRATCH, blocked, blocked_tets, first_flat, gather,
-                      rsqrt, scatter)
+                      put, rsqrt, scatter)
+from ._threads import TwoThreads
 from ._kernels import axpy, dot, sub
 
 # the three edges at each corner: (corner, other end)
@@ -89,6 +90,19 @@ def normal_forces(x, tb, m, vol0, inv_rest, coef_G, out):
     return -1
 
 
+@njit(**OPTIONS)
+def normal_tets(x, tb, m, vol0, inv_rest, coef_G, ft, flat, first, stop):
+    """normal_forces for the tetrahedra [first, stop) into ft (m, 4, 3); collapsed ones
+    flagged in flat (the two-thread mode's twin: the same forces, bit for bit)."""
+    s = np.empty(SCRATCH)
+    n_flat = 0
+    for blk in range(first // B, (stop + B - 1) // B):
+        gather(x, tb, blk, s)
+        normal_block(s, blk, vol0, inv_rest, coef_G)
+        n_flat += put(ft, flat, blk, first, stop, s)
+    return n_flat
+
+
 @njit(cache=True, fastmath=True)
 def normal_forces_reference(x, tets, vol0, rest_len, coef_G, out):
     """Corner by corner, tetrahedron by tetrahedron (the reference of ``normal_forces``)."""
@@ -155,6 +169,11 @@ class NormalEdge(CalibratedTerm):
 
     def kernel_args(self, k):
         return normal_forces, (*self._blocked, k * self.G)
+
+    def threaded_kernel(self):
+        if getattr(self, "_threads", None) is None:
+            self._threads = TwoThreads(self.mesh.tets, self.mesh.n_nodes)
+        return self._threads.kernel(normal_tets, self.kernel()[1])
 
     def reference_kernel(self):
         k = self.kernel()[1][-1]          # the same checks (calibrated)
