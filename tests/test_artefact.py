@@ -475,7 +475,8 @@ def test_normal_stress_is_tested_only_where_the_term_is_active(nine_decides):
     assert ns["decided"] and ns["holds"] and ns["removed"] == ns["tested"] == 3
     assert all(p["reduced"] == "above" for p in ns["pairs"])
     assert ns["signs"] == ["+"]
-    assert "the paper's sign (+): 3 of 3 reduced 3-fold" in a["text"]
+    # 9 and 17 sliding read the same ratio on one base: one observation
+    assert "the paper's sign (+): 2 of 2 reduced 3-fold" in a["text"]
     assert "the reversed sign (-): not tested" in a["text"]
     assert "a normal-stress term removes it (b)" in a["text"]
 
@@ -1251,10 +1252,10 @@ def test_the_open_mirror_reads_are_counted_by_their_reason():
             {"mirror_why": "the ratio at the threshold"},
             {"mirror_why": "a control failed; the ratio on those that ran is 3 or more"}]
     said = analysis._open_reasons(rows)
-    assert said.startswith("constants fitted per split (no control holds the mirrored "
-                           "split's) 2")
-    for part in ("no control part resolved from 0 1", "the ratio at the threshold 1",
-                 "a control failed 1"):
+    assert said.startswith("2 with constants fitted per split (no control holds the mirrored "
+                           "split's)")
+    for part in ("1 with no control part resolved from 0", "1 with the ratio at the threshold",
+                 "1 with a control failed"):
         assert part in said
 
 
@@ -1297,11 +1298,17 @@ def test_the_line_signatures_are_recorded_apart_and_read_back_whole(tmp_path):
 
 def test_two_terms_that_move_a_part_alike_are_one_normal_stress_observation():
     """Pairs of one configuration and one base model whose parts with and without the term
-    agree are counted once; the same numbers on another configuration or base count apart."""
-    p = {"n": 9, "bc": "sliding", "base": "b", "with": 0.004, "without": 0.003}
+    agree are counted once; the same numbers on another configuration or base count apart;
+    one model's pairs on one base at two sizes with the same ratio (to 2 figures) are one
+    observation, with another ratio two."""
+    p = {"n": 9, "bc": "sliding", "base": "b", "model": "b +t", "with": 0.004,
+         "without": 0.003, "ratio": 4 / 3}
     pairs = [p, {**p, "term": "other"}, {**p, "bc": "clamped"}, {**p, "base": "c"},
-             {**p, "with": 0.005}]
+             {**p, "with": 0.005, "ratio": 5 / 3}]
     assert analysis.distinct_pairs(pairs) == [pairs[0]] + pairs[2:]
+    finer = {**p, "n": 17, "with": 0.001, "without": 0.00075}
+    assert analysis.distinct_pairs([p, finer]) == [p]
+    assert analysis.distinct_pairs([p, {**finer, "ratio": 1.5}]) == [p, {**finer, "ratio": 1.5}]
 
 
 def test_the_size_line_gives_the_layer_mean_at_the_finest_size_and_its_fall_per_base():
@@ -1483,3 +1490,31 @@ def test_the_thresholds_tried_move_the_answers_and_leave_the_studys_own_in_place
         analysis.THRESHOLDS_TRIED = keep
     assert ["(a) The mirror symmetry of the five split?", "not shown"] in far["changed"]
     assert analysis.RATIO == before[1]
+
+
+def test_the_tracking_tests_power_is_the_rho_its_interval_needs():
+    """track_needs(n) gives the rho whose 95 % interval over n points starts at the tracking
+    threshold and the one whose interval ends there (rank_interval's own bounds); fewer than
+    4 points have none; more points need less."""
+    hi, lo = analysis.track_needs(7)
+    assert analysis.rank_interval(hi, 7)[0] == pytest.approx(analysis.TRACKS)
+    assert analysis.rank_interval(lo, 7)[1] == pytest.approx(analysis.TRACKS)
+    assert hi == pytest.approx(0.954, abs=1e-3) and lo == pytest.approx(-0.141, abs=1e-3)
+    assert analysis.track_needs(3) is None
+    assert analysis.track_needs(30)[0] < hi and analysis.track_needs(30)[1] > lo
+
+
+def test_a_node_level_parts_u_adds_the_leak_of_its_own_splits_profile():
+    """A cell whose layer profile equals FEM P1's adds nothing to node_u; a smooth difference
+    adds the leak times its smooth amplitude, in mm, in quadrature; no leak adds nothing."""
+    n = 9
+    r = reference(n, "sliding") * 1e-3
+    fem = {"bulge_profile_mm": list(r), "bulge_profile_fem_mm": list(r),
+           "line_alternation_fem_mm": [1e-6, -1e-6]}
+    base = analysis.node_u(fem)
+    same_cell = {"bc": "sliding", "bulge_profile_mm": list(r)}
+    assert analysis.cell_node_u(same_cell, fem, (0.01, 0.0)) == pytest.approx(base)
+    bulge = 1e-4 * np.sin(np.pi * np.linspace(0.0, 1.0, len(r)))
+    barrel = {"bc": "sliding", "bulge_profile_mm": list(r + bulge)}
+    assert analysis.cell_node_u(barrel, fem, (0.0, 0.0)) == pytest.approx(base)
+    assert analysis.cell_node_u(barrel, fem, (0.01, 0.0)) > base

@@ -595,13 +595,16 @@ def units(cells, models=None):
                 row["kind"] = "n/a (no signature)"
                 rows.append(row)
                 continue
+            d, u = _part(c, fem, ref, free, leak)
             dup = next((r for r in seen if one_observation(r, row)), None)
             if dup is not None:
+                # one observation with a model counted before it; its own part is kept for
+                # the pairs that read this model's cell
                 row["same_as"] = dup["name"]
                 row["kind"] = f"same as {dup['name']}"
+                row["own_part"] = (d, u)
                 rows.append(row)
                 continue
-            d, u = _part(c, fem, ref, free, leak)
             parts = []
             for x in own_ctrls:
                 cp, uc = _part(at[(cm, x, n, bc, "paper")], at[(YARDSTICK_MODEL, x, n, bc,
@@ -777,13 +780,12 @@ def normal_stress(cells, us):
             skip(f"{short(base['model'])} has no resolved own part")
             continue
         rw = rows[(n, bc)].get(w["model"], {})
-        if rw.get("same_as"):
-            if rw["same_as"] != r.get("name"):      # one observation with another term's
-                skip(f"one observation with {rw['same_as']}")
-                continue
-            rw = next(x for x in rows[(n, bc)].values() if x["name"] == rw["same_as"])
+        if rw.get("same_as") and rw["same_as"] != r.get("name"):
+            skip(f"one observation with {rw['same_as']}")   # another term's, counted there
+            continue
         without, uw = r["part"], r["u"]
-        with_, uv = rw.get("part"), rw.get("u")
+        # the model's own cell, also where it agrees with its base to two figures
+        with_, uv = rw.get("own_part") or (rw.get("part"), rw.get("u"))
         if with_ is None:
             skip("no part with the term")
             continue
@@ -826,6 +828,15 @@ def rank_interval(rho, n):
         return None
     z, se = np.arctanh(np.clip(rho, -0.999999, 0.999999)), np.sqrt(1.06 / (n - 3))
     return [float(np.tanh(z - Z95 * se)), float(np.tanh(z + Z95 * se))]
+
+
+def track_needs(n):
+    """(the smallest rho read as 'tracks', the largest read as 'does not track') over ``n``
+    independent points: the test's power (``rank_interval``); None below 4 points."""
+    if n < 4:
+        return None
+    w, z = Z95 * np.sqrt(1.06 / (n - 3)), np.arctanh(TRACKS)
+    return float(np.tanh(z + w)), float(np.tanh(z - w))
 
 
 def _track(rho, ci):
@@ -1311,15 +1322,31 @@ def node_u(fem):
     return float(np.hypot(np.sqrt(np.mean(r * r)), ROUND_OFF_FLOOR * scale))
 
 
+def cell_node_u(c, fem, leak):
+    """u [mm] of cell ``c``'s node-level part on its own split (``fem`` FEM P1 there):
+    ``node_u`` with the configuration's ``leak`` (smooth, sharp) times the smooth amplitude
+    and end step of (model - FEM P1)'s layer profile, in mm, in quadrature: a line's smooth
+    shape leaks into its signature as the layer profile's does."""
+    u0 = node_u(fem)
+    p, q = _arr(c.get("bulge_profile_mm")), _arr(fem.get("bulge_profile_mm"))
+    r = _arr(fem.get("bulge_profile_fem_mm"))
+    if u0 is None or p is None or q is None or r is None:
+        return u0
+    lu = leak_u(p - q, r, _free_layers(c["bc"], len(r)), leak) * float(np.abs(r).mean())
+    return float(np.hypot(u0, lu))
+
+
 def node_pattern(cells):
     """The side nodes' own period-2 pattern, per configuration (size, base) of the mirrored
     split from DECISIVE layers at the push: per distinct model its node-level part (``node_part``
-    rms, mm) with u (``node_u``), resolved where RATIO times u, and the same part on each
+    rms, mm) with u (``cell_node_u``: the continuum's own line scores and the configuration's
+    leaks, each split its own), resolved where RATIO times u, and the same part on each
     conforming control (its held model's where run); the share of it the layer mean keeps;
     FEM P1's own node-level pattern (FEM P1's lines less the continuum's) per split; and per
     base the two-point slope in h of each model's resolved node-level part from one size to
     the next (its strain, mm over h, falls at that slope less 1)."""
     at = _index(cells)
+    check = metric_check(cells)
     out = []
     for n, bc in sorted({(c["nodes_per_side"], c["bc"]) for c in cells
                          if c["split"] == MIRRORED and c["nodes_per_side"] >= DECISIVE}):
@@ -1328,6 +1355,7 @@ def node_pattern(cells):
         u = node_u(fem[MIRRORED])
         if u is None:
             continue
+        leak = leaks_of(check.get((n, bc), {}))
         fem_own = {}
         for x, f in fem.items():
             if _lines(f) is not None:
@@ -1348,14 +1376,16 @@ def node_pattern(cells):
             cm = control_model(at, c["model"], n, bc)
             ctrls = {}
             for x in CONFORMING_CONTROLS:
-                cr, _ = node_part(at.get((cm, x, n, bc, "paper")), fem[x])
+                cx = at.get((cm, x, n, bc, "paper"))
+                cr, _ = node_part(cx, fem[x])
                 if cr is not None:
-                    ctrls[x] = (cr, node_u(fem[x]))
+                    ctrls[x] = (cr, cell_node_u(cx, fem[x], leak))
+            uc = cell_node_u(c, fem[MIRRORED], leak)
             row = {"name": short(c["model"]), "model": c["model"], "rms": rms, "mean": mean,
-                   "u": u, "kept": abs(mean) / rms if rms else None,
-                   "resolved": against(rms / u, RATIO), "controls": ctrls}
+                   "u": uc, "kept": abs(mean) / rms if rms else None,
+                   "resolved": against(rms / uc, RATIO), "controls": ctrls}
             if row["resolved"] == "above" and ctrls:
-                lo, hi, call, why = _mirror_call(rms, u, list(ctrls.values()))
+                lo, hi, call, why = _mirror_call(rms, uc, list(ctrls.values()))
                 moved = _constants_moved(c, [at[(cm, x, n, bc, "paper")] for x in ctrls])
                 if moved and call != "at":
                     call, why = "at", f"its constants are fitted per split ({moved})"
@@ -1418,7 +1448,8 @@ def node_text(nodes):
         fo = x["fem_own"]
         parts.append(
             f"{_where((x['n'], x['bc']))}: {len(res)} of {len(rs)} distinct models' node-level "
-            f"parts resolved (u {fmt(x['u'], 2)} mm), "
+            f"parts resolved (u {fmt(min(r['u'] for r in rs), 2)}-"
+            f"{fmt(max(r['u'] for r in rs), 2)} mm), "
             + (f"{fmt(min(r['rms'] for r in res), 2)}-{fmt(max(r['rms'] for r in res), 2)} mm, "
                if res else "")
             + f"{len(mir)} of them the mirror's, {ctrl_res} of {len(rs)} resolved on a "
@@ -1445,7 +1476,9 @@ def node_text(nodes):
         return ""
     return ("The side nodes' own pattern (each vertical line of side-face nodes read with the "
             "layer profile's weights, less FEM P1's line on the same tetrahedra; rms over the "
-            "lines; u the continuum's own line scores, a smooth shape as large as the field): "
+            "lines; u the continuum's own line scores, a smooth shape as large as the field, "
+            "and the configuration's leaks times the smooth shape and end step of the model's "
+            "layer profile less FEM P1's, on each split its own): "
             + "; ".join(parts) + (". Under refinement the node-level part falls at "
                                   + "; ".join(slopes) + " (two sizes only: the order is not "
                                   "decided)" if slopes else ""))
@@ -1543,7 +1576,8 @@ def mesh_pick(resolved, mirrors, against_, fem_units, nodes, stiffer=(), counted
             f"the layer mean {resolved}"
             + (f"; FEM P1's own on {', '.join(fem_units)}" if fem_units else "")
             + " (one mesh per split and size: no spread over meshes; chosen on the pattern "
-            "alone: each mesh family's model-form error is in the scorecard)"
+            "alone: each mesh family's model-form error is in the scorecard and its "
+            "consistency limit in the table below, which this pick does not weigh)"
             + (f"; on a control {len(on_ctrl)} of {len(node_rows)} of these parts keep a "
                "resolved node-level part of their own, smaller: the error changes shape "
                "there, it does not vanish" if on_ctrl else "")
@@ -1635,7 +1669,7 @@ def _open_reasons(rows):
              "no control part resolved from 0" if "unbounded" in why else
              "the ratio at the threshold")
         kinds[k] = kinds.get(k, 0) + 1
-    return ", ".join(f"{k} {v}" for k, v in sorted(kinds.items(), key=lambda kv: -kv[1]))
+    return ", ".join(f"{v} with {k}" for k, v in sorted(kinds.items(), key=lambda kv: -kv[1]))
 
 
 def size_line(layer_orders, below, largest, units_):
@@ -1672,11 +1706,16 @@ def size_line(layer_orders, below, largest, units_):
 def distinct_pairs(pairs):
     """The normal-stress pairs with those of one configuration, one base model and the same
     part with and without the term (to SAME) counted once: two terms that move the part alike
-    are one observation."""
+    are one observation; and one model's pairs on one base at two sizes whose ratios agree to
+    COARSE counted once too (a pattern of fixed strain scales with h alike with and without
+    the term: the same observation again)."""
     kept = []
     for p in pairs:
-        if not any((q["n"], q["bc"], q["base"]) == (p["n"], p["bc"], p["base"])
-                   and same(q["with"], p["with"], SAME) and same(q["without"], p["without"], SAME)
+        if not any(((q["n"], q["bc"], q["base"]) == (p["n"], p["bc"], p["base"])
+                    and same(q["with"], p["with"], SAME)
+                    and same(q["without"], p["without"], SAME))
+                   or ((q["model"], q["bc"]) == (p["model"], p["bc"]) and q["n"] != p["n"]
+                       and same(q["ratio"], p["ratio"], COARSE))
                    for q in kept):
             kept.append(p)
     return kept
@@ -1833,9 +1872,15 @@ def short_answer(below, nodes, sign_rows, ns, cs, nc, fine_units=()):
         mirror_any |= bool(mir)
         every_any |= bool(every)
         open_any |= len(res) > len(mir) + len(every)
+        fo = fine.get("fem_own") or {}
         node_said.append(f"{len(mir)} of {len(res)} resolved parts are the mirror's, "
                          f"{len(every)} on every split, {len(res) - len(mir) - len(every)} not "
-                         f"decided ({bc}, {fine['n']} nodes; unsigned: rms over the lines)")
+                         f"decided ({bc}, {fine['n']} nodes; unsigned: rms over the lines)"
+                         + ("; FEM P1's own there " + ", ".join(
+                             f"{'five' if x == MIRRORED else x} {fmt(v['rms'], 2)}"
+                             + ("" if against(v["rms"] / v["u"], RATIO) == "above"
+                                else " (not resolved)") for x, v in fo.items()) + " mm"
+                            if fo else ""))
     per = {}        # per configuration (the unit), by sign: (the mirror's, resolved)
     for s_ in ("+", "-"):
         for w, r in sign_rows[s_]:
@@ -1872,22 +1917,29 @@ def short_answer(below, nodes, sign_rows, ns, cs, nc, fine_units=()):
     red = sum(p["reduced"] == "above" for p in decided)
     nulls = [p for p in decided if same(abs(p["with"]), abs(p["without"]), 0.02)]
     spans = {s_: [p["ratio"] for p in decided if p["sign"] == s_] for s_ in ("+", "-")}
-    raised = [p for p in decided if p["ratio"] >= RATIO]
+    raised = [p for p in decided if against(p["ratio"], RATIO) == "above"]
+    raised_at = [p for p in decided if against(p["ratio"], RATIO) == "at"]
     lowered = {s_: [p for p in decided if p["sign"] == s_ and p["ratio"] < 1.0]
                for s_ in ("+", "-")}
+    open_ = len(ps) - len(decided)
     b_answer = ("not tested" if not ps else
-                f"not shown: no term reduces the pattern {RATIO:g}-fold" if red == 0
+                f"not shown: no term reduces the pattern {RATIO:g}-fold"
+                + (f" ({open_} at the threshold: not decided)" if open_ else "") if red == 0
                 else f"for {red} pairs")
     if ps and red == 0:
         sign_word = {"+": "the paper's sign", "-": "the reversed sign"}
         b_answer += "".join(
-            f"; with {sign_word[s_]} {len(v)} of {len(spans[s_])} pairs are reduced, to "
-            f"{fmt(min(p['ratio'] for p in v), 2)}-{fmt(max(p['ratio'] for p in v), 2)} of "
-            "the part" for s_, v in lowered.items() if v)
+            f"; with {sign_word[s_]} {len(v)} of {len(spans[s_])} decided pairs are reduced "
+            f"less than that, to {fmt(min(p['ratio'] for p in v), 2)}-"
+            f"{fmt(max(p['ratio'] for p in v), 2)} of the part"
+            for s_, v in lowered.items() if v)
         if raised:
             b_answer += (f"; a term raises it {RATIO:g}-fold or more in {len(raised)} "
                          f"(up to {fmt(max(p['ratio'] for p in raised), 2)}-fold: "
                          + _names(sorted({p['model'] for p in raised})) + ")")
+        if raised_at:
+            b_answer += (f"; {len(raised_at)} raised about {RATIO:g}-fold (at the threshold: "
+                         + _names(sorted({p['model'] for p in raised_at})) + ")")
 
     def how_set(fitted):
         got = [p for p in decided if bool(p.get("fitted")) == fitted]
@@ -1926,7 +1978,12 @@ def short_answer(below, nodes, sign_rows, ns, cs, nc, fine_units=()):
     rows.append(["(c) The model's consistency (its patch-test error)?", c_answer,
                  f"the layer signature at the linear load: {c_word}; the node-level part "
                  "at the linear load against the patch-test error, the interval over the "
-                 "reading families: " + (", ".join(
+                 "reading families"
+                 + (f" (over {fam} families 'tracks' needs rho of {need[0]:.2f} or more and "
+                    f"'does not track' {need[1]:.2f} or less: a test of little power)"
+                    if (fam := min([r.get("families") or 0 for r in (nc or {}).get("rows", [])],
+                                   default=0)) and (need := track_needs(fam)) else "")
+                 + ": " + (", ".join(
                      f"{r['mesh']} {r['verdict']}" + (f" (rho {r['rho']:.2f})"
                                                      if r["rho"] is not None else "")
                      for r in nc["rows"]) if node_words else "not read")])
@@ -2120,7 +2177,7 @@ def answer(cells, models=None, estimates=None):
                f"Large enough to see: not decided (no configuration's leak is below "
                f"{DECIDING_LEAK:g}).")
             + _period_text(dec)
-            + (f" One observation (identical cells): {'; '.join(_duplicates(dec))}."
+            + (f" One observation each (cells that agree to two significant figures on every split): {'; '.join(_duplicates(dec))}."
                if _duplicates(dec) else ""))
     largest = {}
     for u in dec:
@@ -2257,7 +2314,8 @@ def how_sure(ans, verdict):
         "each u holds the metric's leaks (the worst smooth test field's and the worst sharp "
         "end layer's) and the solver's "
         f"tolerance ({ROUND_OFF_FLOOR:g}), not the sensitivity to the fitted constants (fitted "
-        "per mesh, stored in cells.md, not varied; a calibrated reading's controls hold its "
+        "per split (the calibration reads the split's own cells: the same constant at every "
+        "size), stored in cells.md, not varied; a calibrated reading's controls hold its "
         "mirrored fit's, every fitted constant, so its mirror is not read across two "
         "constants) nor a spread over "
         "meshes: the verdicts are provisional on those"

@@ -84,7 +84,18 @@ def conclusion(doc):
             "**How sure.** Each configuration is one mesh per split (n = 1); every u holds the "
             "metric's leaks and the solver's tolerance, not the sensitivity to the fitted "
             "constants nor a spread over meshes, so the answers are provisional on those "
-            "(in full below)."]
+            "(in full below)" + _moved(doc.get("thresholds") or []) + "."]
+
+
+def _moved(moves):
+    """', and on the thresholds: the clear level at 0.005 turns (size) ...': the questions
+    whose short answer a threshold tried changes, in the opening."""
+    said = [f"{m['word']} at {m['value']:g} (ours {m['ours']:g}) changes "
+            + ", ".join("size" if q.startswith("Large") else q.split(" ")[0]
+                        for q, _ in m["changed"])
+            for m in moves if m["changed"]]
+    return ("; they are provisional on this study's thresholds too: " + "; ".join(said)
+            + " ('How the answers move with the thresholds')") if said else ""
 
 
 def reading_line(v):
@@ -878,7 +889,8 @@ def cells_document(doc, s):
         "(fitted by the patch-test calibration where the model says auto, else given; a "
         f"model named '{HELD_SUFFIX.strip()}' holds the constants its calibrated twin fits on "
         "the mirrored five split of the same size, and a calibrated reading's normal term holds "
-        "the shear's c fitted on the same mesh without it; a normal term's c_n = 0: its fit "
+        "the shear's c fitted on the same mesh without it; the calibration reads the split's own "
+        "cells, so a constant is the same at every size of one split; a normal term's c_n = 0: its fit "
         "dropped it there, the model is its reading). "
         f"Definitions: [glossary](../{GLOSSARY}).")
     combos = [(bc, load) for bc in s.bcs for load in s.loads]
