@@ -17,7 +17,7 @@ def test_bench_writes_table_figure_and_in_round_ratios(tmp_path):
     against itself exactly 1, each median inside its rounds' range), calibration time only for
     the calibrated model, a two-thread speed-up for every preset with two numba threads, and
     each optional engine timed or reported as not installed. A rerun replaces the folder's
-    rows."""
+    rows and keeps the folders inside it that another command wrote."""
     out = tmp_path / "bench"
     assert main(["bench", "--sizes", "100", "700", "--rounds", "3", "--models", "msm",
                  "pbcm-variational", "fem-linear", "--out", str(out)]) == 0
@@ -58,10 +58,14 @@ def test_bench_writes_table_figure_and_in_round_ratios(tmp_path):
             assert data["engines"][name] == "not installed" and not timed
             assert f"{name}: not installed" in md
     assert "pbcm-variational" in md and "step vs msm" in md
-    # a second run replaces its own folder (bench.json marks it as pbcm's)
+    # a second run replaces its own folder (bench.json marks it as pbcm's), and keeps the
+    # folders inside it that another command wrote (the Warp device timings)
+    (out / "cuda").mkdir()
+    (out / "cuda" / "warp_forces.md").write_text("device timings")
     assert main(["bench", "--sizes", "100", "--rounds", "1", "--models", "msm",
                  "--out", str(out)]) == 0
     assert {r["tets"] for r in json.loads((out / "bench.json").read_text())["rows"]} == {135}
+    assert (out / "cuda" / "warp_forces.md").read_text() == "device timings"
 
 
 def test_merge_adds_a_composed_model_and_keeps_every_other_row(tmp_path):

@@ -1,4 +1,5 @@
 """`pbcm bench`: what every model costs."""
+import shutil
 from pathlib import Path
 
 from ..running.output import StagedFolder
@@ -69,7 +70,19 @@ def run(args):
         data = bench.run(sizes=sizes, models=models, rounds=3 if args.quick else args.rounds,
                          with_engines=old is None, device=args.device)
         bench.write(bench.merge(old, data) if old else data, out.path)
+        keep_folders(Path(args.out), out.path)
         path = out.commit()
     print(f"bench written to {path}")
     return 0
 
+
+def keep_folders(target, staged):
+    """Copy the folders inside ``target`` that this run does not write into ``staged``: they
+    hold other commands' output (the Warp device timings of `python -m
+    cases.tools.warp_forces --out reports/bench/cuda`), which replacing the folder must not
+    lose."""
+    if not target.is_dir():
+        return
+    for sub in target.iterdir():
+        if sub.is_dir() and not (staged / sub.name).exists():
+            shutil.copytree(sub, staged / sub.name)
