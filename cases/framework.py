@@ -127,14 +127,24 @@ LOAD_SPLITS = (1, 2, 4, 8)
 STALL = 10
 
 
-def solve_split(pm, dirichlet, f_ext=None, splits=LOAD_SPLITS, **kw):
+def solve_split(pm, dirichlet, f_ext=None, splits=LOAD_SPLITS, upright=False, **kw):
     """``(static result, load steps)``: the model's equilibrium under ``dirichlet`` (and
     ``f_ext``), in the fewest of ``splits`` equal steps that converges; the last split's
-    error where none does."""
+    error where none does. With ``upright`` an equilibrium with an inverted tetrahedron (a
+    spring lattice's folded branch, which a Newton solve in one large step can land on)
+    counts as not converged, so that the next split is tried."""
+    from model.geometry import signed_volumes
     extra = {} if f_ext is None else {"f_ext": f_ext}
     for steps in splits:
         try:
-            return pm.solve_static(dirichlet, load_steps=steps, **extra, **kw), steps
+            st = pm.solve_static(dirichlet, load_steps=steps, **extra, **kw)
+            if upright:
+                folded = int(np.sum(signed_volumes(pm.mesh.points + st.u, pm.mesh.tets) <= 0))
+                if folded:
+                    raise ConvergenceError(
+                        f"an equilibrium with {folded} of {pm.mesh.n_tets} tetrahedra "
+                        f"inverted in {steps} load steps")
+            return st, steps
         except ConvergenceError:
             if steps == splits[-1]:
                 raise

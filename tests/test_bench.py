@@ -198,3 +198,39 @@ def test_real_time_is_the_largest_size_measured_at_one_cpu_second_per_simulated_
                      {"model": "b", "tets": 100, "cpu_s_per_simulated_s": 1.5}],
             "implicit_rows": [{"model": "c", "tets": 100, "cpu_s_per_simulated_s": 0.5}]}
     assert bench.real_time_reach(data) == {"a": 1000, "b": None, "c": 100}
+
+
+def test_the_real_time_family_stops_timing_a_model_after_two_sizes_over_real_time(
+        tmp_path, monkeypatch):
+    """The real-time family times each model under the paper's push at its own step, wall
+    clock, serial and (where it has one) in its two-thread mode, and stops timing a model
+    after two sizes in a row over real time: the larger sizes are rows marked not timed;
+    the implicit preset carries its Newton and CG iterations; a row's faster mode is the
+    one `best` reads."""
+    from cases.tools import realtime_bench as RB
+    monkeypatch.setattr(RB, "QUICK_CELLS", (2, 3, 4))
+    monkeypatch.setattr(RB, "REAL_TIME", 0.0)        # every size is over real time
+    rows = RB.run(models=("msm", "fem-corotated-implicit-frame"), quick=True, rounds=2,
+                  progress=lambda *_: None)
+    by = {(r["model"], r["tets"]): r for r in rows}
+    assert sorted({t for _, t in by}) == [40, 135, 320]
+    for m in ("msm", "fem-corotated-implicit-frame"):
+        assert by[(m, 40)]["timed"] and by[(m, 135)]["timed"] and not by[(m, 320)]["timed"]
+        r = by[(m, 135)]
+        lo, hi = r["wall_range"]
+        assert 0 < lo <= r["wall_s_per_simulated_s"] <= hi and r["dt_us"] > 0
+    assert by[("fem-corotated-implicit-frame", 135)]["newton_per_step"] >= 1
+    assert by[("msm", 135)]["newton_per_step"] is None
+    assert RB.best(by[("msm", 320)]) == (None, None)
+    two = {"model": "msm", "timed": True, "wall_s_per_simulated_s": 2.0,
+           "two_thread_wall_s_per_simulated_s": 1.5}
+    assert RB.best(two) == (1.5, "two threads")
+    assert RB.best({**two, "two_thread_wall_s_per_simulated_s": None}) == (2.0, "serial")
+
+
+def test_bench_family_refuses_other_selections_and_a_missing_bench_before_timing(tmp_path):
+    """`pbcm bench --family` times the family alone into an existing bench.json: with
+    --models, --sizes or --merge, or without a bench.json in --out, it fails before timing."""
+    assert main(["bench", "--family", "--models", "msm", "--out", str(tmp_path)]) == 2
+    assert main(["bench", "--family", "--out", str(tmp_path / "none")]) == 2
+    assert not (tmp_path / "none").exists()

@@ -27,6 +27,10 @@ def add(sub):
     bn.add_argument("--merge", action="store_true",
                     help="add the rows of --models to the bench.json in --out (timed against "
                          "the baselines in this process) and keep every other row")
+    bn.add_argument("--family", action="store_true",
+                    help="time only the real-time family (the paper's push on cubes of 320 to "
+                         "1.1e5 tetrahedra, read by `pbcm run realtime`) and put its rows into "
+                         "the bench.json in --out, keeping every other row")
     bn.add_argument("--device", help="also time the Warp kernels of the covered presets on this "
                                       "Warp device (cpu, cuda, cuda:0 ...), float32 and "
                                       "float64; needs warp-lang (default: not timed)")
@@ -56,19 +60,32 @@ def run(args):
     if args.device is not None:
         check_device(args.device)
     old = None
-    if args.merge:
-        if not models:
+    if args.family and (args.merge or args.models or args.sizes or args.device):
+        raise UsageError("--family times the real-time family alone: drop --merge, --models, "
+                         "--sizes and --device, or drop --family")
+    if args.merge or args.family:
+        if not models and not args.family:
             raise UsageError("--merge adds the rows of the --models given to a bench.json: "
                              "name the models to time")
         where = Path(args.out) / costs.FILE
         if not where.is_file():
-            raise UsageError(f"--merge needs an existing {where}; run `pbcm bench` first or "
-                             "drop --merge")
+            flag = "--family" if args.family else "--merge"
+            raise UsageError(f"{flag} needs an existing {where}; run `pbcm bench` first or "
+                             f"drop {flag}")
         old = costs.read(where)
-        models = tuple(m for m in models if m not in bench.BASELINES)
+        models = tuple(m for m in models or () if m not in bench.BASELINES)
     with StagedFolder(Path(args.out), mark=costs.FILE) as out:
+        if args.family:
+            from ..tools import realtime_bench
+            bench.write({**old, "realtime_machine": bench.machine(),
+                         "realtime_rows": realtime_bench.run(quick=args.quick)}, out.path)
+            keep_folders(Path(args.out), out.path)
+            print(f"bench written to {out.commit()}")
+            return 0
         data = bench.run(sizes=sizes, models=models, rounds=3 if args.quick else args.rounds,
-                         with_engines=old is None, device=args.device)
+                         with_engines=old is None, device=args.device,
+                         family=None if args.models or args.sizes else
+                         ("quick" if args.quick else "full"))
         bench.write(bench.merge(old, data) if old else data, out.path)
         keep_folders(Path(args.out), out.path)
         path = out.commit()

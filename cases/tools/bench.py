@@ -68,9 +68,10 @@ def own_stable_step(pm):
 
 class _Timed:
     """One preset on one mesh, ready to be timed: its kernels, a state and the step's
-    buffers (a 1 % push of the top over 1 s, the base held)."""
+    buffers, under ``ramp`` (default the bench's push: 1 % of the side over 1 s, the base
+    held)."""
 
-    def __init__(self, name, mesh, mat):
+    def __init__(self, name, mesh, mat, ramp=None):
         tracemalloc.start()
         self.pm = build(name, mesh, mat)
         self.memory = tracemalloc.get_traced_memory()[1]
@@ -86,11 +87,12 @@ class _Timed:
         if any(threaded) and numba.config.NUMBA_NUM_THREADS >= 2:
             numba.set_num_threads(2)
             self.kernels_2 = tuple(k or t.kernel() for k, t in zip(threaded, self.pm.terms))
-        mask, start, moving = _push(mesh).parts(mesh.n_nodes)
+        ramp = ramp or _push(mesh)
+        mask, start, moving = ramp.parts(mesh.n_nodes)
         self.x, self.v = mesh.points.copy(), np.zeros_like(mesh.points)
         self.out = np.zeros_like(mesh.points)
         self.step_args = (mesh.points, self.pm.mass, np.zeros_like(mesh.points), DAMPING, mask,
-                          start, moving, 1.0, mesh.tets,
+                          start, moving, ramp.t_ramp, mesh.tets,
                           not any(t.checks_inversion for t in self.pm.terms),
                           self.pm.material.p_wave_speed, np.empty((STEP_BUFFERS,) + mesh.points.shape))
         self.dt = self.pm.stable_dt(0.5)
@@ -102,8 +104,8 @@ class _Timed:
         self.reps_force = self._reps(lambda n: _force_loop(self.kernels, self.x, self.out, n))
         self.reps_step = self._reps(self._steps)
 
-    def _steps(self, n):
-        status = rk4_ramp(self.kernels, self.x, self.v, self.t, self.dt, n, *self.step_args)[0]
+    def _steps(self, n, kernels=None):
+        status = rk4_ramp(kernels or self.kernels, self.x, self.v, self.t, self.dt, n, *self.step_args)[0]
         if status:
             raise RuntimeError(f"the benchmark's push blew up for {self.pm.name}")
         self.t += n * self.dt
@@ -144,11 +146,12 @@ def _push(mesh):
 class _ImplicitTimed:
     """An implicit preset (backward Euler at its own step) on the bench's push, timed one
     step per sample, each sample going on from the last state: thread CPU time per step, and
-    the Newton and conjugate-gradient iterations it took."""
+    the Newton and conjugate-gradient iterations it took; under ``ramp`` (default the bench's
+    push)."""
 
-    def __init__(self, name, mesh, mat):
+    def __init__(self, name, mesh, mat, ramp=None):
         self.pm = build(name, mesh, mat)
-        self.dt, self.ramp = IMPLICIT_STEP[name], _push(mesh)
+        self.dt, self.ramp = IMPLICIT_STEP[name], ramp or _push(mesh)
         self.x, self.v, self.t = mesh.points.copy(), np.zeros_like(mesh.points), 0.0
         self._step()       # the first step builds the Jacobian's pattern: outside the timings
 
@@ -239,13 +242,15 @@ def _device_rows(timed, models, rows, device, progress):
     return out
 
 
-def run(sizes=SIZES, models=None, rounds=7, progress=print, with_engines=True, device=None):
+def run(sizes=SIZES, models=None, rounds=7, progress=print, with_engines=True, device=None,
+        family=None):
     """Measure every model at every size; returns the bench document (plain data). The
     baselines (msm, fem-linear) are always timed, for the ratios; the other engines only with
     ``with_engines``. With a Warp ``device`` (``cpu``, ``cuda``, ``cuda:1`` ...) the Warp
     kernels of the covered models are timed there too (``device_rows``). The implicit
     presets' steps (every one without ``models``, else those it names) are timed in the same
-    rounds up to IMPLICIT_TETS (``implicit_rows``)."""
+    rounds up to IMPLICIT_TETS (``implicit_rows``). With ``family`` ("full" or "quick") the
+    real-time family is timed too (cases.tools.realtime_bench, ``realtime_rows``)."""
     if not models:      # every preset and the normal-stress candidates of `pbcm run extensions`
         models = [*PRESETS, *CANDIDATES, *IMPLICIT_STEP]
     implicit = [m for m in models if m in IMPLICIT_STEP]
@@ -313,12 +318,17 @@ def run(sizes=SIZES, models=None, rounds=7, progress=print, with_engines=True, d
         if device is not None:
             device_rows += _device_rows(timed, models, rows, device, progress)
         del timed, timers
-    data = {"machine": _machine(), "sizes": [int(s) for s in sizes], "rows": rows,
+    data = {"machine": machine(), "sizes": [int(s) for s in sizes], "rows": rows,
             "engines": {k: "; ".join(v) for k, v in engines.items()},
             "engine_rows": engine_rows, "implicit_rows": implicit_rows}
     if device is not None:
         from . import warp_forces
         data.update(device=warp_forces.device_name(device), device_rows=device_rows)
+    if family is not None:
+        from . import realtime_bench
+        data.update(realtime_rows=realtime_bench.run(quick=family == "quick",
+                                                     progress=progress),
+                    realtime_machine=data["machine"])
     return data
 
 
@@ -336,7 +346,7 @@ def merge(old, new):
             "implicit_rows": merged("implicit_rows")}
 
 
-def _machine():
+def machine():
     import os
     import platform
     cpu = platform.processor() or platform.machine()
@@ -404,6 +414,8 @@ def write(data, out):
                   "machine (serial): " + "; ".join(
                       f"{m_} {t} tetrahedra" if t else f"{m_} none of the sizes measured"
                       for m_, t in fastest.items()) + ".")
+    if data.get("realtime_rows"):
+        _family_table(doc, data)
     doc.p("Optional engines, timed on the same meshes in the same rounds (`pip install "
           "'pbcm[engines]'`), with the ratio of their force evaluation to pbcm's "
           f"{ENGINE_REFERENCE} kernel taken in-round:")
@@ -427,6 +439,35 @@ def write(data, out):
                    for r in data["device_rows"]])
     doc.img("step_time.png", "RK4 step time against tetrahedra, every model")
     doc.write(out, stem="bench")
+
+
+def _family_table(doc, data):
+    """The real-time family: each model's wall-clock seconds per simulated second at each
+    size, its faster mode (serial, two threads, implicit), the rounds' range beside it."""
+    from . import realtime_bench as RB
+    rows = data["realtime_rows"]
+    models = list(dict.fromkeys(r["model"] for r in rows))
+    by = {(r["model"], r["tets"]): r for r in rows}
+    m = data.get("realtime_machine") or data["machine"]
+
+    def cell(r):
+        cost, mode = RB.best(r)
+        if cost is None:
+            return "not timed"
+        two = mode == "two threads"
+        lo, hi = r["two_thread_range" if two else "wall_range"]
+        return f"{fmt(cost)} [{fmt(lo)}-{fmt(hi)}]" + (" (2 threads)" if two else "")
+    doc.p(f"The real-time family (read by `pbcm run realtime`): wall-clock seconds per "
+          f"simulated second on this machine ({m['cpu']}, {m['cores']} cores) under the "
+          "paper's push (1.7 mm on the 32 mm cube at 1.7 mm/s, clamped base, mass damping "
+          f"{DAMPING:g} 1/s), the median of {rows[0].get('rounds', '?')} rounds taken "
+          "round-robin [smallest-largest], each model in its faster mode (serial or two "
+          "threads, named where two threads are faster): the explicit models at their own "
+          "largest stable RK4 step, the implicit presets at their own step from the push's "
+          f"start. A model is not timed above two sizes in a row over {REAL_TIME:g} (real "
+          "time): its cost grows with the mesh.")
+    doc.table(["tets", *models], [[t, *(cell(by[(mo, t)]) for mo in models)]
+                                  for t in sorted({r["tets"] for r in rows})])
 
 
 def per_simulated_second(data):

@@ -5,25 +5,55 @@ import math
 from pathlib import Path
 
 from ...measuring import catalogue
-from ...measuring.error_model import standings, u_val
+from ...measuring.error_model import JUDGES, ROUND_OFF, u_val
 from ...reporting import figures
 from ...reporting.costs import REAL_TIME
 from ...reporting.document import Document, fmt
 from ...reporting.report import environment, write_study
 from ...running.runner import jsonable
-from .study import ACCURACY_TETS, MODELS, P1, statics_of
+from ...tools import realtime_bench as RB
+from .study import LAWS, MODELS, P1
 
 GATED = catalogue.gated("disp_rel_l2", "disp_form_rel_l2")
+RANKED = tuple(m for m in LAWS if m != P1)   # FEM P1 with the continuum's law is the yardstick
+
+
+def err(v):
+    """An error for a sentence: three decimals (the same for every model), 'n/a' for None."""
+    return "n/a" if v is None else (f"{v:.3f}" if abs(v) >= 1e-3 else fmt(v, 2))
+
+
+def _cost(run):
+    """(wall s per simulated s, mode, [lo, hi] over the rounds) of a run's faster mode, or
+    (None, None, None) where the bench did not time it."""
+    cost, mode = RB.best(run["cost"])
+    if cost is None:
+        return None, None, None
+    key = "two_thread_range" if mode == "two threads" else "wall_range"
+    return cost, mode, run["cost"][key]
 
 
 def reach(runs):
-    """{model: its run at the largest size at which the bench measured it at real time (at
-    most REAL_TIME CPU seconds per simulated second), or None}."""
+    """{law: its reach, or None}: the largest size at which any model with that law's statics
+    (an implicit preset's is fem-corotated's) runs in real time in its faster mode (median wall
+    time per simulated second at most REAL_TIME), the cheapest such model there, and the reach
+    over the rounds' range: ``sure`` the largest size real time in every round, ``maybe`` the
+    largest real time in some round."""
     out = {}
-    for m in MODELS:
-        fit = [r for r in runs if r["model"] == m and r["realtime_factor"] is not None
-               and r["realtime_factor"] <= REAL_TIME]
-        out[m] = max(fit, key=lambda r: r["tets"], default=None)
+    for law in LAWS:
+        own = [(r, *_cost(r)) for r in runs if r["law"] == law]
+        timed = [x for x in own if x[1] is not None]
+        fit = [x for x in timed if x[1] <= REAL_TIME]
+        if not fit:
+            out[law] = None
+            continue
+        top = max(x[0]["tets"] for x in fit)
+        r, cost, mode, rng = min((x for x in fit if x[0]["tets"] == top), key=lambda x: x[1])
+        out[law] = {"tets": top, "model": r["model"], "mode": mode, "cost": cost,
+                    "range": rng, "run": r,
+                    "sure": max((x[0]["tets"] for x in timed if x[3][1] <= REAL_TIME),
+                                default=None),
+                    "maybe": max(x[0]["tets"] for x in timed if x[3][0] <= REAL_TIME)}
     return out
 
 
@@ -39,54 +69,105 @@ def bound(runs, run):
     return run["disp_form_rel_l2"] + p1["disp_rel_l2"]
 
 
+def pair_u(a, b, estimate):
+    """The uncertainty of the difference of two error bounds: on one mesh they differ only in
+    their model-form errors, which the reference does not enter (round-off); on two meshes
+    each carries the reference's estimate through FEM P1's distance (the two in quadrature)."""
+    if a["tets"] == b["tets"]:
+        return ROUND_OFF
+    return u_val(math.sqrt(2.0) * estimate)
+
+
+def rank(scores, at, estimate):
+    """[(rank, law, [laws tied with it])], best first: ``scores`` {law: error bound or None
+    (counts as failed, last)}; two bounds are tied where their difference is within
+    ``pair_u`` or both are below JUDGES times the reference's estimate (it cannot order them);
+    a law shares the rank of the first group whose first it is tied with, pair by pair."""
+    order = sorted(scores, key=lambda m: (scores[m] is None, scores[m] or 0.0, m))
+
+    def tied(a, b):
+        sa, sb = scores[a], scores[b]
+        if sa is None or sb is None:
+            return sa is None and sb is None
+        small = JUDGES * estimate
+        return abs(sa - sb) <= pair_u(at[a], at[b], estimate) or (sa < small and sb < small)
+    out, heads = [], []
+    for k, m in enumerate(order):
+        r = next((r for r, h in heads if tied(m, h)), None)
+        if r is None:
+            r = k + 1
+            heads.append((r, m))
+        out.append((r, m, [o for o in order if o != m and tied(m, o)]))
+    return out
+
+
 def verdict(data):
-    """The most accurate model at real time: the models ranked by their error bound at their
-    real-time reach (``bound``: model-form error plus FEM P1's discretisation error there; a
-    model that failed there, or whose error was not computed, counts as failed), ties within
-    u_val (the reference's estimate); with the models whose distance from the continuum is
-    below their model-form error by more than u_val (their error cancels FEM P1's)."""
+    """The most accurate model at real time: the laws other than the yardstick ranked by their
+    error bound at their own reach (``bound``; a failed run or an error not computed counts as
+    failed), ties by ``rank``; the yardstick's reach and distance beside; the laws whose
+    distance from the continuum is below their model-form error by more than the reference's
+    estimate (their error cancels FEM P1's)."""
     runs = data["runs"]
     at = reach(runs)
-    measured = {m: r for m, r in at.items() if r is not None}
+    measured = {m: r for m, r in at.items() if r is not None and m in RANKED}
     if not measured:
-        return {"decided": False, "why": "no model was measured at real time (run `pbcm "
-                "bench` on this machine)", "reach": {}, "ranks": []}
-    u = u_val(data["error_estimate"] or 0.0)
-    bounds = {m: bound(runs, r) for m, r in measured.items()}
-    ranked = standings({m: [b] for m, b in bounds.items()}, u)
-    first = [s.model for rank, s, _ in ranked if rank == 1 and math.isfinite(s.score)]
-    return {"decided": bool(first), "best": first, "u": u, "bounds": bounds,
-            "reach": {m: None if r is None else r["tets"] for m, r in at.items()},
-            "ranks": [{"rank": rank, "model": s.model, "tied": list(o.tied),
-                       "unresolved": list(o.unresolved),
-                       "score": None if math.isinf(s.score) else s.score} for rank, s, o in ranked],
-            "cancels": [m for m, r in measured.items() if r["disp_form_rel_l2"] is not None
-                        and r["disp_rel_l2"] is not None
-                        and r["disp_rel_l2"] + u < r["disp_form_rel_l2"]]}
+        return {"decided": False, "why": "no model was measured at real time on the bench's "
+                "real-time family (run `pbcm bench` on this machine)",
+                "reach": {m: None for m in LAWS}, "ranks": []}
+    e = data["error_estimate"] or 0.0
+    bounds = {m: bound(runs, r["run"]) for m, r in measured.items()}
+    ranked = rank(bounds, measured, e)
+    first = [m for k, m, _ in ranked if k == 1 and bounds[m] is not None]
+    yard = at.get(P1)
+    return {"decided": bool(first), "best": first, "estimate": e,
+            "u_two_meshes": u_val(math.sqrt(2.0) * e), "bounds": bounds,
+            "reach": {m: None if r is None else {k: v for k, v in r.items() if k != "run"}
+                      for m, r in at.items()},
+            "ranks": [{"rank": k, "model": m, "tied": tied, "score": bounds[m]}
+                      for k, m, tied in ranked],
+            "yardstick": None if yard is None else {
+                "model": P1, "tets": yard["tets"], "distance": yard["run"]["disp_rel_l2"]},
+            "cancels": [m for m, r in measured.items()
+                        if r["run"]["disp_form_rel_l2"] is not None
+                        and r["run"]["disp_rel_l2"] is not None
+                        and r["run"]["disp_rel_l2"] + e < r["run"]["disp_form_rel_l2"]]}
 
 
 def machine(data):
     m = data.get("machine") or {}
-    return f"{m.get('cpu', 'an unnamed processor')}, {m.get('cores', '?')} cores, one used"
+    return f"{m.get('cpu', 'an unnamed processor')}, {m.get('cores', '?')} cores"
+
+
+def _law_run(runs, law, tets):
+    return next(r for r in runs if r["model"] == law and r["tets"] == tets)
 
 
 def answer_line(data, v, quick):
     """The index's one line: the most accurate model at real time on the bench's machine."""
     if quick:
-        return ("Quick: not decided (two mesh sizes; `pbcm run realtime` reads every size the "
-                "bench measured).")
+        return ("Quick: not decided (two mesh sizes; `pbcm run realtime` reads the bench's "
+                "whole real-time family).")
     if not v["decided"]:
         return f"Not decided: {v.get('why', 'no model has an error at its real-time reach')}."
-    runs = {(r["model"], r["tets"]): r for r in data["runs"]}
-    best = [runs[(m, v["reach"][m])] for m in v["best"]]
-    said = "; ".join(f"{r['model']}, with {r['tets']} tetrahedra, error bound "
-                     f"{fmt(v['bounds'][r['model']], 2)} (model-form "
-                     f"{fmt(r['disp_form_rel_l2'], 2)} plus FEM P1's discretisation error "
-                     f"there; its distance from the continuum {fmt(r['disp_rel_l2'], 2)})"
-                     for r in best)
-    tie = " (tied within u_val)" if len(best) > 1 else ""
-    return (f"At real time on this machine ({machine(data)}), the most accurate model is "
-            f"{said}{tie}, the paper's push on its cube, static.")
+    said = []
+    for m in v["best"]:
+        r, reach_ = _law_run(data["runs"], m, v["reach"][m]["tets"]), v["reach"][m]
+        mode = reach_["model"] if reach_["model"] != m else reach_["mode"]
+        said.append(f"{m} ({mode}), with {r['tets']} tetrahedra and error bound "
+                    f"{err(v['bounds'][m])} (model-form {err(r['disp_form_rel_l2'])} plus "
+                    f"FEM P1's discretisation error {err(v['bounds'][m] - r['disp_form_rel_l2'])}"
+                    " there)")
+    if len(said) > 1:
+        head = (f"the most accurate models, tied (their error bounds within "
+                f"{err(v['u_two_meshes'])}, the reference's estimate on two meshes), are "
+                + "; ".join(said))
+    else:
+        head = f"the most accurate model is {said[0]}"
+    y = v.get("yardstick")
+    beside = (f"; the yardstick, FEM P1 with the continuum's law ({P1}), runs "
+              f"{y['tets']} tetrahedra at distance {err(y['distance'])}" if y else "")
+    return (f"At real time on this machine ({machine(data)}, wall clock), {head}{beside}; "
+            "the paper's push on its cube.")
 
 
 def write(out, study, s, data):
@@ -97,87 +178,125 @@ def write(out, study, s, data):
                     "gate_runs": [{"mesh": r["mesh"], "bc": r["bc"], "model": r["model"],
                                    "disp_rel_l2": r["disp_rel_l2"],
                                    "disp_form_rel_l2": r["disp_form_rel_l2"]}
-                                  for r in data["runs"] if r["accuracy"]]})
+                                  for r in data["runs"]
+                                  if r["accuracy"] and r["model"] == r["law"]]})
     return write_study(out, doc, lambda folder: build(folder, study, s, doc))
 
 
-def _cell(x, digits=3):
-    return "n/a" if x is None else fmt(x, digits)
+def _cost_cell(run, key):
+    c = run["cost"]
+    if not c.get("timed"):
+        return "not timed"
+    value = c.get(key)
+    if value is None:
+        return "-"
+    lo, hi = c["two_thread_range" if key.startswith("two") else "wall_range"]
+    return f"{fmt(value)} [{fmt(lo)}-{fmt(hi)}]"
 
 
 def build(out, study, s, doc):
     out = Path(out)
     d = Document(f"pbcm report: {study.name}")
     v = doc["verdict"]
+    runs = doc["runs"]
+    where = machine(doc)
     d.opening([f"**At a real-time budget.** {doc['answer']}"])
     d.p("The question the paper leaves open: at real time, how large a mesh can each model "
         "run, and how far from the continuum is it there? The cost is what `pbcm bench` "
-        f"measured on {machine(doc)}: CPU seconds per simulated second on the bench's five "
-        "cubes, the explicit models at their own largest stable RK4 step, the implicit "
-        "presets (backward Euler, Newton with conjugate gradients) at their own step; at most "
+        f"measured on {where}: wall-clock seconds per simulated second under the paper's push "
+        "(1.7 mm on the 32 mm cube at 1.7 mm/s, clamped base) on the 'five' cubes of its "
+        "real-time family, each model in its faster mode (serial or two threads), the "
+        "explicit models at their own largest stable RK4 step, the implicit presets "
+        "(backward Euler, Newton with conjugate gradients) at their own step; at most "
         f"{REAL_TIME:g} is real time. The accuracy is each model's static equilibrium under "
-        "the paper's push (1.7 mm on the 32 mm cube, clamped base: a push at 1.7 mm/s is "
-        "quasi-static for the cube, whose lowest mode is tens of hertz), on the same meshes up "
-        f"to {ACCURACY_TETS:g} tetrahedra: the distance from the converged continuum "
-        "(||u - u_c|| / ||u_c||, neo-Hookean P2) and the model-form error against FEM P1 with "
-        f"the continuum's law on the same tetrahedra ({P1}). An implicit preset's equilibrium "
-        f"is its explicit twin's ({statics_of(MODELS[-1])}): its step changes the dynamics, "
-        "which the paper-cube case judges against the FEM transient where it is run by name. "
-        "Differences below u_val (the reference's estimate, "
-        f"{fmt(v.get('u'), 2) if v.get('u') is not None else 'n/a'}) are ties.")
+        "the same push (at 1.7 mm/s it is quasi-static for the cube, whose lowest mode is "
+        "tens of hertz): its distance from the converged continuum (||u - u_c|| / ||u_c||, "
+        "neo-Hookean P2) and its model-form error against FEM P1 with the continuum's law on "
+        f"the same tetrahedra ({P1}). The implicit presets have fem-corotated's equilibrium: "
+        "they are fem-corotated's other modes, and fem-corotated is ranked once, at the "
+        "largest reach of any of its modes. The accuracy is computed where the bench timed a "
+        "model: it stops timing a model above two sizes in a row over real time.")
     if v.get("ranks") and not doc["parameters"]["quick"]:
-        runs = {(r["model"], r["tets"]): r for r in doc["runs"]}
         rows = []
         for k in v["ranks"]:
-            r = runs[(k["model"], v["reach"][k["model"]])]
-            rows.append([k["rank"], k["model"], r["tets"], _cell(r["realtime_factor"]),
-                         _cell(v["bounds"].get(k["model"])), _cell(r["disp_form_rel_l2"]),
-                         _cell(r["disp_rel_l2"]), ", ".join(k["tied"]) or "-"])
-        d.p("Each model at the largest mesh it runs in real time, ranked by its error bound "
-            "there: its model-form error plus FEM P1's distance from the continuum on that "
-            "mesh (the discretisation error every model there shares; the bound of its own "
-            "distance by the triangle inequality, which a model whose error happens to cancel "
-            "FEM P1's on a coarse mesh cannot undercut); a failed run or an error not computed "
-            "counts against it:")
-        d.table(["rank", "model", "tets", "CPU s per simulated s", "error bound",
-                 "model-form error", "distance from continuum", "tied with"], rows)
-        costed = {r["model"] for r in doc["runs"] if r["realtime_factor"] is not None}
-        none = [m for m, t in v["reach"].items() if t is None and m in costed]
+            m, reach_ = k["model"], v["reach"][k["model"]]
+            r = _law_run(runs, m, reach_["tets"])
+            mode = reach_["model"] if reach_["model"] != m else reach_["mode"]
+            rows.append([k["rank"], m, mode, reach_["tets"],
+                         f"{reach_['sure'] or 'none'}-{reach_['maybe']}",
+                         f"{fmt(reach_['cost'])} [{fmt(reach_['range'][0])}-"
+                         f"{fmt(reach_['range'][1])}]", err(k["score"]),
+                         err(r["disp_form_rel_l2"]), err(r["disp_rel_l2"]),
+                         ", ".join(k["tied"]) or "-"])
+        d.p(f"Each model at the largest mesh it runs in real time on {where}, ranked by its "
+            "error bound there: its model-form error plus FEM P1's distance from the continuum "
+            "on that mesh (the discretisation error every model there shares; the bound of its "
+            "own distance by the triangle inequality, which a model whose error cancels FEM "
+            "P1's on a coarse mesh cannot undercut); a failed run or an error not computed "
+            "counts against it. Two bounds on different meshes are tied within "
+            f"{err(v['u_two_meshes'])} (the reference's estimate {err(v['estimate'])} on each "
+            "mesh's FEM P1 distance, in quadrature); two on one mesh differ only in model-form "
+            "error, tied within round-off; bounds both below "
+            f"{err(JUDGES * v['estimate'])} ({JUDGES} times the estimate) are not resolved. "
+            "The reach's range: from the largest size real time in every round to the "
+            "largest real time in some round.")
+        d.table(["rank", "model", "mode at its reach", "tets", "reach over the rounds",
+                 f"wall s per simulated s ({where})", "error bound", "model-form error",
+                 "distance from continuum", "tied with"], rows)
+        y = v.get("yardstick")
+        if y:
+            d.p(f"Beside the ranking, the yardstick: FEM P1 with the continuum's law ({P1}), "
+                "model-form error 0 by definition, runs in real time up to "
+                f"{y['tets']} tetrahedra, at distance {err(y['distance'])} from the continuum.")
+        none = [m for m in RANKED if v["reach"].get(m) is None]
         if none:
-            d.p("Not in real time at any size measured: " + ", ".join(none) + ".")
-        unmeasured = [m for m in MODELS if m not in costed]
-        if unmeasured:
-            d.p("Not measured by the bench at any of these sizes (`pbcm bench` times them): "
-                + ", ".join(unmeasured) + ".")
+            d.p("Not in real time at any size timed: " + ", ".join(none) + ".")
         if v.get("cancels"):
             d.p("Closer to the continuum than to FEM P1 on the same mesh (the model's error "
                 "cancels part of FEM P1's discretisation error there, a coarse mesh's luck, "
                 "not a property of the model): " + ", ".join(v["cancels"]) + ".")
     d.h(2, "Every size")
-    d.table(["model", "tets", "CPU s per simulated s", "real time", "distance from continuum",
-             "model-form error", "load steps", "failed"],
-            [[r["model"], r["tets"], _cell(r["realtime_factor"]),
-              "n/a" if r["realtime_factor"] is None else
-              ("yes" if r["realtime_factor"] <= REAL_TIME else "no"),
-              _cell(r["disp_rel_l2"]) if r["accuracy"] else "not computed",
-              _cell(r["disp_form_rel_l2"]) if r["accuracy"] else "not computed",
-              r["load_steps"] or "-", r["failed"] or "-"] for r in doc["runs"]])
-    d.p("'n/a' cost: the bench did not measure that model's cost per simulated second at "
-        "that size (`pbcm bench` measures the stable step and the implicit step up to 2e5 "
-        "tetrahedra); 'not computed': above the sizes whose accuracy this study solves.")
+    shown = [r for r in runs if r["cost"].get("timed") or r["accuracy"]]
+    d.p(f"Wall-clock seconds per simulated second on {where} (median [smallest-largest over "
+        "the bench's rounds]), serial and in the two-thread mode ('-': the model has none); "
+        "the errors are the model's law's static equilibrium. Sizes at which the bench did "
+        "not time a model and no error was computed are left out: "
+        + (", ".join(f"{m} above {max(r['tets'] for r in shown if r['model'] == m)}"
+                     for m in MODELS if any(r["model"] == m for r in shown)
+                     and any(r["model"] == m and r not in shown for r in runs)) or "none")
+        + ".")
+    d.table(["model", "tets", "wall s/s serial", "wall s/s two threads", "real time",
+             "error bound", "model-form error", "distance from continuum", "load steps",
+             "failed"],
+            [[r["model"], r["tets"], _cost_cell(r, "wall_s_per_simulated_s"),
+              _cost_cell(r, "two_thread_wall_s_per_simulated_s"),
+              "not timed" if _cost(r)[0] is None else fmt(_cost(r)[0] <= REAL_TIME),
+              err(bound(runs, r)) if r["accuracy"] else "not computed",
+              err(r["disp_form_rel_l2"]) if r["accuracy"] else "not computed",
+              err(r["disp_rel_l2"]) if r["accuracy"] else "not computed",
+              r["load_steps"] or "-", r["failed"] or "-"] for r in shown])
     series = []
-    for m in MODELS:
-        pts = sorted((r["realtime_factor"], r["disp_rel_l2"]) for r in doc["runs"]
-                     if r["model"] == m and r["realtime_factor"] is not None
-                     and r["disp_rel_l2"] is not None)
+    for m in LAWS:
+        pts = []
+        for r in runs:
+            if r["model"] != m or not r["accuracy"]:
+                continue
+            costs = [c for q in runs if q["law"] == m and q["tets"] == r["tets"]
+                     for c in [_cost(q)[0]] if c is not None]
+            y = r["disp_rel_l2"] if m == P1 else bound(runs, r)
+            if costs and y is not None:
+                pts.append((min(costs), y))
         if pts:
-            series.append((m, [p[0] for p in pts], [p[1] for p in pts]))
+            pts.sort()
+            series.append((m if m != P1 else f"{m} (yardstick: its distance)",
+                           [p[0] for p in pts], [p[1] for p in pts]))
     if series:
         figures.error_against_cost(out / "error_vs_cost.png", series, REAL_TIME,
-                                   f"CPU s per simulated s ({machine(doc)})",
-                                   "distance from the continuum", "Accuracy against cost, "
-                                   "the paper's push")
-        d.img("error_vs_cost.png", "distance from the continuum against CPU seconds per "
-              "simulated second, every model and size; the dashed line is real time")
+                                   f"wall s per simulated s, faster mode ({where})",
+                                   "error bound (model-form + FEM P1's distance)",
+                                   "Accuracy against cost, the paper's push")
+        d.img("error_vs_cost.png", "each model's error bound against its wall-clock seconds "
+              "per simulated second in its faster mode, every size timed; the yardstick's "
+              "distance from the continuum; the dashed line is real time")
     d.p(f"Environment: {doc['environment']}.")
     return d

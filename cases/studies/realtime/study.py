@@ -1,9 +1,12 @@
-"""The real-time study's runs: the paper's push on the five cube over the bench's mesh sizes,
-each model's static equilibrium against FEM P1 on the same tetrahedra and against the converged
-continuum, beside what `pbcm bench` measured that model to cost per simulated second there.
+"""The real-time study's runs: the paper's push on the 'five' cubes of the bench's real-time
+family, each model's static equilibrium against FEM P1 on the same tetrahedra and against the
+converged continuum, beside the wall time per simulated second `pbcm bench` measured for that
+model there (``cases.tools.realtime_bench``: the same push, each model at its own step).
 
-Nothing is timed here: every cost is the bench's (``cases.reporting.costs``), measured in one
-process on the machine the bench names, so that the accuracy runs stay deterministic."""
+Nothing is timed here: every cost is the bench's, measured in one process on the machine the
+bench names, so that the accuracy runs stay deterministic. The accuracy is computed where the
+bench timed a model (and FEM P1 there): above the sizes where a model was over real time twice
+in a row, neither is measured, since those sizes cannot be its reach."""
 from dataclasses import dataclass
 
 import numpy as np
@@ -19,16 +22,11 @@ from ...running.progress import Progress
 from ...running.runner import free_components, jsonable
 from ...running.store import OFF, key
 from ...running.workers import dearest_first
+from ...tools import realtime_bench as RB
 
-# the bench's sizes from the paper's cube up (the same 'five' cubes it times); the accuracy is
-# computed up to ACCURACY_TETS (a static Newton solve per model and size), the cost read at all
-SIZES = (3.2e2, 1e3, 1e4, 1e5)
-QUICK_SIZES = (3.2e2, 1e3)
-ACCURACY_TETS = 2.5e4
 BC = "clamped"                  # the paper's base
 P1 = "fem-neohookean"           # FEM P1 with the continuum's law: the model-form twin
-MODELS = ("pbcm-corner", "pbcm-balanced", "pbcm-variational", "msm", "fem-linear",
-          "fem-corotated", P1, *IMPLICIT_STEP)
+MODELS = RB.MODELS              # the bench's real-time family's models
 REF_MESH = ("six", 5)           # the continuum: neo-Hookean P2 on this cube, refined
 REF_LEVELS, QUICK_REF_LEVELS = 2, 1
 STATIC_RTOL = 1e-10
@@ -40,6 +38,9 @@ def statics_of(model):
     return "fem-corotated" if model in IMPLICIT_STEP else model
 
 
+LAWS = tuple(dict.fromkeys(statics_of(m) for m in MODELS))   # one static solve each
+
+
 @dataclass
 class RealtimeSettings(MaterialSettings):
     """Material (the paper cube's) and the mode."""
@@ -47,34 +48,42 @@ class RealtimeSettings(MaterialSettings):
     quick: bool = False
 
     @property
-    def sizes(self):
-        return QUICK_SIZES if self.quick else SIZES
-
-    @property
     def ref_levels(self):
         return QUICK_REF_LEVELS if self.quick else REF_LEVELS
 
     @property
     def units(self):
-        """Work units a pool could share: each explicit model's static solve per size whose
-        accuracy is computed."""
-        return len([t for t in self.sizes if t <= ACCURACY_TETS]) * len(
-            {statics_of(m) for m in MODELS})
+        """Work units a pool could share: each static solve of the quick family (the full
+        run's count depends on the bench)."""
+        return len(RB.sizes(True)) * len(LAWS)
 
     def problem(self):
         return {**self.material_record(), "size_mm": P.SIZE_MM, "push_mm": P.PUSH_MM,
-                "bc": BC, "sizes": [int(t) for t in self.sizes],
-                "accuracy_tets": ACCURACY_TETS,
-                "reference": {"element": "P2", "mesh": f"{REF_MESH[0]} {REF_MESH[1]}^3",
-                              "refinements": self.ref_levels}}
+                "bc": BC, "reference": {"element": "P2",
+                                        "mesh": f"{REF_MESH[0]} {REF_MESH[1]}^3",
+                                        "refinements": self.ref_levels}}
 
     def describe(self):
         return {**self.problem(), "quick": self.quick, "models": list(MODELS)}
 
 
-def meshes(s):
-    """{tetrahedra: mesh} of the bench's 'five' cubes at the study's sizes."""
-    return {m.n_tets: m for m in (bench_mesh(t) for t in s.sizes)}
+def cost_rows(bench, quick):
+    """{(model, tets): the bench's real-time family row} (every model and size of the family;
+    the quick run's two sizes whether or not the bench timed them)."""
+    got = {(r["model"], r["tets"]): r for r in (bench or {}).get("realtime_rows", [])}
+    return {(m, t): got.get((m, t), {"model": m, "tets": t, "timed": False})
+            for t in RB.sizes(quick) for m in MODELS}
+
+
+def solved_pairs(costs, quick):
+    """The (law, tets) whose static equilibrium is solved: every law on the quick family; in
+    the full run each law where the bench timed any model with its statics there, and FEM P1
+    wherever another law is solved (the model-form twin)."""
+    if quick:
+        return [(t, m) for t in RB.sizes(True) for m in LAWS]
+    pairs = {(t, statics_of(m)) for (m, t), r in costs.items() if r.get("timed")}
+    pairs |= {(t, P1) for t, _ in pairs}
+    return sorted(pairs, key=lambda p: (p[0], LAWS.index(p[1])))
 
 
 def reference(s):
@@ -86,62 +95,69 @@ def reference(s):
 
 
 def _solve(job):
-    """One model's static equilibrium on one mesh: its displacement field [m], or why it
-    failed."""
+    """One model's static equilibrium on one mesh with every tetrahedron upright: its
+    displacement field [m], or why it failed."""
     model, mesh, s = job
     try:
         pm = build(model, mesh, s.material)
         st, steps = solve_split(pm, P.static_bc(mesh, BC, P.PUSH_MM), splits=LOAD_SPLITS,
-                                rtol=STATIC_RTOL, stall=STALL)
+                                upright=True, rtol=STATIC_RTOL, stall=STALL)
     except FINDINGS as exc:
         return {"u": None, "failed": str(exc), "load_steps": None}
     return {"u": st.u, "failed": None, "load_steps": steps}
 
 
+def _reference_at(s, meshes, store, progress):
+    """{tets: the continuum at that mesh's nodes} and the reference's error estimate, each
+    mesh's values kept under its own key (the family grows with the bench)."""
+    keys = {t: key(kind="realtime-reference", **s.problem(), tets=t) for t in meshes}
+    est_key = key(kind="realtime-reference", **s.problem(), what="estimate")
+    at = {t: store.get(k) for t, k in keys.items()}
+    est = store.get(est_key)
+    if est is None or any(v is None for v in at.values()):
+        r = reference(s)
+        est = store.put(est_key, {"error_estimate": r.error_estimate})
+        for t, v in at.items():
+            if v is None:
+                at[t] = store.put(keys[t], {"u": r.result.at(meshes[t].points)})
+    progress.advance(1, "reference")
+    return {t: v["u"] for t, v in at.items()}, est["error_estimate"]
+
+
 def run(s, workers=None, log=True, bench=None, store=OFF):
-    """Every (size, model) run's errors where the size is at most ACCURACY_TETS (each
-    explicit model's own static solve, the implicit presets reading their twin's), and the
-    bench's cost per simulated second at every size."""
-    from ...reporting import costs
-    by_tets = meshes(s)
-    solved = {t: m for t, m in by_tets.items() if t <= ACCURACY_TETS}
-    own = sorted({statics_of(m) for m in MODELS})
-    jobs = [(t, m) for t in solved for m in own]
+    """Every solved (size, law)'s errors, and each (model, size)'s row with the bench's cost
+    beside its law's errors."""
+    costs = cost_rows(bench, s.quick)
+    jobs = solved_pairs(costs, s.quick)
+    meshes = {t: bench_mesh(t) for t in sorted({t for t, _ in jobs})}
     with Progress("realtime", 1 + len(jobs), log=log) as progress:
-        ref_key = key(kind="realtime-reference", **s.problem())
-        ref = store.get(ref_key)
-        if ref is None:
-            r = reference(s)
-            ref = store.put(ref_key, {"at": {t: r.result.at(m.points) for t, m in solved.items()},
-                                      "error_estimate": r.error_estimate})
-        progress.advance(1, "reference")
+        ref_at, estimate = _reference_at(s, meshes, store, progress)
         keys = [key(kind="realtime-run", **s.problem(), tets=t, model=m) for t, m in jobs]
         found = [store.get(k) for k in keys]
         todo = [i for i, f in enumerate(found) if f is None]
         progress.advance(len(jobs) - len(todo))
-        made = dearest_first(_solve, [(jobs[i][1], solved[jobs[i][0]], s) for i in todo],
+        made = dearest_first(_solve, [(jobs[i][1], meshes[jobs[i][0]], s) for i in todo],
                              workers, lambda i: progress.advance(1, " ".join(
                                  map(str, jobs[todo[i]]))), [jobs[i][0] for i in todo])
         for i, got in zip(todo, made):
             found[i] = store.put(keys[i], got)
     fields = dict(zip(jobs, found))
     rows = []
-    for t, mesh in by_tets.items():
-        cost = {m: costs.per_simulated_second(bench, m, t) for m in MODELS}
-        for m in MODELS:
-            row = {"mesh": f"five-{t}", "tets": t, "nodes": mesh.n_nodes, "bc": BC,
-                   "model": m, "realtime_factor": cost[m], "accuracy": t in solved,
-                   "failed": None, "disp_rel_l2": None, "disp_form_rel_l2": None,
-                   "load_steps": None}
-            if t in solved:
-                got, p1 = fields[(t, statics_of(m))], fields[(t, P1)]
-                row.update(failed=got["failed"], load_steps=got["load_steps"])
-                if got["u"] is not None:
-                    row.update(_errors(got["u"], None if p1["u"] is None else p1["u"],
-                                       ref["at"][t], mesh))
-            rows.append(row)
-    return jsonable({"runs": rows, "error_estimate": ref["error_estimate"],
-                     "machine": (bench or {}).get("machine")})
+    for (m, t), cost in costs.items():
+        law = statics_of(m)
+        row = {"mesh": f"five-{t}", "tets": t, "bc": BC, "model": m, "law": law,
+               "cost": cost, "accuracy": (t, law) in fields, "failed": None,
+               "disp_rel_l2": None, "disp_form_rel_l2": None, "load_steps": None}
+        if row["accuracy"]:
+            got, p1 = fields[(t, law)], fields.get((t, P1))
+            row.update(failed=got["failed"], load_steps=got["load_steps"])
+            if got["u"] is not None:
+                row.update(_errors(got["u"], None if p1 is None else p1["u"], ref_at[t],
+                                   meshes[t]))
+        rows.append(row)
+    return jsonable({"runs": rows, "error_estimate": estimate,
+                     "machine": (bench or {}).get("realtime_machine")
+                     or (bench or {}).get("machine")})
 
 
 def _errors(u, u_p1, u_c, mesh):

@@ -1,0 +1,140 @@
+"""The bench's real-time family: wall-clock seconds per simulated second of each model under
+the paper's push (1.7 mm on the 32 mm cube at 1.7 mm/s, clamped base, mass damping 50 1/s),
+on the 'five' cubes from the paper's 125 nodes to above 1e5 tetrahedra, one step of the mesh
+at a time, so that the real-time study reads each model's reach from its own measurements.
+
+Explicit models run RK4 at their own largest stable step (``bench.own_stable_step``), serial
+and, where the model has one, in its two-thread mode; the implicit presets (backward Euler,
+Newton with conjugate gradients) at their own step, on the same push, since their iterations
+depend on the load. Times are wall clock (a simulator's budget is the wall's), medians over
+rounds taken round-robin across the models at one size, with the rounds' range beside them.
+A model is timed up the family until it is over real time at two sizes in a row: the
+larger ones cannot be its reach (its cost grows with the mesh), and are marked as not timed.
+"""
+import time
+
+import numpy as np
+
+from model.presets import IMPLICIT_STEP
+
+from ..framework import DEFAULT_MATERIAL
+from ..library import paper_cube as P
+from ..library.common import bench_mesh
+from ..reporting.costs import REAL_TIME
+from ..running import stop
+
+# cells per side of the 'five' cubes (5 k^3 tetrahedra): the paper's 4 (125 nodes) up to 28
+# (109760 tetrahedra), neighbours at most 1.5 times apart in tetrahedra
+CELLS = (4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 15, 17, 19, 22, 25, 28)
+QUICK_CELLS = (4, 6)
+MODELS = ("pbcm-corner", "pbcm-balanced", "pbcm-variational", "msm", "fem-linear",
+          "fem-corotated", "fem-neohookean", *IMPLICIT_STEP)
+OVER_IN_A_ROW = 2        # sizes over real time in a row after which a model is not timed up
+MIN_SAMPLE_S = 0.05      # each sample runs at least this long (many steps if need be)
+
+
+def sizes(quick=False):
+    """The family's tetrahedron counts."""
+    return [5 * k ** 3 for k in (QUICK_CELLS if quick else CELLS)]
+
+
+def _ramp(mesh):
+    return P.dynamic_bc(mesh, "clamped")
+
+
+class _Explicit:
+    """An explicit model on one mesh: its own stable step, and wall-clock seconds per RK4
+    step serial and in its two-thread mode (None without one)."""
+
+    def __init__(self, name, mesh):
+        from .bench import _Timed, own_stable_step
+        self.t = _Timed(name, mesh, DEFAULT_MATERIAL, ramp=_ramp(mesh))
+        self.dt = own_stable_step(self.t.pm)
+        if self.t.kernels_2 is not None:
+            self.t._steps(1, self.t.kernels_2)       # compile outside the timings
+        one = self._wall(1, self.t.kernels)
+        self.reps = max(1, int(MIN_SAMPLE_S / max(one, 1e-7)))
+
+    def _wall(self, n, kernels):
+        w0 = time.perf_counter()
+        self.t._steps(n, kernels)
+        return (time.perf_counter() - w0) / n
+
+    def sample(self):
+        serial = self._wall(self.reps, self.t.kernels)
+        two = None if self.t.kernels_2 is None else self._wall(self.reps, self.t.kernels_2)
+        return serial / self.dt, (np.nan if two is None else two / self.dt)
+
+
+class _Implicit:
+    """An implicit preset at its own step on one mesh: wall-clock seconds per step, and its
+    Newton and CG iterations (each sample goes on from the last state along the push)."""
+
+    def __init__(self, name, mesh):
+        from .bench import _ImplicitTimed
+        self.t = _ImplicitTimed(name, mesh, DEFAULT_MATERIAL, ramp=_ramp(mesh))
+        self.dt = self.t.dt
+
+    def sample(self):
+        w0 = time.perf_counter()
+        stats = self.t._step()
+        wall = time.perf_counter() - w0
+        return (wall / self.dt, np.nan, stats["newton_iterations"],
+                stats["cg_iterations"] / max(stats["newton_iterations"], 1))
+
+
+def _row(name, mesh, timer, got, rounds):
+    got = np.array(got, dtype=float)
+    serial = got[:, 0]
+    row = {"model": name, "tets": mesh.n_tets, "nodes": mesh.n_nodes, "timed": True,
+           "dt_us": timer.dt * 1e6, "rounds": rounds,
+           "wall_s_per_simulated_s": float(np.median(serial)),
+           "wall_range": [float(serial.min()), float(serial.max())],
+           "two_thread_wall_s_per_simulated_s": None, "two_thread_range": None,
+           "newton_per_step": None, "cg_per_newton": None}
+    if not np.all(np.isnan(got[:, 1])):
+        row.update(two_thread_wall_s_per_simulated_s=float(np.median(got[:, 1])),
+                   two_thread_range=[float(got[:, 1].min()), float(got[:, 1].max())])
+    if got.shape[1] > 2:
+        row.update(newton_per_step=float(np.median(got[:, 2])),
+                   cg_per_newton=float(np.median(got[:, 3])))
+    return row
+
+
+def best(row):
+    """(wall seconds per simulated second, mode) of a row's faster mode, or (None, None) for a
+    size not timed."""
+    if not row.get("timed"):
+        return None, None
+    two = row.get("two_thread_wall_s_per_simulated_s")
+    if two is not None and two < row["wall_s_per_simulated_s"]:
+        return two, "two threads"
+    return row["wall_s_per_simulated_s"], ("implicit" if row["model"] in IMPLICIT_STEP
+                                           else "serial")
+
+
+def run(models=MODELS, quick=False, rounds=5, progress=print):
+    """The family's rows: one per (model, size), timed or marked not timed (over real time at
+    OVER_IN_A_ROW smaller sizes in a row)."""
+    over = {m: 0 for m in models}
+    rows = []
+    for tets in sizes(quick):
+        mesh = bench_mesh(tets)
+        live = [m for m in models if over[m] < OVER_IN_A_ROW]
+        progress(f"bench: real-time family, {mesh.n_tets} tetrahedra, {len(live)} models")
+        timers = {m: (_Implicit if m in IMPLICIT_STEP else _Explicit)(m, mesh) for m in live}
+        got = {m: [] for m in live}
+        for _ in range(rounds):
+            stop.checkpoint()
+            for m, timer in timers.items():
+                got[m].append(timer.sample())
+        for m in models:
+            if m not in timers:
+                rows.append({"model": m, "tets": mesh.n_tets, "nodes": mesh.n_nodes,
+                             "timed": False})
+                continue
+            row = _row(m, mesh, timers[m], got[m], rounds)
+            rows.append(row)
+            over[m] = over[m] + 1 if best(row)[0] > REAL_TIME else 0
+        del timers
+    return rows
