@@ -165,8 +165,9 @@ DESCRIPTORS = frozenset({
     # order, bound and tolerance, its verdict; a patch's interior node count
     "ladder", "cells", "formal_order", "finest_bound", "tolerance", "passed", "interior",
     "one_sided", "dt_s", "steps", "failed_divisor",
-    # the real-time study: whether a size's accuracy was computed
-    "accuracy"})
+    # the real-time study: whether a size's accuracy was computed, the law whose statics a
+    # model has, and the bench's timing row of the model and size (its own record)
+    "accuracy", "law", "cost"})
 
 # ---------------------------------------------------------------- the standard static metrics
 declare("disp_rel_l2_p1", "1", "disp L2 P1",
@@ -467,10 +468,6 @@ declare("disp_form_rel_l2", "1", "model-form disp L2",
         "||u_model - u_P1|| / ||u_ref|| over the free components: the model-form error, the "
         "model against FEM P1 with the continuum's law on the same tetrahedra, relative to "
         "the converged continuum's field.", "max")
-declare("realtime_factor", "1", "CPU s per simulated s",
-        "the real-time factor: CPU seconds one simulated second takes on the machine `pbcm bench` ran on (one core, "
-        "at the model's own stable RK4 step or an implicit preset's own step); at most 1: "
-        "real time.")
 declare("e_inf", "1", "e_inf",
          "the error extrapolated to h -> 0 by the fit of error against mesh size.", "max")
 declare("e_inf_err", "1", "e_inf uncertainty", "the fit's uncertainty of e_inf.")

@@ -12,6 +12,8 @@ from pathlib import Path
 
 import numpy as np
 
+from model.presets import IMPLICIT_STEP
+
 from .document import Table, fmt
 
 FILE = "bench.json"
@@ -95,4 +97,33 @@ def cost_items(data, models, tets):
           fmt(r.get("stable_dt_us")), *per_second(r)] for r in near])]
 
 
-__all__ = ["FILE", "FOLDER", "SOURCE", "read", "load", "step_cost_us", "cost_items"]
+# ------------------------------------------------ the real-time family (``realtime_rows``)
+# what `pbcm bench` times wall clock under the paper's push (cases.tools.realtime_bench) and
+# `pbcm run realtime` reads
+# cells per side of the 'five' cubes (5 k^3 tetrahedra): the paper's 4 (125 nodes) up to 28
+# (109760 tetrahedra), neighbours at most 1.5 times apart in tetrahedra
+CELLS = (4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 15, 17, 19, 22, 25, 28)
+QUICK_CELLS = (4, 6)
+FAMILY_MODELS = ("pbcm-corner", "pbcm-balanced", "pbcm-variational", "msm", "fem-linear",
+                 "fem-corotated", "fem-neohookean", *IMPLICIT_STEP)
+
+
+def sizes(quick=False):
+    """The family's tetrahedron counts."""
+    return [5 * k ** 3 for k in (QUICK_CELLS if quick else CELLS)]
+
+
+def best(row):
+    """(wall seconds per simulated second, mode) of a row's faster mode, or (None, None) for a
+    size not timed."""
+    if not row.get("timed"):
+        return None, None
+    two = row.get("two_thread_wall_s_per_simulated_s")
+    if two is not None and two < row["wall_s_per_simulated_s"]:
+        return two, "two threads"
+    return row["wall_s_per_simulated_s"], ("implicit" if row["model"] in IMPLICIT_STEP
+                                           else "serial")
+
+
+__all__ = ["FILE", "FOLDER", "SOURCE", "read", "load", "step_cost_us", "cost_items",
+           "FAMILY_MODELS", "sizes", "best"]

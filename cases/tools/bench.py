@@ -12,162 +12,31 @@ With ``--device`` the covered presets' forces are also timed as Warp kernels on 
 """
 import json
 import time
-import tracemalloc
 
 import numpy as np
-import numba
-from numba import njit
 
 from model import PRESETS, build
-from model.implicit import backward_euler
 from model.presets import IMPLICIT_STEP
-from model.bc import Ramp
-from model.calibrate import calibrate
-from model.integrate import STEP_BUFFERS, rk4_ramp, total_forces
 from model.candidates import CANDIDATES
 
-from ..framework import DEFAULT_MATERIAL, MM
-from ..library.common import CUBE_MM, bench_mesh
+from ..framework import DEFAULT_MATERIAL
+from ..library.common import bench_mesh
 from ..reporting import figures
 from ..running import stop
 from .engines import ENGINES
-from ..reporting.costs import FILE, REAL_TIME
+from ..reporting.costs import FILE, REAL_TIME, best
+from . import realtime_bench
+from .timers import DAMPING, SAMPLE_S, ImplicitTimed, Timed, own_stable_step
 from ..reporting.document import Document, fmt
 
 SIZES = (1e2, 3.2e2, 1e3, 1e4, 1e5, 1e6)   # 3.2e2: the paper's 125-node cube (five split)
 STABLE_STEP_TETS = 2e5      # the own stable step is measured up to this size (an eigenvalue)
-RK4_LIMIT = 2 * np.sqrt(2)  # RK4 is stable for |omega dt| up to 2 sqrt 2 on the imaginary axis
 QUICK_SIZES = (1e2, 1e3)
 BASELINES = ("msm", "fem-linear")
-SAMPLE_S = 0.02          # each timing sample runs at least this long (many calls if need be)
 ENGINE_REFERENCE = "fem-neohookean"   # what the optional engines' forces are compared with
 # the implicit presets' steps are timed up to this size: each solves a Newton system by
 # conjugate gradients whose iterations grow with the mesh
 IMPLICIT_TETS = 2e5
-DAMPING = 50.0           # the push's mass damping [1/s] (the paper cube's)
-
-
-@njit   # not cached: it takes the kernels (see model.integrate)
-def _force_loop(kernels, x, out, reps):
-    for _ in range(reps):
-        total_forces(kernels, x, out)
-
-
-def own_stable_step(pm):
-    """The model's own largest stable RK4 step [s] on its mesh, undamped: 2 sqrt 2 / omega_max
-    with omega_max^2 the largest |eigenvalue| of M^-1 df/dx at rest (lumped mass), so that a
-    stiffer model pays for its stiffness in steps per simulated second."""
-    from scipy.sparse import diags
-    from scipy.sparse.linalg import eigs
-    J = pm.jacobian(pm.mesh.points)
-    A = diags(1.0 / np.repeat(pm.mass, 3)) @ J
-    start = np.random.default_rng(0).standard_normal(A.shape[0])   # the same bits every run
-    lam = eigs(A, k=1, which="LM", v0=start, tol=1e-6, return_eigenvectors=False)
-    return float(RK4_LIMIT / np.sqrt(np.abs(lam[0])))
-
-
-class _Timed:
-    """One preset on one mesh, ready to be timed: its kernels, a state and the step's
-    buffers, under ``ramp`` (default the bench's push: 1 % of the side over 1 s, the base
-    held)."""
-
-    def __init__(self, name, mesh, mat, ramp=None):
-        tracemalloc.start()
-        self.pm = build(name, mesh, mat)
-        self.memory = tracemalloc.get_traced_memory()[1]
-        tracemalloc.stop()
-        t0 = time.perf_counter()
-        calibrate(self.pm.terms, mesh, mat, cache=False)
-        self.calibration = time.perf_counter() - t0 if any(
-            getattr(t, "calibrate", False) for t in self.pm.terms) else 0.0
-        self.kernels = self.pm.kernels()
-        # the two-thread mode of the terms that have one (model.terms._threads)
-        threaded = [t.threaded_kernel() for t in self.pm.terms]
-        self.kernels_2 = None
-        if any(threaded) and numba.config.NUMBA_NUM_THREADS >= 2:
-            numba.set_num_threads(2)
-            self.kernels_2 = tuple(k or t.kernel() for k, t in zip(threaded, self.pm.terms))
-        ramp = ramp or _push(mesh)
-        mask, start, moving = ramp.parts(mesh.n_nodes)
-        self.x, self.v = mesh.points.copy(), np.zeros_like(mesh.points)
-        self.out = np.zeros_like(mesh.points)
-        self.step_args = (mesh.points, self.pm.mass, np.zeros_like(mesh.points), DAMPING, mask,
-                          start, moving, ramp.t_ramp, mesh.tets,
-                          not any(t.checks_inversion for t in self.pm.terms),
-                          self.pm.material.p_wave_speed, np.empty((STEP_BUFFERS,) + mesh.points.shape))
-        self.dt = self.pm.stable_dt(0.5)
-        self.t = 0.0
-        _force_loop(self.kernels, self.x, self.out, 1)    # compile outside the timings
-        if self.kernels_2 is not None:
-            _force_loop(self.kernels_2, self.x, self.out, 1)
-        self._steps(1)
-        self.reps_force = self._reps(lambda n: _force_loop(self.kernels, self.x, self.out, n))
-        self.reps_step = self._reps(self._steps)
-
-    def _steps(self, n, kernels=None):
-        status = rk4_ramp(kernels or self.kernels, self.x, self.v, self.t, self.dt, n, *self.step_args)[0]
-        if status:
-            raise RuntimeError(f"the benchmark's push blew up for {self.pm.name}")
-        self.t += n * self.dt
-
-    @staticmethod
-    def _reps(call):
-        t0 = time.thread_time()
-        call(1)
-        one = max(time.thread_time() - t0, 1e-7)
-        return max(1, int(SAMPLE_S / one))
-
-    def sample(self):
-        """(seconds per force evaluation, seconds per RK4 step) in thread CPU time, and the
-        two-thread mode's speed-up of the force evaluation (wall clock, serial and threaded
-        back to back; NaN without a two-thread mode)."""
-        t0 = time.thread_time_ns()
-        _force_loop(self.kernels, self.x, self.out, self.reps_force)
-        t1 = time.thread_time_ns()
-        self._steps(self.reps_step)
-        t2 = time.thread_time_ns()
-        speedup = float("nan")
-        if self.kernels_2 is not None:
-            w0 = time.perf_counter()
-            _force_loop(self.kernels, self.x, self.out, self.reps_force)
-            w1 = time.perf_counter()
-            _force_loop(self.kernels_2, self.x, self.out, self.reps_force)
-            speedup = (w1 - w0) / (time.perf_counter() - w1)
-        return (t1 - t0) * 1e-9 / self.reps_force, (t2 - t1) * 1e-9 / self.reps_step, speedup
-
-
-def _push(mesh):
-    """The bench's push: the top moved down 1 % of the side in one second, the base held."""
-    side = CUBE_MM * MM
-    top, bot = mesh.nodes_on_plane("y", side), mesh.nodes_on_plane("y", 0.0)
-    return Ramp(top, (0.0, -0.01 * side, 0.0), 1.0, fixed=bot)
-
-
-class _ImplicitTimed:
-    """An implicit preset (backward Euler at its own step) on the bench's push, timed one
-    step per sample, each sample going on from the last state: thread CPU time per step, and
-    the Newton and conjugate-gradient iterations it took; under ``ramp`` (default the bench's
-    push)."""
-
-    def __init__(self, name, mesh, mat, ramp=None):
-        self.pm = build(name, mesh, mat)
-        self.dt, self.ramp = IMPLICIT_STEP[name], ramp or _push(mesh)
-        self.x, self.v, self.t = mesh.points.copy(), np.zeros_like(mesh.points), 0.0
-        self._step()       # the first step builds the Jacobian's pattern: outside the timings
-
-    def _step(self):
-        stats = {}
-        run = backward_euler(self.pm, self.ramp, self.t + self.dt, self.dt, damping=DAMPING,
-                             frames=2, x0=self.x, v0=self.v, t0=self.t, stats=stats)
-        self.x, self.v, self.t = run.x[-1], run.v, self.t + self.dt
-        return stats
-
-    def sample(self):
-        """(seconds per step, Newton iterations, conjugate-gradient iterations)."""
-        t0 = time.thread_time_ns()
-        stats = self._step()
-        return ((time.thread_time_ns() - t0) * 1e-9, stats["newton_iterations"],
-                stats["cg_iterations"])
 
 
 def implicit_row(name, mesh, samples, rounds):
@@ -266,13 +135,13 @@ def run(sizes=SIZES, models=None, rounds=7, progress=print, with_engines=True, d
     for target in sizes:
         mesh = bench_mesh(target)
         progress(f"bench: {mesh.n_tets} tetrahedra, {len(timed_models)} models")
-        timed = {name: _Timed(name, mesh, mat) for name in timed_models}
+        timed = {name: Timed(name, mesh, mat) for name in timed_models}
         timers, status = _engine_timers(mesh, timed, progress) if with_engines \
             else ({}, {})
         for name, line in status.items():
             if line not in engines.setdefault(name, []):
                 engines[name].append(line)
-        stepped = {name: _ImplicitTimed(name, mesh, mat) for name in implicit
+        stepped = {name: ImplicitTimed(name, mesh, mat) for name in implicit
                    if mesh.n_tets <= IMPLICIT_TETS}
         samples = {name: [] for name in timed}
         engine_samples = {name: [] for name in timers}
@@ -325,7 +194,6 @@ def run(sizes=SIZES, models=None, rounds=7, progress=print, with_engines=True, d
         from . import warp_forces
         data.update(device=warp_forces.device_name(device), device_rows=device_rows)
     if family is not None:
-        from . import realtime_bench
         data.update(realtime_rows=realtime_bench.run(quick=family == "quick",
                                                      progress=progress),
                     realtime_machine=data["machine"])
@@ -444,14 +312,13 @@ def write(data, out):
 def _family_table(doc, data):
     """The real-time family: each model's wall-clock seconds per simulated second at each
     size, its faster mode (serial, two threads, implicit), the rounds' range beside it."""
-    from . import realtime_bench as RB
     rows = data["realtime_rows"]
     models = list(dict.fromkeys(r["model"] for r in rows))
     by = {(r["model"], r["tets"]): r for r in rows}
     m = data.get("realtime_machine") or data["machine"]
 
     def cell(r):
-        cost, mode = RB.best(r)
+        cost, mode = best(r)
         if cost is None:
             return "not timed"
         two = mode == "two threads"

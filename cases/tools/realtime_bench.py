@@ -3,7 +3,7 @@ the paper's push (1.7 mm on the 32 mm cube at 1.7 mm/s, clamped base, mass dampi
 on the 'five' cubes from the paper's 125 nodes to above 1e5 tetrahedra, one step of the mesh
 at a time, so that the real-time study reads each model's reach from its own measurements.
 
-Explicit models run RK4 at their own largest stable step (``bench.own_stable_step``), serial
+Explicit models run RK4 at their own largest stable step (``timers.own_stable_step``), serial
 and, where the model has one, in its two-thread mode; the implicit presets (backward Euler,
 Newton with conjugate gradients) at their own step, on the same push, since their iterations
 depend on the load. Times are wall clock (a simulator's budget is the wall's), medians over
@@ -20,22 +20,12 @@ from model.presets import IMPLICIT_STEP
 from ..framework import DEFAULT_MATERIAL
 from ..library import paper_cube as P
 from ..library.common import bench_mesh
-from ..reporting.costs import REAL_TIME
+from ..reporting.costs import FAMILY_MODELS as MODELS, REAL_TIME, best, sizes
 from ..running import stop
+from .timers import ImplicitTimed, Timed, own_stable_step
 
-# cells per side of the 'five' cubes (5 k^3 tetrahedra): the paper's 4 (125 nodes) up to 28
-# (109760 tetrahedra), neighbours at most 1.5 times apart in tetrahedra
-CELLS = (4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 15, 17, 19, 22, 25, 28)
-QUICK_CELLS = (4, 6)
-MODELS = ("pbcm-corner", "pbcm-balanced", "pbcm-variational", "msm", "fem-linear",
-          "fem-corotated", "fem-neohookean", *IMPLICIT_STEP)
 OVER_IN_A_ROW = 2        # sizes over real time in a row after which a model is not timed up
 MIN_SAMPLE_S = 0.05      # each sample runs at least this long (many steps if need be)
-
-
-def sizes(quick=False):
-    """The family's tetrahedron counts."""
-    return [5 * k ** 3 for k in (QUICK_CELLS if quick else CELLS)]
 
 
 def _ramp(mesh):
@@ -47,8 +37,7 @@ class _Explicit:
     step serial and in its two-thread mode (None without one)."""
 
     def __init__(self, name, mesh):
-        from .bench import _Timed, own_stable_step
-        self.t = _Timed(name, mesh, DEFAULT_MATERIAL, ramp=_ramp(mesh))
+        self.t = Timed(name, mesh, DEFAULT_MATERIAL, ramp=_ramp(mesh))
         self.dt = own_stable_step(self.t.pm)
         if self.t.kernels_2 is not None:
             self.t._steps(1, self.t.kernels_2)       # compile outside the timings
@@ -71,8 +60,7 @@ class _Implicit:
     Newton and CG iterations (each sample goes on from the last state along the push)."""
 
     def __init__(self, name, mesh):
-        from .bench import _ImplicitTimed
-        self.t = _ImplicitTimed(name, mesh, DEFAULT_MATERIAL, ramp=_ramp(mesh))
+        self.t = ImplicitTimed(name, mesh, DEFAULT_MATERIAL, ramp=_ramp(mesh))
         self.dt = self.t.dt
 
     def sample(self):
@@ -99,18 +87,6 @@ def _row(name, mesh, timer, got, rounds):
         row.update(newton_per_step=float(np.median(got[:, 2])),
                    cg_per_newton=float(np.median(got[:, 3])))
     return row
-
-
-def best(row):
-    """(wall seconds per simulated second, mode) of a row's faster mode, or (None, None) for a
-    size not timed."""
-    if not row.get("timed"):
-        return None, None
-    two = row.get("two_thread_wall_s_per_simulated_s")
-    if two is not None and two < row["wall_s_per_simulated_s"]:
-        return two, "two threads"
-    return row["wall_s_per_simulated_s"], ("implicit" if row["model"] in IMPLICIT_STEP
-                                           else "serial")
 
 
 def run(models=MODELS, quick=False, rounds=5, progress=print):

@@ -11,7 +11,7 @@ from ...reporting.costs import REAL_TIME
 from ...reporting.document import Document, fmt
 from ...reporting.report import environment, write_study
 from ...running.runner import jsonable
-from ...tools import realtime_bench as RB
+from ...reporting import costs as bench_costs
 from .study import LAWS, MODELS, P1
 
 GATED = catalogue.gated("disp_rel_l2", "disp_form_rel_l2")
@@ -26,7 +26,7 @@ def err(v):
 def _cost(run):
     """(wall s per simulated s, mode, [lo, hi] over the rounds) of a run's faster mode, or
     (None, None, None) where the bench did not time it."""
-    cost, mode = RB.best(run["cost"])
+    cost, mode = bench_costs.best(run["cost"])
     if cost is None:
         return None, None, None
     key = "two_thread_range" if mode == "two threads" else "wall_range"

@@ -22,11 +22,11 @@ from ...running.progress import Progress
 from ...running.runner import free_components, jsonable
 from ...running.store import OFF, key
 from ...running.workers import dearest_first
-from ...tools import realtime_bench as RB
+from ...reporting import costs as bench_costs
 
 BC = "clamped"                  # the paper's base
 P1 = "fem-neohookean"           # FEM P1 with the continuum's law: the model-form twin
-MODELS = RB.MODELS              # the bench's real-time family's models
+MODELS = bench_costs.FAMILY_MODELS              # the bench's real-time family's models
 REF_MESH = ("six", 5)           # the continuum: neo-Hookean P2 on this cube, refined
 REF_LEVELS, QUICK_REF_LEVELS = 2, 1
 STATIC_RTOL = 1e-10
@@ -55,7 +55,7 @@ class RealtimeSettings(MaterialSettings):
     def units(self):
         """Work units a pool could share: each static solve of the quick family (the full
         run's count depends on the bench)."""
-        return len(RB.sizes(True)) * len(LAWS)
+        return len(bench_costs.sizes(True)) * len(LAWS)
 
     def problem(self):
         return {**self.material_record(), "size_mm": P.SIZE_MM, "push_mm": P.PUSH_MM,
@@ -72,7 +72,7 @@ def cost_rows(bench, quick):
     the quick run's two sizes whether or not the bench timed them)."""
     got = {(r["model"], r["tets"]): r for r in (bench or {}).get("realtime_rows", [])}
     return {(m, t): got.get((m, t), {"model": m, "tets": t, "timed": False})
-            for t in RB.sizes(quick) for m in MODELS}
+            for t in bench_costs.sizes(quick) for m in MODELS}
 
 
 def solved_pairs(costs, quick):
@@ -80,7 +80,7 @@ def solved_pairs(costs, quick):
     the full run each law where the bench timed any model with its statics there, and FEM P1
     wherever another law is solved (the model-form twin)."""
     if quick:
-        return [(t, m) for t in RB.sizes(True) for m in LAWS]
+        return [(t, m) for t in bench_costs.sizes(True) for m in LAWS]
     pairs = {(t, statics_of(m)) for (m, t), r in costs.items() if r.get("timed")}
     pairs |= {(t, P1) for t, _ in pairs}
     return sorted(pairs, key=lambda p: (p[0], LAWS.index(p[1])))
