@@ -14,8 +14,9 @@ from cases.cli import main
 def test_bench_writes_table_figure_and_in_round_ratios(tmp_path):
     """`pbcm bench` writes bench.json, bench.md and the step-time figure on the five cubes nearest
     the sizes asked; every row has finite positive timings, memory and in-round ratios (a model
-    against itself exactly 1, each median inside its rounds' range), calibration time only for
-    the calibrated model, a two-thread speed-up for every preset with two numba threads, and
+    against itself exactly 1, each median inside its rounds' range), its roofline (counted
+    operations, compulsory bytes, the fraction of the rate attainable at the peaks measured in
+    the same run), calibration time only for the calibrated model, a two-thread speed-up for every preset with two numba threads, and
     each optional engine timed or reported as not installed. A rerun replaces the folder's
     rows and keeps the folders inside it that another command wrote."""
     out = tmp_path / "bench"
@@ -37,6 +38,14 @@ def test_bench_writes_table_figure_and_in_round_ratios(tmp_path):
         lo, hi = r["step_vs_fem-linear_range"]
         assert lo <= r["step_vs_fem-linear"] <= hi
     assert rows[("pbcm-variational", 625)]["calibration_s"] > 0
+    # the roofline: the peaks of this run, each row's counted operations (fem-linear's 188,
+    # tests/test_roofline.py), compulsory bytes and its fraction of the attainable rate
+    assert data["peaks"]["copy_gb_s"] > 0 and data["peaks"]["fma_gflop_s"] > 0
+    assert rows[("fem-linear", 625)]["flops_per_tet"] == 188.0
+    for r in rows.values():
+        assert r["flops_per_tet"] > 0 and r["bytes_per_tet"] > 0
+        assert r["gflop_s"] == pytest.approx(r["flops_per_tet"] / r["ns_per_tet"])
+        assert 0 < r["roofline_fraction"] and np.isfinite(r["roofline_fraction"])
     assert rows[("msm", 625)]["calibration_s"] == 0
     # every preset has a two-thread mode; where numba has two threads its speed-up is a
     # measured positive number

@@ -3,7 +3,7 @@ their end faces."""
 import numpy as np
 
 from model import ModelError
-from model.bc import merge
+from model.bc import Ramp, merge
 from model.mesh import box
 from model.mesh import cube
 from model.paper_mesh import PAPER_NODES  # noqa: F401 (the paper's lattice, for the cases)
@@ -11,6 +11,8 @@ from ..framework import MM
 
 CUBE_BCS = ("clamped", "sliding")    # the compressed cube's bases
 CUBE_MM = 32.0                        # the paper's cube: its side, every cube case's
+PUSH_MM = 1.7                         # the paper's push of its top, and its speed
+SPEED_MM_S = 1.7
 BAR_MM = (64.0, 16.0, 16.0)           # the bars (bending, torsion): length along x, section
 
 
@@ -59,3 +61,11 @@ def bar(family, length_mm, height_mm, width_mm, spacing_mm):
 def face(mesh, x):
     """The nodes of the end face at x [m]."""
     return mesh.nodes_on_plane("x", x)
+
+
+def paper_push(mesh, bc, push_mm=PUSH_MM):
+    """The paper's push of the cube's top as a ramp: ``push_mm`` down at SPEED_MM_S, the base
+    held as ``bc`` says (``cube_boundary_sets``)."""
+    top, lateral, held = cube_boundary_sets(mesh, bc, CUBE_MM * MM)
+    return Ramp(top, (lateral[0], -push_mm * MM, lateral[2]), push_mm / SPEED_MM_S, held=held)
+

@@ -9,7 +9,7 @@ import time
 import numpy as np
 
 from model import PRESETS, BlowUpError, ModelError
-from model.bc import Ramp, bc_arrays
+from model.bc import bc_arrays
 from model.mesh import cube
 from ..measuring import metrics as M
 from . import transient
@@ -19,8 +19,8 @@ from . import common
 
 SIZE_MM = common.CUBE_MM
 NODES_PER_SIDE = common.PAPER_NODES
-PUSH_MM = 1.7
-SPEED_MM_S = 1.7
+PUSH_MM = common.PUSH_MM
+SPEED_MM_S = common.SPEED_MM_S
 BCS = common.CUBE_BCS
 # the paper cube's own columns (catalogue names)
 COLUMNS = ("alternation_mm", "alternation_rel", "paper_pattern", "growth_rate_1_s",
@@ -104,8 +104,7 @@ def static_bc(mesh, bc, push_mm=PUSH_MM):
 
 
 def dynamic_bc(mesh, bc, push_mm=PUSH_MM):
-    top, lateral, held = boundary_sets(mesh, bc)
-    return Ramp(top, (lateral[0], -push_mm * MM, lateral[2]), push_mm / SPEED_MM_S, held=held)
+    return common.paper_push(mesh, bc, push_mm)
 
 
 def dynamic_run(pm, mesh, bc, cfg, dt_scale=1.0):

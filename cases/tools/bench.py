@@ -25,7 +25,7 @@ from ..reporting import figures
 from ..running import stop
 from .engines import ENGINES
 from ..reporting.costs import FILE, REAL_TIME, best
-from . import realtime_bench
+from . import flops, realtime_bench, roofline
 from .timers import DAMPING, SAMPLE_S, ImplicitTimed, Timed, own_stable_step
 from ..reporting.document import Document, fmt
 
@@ -132,6 +132,9 @@ def run(sizes=SIZES, models=None, rounds=7, progress=print, with_engines=True, d
     for name in timed_models:   # load every module once, so that memory counts the model only
         build(name, bench_mesh(1), mat)
     rows, engine_rows, engines, device_rows, implicit_rows = [], [], {}, [], []
+    # the roofline: this machine's peaks in this run, each model's counted operations
+    peak = roofline.peaks()
+    flop_counts = flops.counts(models)
     for target in sizes:
         mesh = bench_mesh(target)
         progress(f"bench: {mesh.n_tets} tetrahedra, {len(timed_models)} models")
@@ -171,7 +174,12 @@ def run(sizes=SIZES, models=None, rounds=7, progress=print, with_engines=True, d
                    "calibration_s": timed[name].calibration,
                    "two_thread_speedup": (float(np.median(own[:, 2]))
                                           if timed[name].kernels_2 is not None else None),
-                   "memory_mb": timed[name].memory / 1e6, "rounds": rounds}
+                   "memory_mb": timed[name].memory / 1e6, "rounds": rounds,
+                   "flops_per_tet": flop_counts.get(name),
+                   "bytes_per_tet": roofline.bytes_per_tet(timed[name].pm)}
+            row.update(zip(("gflop_s", "attainable_gflop_s", "roofline_fraction"),
+                           roofline.fraction(row["flops_per_tet"], row["bytes_per_tet"],
+                                             row["ns_per_tet"], peak)))
             if mesh.n_tets <= STABLE_STEP_TETS:
                 dt = own_stable_step(timed[name].pm)
                 row.update(stable_dt_us=dt * 1e6,
@@ -187,7 +195,7 @@ def run(sizes=SIZES, models=None, rounds=7, progress=print, with_engines=True, d
         if device is not None:
             device_rows += _device_rows(timed, models, rows, device, progress)
         del timed, timers
-    data = {"machine": machine(), "sizes": [int(s) for s in sizes], "rows": rows,
+    data = {"machine": machine(), "peaks": peak, "sizes": [int(s) for s in sizes], "rows": rows,
             "engines": {k: "; ".join(v) for k, v in engines.items()},
             "engine_rows": engine_rows, "implicit_rows": implicit_rows}
     if device is not None:
@@ -265,6 +273,8 @@ def write(data, out):
                 fmt(r["memory_mb"], 3),
                 "-" if r.get("two_thread_speedup") is None else fmt(r["two_thread_speedup"])]
                for r in rows])
+    if data.get("peaks"):
+        _roofline_table(doc, data)
     per_second = per_simulated_second(data)
     if per_second:
         doc.p("One simulated second (the bench's push, 1 % of the side in one second, base "
@@ -307,6 +317,29 @@ def write(data, out):
                    for r in data["device_rows"]])
     doc.img("step_time.png", "RK4 step time against tetrahedra, every model")
     doc.write(out, stem="bench")
+
+
+def _roofline_table(doc, data):
+    """Each row's roofline: its counted operations and compulsory bytes per tetrahedron, its
+    rate, the rate attainable at its intensity on this machine and the fraction it reaches."""
+    pk, m = data["peaks"], data["machine"]
+    doc.p(f"The roofline on this machine ({m['cpu']}, one core), its peaks measured in the same "
+          f"run: a STREAM-like copy at {fmt(pk['copy_gb_s'])} GB/s and a fused multiply-add loop "
+          f"at {fmt(pk['fma_gflop_s'])} GFLOP/s. Operations per tetrahedron are counted (each "
+          "kernel run uncompiled on counting numbers: an FMA is two), bytes are the compulsory "
+          "traffic (every array the kernels take, once; positions read, forces read and "
+          "written); the attainable rate is min(FMA peak, bandwidth x operations / byte), and "
+          "the fraction the kernel's serial force evaluation reaches of it; '-' where a "
+          "kernel's operations could not be counted.")
+    doc.table(["model", "tets", "ns/tet (force)", "flops/tet", "bytes/tet", "GFLOP/s",
+               "attainable GFLOP/s", "fraction of attainable"],
+              [[r["model"], r["tets"], fmt(r["ns_per_tet"]),
+                "-" if r.get("flops_per_tet") is None else fmt(r["flops_per_tet"], 4),
+                fmt(r.get("bytes_per_tet")),
+                "-" if r.get("gflop_s") is None else fmt(r["gflop_s"]),
+                "-" if r.get("attainable_gflop_s") is None else fmt(r["attainable_gflop_s"]),
+                "-" if r.get("roofline_fraction") is None else fmt(r["roofline_fraction"], 2)]
+               for r in data["rows"]])
 
 
 def _family_table(doc, data):

@@ -18,8 +18,7 @@ import numpy as np
 from model.presets import IMPLICIT_STEP
 
 from ..framework import DEFAULT_MATERIAL
-from ..library import paper_cube as P
-from ..library.common import bench_mesh
+from ..library.common import bench_mesh, paper_push
 from ..reporting.costs import FAMILY_MODELS as MODELS, REAL_TIME, best, sizes
 from ..running import stop
 from .timers import ImplicitTimed, Timed, own_stable_step
@@ -29,7 +28,7 @@ MIN_SAMPLE_S = 0.05      # each sample runs at least this long (many steps if ne
 
 
 def _ramp(mesh):
-    return P.dynamic_bc(mesh, "clamped")
+    return paper_push(mesh, "clamped")
 
 
 class _Explicit:
