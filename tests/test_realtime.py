@@ -158,3 +158,28 @@ def test_an_equilibrium_with_an_inverted_tetrahedron_is_refused_and_the_next_spl
     assert solve_split(Stub(1), None)[1] == 1
     with pytest.raises(ConvergenceError, match="1 of 1 tetrahedra inverted in 8 load steps"):
         solve_split(Stub(8), None, upright=True)
+
+
+def test_a_reach_the_timing_rounds_do_not_settle_widens_the_tie():
+    """Where a law is real time at its reach in some rounds only, its bound spans from the
+    bound there to the bound at the largest size real time in every round; two laws whose
+    spans overlap are tied even where their bounds at the reach are further apart than the
+    reference resolves, and the report's tie names the timing rounds."""
+    e = 0.001
+    runs = [_run("fem-neohookean", 2560, 2.0, 0.040, 0.0),
+            _run("fem-neohookean", 5000, 2.0, 0.027, 0.0),
+            _run("fem-neohookean", 8640, 2.0, 0.021, 0.0),
+            _run("pbcm-balanced", 2560, 0.5, 0.04, 0.004),
+            _run("pbcm-balanced", 5000, 0.96, 0.03, 0.004, spread=0.06),
+            _run("fem-linear", 8640, 0.9, 0.03, 0.014)]
+    data = {"runs": runs, "error_estimate": e, "machine": {"cpu": "X", "cores": 2}}
+    v = R.verdict(data)
+    assert v["bounds"]["pbcm-balanced"] == pytest.approx(0.031)
+    assert v["spans"]["pbcm-balanced"] == pytest.approx((0.031, 0.044))
+    assert v["spans"]["fem-linear"] == pytest.approx((0.035, 0.035))
+    assert sorted(v["best"]) == ["fem-linear", "pbcm-balanced"]
+    assert "what their reach spans over the bench's timing rounds" in R.answer_line(
+        data, v, quick=False)
+    settled = {**data, "runs": runs[:4] + [_run("pbcm-balanced", 5000, 0.96, 0.03, 0.004)]
+               + runs[5:]}
+    assert R.verdict(settled)["best"] == ["pbcm-balanced"]

@@ -78,19 +78,26 @@ def pair_u(a, b, estimate):
     return u_val(math.sqrt(2.0) * estimate)
 
 
-def rank(scores, at, estimate):
+def rank(scores, at, estimate, spans=None):
     """[(rank, law, [laws tied with it])], best first: ``scores`` {law: error bound or None
     (counts as failed, last)}; two bounds are tied where their difference is within
-    ``pair_u`` or both are below JUDGES times the reference's estimate (it cannot order them);
-    a law shares the rank of the first group whose first it is tied with, pair by pair."""
+    ``pair_u``, where both are below JUDGES times the reference's estimate (it cannot order
+    them), or where their ``spans`` {law: (lo, hi)} overlap within ``pair_u`` (the bound over
+    the reach's range in the bench's rounds: which of the two is further ahead depends on
+    the round); a law shares the rank of the first group whose first it is tied with, pair by
+    pair."""
     order = sorted(scores, key=lambda m: (scores[m] is None, scores[m] or 0.0, m))
+    spans = spans or {}
 
     def tied(a, b):
         sa, sb = scores[a], scores[b]
         if sa is None or sb is None:
             return sa is None and sb is None
-        small = JUDGES * estimate
-        return abs(sa - sb) <= pair_u(at[a], at[b], estimate) or (sa < small and sb < small)
+        small, u = JUDGES * estimate, pair_u(at[a], at[b], estimate)
+        lo_a, hi_a = spans.get(a, (sa, sa))
+        lo_b, hi_b = spans.get(b, (sb, sb))
+        return (abs(sa - sb) <= u or (sa < small and sb < small)
+                or max(lo_a, lo_b) <= min(hi_a, hi_b) + u)
     out, heads = [], []
     for k, m in enumerate(order):
         r = next((r for r, h in heads if tied(m, h)), None)
@@ -99,6 +106,18 @@ def rank(scores, at, estimate):
             heads.append((r, m))
         out.append((r, m, [o for o in order if o != m and tied(m, o)]))
     return out
+
+
+def span(runs, law, reach_):
+    """(lo, hi) of a law's error bound over its reach's range in the bench's rounds: at the
+    largest size real time in some round, and at the largest real time in every round
+    (infinite where no size is)."""
+    def at(tets):
+        if tets is None:
+            return math.inf
+        b = bound(runs, _law_run(runs, law, tets))
+        return math.inf if b is None else b
+    return at(reach_["maybe"]), at(reach_["sure"])
 
 
 def verdict(data):
@@ -116,11 +135,12 @@ def verdict(data):
                 "reach": {m: None for m in LAWS}, "ranks": []}
     e = data["error_estimate"] or 0.0
     bounds = {m: bound(runs, r["run"]) for m, r in measured.items()}
-    ranked = rank(bounds, measured, e)
+    spans = {m: span(runs, m, r) for m, r in measured.items() if bounds[m] is not None}
+    ranked = rank(bounds, measured, e, spans)
     first = [m for k, m, _ in ranked if k == 1 and bounds[m] is not None]
     yard = at.get(P1)
     return {"decided": bool(first), "best": first, "estimate": e,
-            "u_two_meshes": u_val(math.sqrt(2.0) * e), "bounds": bounds,
+            "u_two_meshes": u_val(math.sqrt(2.0) * e), "bounds": bounds, "spans": spans,
             "reach": {m: None if r is None else {k: v for k, v in r.items() if k != "run"}
                       for m, r in at.items()},
             "ranks": [{"rank": k, "model": m, "tied": tied, "score": bounds[m]}
@@ -159,7 +179,8 @@ def answer_line(data, v, quick):
                     " there)")
     if len(said) > 1:
         head = (f"the most accurate models, tied (their error bounds within "
-                f"{err(v['u_two_meshes'])}, the reference's estimate on two meshes), are "
+                f"{err(v['u_two_meshes'])}, the reference's estimate on two meshes, or within "
+                "what their reach spans over the bench's timing rounds), are "
                 + "; ".join(said))
     else:
         head = f"the most accurate model is {said[0]}"
@@ -181,6 +202,13 @@ def write(out, study, s, data):
                                   for r in data["runs"]
                                   if r["accuracy"] and r["model"] == r["law"]]})
     return write_study(out, doc, lambda folder: build(folder, study, s, doc))
+
+
+def _span_cell(span_):
+    if span_ is None:
+        return "n/a"
+    lo, hi = span_
+    return f"{err(lo)}-{'none real time in every round' if math.isinf(hi) else err(hi)}"
 
 
 def _cost_cell(run, key):
@@ -222,10 +250,11 @@ def build(out, study, s, doc):
             m, reach_ = k["model"], v["reach"][k["model"]]
             r = _law_run(runs, m, reach_["tets"])
             mode = reach_["model"] if reach_["model"] != m else reach_["mode"]
-            rows.append([k["rank"], m, mode, reach_["tets"],
-                         f"{reach_['sure'] or 'none'}-{reach_['maybe']}",
+            rows.append([k["rank"], m, mode,
+                         f"{reach_['tets']} ({reach_['sure'] or 'none'}-{reach_['maybe']})",
                          f"{fmt(reach_['cost'])} [{fmt(reach_['range'][0])}-"
                          f"{fmt(reach_['range'][1])}]", err(k["score"]),
+                         _span_cell(v.get("spans", {}).get(m)),
                          err(r["disp_form_rel_l2"]), err(r["disp_rel_l2"]),
                          ", ".join(k["tied"]) or "-"])
         d.p(f"Each model at the largest mesh it runs in real time on {where}, ranked by its "
@@ -239,9 +268,12 @@ def build(out, study, s, doc):
             "error, tied within round-off; bounds both below "
             f"{err(JUDGES * v['estimate'])} ({JUDGES} times the estimate) are not resolved. "
             "The reach's range: from the largest size real time in every round to the "
-            "largest real time in some round.")
-        d.table(["rank", "model", "mode at its reach", "tets", "reach over the rounds",
-                 f"wall s per simulated s ({where})", "error bound", "model-form error",
+            "largest real time in some round; the bound over it runs from the bound there to "
+            "the bound here, and two models whose bounds over their ranges overlap (within "
+            "the same uncertainty) are tied: which is ahead depends on the timing round.")
+        d.table(["rank", "model", "mode at its reach", "tets (over the rounds)",
+                 f"wall s per simulated s ({where})", "error bound",
+                 "bound over the reach's range", "model-form error",
                  "distance from continuum", "tied with"], rows)
         y = v.get("yardstick")
         if y:
