@@ -244,3 +244,11 @@ def test_bench_family_refuses_other_selections_and_a_missing_bench_before_timing
     assert main(["bench", "--family", "--models", "msm", "--out", str(tmp_path)]) == 2
     assert main(["bench", "--family", "--out", str(tmp_path / "none")]) == 2
     assert not (tmp_path / "none").exists()
+
+
+def test_the_real_time_family_times_every_preset():
+    """The real-time family's models are every preset and every implicit preset: no model a
+    user could pick is left out of the real-time study."""
+    from model import PRESETS
+    from model.presets import IMPLICIT_STEP
+    assert set(costs.FAMILY_MODELS) == {*PRESETS, *IMPLICIT_STEP}

@@ -104,8 +104,9 @@ def cost_items(data, models, tets):
 # (109760 tetrahedra), neighbours at most 1.5 times apart in tetrahedra
 CELLS = (4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 15, 17, 19, 22, 25, 28)
 QUICK_CELLS = (4, 6)
-FAMILY_MODELS = ("pbcm-corner", "pbcm-balanced", "pbcm-variational", "msm", "fem-linear",
-                 "fem-corotated", "fem-neohookean", *IMPLICIT_STEP)
+FAMILY_MODELS = ("pbcm-corner", "pbcm-balanced", "pbcm-variational", "pbcm-variational+normal",
+                 "msm", "msm+volume", "fem-linear", "fem-corotated", "fem-neohookean",
+                 *IMPLICIT_STEP)     # every preset
 
 
 def sizes(quick=False):
