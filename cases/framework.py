@@ -19,7 +19,7 @@ from model.units import MM  # noqa: F401 (the cases' millimetre)
 from model import PRESETS, Material, PbcmError, build
 from model.errors import ConvergenceError, ModelError
 from model import static
-from model.compose import parse
+from model.compose import parse, simulator
 from model.mesh import SCHEMES
 from model.loads import body_forces, traction_forces
 from .measuring import catalogue
@@ -435,7 +435,7 @@ class Case(abc.ABC):
     def build_model(self, name, mesh, s):
         """The particle model ``name`` (a preset or a composed spec, ``model.compose``), with
         the test-only shear scale."""
-        has_shear = any(t == "shear" for t, _ in parse(name))
+        has_shear = not simulator(name) and any(t == "shear" for t, _ in parse(name))
         extra = {"shear": {"scale": s.shear_scale}} if has_shear and s.shear_scale != 1 else {}
         return build(name, mesh, s.material, **extra)
 

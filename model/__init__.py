@@ -36,9 +36,21 @@ def build(model, mesh, material, threads=1, **term_params):
     ``build("pbcm-variational", mesh, mat, shear={"scale": 0.5})``. ``threads`` > 1 runs the
     terms that have a threaded kernel (the shear readings, the volume term, the FEM baselines) on that many of numba's threads,
     with forces equal bit for bit to the serial ones.
+
+    A name registered in ``model.simulators`` (``newton-xpbd``, ``newton-vbd``,
+    ``newton-semi-implicit``, a user's ``--model-file``), alone and with its settings
+    (``newton-vbd(iterations=20)``), builds that simulator instead (a
+    ``model.simulators.Simulator``, the contract every model satisfies).
     """
     if isinstance(model, str):
-        from .compose import label, parse
+        from .compose import label, parse, simulator
+        sim = simulator(model)
+        if sim:                       # a simulator pbcm does not integrate (model.simulators)
+            if term_params:
+                raise ModelError(f"model {model!r} is a simulator: it has no terms to set "
+                                 f"({', '.join(term_params)})")
+            from .simulators import make_simulator
+            return make_simulator(sim[0], mesh, material, label(model), **sim[1])
         name, terms = label(model), parse(model)
     else:
         name, terms = "custom", list(model)

@@ -24,6 +24,11 @@ def _presets():
     return NAMED
 
 
+def _simulators():
+    from .simulators import registered
+    return registered()
+
+
 def _value(text, where):
     text = text.strip()
     if _NUMBER.match(text):
@@ -53,6 +58,35 @@ def _split(spec):
     return parts + [cur]
 
 
+def _params(args, spec, allowed, whose):
+    """{key: value} of ``key=value, ...`` in ``args``, every key among ``allowed``."""
+    params = {}
+    for kv in filter(str.strip, (args or "").split(",")):
+        if "=" not in kv:
+            raise ModelError(f"parameter {kv.strip()!r} of {whose} in {spec!r} needs "
+                             "key=value")
+        k, v = (s.strip() for s in kv.split("=", 1))
+        if k not in allowed:
+            raise ModelError(f"{whose} has no parameter {k!r}; it takes "
+                             f"{', '.join(sorted(allowed)) or 'none'}")
+        params[k] = _value(v, spec)
+    return params
+
+
+def simulator(spec):
+    """``(name, params)`` where ``spec`` names a registered simulator (``model.simulators``),
+    alone and with optional ``key=value`` settings, e.g. ``newton-xpbd(iterations=20)``;
+    None where it names terms or a preset."""
+    from .simulators import registered
+    if not isinstance(spec, str) or spec.strip() in _presets():
+        return None
+    m = _COMPONENT.match(spec)
+    if not m or m.group(1) not in (sims := registered()):
+        return None
+    name = m.group(1)
+    return name, _params(m.group(2), spec, set(sims[name].params), f"model {name!r}")
+
+
 def parse(spec):
     """``[(term, params), ...]`` of a preset name or a composed spec; every term name and
     parameter name is checked against the registry (values are checked by the term when the
@@ -61,6 +95,8 @@ def parse(spec):
     presets = _presets()
     if not isinstance(spec, str) or not spec.strip():
         raise ModelError(f"a model is a preset name or terms joined by '+', got {spec!r}")
+    if simulator(spec):
+        raise ModelError(f"model {spec!r} is a simulator (model.simulators), not force terms")
     if spec.strip() in presets:
         return [(t, dict(p)) for t, p in presets[spec.strip()]]
     terms = registered()
@@ -76,21 +112,13 @@ def parse(spec):
             out += [(t, dict(p)) for t, p in presets[name]]
             continue
         if name not in terms:
-            raise ModelError(f"unknown model {name!r} (a preset or a term) in {spec!r}; valid: "
-                             f"presets {', '.join(presets)}; terms {', '.join(sorted(terms))} "
-                             "(a user term: pbcm --term FILE)")
-        params = {}
-        for kv in filter(str.strip, (args or "").split(",")):
-            if "=" not in kv:
-                raise ModelError(f"parameter {kv.strip()!r} of {name} in {spec!r} needs "
-                                 "key=value")
-            k, v = (s.strip() for s in kv.split("=", 1))
-            allowed = set(terms[name].params) | {"scale"}
-            if k not in allowed:
-                raise ModelError(f"term {name!r} has no parameter {k!r}; it takes "
-                                 f"{', '.join(sorted(allowed))}")
-            params[k] = _value(v, spec)
-        out.append((name, params))
+            raise ModelError(f"unknown model {name!r} (a preset, a term or a simulator) in "
+                             f"{spec!r}; valid: presets {', '.join(presets)}; terms "
+                             f"{', '.join(sorted(terms))}; simulators "
+                             f"{', '.join(sorted(_simulators()))} (a user term: pbcm --term FILE;"
+                             " a user simulator: pbcm --model-file FILE)")
+        out.append((name, _params(args, spec, set(terms[name].params) | {"scale"},
+                                  f"term {name!r}")))
     names = [t for t, _ in out]
     twice = sorted({t for t in names if names.count(t) > 1})
     if twice:
@@ -109,7 +137,11 @@ def label(spec):
     (so that equal specs gate and report under one name)."""
     if isinstance(spec, str) and spec.strip() in _presets():
         return spec.strip()
-    terms = parse(spec) if isinstance(spec, str) else list(spec)
+    sim = simulator(spec)
+    if sim:
+        terms = [sim]
+    else:
+        terms = parse(spec) if isinstance(spec, str) else list(spec)
     return " + ".join(t + (f"({', '.join(f'{k}={_fmt(v)}' for k, v in p.items())})" if p else "")
                       for t, p in terms)
 
@@ -132,6 +164,11 @@ def checked(spec):
     from .terms import make_term
     name = label(spec)        # names an unknown term or parameter
     cell = cube(2, 0.01, "five")
+    sim = simulator(name)
+    if sim:
+        from .simulators import make_simulator
+        make_simulator(sim[0], cell, Material(E=1e4, nu=0.3), **sim[1])
+        return name
     for term, params in parse(name):
         make_term(term, cell, Material(E=1e4, nu=0.3), **params)
     return name

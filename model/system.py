@@ -6,14 +6,14 @@ from .calibrate import calibrate
 from .geometry import smallest_heights
 from .errors import ModelError
 from .terms import make_term
-from .terms.shear import Shear
-from .terms._kernels import volume_gradient_numpy
 from .integrate import simulate as rk4_simulate
+from .simulators.base import Simulator
 from .static import RTOL as STATIC_RTOL, JacobianPattern, jacobian, solve as static_solve
 
 
-class ParticleModel:
-    """Forces, energy, per-tetrahedron stresses, static equilibrium and RK4 dynamics.
+class ParticleModel(Simulator):
+    """Forces, energy, per-tetrahedron stresses, static equilibrium and RK4 dynamics: the
+    :class:`model.simulators.Simulator` contract with pbcm's own integrators.
 
     Build one with :func:`model.build`. ``info`` holds what a report must state: the terms,
     their parameters and calibration constants (``shear_c``, ``normal_edge_c``).
@@ -31,8 +31,6 @@ class ParticleModel:
         if not self.terms:
             raise ModelError("a model needs at least one force term")
         fit = calibrate(self.terms, mesh, material)
-        self.mass = np.zeros(mesh.n_nodes)
-        np.add.at(self.mass, mesh.tets, np.repeat(material.rho * mesh.volumes[:, None] / 4, 4, 1))
         self._strain_probe = None   # built on the first tet_stress: 24 strains per tet
         self._jacobian_pattern = None
         self.info = {"model": name, "terms": [{"term": t.describe(), **t.info()}
@@ -69,35 +67,19 @@ class ParticleModel:
         """Total stored energy [J]; an error for a model with a non-conservative term."""
         return sum(t.energy(x) for t in self.terms)
 
-    def tet_stress(self, x):
-        """Per-tetrahedron ``max_tau`` = G max |gamma| over the 24 shear strains (the paper's
-        Figure 1 measure) and ``pressure`` p = -K (V - V0) / V [Pa], whatever the terms."""
-        V, _ = volume_gradient_numpy(np.asarray(x, dtype=np.float64), self.mesh.tets)
-        V0 = self.mesh.volumes
-        if self._strain_probe is None:
-            self._strain_probe = Shear(self.mesh, self.material, reading="corner")
-        return {"max_tau": self._strain_probe.max_tau(x),
-                "pressure": -self.material.K * (V - V0) / V}
-
-    def tet_virial(self, x):
-        """The model's own stress per tetrahedron (m, 3, 3) [Pa], from its forces: the virial
-        sigma_t = -(1 / V_t) sym sum_a (x_a - c_t) (x) f_a^(t) of the forces f^(t) the terms
-        put on the four corners of tetrahedron t alone. The terms are evaluated on the
-        tetrahedra taken apart, each translated to a cell of its own (no term sees a
-        translation), with the constants this model was calibrated to; a term whose forces
-        do not split over tetrahedra (none built in) would need its own split."""
+    def tet_forces(self, x):
+        """The forces (m, 4, 3) the terms put on the four corners of each tetrahedron alone:
+        the terms evaluated on the tetrahedra taken apart, each translated to a cell of its
+        own (no term sees a translation), with the constants this model was calibrated to; a
+        term whose forces do not split over tetrahedra (none built in) would need its own
+        split."""
         parts = self._apart()
         xa = np.ascontiguousarray(x, dtype=np.float64)[self.mesh.tets].reshape(-1, 3) \
             + parts["offset"]
         f = np.zeros_like(xa)
         for t in parts["terms"]:
             t.forces(xa, out=f)
-        m = self.mesh.n_tets
-        xt, ft = (xa - parts["offset"]).reshape(m, 4, 3), f.reshape(m, 4, 3)
-        arm = xt - xt.mean(axis=1, keepdims=True)
-        V, _ = volume_gradient_numpy(np.asarray(x, dtype=np.float64), self.mesh.tets)
-        sigma = -np.einsum("tai,taj->tij", arm, ft) / V[:, None, None]
-        return 0.5 * (sigma + np.swapaxes(sigma, 1, 2))
+        return f.reshape(self.mesh.n_tets, 4, 3)
 
     def _apart(self):
         """The terms rebuilt on the mesh's tetrahedra taken apart (built once)."""
@@ -122,18 +104,6 @@ class ParticleModel:
                 terms.append(make_term(t.name, apart, self.material, scale=t.scale, **params))
             self._apart_cache = {"offset": offset, "terms": terms}
         return self._apart_cache
-
-    def net_force_torque(self, x):
-        """Net force and torque (about the centroid) of the internal forces at x, absolute and
-        relative to sum |f_i| and sum |x_i - c| |f_i|. Zero for a momentum-conserving model."""
-        f = self.forces(x)
-        r = x - x.mean(axis=0)
-        F, T = f.sum(axis=0), np.cross(r, f).sum(axis=0)
-        fs = np.linalg.norm(f, axis=1)
-        return {"force": F, "torque": T,
-                "force_rel": float(np.linalg.norm(F) / max(fs.sum(), 1e-300)),
-                "torque_rel": float(np.linalg.norm(T)
-                                    / max((np.linalg.norm(r, axis=1) * fs).sum(), 1e-300))}
 
     def stable_dt(self, safety=0.5):
         """safety * min_T h_T / c_p, with h_T the smallest height and c_p the P-wave speed;

@@ -11,6 +11,7 @@ import os
 import sys
 
 import model
+import model.simulators
 import model.terms
 from model.errors import PbcmError
 from ..running import stop
@@ -67,6 +68,8 @@ def _main(argv):
             return exc.code if isinstance(exc.code, int) else 2
         for f in getattr(args, "term", []):   # before any model name is checked
             model.terms.add_user_file(f)
+        for f in getattr(args, "model_file", []):
+            model.simulators.add_user_file(f)
         status = args.func(args)
         stop.checkpoint()   # a signal whose exception a library swallowed still stops us
         return status

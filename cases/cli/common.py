@@ -212,4 +212,8 @@ def add_term_files(p):
     p.add_argument("--term", action="append", default=[], metavar="FILE",
                    help="a Python file that registers force terms (repeatable); its terms can "
                         "then be composed in --models")
+    p.add_argument("--model-file", action="append", default=[], metavar="FILE",
+                   help="a Python file that registers a simulator, a model pbcm does not "
+                        "integrate itself (model.simulators; repeatable); its name can then be "
+                        "given in --models")
 

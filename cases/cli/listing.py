@@ -1,8 +1,9 @@
-"""`pbcm list`: the cases, studies, shipped sweeps and force terms."""
+"""`pbcm list`: the cases, studies, shipped sweeps, force terms and simulators."""
 import sys
 import textwrap
 
 import model
+import model.simulators
 import model.terms
 from .common import add_term_files
 
@@ -35,6 +36,12 @@ def run(args):
         print(f"{path.stem} (sweep, pbcm sweep {path.stem}): {load(path, cases).title}")
     print("force terms (compose them with '+' in --models):")
     for name, cls in sorted(model.terms.registered().items()):
+        params = ", ".join(f"{k}={v}" for k, v in cls.params.items())
+        doc = (cls.__doc__ or "").strip().split("\n")[0]
+        print(textwrap.fill(f"{name}({params}): {doc}", width=96, initial_indent="  ",
+                            subsequent_indent="    "))
+    print("simulators (a model by name in --models, with its settings):")
+    for name, cls in sorted(model.simulators.registered().items()):
         params = ", ".join(f"{k}={v}" for k, v in cls.params.items())
         doc = (cls.__doc__ or "").strip().split("\n")[0]
         print(textwrap.fill(f"{name}({params}): {doc}", width=96, initial_indent="  ",

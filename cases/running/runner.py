@@ -98,7 +98,7 @@ class LinearRegime:
     def of(cls, st, pm, scale):
         stress = {**pm.tet_stress(st.x), "virial": pm.tet_virial(st.x)}
         return cls(u=st.u / scale, reaction=st.reaction / scale, residual=st.residual / scale,
-                   stress={k: v / scale for k, v in stress.items()})
+                   stress={k: None if v is None else v / scale for k, v in stress.items()})
 
 
 def linear_regime(case, pm, mesh, bc, s, ref):
@@ -123,7 +123,7 @@ def static_metrics(case, lr, mesh, bc, s, ref):
            "disp_energy_rel_p2": M.energy_rel(lr.u, ref.p2.u,
                                               linear.p1_stiffness(mesh, s.material))}
     driven = case.driven(mesh, bc, s)
-    if driven is None:
+    if driven is None or not np.isfinite(lr.reaction).all():    # none, or a model without forces
         out.update(reaction_n=None, reaction_ratio=None, reaction_rel_err=None)
     else:
         reaction = M.finite("reaction", reaction_along(lr.reaction, driven))
@@ -137,11 +137,14 @@ def static_metrics(case, lr, mesh, bc, s, ref):
         "pressure_corr": (None if uniform(ref.p2.pressure)
                           else M.correlation(stress["pressure"], ref.p2.pressure)),
         "pressure_rel_err": M.rel_l2(stress["pressure"], ref.p2.pressure)})
-    nodal = M.node_patch_average(mesh, stress["virial"])
-    out.update({"stress_force_rel_err": M.tensor_rel_l2(nodal, ref.p2.stress_nodes),
-                "stress_force_corr": (None if uniform(M.von_mises(ref.p2.stress_nodes))
-                                      else M.correlation(M.von_mises(nodal),
-                                                         M.von_mises(ref.p2.stress_nodes)))})
+    if stress["virial"] is None:          # a model that gives no forces
+        out.update(stress_force_rel_err=None, stress_force_corr=None)
+    else:
+        nodal = M.node_patch_average(mesh, stress["virial"])
+        out.update({"stress_force_rel_err": M.tensor_rel_l2(nodal, ref.p2.stress_nodes),
+                    "stress_force_corr": (None if uniform(M.von_mises(ref.p2.stress_nodes))
+                                          else M.correlation(M.von_mises(nodal),
+                                                             M.von_mises(ref.p2.stress_nodes)))})
     q = case.quantities(mesh, lr.u, lr.reaction, s, bc)
     out.update(q)
     out.update(case.quantity_metrics(q, ref.quantities, bc))
@@ -254,8 +257,8 @@ def model_run(case, mesh_name, mesh, bc, model_name, s, ref):
                 r.update(finite_metrics(case, st, mesh, bc, s, ref))
             except FINDINGS as exc:
                 r["finite_failed"] = str(exc)
-    if ref.p2 is not None:
-        nft = pm.net_force_torque(mesh.points + ref.p2.u)
+    nft = None if ref.p2 is None else pm.net_force_torque(mesh.points + ref.p2.u)
+    if nft is not None:
         r.update(net_force_rel=M.finite("net_force", nft["force_rel"]),
                  net_torque_rel=M.finite("net_torque", nft["torque_rel"]))
     else:

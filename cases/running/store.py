@@ -69,8 +69,8 @@ def fingerprint():
     entry-point term package it loads (``PBCM_TERMS``, group ``pbcm.terms``); taken once per
     set of term files (a process runs the code it loaded, whatever happens to the files
     later)."""
-    from model.terms import user_files
-    return _fingerprint(tuple(user_files()))
+    from model import simulators, terms
+    return _fingerprint(tuple(terms.user_files()) + tuple(simulators.user_files()))
 
 
 @lru_cache(maxsize=None)
@@ -82,13 +82,17 @@ def _fingerprint(term_files):
 
 
 def term_sources(term_files=()):
-    """The files of the terms pbcm loads from outside its package: ``term_files`` and every
-    Python file of the packages named in the ``pbcm.terms`` entry-point group, sorted."""
+    """The files of the terms and simulators pbcm loads from outside its package:
+    ``term_files`` and every Python file of the packages named in the ``pbcm.terms`` and
+    ``pbcm.models`` entry-point groups, sorted."""
     import importlib.metadata
     import importlib.util
-    from model.terms import ENTRY_POINT_GROUP
+    from model.simulators import ENTRY_POINT_GROUP as MODELS
+    from model.terms import ENTRY_POINT_GROUP as TERMS
     out = {Path(f).resolve() for f in term_files if Path(f).is_file()}
-    for ep in importlib.metadata.entry_points(group=ENTRY_POINT_GROUP):
+    eps = [*importlib.metadata.entry_points(group=TERMS),
+           *importlib.metadata.entry_points(group=MODELS)]
+    for ep in eps:
         top = ep.value.split(":")[0].split(".")[0]
         try:
             spec = importlib.util.find_spec(top)
@@ -118,8 +122,21 @@ def source_hash(root):
             if f.is_file() and not SKIP & set(f.parts) and f.suffix not in (".pyc",):
                 h.update(str(f.relative_to(root)).encode() + b"\0" + f.read_bytes() + b"\0")
     h.update(json.dumps([numpy.__version__, scipy.__version__, numba.__version__,
-                         getattr(skfem, "__version__", "?")]).encode())
+                         getattr(skfem, "__version__", "?"), *engine_versions()]).encode())
     return h.hexdigest()
+
+
+def engine_versions():
+    """The optional engines' versions (the Newton models' numbers come from them), where
+    installed."""
+    import importlib.metadata
+    out = []
+    for dist in ("warp-lang", "newton"):
+        try:
+            out.append(f"{dist} {importlib.metadata.version(dist)}")
+        except importlib.metadata.PackageNotFoundError:
+            pass
+    return out
 
 
 def key(**what):

@@ -140,10 +140,15 @@ def deformation_gradients_numpy(x, tets, Dinv):
     return Ds @ Dinv
 
 
+def piola_tet_forces(P, Dinv, vol0):
+    """The forces (m, 4, 3) of per-tetrahedron stresses P (m, 3, 3) on each tetrahedron's four
+    corners: -V0 P Dm^-T gives corners 1..3 as columns, corner 0 takes minus their sum."""
+    H = -vol0[:, None, None] * P @ np.transpose(Dinv, (0, 2, 1))   # (m, 3, 3): columns f1..f3
+    return np.concatenate([-H.sum(axis=2)[:, None, :], np.transpose(H, (0, 2, 1))], axis=1)
+
+
 def piola_forces_numpy(P, Dinv, vol0, tets, n_nodes):
     """Nodal forces (n, 3) of per-tetrahedron stresses P (m, 3, 3)."""
-    H = -vol0[:, None, None] * P @ np.transpose(Dinv, (0, 2, 1))   # (m, 3, 3): columns f1..f3
-    f = np.concatenate([-H.sum(axis=2)[:, None, :], np.transpose(H, (0, 2, 1))], axis=1)
     out = np.zeros((n_nodes, 3))
-    np.add.at(out, tets, f)
+    np.add.at(out, tets, piola_tet_forces(P, Dinv, vol0))
     return out

@@ -2,7 +2,7 @@
 
 Each reading's derivation is in the docstring of its writer there.
 
-_kernels.py sha256 9aa3a69f33f8f830
+_kernels.py sha256 8257983fdd878c7c
 _blocks.py sha256 a0a01f096ad04838
 """
 import numpy as np
