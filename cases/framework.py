@@ -135,6 +135,8 @@ def solve_split(pm, dirichlet, f_ext=None, splits=LOAD_SPLITS, upright=False, **
     counts as not converged, so that the next split is tried."""
     from model.geometry import signed_volumes
     extra = {} if f_ext is None else {"f_ext": f_ext}
+    if not getattr(pm, "splits_load", True):      # a simulator run to rest: more load steps change nothing
+        splits = splits[:1]
     for steps in splits:
         try:
             st = pm.solve_static(dirichlet, load_steps=steps, **extra, **kw)

@@ -18,6 +18,7 @@ STUDY_MODULES = {
     "artefact": "cases.studies.artefact",
     "truth-cube": "cases.studies.truthcube",
     "realtime": "cases.studies.realtime",
+    "engines": "cases.studies.engines",
 }
 
 CASES = {name: importlib.import_module(module).CASE for name, module in MODULES.items()}

@@ -19,6 +19,8 @@ class ParticleModel(Simulator):
     their parameters and calibration constants (``shear_c``, ``normal_edge_c``).
     """
 
+    splits_load = True      # its Newton solve takes the load in load_steps
+
     def __init__(self, mesh, material, terms, name="custom", threads=1, implicit_dt=None):
         self.mesh, self.material, self.name = mesh, material, name
         # None: RK4 at the stable step; a step [s]: backward Euler at it (model.implicit)

@@ -121,7 +121,7 @@ def test_headers_show_units_where_they_are_not_ratios():
 
 def test_cases_and_studies_gate_declared_metrics():
     """Every headline, gated, column and QoI-error metric of every case is declared; the studies are
-    exactly convergence, extensions, artefact, truth-cube and realtime, and each metric a study
+    exactly convergence, extensions, artefact, truth-cube, realtime and engines, and each metric a study
     gates has the direction the catalogue declares for it."""
     for case in CASES.values():
         for name in (case.headline, *case.gated, *case.columns, *case.qoi_errors):
@@ -131,7 +131,9 @@ def test_cases_and_studies_gate_declared_metrics():
     from cases.studies.artefact.report import GATED as ARTEFACT
     from cases.studies.truthcube.report import GATED as TRUTHCUBE
     from cases.studies.realtime.report import GATED as REALTIME
-    assert set(studies()) == {"convergence", "extensions", "artefact", "truth-cube", "realtime"}
-    for gated in (CONVERGENCE, EXTENSIONS, ARTEFACT, TRUTHCUBE, REALTIME):
+    from cases.studies.engines.report import GATED as ENGINES
+    assert set(studies()) == {"convergence", "extensions", "artefact", "truth-cube", "realtime",
+                              "engines"}
+    for gated in (CONVERGENCE, EXTENSIONS, ARTEFACT, TRUTHCUBE, REALTIME, ENGINES):
         for name, direction in gated.items():
             assert metric(name).direction == direction

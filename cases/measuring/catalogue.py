@@ -167,7 +167,9 @@ DESCRIPTORS = frozenset({
     "one_sided", "dt_s", "steps", "failed_divisor",
     # the real-time study: whether a size's accuracy was computed, the law whose statics a
     # model has, and the bench's timing row of the model and size (its own record)
-    "accuracy", "law", "cost"})
+    "accuracy", "law", "cost",
+    # the engines study: the regime and quantity compared, the engine's solver and settings
+    "regime", "quantity", "solver", "iterations", "substeps"})
 
 # ---------------------------------------------------------------- the standard static metrics
 declare("disp_rel_l2_p1", "1", "disp L2 P1",
@@ -532,6 +534,21 @@ declare("error", "1", "case error",
          "the model-form error of the case's decomposed quantity for one run, against FEM P1 "
          "with the same law on the same tetrahedra (the extensions study's ranking unit).",
          "max")
+declare("engine_error", "1", "engine model-form error",
+         "|model-form error| of an engine's run (the engines study): its case's decomposed "
+         "quantity against FEM P1 with the same law on the same tetrahedra, relative to the "
+         "continuum's.", "max")
+declare("value_rel", "1", "Q / |Q_c|",
+         "the case's decomposed quantity from one run over the converged continuum's |Q_c| on "
+         "the run's mesh (the engines study): 1 is the continuum's answer.")
+declare("estimate", "1", "reference's estimate",
+         "the continuum reference's own relative error estimate for the run's regime (P2 in the "
+         "linear regime, neo-Hookean at the load).")
+declare("model_form", "1", "model-form error (signed)",
+         "(Q - Q_P1) / |Q_c| of one run: against FEM P1 with the same law on the same "
+         "tetrahedra, relative to the continuum's value (the engines study).")
+declare("total", "1", "distance from the continuum (signed)",
+         "(Q - Q_c) / |Q_c| of one run: model-form plus FEM P1's discretisation error.")
 declare("discretisation", "1", "P1 discretisation",
          "FEM P1's discretisation error of the case's decomposed quantity on the run's mesh, "
          "against the converged continuum (the extensions study's failure criterion).")

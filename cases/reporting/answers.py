@@ -722,12 +722,16 @@ def recommendation(root, models, pops, quick, bench_rows):
     rt = _load(root, "realtime", "metrics.json")
     if rt and not rt["parameters"]["quick"]:
         out.append(f"- A real-time budget ([realtime](realtime/report.md)): {rt['answer']}")
+    eng = _load(root, "engines", "metrics.json")
+    if eng and not eng["parameters"]["quick"]:
+        out.append(f"- A physics engine instead (Newton; [engines](engines/report.md)): "
+                   f"{eng['answer']}.")
     art = _record(root, "artefact")
     pick = None if not art or art["parameters"]["quick"] else art["answer"].get("mesh_pick")
     if pick:
         out.append("- Meshing a cube lattice for a particle model (the bulge/neck pattern; "
                    f"[artefact study](artefact/report.md)): {pick}.")
-    return out[:7] if len(out) > 1 else []
+    return out[:8] if len(out) > 1 else []
 
 
 def _cheaper_contender(best, others, bench_rows, base, conv=None):

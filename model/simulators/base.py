@@ -49,6 +49,9 @@ class Simulator:
 
     name = ""
     params = {}
+    # whether solve_static's load_steps change its answer (a Newton solve in load steps);
+    # a simulator run to rest takes its loads in its own ramp
+    splits_load = False
     # the smallest change of position the simulator resolves [m] (its arithmetic's), below
     # which run_to_rest cannot ask it to settle
     resolution = 0.0
@@ -157,32 +160,52 @@ class Simulator:
 # simulator is at rest; and how many of the body's slowest periods it may take
 REST_TOL = 1e-3
 REST_PERIODS = 200
+# periods without the motion shrinking below 0.9 of its least: a simulator that stalls
+STALLED = 30
 # the loads reach their value over the first period in this many equal steps
 RAMP_PIECES = 10
 
 
-def slowest_frequency(mesh, material):
-    """An estimate of the body's lowest angular frequency [rad/s]: a quarter shear wave across
-    its largest extent, pi c_s / (2 L)."""
+def slowest_frequency(mesh, material, mask=None):
+    """The body's lowest angular frequency [rad/s] with the components ``mask`` (n, 3)
+    prescribed: linear FEM P1's on the mesh, lumped masses (the same for every simulator);
+    where that has none (an unconstrained body) or its solve fails, a quarter shear wave
+    across the largest extent, pi c_s / (2 L)."""
+    import scipy.sparse as sp
+    from scipy.sparse.linalg import eigsh
+    from ..terms import make_term
+    if mask is not None and mask.any():
+        try:
+            K = -make_term("fem_linear", mesh, material).tangent(mesh.points).tocsr()
+            m = np.zeros(mesh.n_nodes)
+            np.add.at(m, mesh.tets, np.repeat(material.rho * mesh.volumes[:, None] / 4, 4, 1))
+            free = ~np.asarray(mask).ravel()
+            lam = eigsh(K[free][:, free], k=1, M=sp.diags(np.repeat(m, 3)[free]), sigma=0.0,
+                        which="LM", return_eigenvectors=False)[0]
+            if lam > 0 and math.isfinite(lam):
+                return math.sqrt(lam)
+        except Exception:       # a singular or failed solve: the estimate below
+            pass
     L = float(np.ptp(mesh.points, axis=0).max())
     return math.pi * math.sqrt(material.G / material.rho) / (2.0 * L)
 
 
 def run_to_rest(sim, bc, f_ext=None, rtol=None):
     """The equilibrium of a simulator under ``bc`` and ``f_ext``, run to rest: the prescribed
-    displacements and the loads ramped over one slowest period (:func:`slowest_frequency`),
-    mass damping twice the slowest frequency (critical for that mode), then held, period by
-    period, until the motion still to come (the last period's, continued as a geometric series
-    at the ratio of the last two periods') is below ``REST_TOL`` of the largest displacement, or
-    a period's motion is below what the simulator resolves; a ``ConvergenceError`` after
-    ``REST_PERIODS`` periods. The reactions and the
-    residual (the largest free-node force) come from the simulator's own forces where it gives
-    them (``tet_forces``), NaN where not. ``rtol`` is the static solver's and is not used: the
-    rest criterion is the motion's."""
+    displacements and the loads ramped over the body's slowest period under ``bc``
+    (:func:`slowest_frequency`), mass damping twice that frequency (critical for that mode),
+    then held, period by period, until the motion still to come (the last period's, continued
+    as a geometric series at the ratio of the last two periods') is below ``REST_TOL`` of the
+    largest displacement, or a period's motion is below what the simulator resolves. A
+    ``ConvergenceError`` after ``REST_PERIODS`` periods, or where the motion has not shrunk
+    below 0.9 of its least over ``STALLED`` periods (not coming to rest). The reactions and
+    the residual (the largest free-node force) come from the simulator's own forces where it
+    gives them (``tet_forces``), NaN where not. ``rtol`` is the static solver's and is not
+    used: the rest criterion is the motion's."""
     mesh = sim.mesh
     mask, u_end = bc_arrays(bc, mesh.n_nodes)
     f_ext = np.zeros_like(mesh.points) if f_ext is None else np.asarray(f_ext, dtype=float)
-    w = slowest_frequency(mesh, sim.material)
+    w = slowest_frequency(mesh, sim.material, mask)
     period = 2.0 * math.pi / w
     held = {int(n): tuple(float(u_end[n, k]) if mask[n, k] else None for k in range(3))
             for n in np.flatnonzero(mask.any(axis=1))}
@@ -194,7 +217,7 @@ def run_to_rest(sim, bc, f_ext=None, rtol=None):
                           t0=(k - 1) * period / RAMP_PIECES)
         x, v = tr.x[-1], tr.v
     t = period
-    before = 0.0
+    before, least, since = 0.0, math.inf, 0
     floor = 8.0 * sim.resolution
     for _ in range(REST_PERIODS):
         tr = sim.simulate(ramp, t + period, damping=2.0 * w, f_ext=f_ext, frames=2, x0=x, v0=v,
@@ -208,6 +231,12 @@ def run_to_rest(sim, bc, f_ext=None, rtol=None):
         before = moved
         if moved <= floor or to_come <= REST_TOL * scale:
             break
+        least, since = (moved, 0) if moved < 0.9 * least else (least, since + 1)
+        if since >= STALLED:
+            raise ConvergenceError(
+                f"{sim.name} is not coming to rest: over its last {STALLED} slowest periods "
+                f"its motion did not shrink below 0.9 of its least ({least / scale:.2g} of its "
+                f"largest displacement a period)")
     else:
         raise ConvergenceError(f"{sim.name} is not at rest after {REST_PERIODS} of its slowest "
                                f"periods ({REST_PERIODS * period:.3g} s): it moved "

@@ -68,6 +68,18 @@ def piola(solver, F, mu, lam):
     raise ModelError(f"no Newton solver {solver!r}")
 
 
+def small_strain_moduli(solver, material, e=1e-6):
+    """(shear modulus, Lame lambda) [Pa] of ``solver``'s law at small strain with the material
+    mapped by :func:`lame`, read off its stress under a pure shear and a pure dilatation e."""
+    shear = np.eye(3)[None].copy()
+    shear[0, 0, 1] = shear[0, 1, 0] = e
+    mu, lam = lame(material)
+    P_s = piola(solver, shear, mu, lam)[0]
+    P_d = piola(solver, (1.0 + e) * np.eye(3)[None], mu, lam)[0]
+    G = P_s[0, 1] / (2.0 * e)
+    return G, (P_d[0, 0] / e - 2.0 * G) / 3.0      # a dilatation e: P = (3 lam + 2 G) e I
+
+
 def import_newton():
     """(newton, warp), or a ModelError saying how to install them."""
     try:

@@ -1,0 +1,27 @@
+"""Today's fast models as baselines: the Newton engine's XPBD, VBD and semi-implicit solvers
+(model.simulators.newton) on the bar, the cube and the cantilever, against FEM P1 on the same
+tetrahedra and the converged continuum, at their default settings and up a ladder of iteration
+counts. Needs the engines extra; without it the report says so and runs nothing."""
+from ...framework import Study
+from ...running.store import OFF
+from . import report
+from .study import EngineSettings, run
+
+
+class Engines(Study):
+    name = "engines"
+    selections = ()            # its models and meshes are its own
+    takes = ()
+    runs_recorded = ("runs",)
+    recorded_keys = ("installed", "engine", "runs")
+    title = "today's fast models: Newton's XPBD, VBD and semi-implicit FEM against the continuum"
+    settings_class = EngineSettings
+
+    def run(self, s, workers=None, log=True, bench=None, store=None):
+        return run(s, workers=workers, log=log, bench=bench, store=store or OFF)
+
+    def write(self, out, s, data):
+        return report.write(out, self, s, data)
+
+
+STUDY = Engines()

@@ -1,0 +1,124 @@
+"""The engines study's verdicts on runs whose answers are known: where an iterative solver's
+answer converges, where it matches FEM P1, the rows the gate reads, and a report without the
+engines extra."""
+import pytest
+
+from cases.studies.engines import STUDY
+from cases.studies.engines.report import convergence, findings, gate_rows
+from cases.studies.engines.study import solver_of, spec
+
+LADDER = {"newton-xpbd": (2, 8, 32), "newton-vbd": (10, 40)}
+
+
+def row(model, value, mesh="five", case="paper-cube", regime="linear regime", failed=None,
+        continuum=1.0, p1=1.0):
+    solver, n = solver_of(model)
+    return {"case": case, "regime": regime, "quantity": "reaction", "mesh": mesh, "bc": "clamped",
+            "model": model, "solver": solver, "iterations": n, "value_rel": None if failed else value / abs(continuum),
+            "estimate": 1e-4,
+            "model_form": None if failed else (value - p1) / abs(continuum),
+            "discretisation": (p1 - continuum) / abs(continuum),
+            "total": None if failed else (value - continuum) / abs(continuum), "failed": failed}
+
+
+def test_model_names_and_solvers_round_trip():
+    """An engine model's name carries its iteration count; the default count is the plain
+    name."""
+    assert spec("newton-xpbd", 2) == "newton-xpbd"
+    assert spec("newton-xpbd", 8) == "newton-xpbd(iterations=8)"
+    assert solver_of("newton-xpbd(iterations=8)") == ("newton-xpbd", 8)
+    assert solver_of("newton-vbd") == ("newton-vbd", 10)
+    assert solver_of("newton-semi-implicit") == ("newton-semi-implicit", None)
+    assert solver_of("fem-linear") == (None, None)
+
+
+def test_convergence_is_the_count_from_which_the_answer_stays_within_one_percent():
+    """Values 1.5, 1.105, 1.1 (of |Q_c| = 1) at 2, 8, 32 iterations: converged from 8 (within
+    0.01 of the top's); 1.5, 1.2, 1.1: only at the top, not shown converged; a failed run at
+    the top decides nothing."""
+    data = {"runs": [row("newton-xpbd", 1.5), row("newton-xpbd(iterations=8)", 1.105),
+                     row("newton-xpbd(iterations=32)", 1.1)]}
+    assert convergence(data, "paper-cube", "linear regime", "newton-xpbd",
+                       LADDER["newton-xpbd"]) == (8, None)
+    data["runs"][1] = row("newton-xpbd(iterations=8)", 1.2)
+    n, why = convergence(data, "paper-cube", "linear regime", "newton-xpbd",
+                         LADDER["newton-xpbd"])
+    assert n == 32 and "not shown converged" in why
+    data["runs"][2] = row("newton-xpbd(iterations=32)", 1.0, failed="not at rest")
+    assert convergence(data, "paper-cube", "linear regime", "newton-xpbd",
+                       LADDER["newton-xpbd"])[0] is None
+
+
+def test_a_solver_matches_fem_p1_where_its_model_form_error_is_within_five_percent_on_every_mesh():
+    """At 10 iterations 0.03 on one mesh and 0.08 on the other: no match; at 40 iterations
+    0.01 and 0.04 on both: a match at 40 only; the default's errors are reported with their
+    failures counted."""
+    data = {"runs": [row("newton-vbd", 1.03), row("newton-vbd", 1.08, mesh="six"),
+                     row("newton-vbd(iterations=40)", 1.01),
+                     row("newton-vbd(iterations=40)", 1.04, mesh="six")]}
+    f = findings(data, {"newton-vbd": LADDER["newton-vbd"]})["newton-vbd"]["cases"]
+    c = f["paper-cube/linear regime"]
+    assert c["matches_p1_at"] == [40]
+    assert c["model_form"] == pytest.approx([0.03, 0.08])
+    assert c["converged_at"] == 40 and "not shown converged" in c["converged_why"]
+
+
+def test_the_gate_reads_every_engine_run_by_case_bc_and_regime():
+    """One gate row per engine run (not FEM P1's), keyed so that cases and regimes do not
+    collide, holding |model-form error|, None for a failed run."""
+    runs = [row("newton-vbd", 0.9), row("newton-vbd", 1.0, regime="at the load",
+                                         failed="not at rest"), row("fem-linear", 1.0)]
+    rows = gate_rows({"runs": runs})
+    assert [(r["bc"], r["engine_error"]) for r in rows] == [
+        ("paper-cube/clamped/linear regime", pytest.approx(0.1)),
+        ("paper-cube/clamped/at the load", None)]
+
+
+def test_without_the_engines_extra_the_report_says_so(tmp_path):
+    """With no engine installed the study writes a report that says so, with a row per
+    solver, and no gate rows."""
+    import json
+    s = STUDY.settings(quick=True)
+    STUDY.write(tmp_path, s, {"installed": False, "engine": None, "runs": []})
+    text = (tmp_path / "report.md").read_text()
+    assert "not installed" in text and "newton-xpbd" in text
+    assert json.loads((tmp_path / "metrics.json").read_text())["gate_runs"] == []
+
+
+def test_the_quick_engines_run_is_a_preview_that_holds_its_gold(tmp_path, capsys):
+    """`pbcm run engines --quick` runs the Newton engine's solvers on Warp's CPU backend on the
+    bar, the cube and the cantilever beside FEM P1, says 'quick: not decided', gates one row
+    per engine run and passes the committed quick gold."""
+    pytest.importorskip("newton")
+    import json
+    from pathlib import Path
+    from cases.cli import main
+    out = tmp_path / "m" / "engines"
+    assert main(["run", "engines", "--quick", "--out", str(out)]) == 0
+    doc = json.loads((out / "metrics.json").read_text())
+    assert "Quick: not decided" in (out / "report.md").read_text()
+    assert doc["answer"].startswith("quick: not decided")
+    engine_runs = [r for r in doc["runs"] if r["solver"]]
+    assert len(doc["gate_runs"]) == len(engine_runs) > 0
+    capsys.readouterr()
+    gold = Path(__file__).resolve().parents[1] / "gold"
+    assert main(["check", "--metrics", str(out.parent), "--gold", str(gold)]) == 0, \
+        capsys.readouterr().out
+
+
+def test_the_answer_names_per_case_the_solver_that_matches_fem_p1_and_from_which_count():
+    """A solver within 0.05 of FEM P1 in both regimes of a case from 40 iterations on (not at
+    10) is named there 'from 40 iterations'; a case where no solver matches reads 'none'."""
+    from cases.studies.engines.report import answer
+    runs = []
+    for regime in ("linear regime", "at the load"):
+        runs += [row("newton-vbd", 1.2, regime=regime), row("newton-vbd(iterations=40)", 1.03,
+                                                             regime=regime),
+                 row("newton-semi-implicit", 1.3, regime=regime),
+                 row("newton-xpbd", 1.0, regime=regime, failed="not at rest"),
+                 row("newton-vbd", 1.3, regime=regime, case="cantilever"),
+                 row("newton-vbd(iterations=40)", 1.3, regime=regime, case="cantilever")]
+    ladder = {"newton-xpbd": (2,), "newton-vbd": (10, 40)}
+    text = answer(findings({"runs": runs}, ladder), ladder, quick=False, installed=True)
+    assert "the cube (paper-cube): newton-vbd from 40 iterations" in text
+    assert "the cantilever (cantilever): none" in text
