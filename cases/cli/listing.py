@@ -34,18 +34,15 @@ def run(args):
     from ..registry import CASES as cases
     for path in sorted(SHIPPED.glob("*.toml")):
         print(f"{path.stem} (sweep, pbcm sweep {path.stem}): {load(path, cases).title}")
-    print("force terms (compose them with '+' in --models):")
-    for name, cls in sorted(model.terms.registered().items()):
-        params = ", ".join(f"{k}={v}" for k, v in cls.params.items())
-        doc = (cls.__doc__ or "").strip().split("\n")[0]
-        print(textwrap.fill(f"{name}({params}): {doc}", width=96, initial_indent="  ",
-                            subsequent_indent="    "))
-    print("simulators (a model by name in --models, with its settings):")
-    for name, cls in sorted(model.simulators.registered().items()):
-        params = ", ".join(f"{k}={v}" for k, v in cls.params.items())
-        doc = (cls.__doc__ or "").strip().split("\n")[0]
-        print(textwrap.fill(f"{name}({params}): {doc}", width=96, initial_indent="  ",
-                            subsequent_indent="    "))
+    for title, registry in (("force terms (compose them with '+' in --models)", model.terms),
+                            ("simulators (a model by name in --models, with its settings)",
+                             model.simulators)):
+        print(f"{title}:")
+        for name, cls in sorted(registry.registered().items()):
+            params = ", ".join(f"{k}={v}" for k, v in cls.params.items())
+            doc = (cls.__doc__ or "").strip().split("\n")[0]
+            print(textwrap.fill(f"{name}({params}): {doc}", width=96, initial_indent="  ",
+                                subsequent_indent="    "))
     return 0
 
 
