@@ -64,6 +64,25 @@ def bc_arrays(bc, n_nodes):
     return mask, vals
 
 
+def path(bc_of_t, n_nodes, t0=0.0):
+    """(mask, u_of_t): the components ``bc_of_t`` prescribes (at ``t0``) and a function of t
+    giving their displacements (n, 3), through ``bc_of_t.arrays`` where it has one (no mapping
+    rebuilt at every step), else ``bc_arrays``, refusing a set of prescribed components that
+    changes with time."""
+    mask, _ = bc_arrays(bc_of_t(t0), n_nodes)
+    if hasattr(bc_of_t, "arrays"):
+        def u_of_t(t):
+            return bc_of_t.arrays(t, n_nodes)[1]
+    else:
+        def u_of_t(t):
+            m, u = bc_arrays(bc_of_t(t), n_nodes)
+            if not np.array_equal(m, mask):
+                raise ModelError(f"bc_of_t({t:g}) prescribes other components than at t = "
+                                 f"{t0:g}; the set of prescribed components must stay the same")
+            return u
+    return mask, u_of_t
+
+
 def load_fractions(load_steps):
     """The load fractions of ``load_steps``: k / n for an int n, or the given increasing
     fractions in (0, 1] ending at 1 (steps of unequal size, e.g. to stop at measured states)."""

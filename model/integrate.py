@@ -13,7 +13,7 @@ import warnings
 from numba import literal_unroll, njit
 from numba.core.errors import NumbaExperimentalFeatureWarning
 
-from .bc import Ramp, bc_arrays
+from .bc import Ramp, path
 from .errors import BlowUpError, DegenerateTetError, ModelError
 from .geometry import min_signed_volume
 from .step_cache import step_for
@@ -247,20 +247,9 @@ def simulate(model, bc_of_t, t_end, dt=None, damping=0.0, f_ext=None, frames=101
         raise ModelError(f"dt must be a positive time in seconds, got {dt!r}")
     steps = max(1, math.ceil((t_end - t0) / dt - 1e-9))
     dt = (t_end - t0) / steps
-    mask, _ = bc_arrays(bc_of_t(0.0), mesh.n_nodes)
+    mask, prescribed = path(bc_of_t, mesh.n_nodes)
     f_ext = np.zeros_like(mesh.points) if f_ext is None else np.asarray(f_ext, dtype=float)
     h_fd = 1e-6 * dt
-
-    if hasattr(bc_of_t, "arrays"):   # e.g. model.bc.Ramp: no mapping rebuilt per stage
-        def prescribed(t):
-            return bc_of_t.arrays(t, mesh.n_nodes)[1]
-    else:
-        def prescribed(t):
-            m, u = bc_arrays(bc_of_t(t), mesh.n_nodes)
-            if not np.array_equal(m, mask):
-                raise ModelError(f"bc_of_t({t:g}) prescribes other components than at t = 0; "
-                                 "the set of prescribed components must stay the same")
-            return u
 
     if hasattr(bc_of_t, "velocity"):
         def prescribed_velocity(t):

@@ -252,3 +252,27 @@ def test_the_real_time_family_times_every_preset():
     from model import PRESETS
     from model.presets import IMPLICIT_STEP
     assert set(costs.FAMILY_MODELS) == {*PRESETS, *IMPLICIT_STEP}
+
+
+def test_the_real_time_family_times_newtons_solvers_up_their_ladder_where_installed(
+        monkeypatch):
+    """With the engines extra the family holds Newton's solvers at every count of their
+    ladder (the quick family at their defaults), each timed through its adapter at its own
+    step; without it, the presets alone."""
+    from model.simulators import newton
+    if newton.installed():
+        assert costs.family_models() == costs.FAMILY_MODELS + newton.ladder_models()
+        assert costs.family_models(True) == costs.FAMILY_MODELS + newton.ladder_models(1)
+        from cases.tools import realtime_bench as RB
+        monkeypatch.setattr(costs, "QUICK_CELLS", (2,))
+        rows = RB.run(models=("newton-semi-implicit",), quick=True, rounds=2,
+                      progress=lambda *_: None)
+        (r,) = rows
+        assert r["timed"] and r["wall_range"][0] > 0 and r["two_thread_range"] is None
+        from model import build
+        from cases.framework import DEFAULT_MATERIAL
+        from cases.library.common import bench_mesh
+        sim = build("newton-semi-implicit", bench_mesh(r["tets"]), DEFAULT_MATERIAL)
+        assert r["dt_us"] == pytest.approx(sim.stable_dt() * 1e6)
+    monkeypatch.setattr(newton, "installed", lambda: False)
+    assert costs.family_models() == costs.FAMILY_MODELS

@@ -2,6 +2,7 @@
 its implicit modes counted as its law's), its errors there, the ranking with ties read against
 the right uncertainty, the yardstick beside the ranking, and the quick run a preview."""
 import json
+from pathlib import Path
 import math
 
 import pytest
@@ -112,11 +113,11 @@ def test_no_model_measured_at_real_time_is_not_decided():
     assert R.answer_line(data, v, quick=False).startswith("Not decided: no model was measured")
 
 
-def test_the_quick_run_is_a_preview_with_every_size_and_no_ranking(tmp_path):
+def test_the_quick_run_is_a_preview_with_every_size_and_no_ranking(tmp_path, capsys):
     """`pbcm run realtime --quick` writes metrics.json and a report that says 'quick: not
     decided' and ranks nothing; every law on its two sizes has finite errors against FEM P1 (0
-    for FEM P1 itself) and the continuum, the implicit presets read their law's, and the gate
-    reads each law once."""
+    for FEM P1 itself) and the continuum, the implicit presets read their law's, the gate
+    reads each law once and holds the committed quick gold."""
     out = tmp_path / "realtime"
     assert main(["run", "realtime", "--quick", "--out", str(out)]) == 0
     doc = json.loads((out / "metrics.json").read_text())
@@ -133,6 +134,10 @@ def test_the_quick_run_is_a_preview_with_every_size_and_no_ranking(tmp_path):
     gate = [(g["model"], g["mesh"]) for g in doc["gate_runs"]]
     assert len(gate) == len(set(gate))
     assert {m for m, _ in gate} == {r["law"] for r in doc["runs"]}
+    capsys.readouterr()
+    gold = Path(__file__).resolve().parents[1] / "gold"
+    assert main(["check", "--metrics", str(tmp_path), "--gold", str(gold)]) == 0, \
+        capsys.readouterr().out
 
 
 def test_an_equilibrium_with_an_inverted_tetrahedron_is_refused_and_the_next_split_tried():

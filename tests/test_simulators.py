@@ -191,3 +191,41 @@ def test_the_semi_implicit_model_reproduces_its_closed_form_under_compression():
     G, lam = small_strain_moduli("semi-implicit")
     E = G * (3 * lam + 2 * G) / (lam + G)
     assert st.reaction[top, 2].sum() == pytest.approx(-E * SIZE ** 2 * 0.001, rel=1e-2)
+
+
+def test_a_prescribed_path_is_the_mapping_it_comes_from_and_refuses_changing_components():
+    """``path`` gives at every t the displacements ``bc_arrays(bc_of_t(t))`` gives, through a
+    ramp's own arrays where it has them (the run to rest's ramp included), and refuses a
+    ``bc_of_t`` whose prescribed components change with time."""
+    from model.bc import Ramp, bc_arrays, path
+    from model.simulators.base import _RampedHeld
+    held = {0: (0.0, 0.0, 0.0), 3: (None, -1e-3, None), 5: (2e-4, None, 1e-4)}
+    for bc_of_t in (_RampedHeld(held, 0.5), Ramp([3, 4], (None, -1e-3, 0.0), 0.5, fixed=[0]),
+                    lambda t: {n: tuple(None if u is None else min(t / 0.5, 1) * u for u in c)
+                               for n, c in held.items()}):
+        mask, u_of_t = path(bc_of_t, 6)
+        for t in (0.0, 0.2, 0.5, 0.9):
+            m, u = bc_arrays(bc_of_t(t), 6)
+            assert np.array_equal(m, mask) and np.allclose(u_of_t(t), u, rtol=0, atol=1e-18)
+    _, u_of_t = path(lambda t: {0: (0.0, 0.0, 0.0)} if t < 1 else {1: (0.0, 0.0, 0.0)}, 6)
+    with pytest.raises(ModelError, match="other components"):
+        u_of_t(2.0)
+
+
+def test_a_users_problem_file_runs_a_newton_model_beside_fem_p1(tmp_path):
+    """`pbcm run --problem FILE --models newton-semi-implicit fem-linear` runs the user's
+    problem with the engine through the cases' runner: the engine's run comes to rest and its
+    model-form error against FEM P1 on the user's mesh is a number in the metrics."""
+    import json
+    from cases.cli import main
+    toml = tmp_path / "demo.toml"
+    assert main(["problem", "new", "demo", "--out", str(toml)]) == 0
+    out = tmp_path / "demo"
+    assert main(["run", "--problem", str(toml), "--quick", "--models", "newton-semi-implicit",
+                 "fem-linear", "--out", str(out), "--no-cache"]) == 0
+    doc = json.loads((out / "metrics.json").read_text())
+    ours = [r for r in doc["runs"] if r["model"] == "newton-semi-implicit"]
+    assert ours and all(r["static_failed"] is None for r in ours)
+    # its law's shear modulus is 3/4 G under the documented mapping: the end force is off
+    assert all(0.05 < r["end_force_rel_err"] < 1 for r in ours)
+    assert "newton-semi-implicit" in (out / "report.md").read_text()

@@ -109,6 +109,15 @@ FAMILY_MODELS = ("pbcm-corner", "pbcm-balanced", "pbcm-variational", "pbcm-varia
                  *IMPLICIT_STEP)     # every preset
 
 
+def family_models(quick=False):
+    """The real-time family's models: every preset and, where the engines extra is installed,
+    Newton's solvers at the iteration counts the engines study runs them (the quick family:
+    at their defaults)."""
+    from model.simulators import newton
+    engines = newton.ladder_models(1 if quick else None) if newton.installed() else ()
+    return FAMILY_MODELS + engines
+
+
 def sizes(quick=False):
     """The family's tetrahedron counts."""
     return [5 * k ** 3 for k in (QUICK_CELLS if quick else CELLS)]
@@ -127,4 +136,4 @@ def best(row):
 
 
 __all__ = ["FILE", "FOLDER", "SOURCE", "read", "load", "step_cost_us", "cost_items",
-           "FAMILY_MODELS", "sizes", "best"]
+           "FAMILY_MODELS", "family_models", "sizes", "best"]

@@ -111,13 +111,16 @@ class Document:
 
     def table(self, header, rows, keys=1):
         """A table; one wider than MAX_COLUMNS is split into several that each repeat the
-        first ``keys`` columns (what names a row)."""
+        first ``keys`` columns (what names a row), a row left out of a part where its every
+        other cell is empty (it has nothing there)."""
         header, rows = list(header), [list(r) for r in rows]
         width = MAX_COLUMNS - keys
+        split = len(header) > MAX_COLUMNS
         for k in range(keys, max(len(header), keys + 1), width):
             cols = list(range(keys)) + list(range(k, min(k + width, len(header))))
             self.blocks.append(("table", [header[c] for c in cols],
-                                [[r[c] for c in cols] for r in rows]))
+                                [[r[c] for c in cols] for r in rows
+                                 if not split or any(r[c] != "" for c in cols[keys:])]))
 
     def img(self, filename, alt):
         self.blocks.append(("img", filename, alt))

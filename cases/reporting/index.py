@@ -243,14 +243,23 @@ def index_documents(root, cases, studies=(), missing=()):
           + ", ".join(f"{label}" for _, _, label in BANDS) + ", red also for a failed run. "
           "Quick-mode cases are marked. The last rows are measured against reality (the "
           "Truth Cube's beads).")
-    rows = scorecard_rows(pops, data, models)
-    for n in shown:       # the studies' own rows (the one measured against reality)
-        for label, metric, cells in declared()[n].scorecard(
-                json.loads((root / n / "metrics.json").read_text())):
-            rows.append([Link(label, f"{n}/report.md", f"{n}/report.html"), metric, "", ""]
-                        + [Cell(cells[m][0], BANDS[cells[m][1]][1]) if m in cells else ""
-                           for m in models])
-    doc.table(["case/bc", "error", "FEM P1 vs continuum", "u_val"] + models, rows, keys=4)
+    extra = [(n, r) for n in shown   # the studies' own rows: reality, today's engines
+             for r in declared()[n].scorecard(json.loads((root / n / "metrics.json").read_text()))]
+    # a model only a study measures (an engine) gets a column of its own, empty in the cases'
+    # rows: the library's cases do not run it
+    columns = models + [m for _, (_, _, cells) in extra for m in cells if m not in models]
+    columns = list(dict.fromkeys(columns))
+    rows = [row + [""] * (len(columns) - len(models))
+            for row in scorecard_rows(pops, data, models)]
+    for n, (label, metric, cells) in extra:
+        rows.append([Link(label, f"{n}/report.md", f"{n}/report.html"), metric, "", ""]
+                    + [Cell(cells[m][0], BANDS[cells[m][1]][1]) if m in cells else ""
+                       for m in columns])
+    if len(columns) > len(models):
+        doc.p(", ".join(columns[len(models):]) + ": measured by a study on its own meshes, "
+              "not in the library's cases (their cells there are empty); their rows are the "
+              "study's, at each model's default settings, and are not ranked with the cases'.")
+    doc.table(["case/bc", "error", "FEM P1 vs continuum", "u_val"] + columns, rows, keys=4)
     recorded = {n: (read_study(root / n, declared()[n]), declared()[n].runs_recorded)
                 for n in shown}
     for line in conclusion(pops, models, quick) + [failed_checks(data, recorded)]:

@@ -366,7 +366,9 @@ def _family_table(doc, data):
           "round-robin [smallest-largest], each model in its faster mode (serial or two "
           "threads, named where two threads are faster): the explicit models at their own "
           "largest stable RK4 step, the implicit presets at their own step from the push's "
-          f"start. A model is not timed above two sizes in a row over {REAL_TIME:g} (real "
+          "start, Newton's solvers (where the engines extra is installed) at their own step "
+          "through pbcm's adapter (model.simulators.newton), single precision on Warp's CPU "
+          f"backend. A model is not timed above two sizes in a row over {REAL_TIME:g} (real "
           "time): its cost grows with the mesh.")
     doc.table(["tets", *models], [[t, *(cell(by[(mo, t)]) for mo in models)]
                                   for t in sorted({r["tets"] for r in rows})])

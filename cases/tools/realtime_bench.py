@@ -6,7 +6,8 @@ at a time, so that the real-time study reads each model's reach from its own mea
 Explicit models run RK4 at their own largest stable step (``timers.own_stable_step``), serial
 and, where the model has one, in its two-thread mode; the implicit presets (backward Euler,
 Newton with conjugate gradients) at their own step, on the same push, since their iterations
-depend on the load. Times are wall clock (a simulator's budget is the wall's), medians over
+depend on the load; Newton's solvers (where the engines extra is installed) at their own step
+through their adapter (model.simulators.newton). Times are wall clock (a simulator's budget is the wall's), medians over
 rounds taken round-robin across the models at one size, with the rounds' range beside them.
 A model is timed up the family until it is over real time at two sizes in a row: the
 larger ones cannot be its reach (its cost grows with the mesh), and are marked as not timed.
@@ -19,9 +20,11 @@ from model.presets import IMPLICIT_STEP
 
 from ..framework import DEFAULT_MATERIAL
 from ..library.common import bench_mesh, paper_push
-from ..reporting.costs import FAMILY_MODELS as MODELS, REAL_TIME, best, sizes
+from model import build
+from model.compose import simulator
+from ..reporting.costs import REAL_TIME, best, family_models, sizes
 from ..running import stop
-from .timers import ImplicitTimed, Timed, own_stable_step
+from .timers import DAMPING, ImplicitTimed, Timed, own_stable_step
 
 OVER_IN_A_ROW = 2        # sizes over real time in a row after which a model is not timed up
 MIN_SAMPLE_S = 0.05      # each sample runs at least this long (many steps if need be)
@@ -70,6 +73,37 @@ class _Implicit:
                 stats["cg_iterations"] / max(stats["newton_iterations"], 1))
 
 
+class _Engine:
+    """A simulator pbcm does not integrate (Newton's solvers) on one mesh at its own step:
+    wall-clock seconds per step through its adapter's ``simulate``, the push set around every
+    step as in its equilibrium runs, each sample going on from the last state."""
+
+    def __init__(self, name, mesh):
+        self.sim, self.ramp = build(name, mesh, DEFAULT_MATERIAL), _ramp(mesh)
+        self.dt = self.sim.stable_dt()
+        self.x = self.v = None
+        self.t = 0.0
+        self._wall(1)                                   # load the engine's kernels first
+        self.reps = max(1, int(MIN_SAMPLE_S / max(self._wall(1), 1e-7)))
+
+    def _wall(self, n):
+        w0 = time.perf_counter()
+        tr = self.sim.simulate(self.ramp, self.t + n * self.dt, dt=self.dt, damping=DAMPING,
+                               frames=2, x0=self.x, v0=self.v, t0=self.t)
+        wall = time.perf_counter() - w0
+        self.x, self.v, self.t = tr.x[-1], tr.v, self.t + n * self.dt
+        return wall / n
+
+    def sample(self):
+        return self._wall(self.reps) / self.dt, np.nan
+
+
+def _timer(name, mesh):
+    if name in IMPLICIT_STEP:
+        return _Implicit(name, mesh)
+    return (_Engine if simulator(name) else _Explicit)(name, mesh)
+
+
 def _row(name, mesh, timer, got, rounds):
     got = np.array(got, dtype=float)
     serial = got[:, 0]
@@ -88,16 +122,17 @@ def _row(name, mesh, timer, got, rounds):
     return row
 
 
-def run(models=MODELS, quick=False, rounds=5, progress=print):
+def run(models=None, quick=False, rounds=5, progress=print):
     """The family's rows: one per (model, size), timed or marked not timed (over real time at
-    OVER_IN_A_ROW smaller sizes in a row)."""
+    OVER_IN_A_ROW smaller sizes in a row); ``models`` default the family's."""
+    models = models or family_models(quick)
     over = {m: 0 for m in models}
     rows = []
     for tets in sizes(quick):
         mesh = bench_mesh(tets)
         live = [m for m in models if over[m] < OVER_IN_A_ROW]
         progress(f"bench: real-time family, {mesh.n_tets} tetrahedra, {len(live)} models")
-        timers = {m: (_Implicit if m in IMPLICIT_STEP else _Explicit)(m, mesh) for m in live}
+        timers = {m: _timer(m, mesh) for m in live}
         got = {m: [] for m in live}
         for _ in range(rounds):
             stop.checkpoint()

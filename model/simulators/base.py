@@ -258,8 +258,17 @@ class _RampedHeld:
 
     def __init__(self, held, t_ramp):
         self.held, self.t_ramp = held, t_ramp
+        self._end = (None,)
 
     def __call__(self, t):
         s = min(max(t / self.t_ramp, 0.0), 1.0)
         return {n: tuple(None if u is None else s * u for u in c) for n, c in self.held.items()}
+
+    def arrays(self, t, n_nodes):
+        """(mask, displacement) at t, as bc_arrays(self(t), n_nodes) gives them (the end state
+        scaled, no mapping rebuilt)."""
+        if self._end[0] != n_nodes:
+            self._end = (n_nodes, *bc_arrays(self.held, n_nodes))
+        _, mask, end = self._end
+        return mask, min(max(t / self.t_ramp, 0.0), 1.0) * end
 

@@ -29,7 +29,7 @@ import math
 
 import numpy as np
 
-from ..bc import bc_arrays
+from ..bc import path
 from ..errors import BlowUpError, ModelError
 from ..geometry import smallest_heights
 from ..terms._kernels import deformation_gradients_numpy, piola_tet_forces, rest_shape_inverse
@@ -37,6 +37,32 @@ from . import register
 from .base import Simulator
 
 FRAME_S = 1.0 / 60.0
+SOLVERS = ("newton-semi-implicit", "newton-xpbd", "newton-vbd")
+# the iteration counts at which pbcm measures each iterative solver: its default, then up by 4x
+LADDER = {"newton-xpbd": (2, 8, 32), "newton-vbd": (10, 40, 160)}
+
+
+def installed():
+    """Whether the engines extra (newton, on warp) is installed."""
+    import importlib.util
+    return importlib.util.find_spec("newton") is not None
+
+
+def spec(solver, iterations):
+    """The model name of ``solver`` at ``iterations`` (at its default: the plain name)."""
+    ladder = LADDER.get(solver)
+    if ladder is None or iterations == ladder[0]:
+        return solver
+    return f"{solver}(iterations={iterations})"
+
+
+def ladder_models(rungs=None):
+    """The solvers as models: the semi-implicit one, each iterative one at the first ``rungs``
+    of its ladder (every rung without)."""
+    out = ["newton-semi-implicit"]
+    for solver, counts in LADDER.items():
+        out += [spec(solver, n) for n in counts[:rungs]]
+    return tuple(out)
 
 
 def lame(material):
@@ -149,7 +175,7 @@ class NewtonModel(Simulator):
         dt = self.stable_dt() if dt is None else float(dt)
         steps = max(1, math.ceil((t_end - t0) / dt - 1e-9))
         dt = (t_end - t0) / steps
-        mask, _ = bc_arrays(bc_of_t(t0), mesh.n_nodes)
+        mask, prescribed = path(bc_of_t, mesh.n_nodes, t0)
         X = mesh.points
         f_ext = np.zeros_like(X) if f_ext is None else np.asarray(f_ext, dtype=float)
         m = self._model
@@ -163,8 +189,7 @@ class NewtonModel(Simulator):
                               else np.asarray(v0).astype(np.float32))
 
         def prescribe(state, t):
-            u = bc_arrays(bc_of_t(t), mesh.n_nodes)[1]
-            u_next = bc_arrays(bc_of_t(t + dt), mesh.n_nodes)[1]
+            u, u_next = prescribed(t), prescribed(t + dt)
             q, qd = state.particle_q.numpy(), state.particle_qd.numpy()   # views on the CPU
             q[mask] = (X + u)[mask]
             qd[mask] = ((u_next - u) / dt)[mask]

@@ -13,7 +13,7 @@ class Engines(Study):
     selections = ()            # its models and meshes are its own
     takes = ()
     runs_recorded = ("runs",)
-    recorded_keys = ("installed", "engine", "runs")
+    recorded_keys = ("installed", "engine", "runs", "dynamic", "costs", "cost_tets", "machine")
     title = "today's fast models: Newton's XPBD, VBD and semi-implicit FEM against the continuum"
     settings_class = EngineSettings
 
@@ -22,6 +22,9 @@ class Engines(Study):
 
     def write(self, out, s, data):
         return report.write(out, self, s, data)
+
+    def scorecard(self, metrics):
+        return report.scorecard(metrics)
 
 
 STUDY = Engines()

@@ -8,11 +8,11 @@ prismatic bar whose closed form is exact), the cube the paper's (``paper-cube``,
 the cantilever ``cantilever`` (clamped). Each runs on its quick-mode meshes and references (the
 engines' single precision and run-to-rest tolerance, 1e-3, are coarser than those references'
 estimates), on the 'five' split in the quick run and on 'five' and 'six' in the full run."""
-import importlib.util
 from dataclasses import dataclass
 
 import numpy as np
 
+from model.simulators.newton import LADDER, SOLVERS, installed, ladder_models
 from ...framework import MaterialSettings
 from ...measuring.error_model import P1_FINITE, P1_LINEAR, at_load, decomposed
 from ...running.runner import jsonable, run as run_case
@@ -20,26 +20,10 @@ from ...running.store import OFF
 
 CASE_NAMES = {"self-weight": "the bar", "paper-cube": "the cube", "cantilever": "the cantilever"}
 BCS = {"self-weight": "sliding", "paper-cube": "clamped", "cantilever": "clamped"}
-SOLVERS = ("newton-semi-implicit", "newton-xpbd", "newton-vbd")
-# the iteration counts each iterative solver runs at: its default first, then up by 4x each
-LADDER = {"newton-xpbd": (2, 8, 32), "newton-vbd": (10, 40, 160)}
-QUICK_LADDER = {"newton-xpbd": (2, 8), "newton-vbd": (10, 40)}
+QUICK_RUNGS = 2       # the quick run's iterative solvers: the first two rungs of their ladders
 MESHES, QUICK_MESHES = ("five", "six"), ("five",)
-CONVERGED = 0.01      # within this of its own answer at the ladder's top (relative to |Q_c|)
+CONVERGED = 0.01      # within this fraction of its own answer at the ladder's top
 MATCH = 0.05          # "matches FEM P1": a model-form error at most this
-
-
-def spec(solver, iterations):
-    """The model name of ``solver`` at ``iterations`` (its default: the plain name)."""
-    ladder = LADDER.get(solver)
-    if ladder is None or iterations == ladder[0]:
-        return solver
-    return f"{solver}(iterations={iterations})"
-
-
-def installed():
-    """Whether the engines extra (newton, on warp) is installed."""
-    return importlib.util.find_spec("newton") is not None
 
 
 @dataclass
@@ -50,7 +34,7 @@ class EngineSettings(MaterialSettings):
 
     @property
     def ladder(self):
-        return QUICK_LADDER if self.quick else LADDER
+        return {k: v[:QUICK_RUNGS] if self.quick else v for k, v in LADDER.items()}
 
     @property
     def meshes(self):
@@ -58,10 +42,7 @@ class EngineSettings(MaterialSettings):
 
     def models(self):
         """Every engine model run: the semi-implicit solver, each iterative one up its ladder."""
-        out = ["newton-semi-implicit"]
-        for solver, counts in self.ladder.items():
-            out += [spec(solver, n) for n in counts]
-        return tuple(out)
+        return ladder_models(QUICK_RUNGS if self.quick else None)
 
     def case_settings(self):
         from ...registry import CASES
@@ -145,10 +126,48 @@ def run(s, workers=None, log=True, bench=None, store=OFF):
     runs where the engines extra is not installed (the report says so)."""
     from ...registry import CASES
     if not installed():
-        return {"installed": False, "engine": None, "runs": []}
-    rows = []
+        return {"installed": False, "engine": None, "runs": [], "dynamic": [], "costs": {},
+                "cost_tets": None, "machine": None}
+    rows, dynamic = [], []
     for name, cfg in s.case_settings().items():
         runs, _ = run_case(CASES[name], cfg, workers=workers, store=store, reuse_full=True)
         rows += case_rows(CASES[name], runs)
+        dynamic += dynamic_rows(name, runs, cfg)
     import newton
-    return jsonable({"installed": True, "engine": f"newton {newton.__version__}", "runs": rows})
+    return jsonable({"installed": True, "engine": f"newton {newton.__version__}", "runs": rows,
+                     "dynamic": dynamic, **costs(bench, s.models())})
+
+
+def dynamic_rows(case, runs, cfg):
+    """The dynamic push of each run that has one (the paper cube's: its push over 1 s, then
+    held to rest): the top reaction over time and the displacement at the push's end against
+    linear FEM's exact transient on the mesh (its element P1 in the cases' quick settings:
+    the same tetrahedra), whether it came to rest, or why it failed; beside it the speed
+    below which the case calls a body at rest and the smallest speed a single-precision
+    position resolves over the run's step (the cube's side times float32's epsilon, over dt)."""
+    from ...library.common import CUBE_MM, SPEED_MM_S
+    from ...framework import MM
+    eps = float(np.finfo(np.float32).eps) * CUBE_MM * MM
+    return [{"case": case, "mesh": r["mesh"], "model": r["model"],
+             "solver": solver_of(r["model"])[0], "element": cfg.transient_element,
+             "rest_speed_m_s": cfg.rest_speed * SPEED_MM_S * MM,
+             "float32_speed_m_s": eps / r["dyn_dt_s"] if solver_of(r["model"])[0]
+             and r.get("dyn_dt_s") else None,
+             "reaction_time_rel_l2": r.get("reaction_time_rel_l2"),
+             "disp_end_push_rel_l2": r.get("disp_end_push_rel_l2"),
+             "at_rest": r.get("dyn_at_rest"), "dt_s": r.get("dyn_dt_s"),
+             "failed": r.get("dyn_failed")}
+            for r in runs if "reaction_time_rel_l2" in r]
+
+
+def costs(bench, models):
+    """The bench's wall-clock cost of each engine model on the real-time family's smallest
+    cube (the paper's 125 nodes, 320 tetrahedra, under its push, at the model's own step):
+    {"costs": {model: row or None (not timed)}, "cost_tets", "machine"}. Nothing is timed
+    here, so that the runs stay deterministic."""
+    from ...reporting.costs import sizes
+    tets = sizes(True)[0]
+    got = {r["model"]: r for r in (bench or {}).get("realtime_rows", [])
+           if r["tets"] == tets and r.get("timed")}
+    return {"costs": {m: got.get(m) for m in models}, "cost_tets": tets,
+            "machine": (bench or {}).get("realtime_machine")}

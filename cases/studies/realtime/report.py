@@ -12,10 +12,24 @@ from ...reporting.document import Document, fmt
 from ...reporting.report import environment, write_study
 from ...running.runner import jsonable
 from ...reporting import costs as bench_costs
-from .study import LAWS, MODELS, P1
+from .study import P1
 
 GATED = catalogue.gated("disp_rel_l2", "disp_form_rel_l2")
-RANKED = tuple(m for m in LAWS if m != P1)   # FEM P1 with the continuum's law is the yardstick
+
+
+def laws(runs):
+    """The laws of the runs, in their order (an implicit preset's is fem-corotated's)."""
+    return tuple(dict.fromkeys(r["law"] for r in runs))
+
+
+def models(runs):
+    """The models of the runs, in their order."""
+    return tuple(dict.fromkeys(r["model"] for r in runs))
+
+
+def ranked_laws(runs):
+    """The laws ranked: every one but FEM P1 with the continuum's law, the yardstick."""
+    return tuple(m for m in laws(runs) if m != P1)
 
 
 def err(v):
@@ -44,7 +58,7 @@ def reach(runs, margin=1.0):
     largest real time in some round. With ``margin`` < 1 every cost is divided by it (a step
     that much below the own stable step)."""
     out = {}
-    for law in LAWS:
+    for law in laws(runs):
         own = [(r, c / margin, mode, [x / margin for x in rng]) for r in runs
                if r["law"] == law for c, mode, rng in [_cost(r)] if c is not None]
         timed = own
@@ -136,11 +150,11 @@ def verdict(data):
     estimate (their error cancels FEM P1's)."""
     runs = data["runs"]
     at = reach(runs)
-    measured = {m: r for m, r in at.items() if r is not None and m in RANKED}
+    measured = {m: r for m, r in at.items() if r is not None and m in ranked_laws(runs)}
     if not measured:
         return {"decided": False, "why": "no model was measured at real time on the bench's "
                 "real-time family (run `pbcm bench` on this machine)",
-                "reach": {m: None for m in LAWS}, "ranks": []}
+                "reach": {m: None for m in laws(runs)}, "ranks": []}
     e = data["error_estimate"] or 0.0
     bounds = {m: bound(runs, r["run"]) for m, r in measured.items()}
     spans = {m: span(runs, m, r) for m, r in measured.items() if bounds[m] is not None}
@@ -154,7 +168,7 @@ def verdict(data):
     pick = min(sure or first, key=lambda m: measured[m]["range"][1])
     modes = {m: max((r["tets"] for r in runs if r["model"] == m and _cost(r)[0] is not None
                      and _cost(r)[0] <= REAL_TIME), default=None)
-             for m in MODELS if m not in LAWS}
+             for m in models(runs) if m not in laws(runs)}
     return {"decided": bool(first), "best": first, "estimate": e, "pick": pick,
             "pick_sure": bool(sure), "modes": modes,
             "cautious": {m: None if r is None else r["tets"] for m, r in cautious.items()},
@@ -266,8 +280,12 @@ def build(out, study, s, doc):
         "(1.7 mm on the 32 mm cube at 1.7 mm/s, clamped base) on the 'five' cubes of its "
         "real-time family, each model in its faster mode (serial or two threads), the "
         "explicit models at their own largest stable RK4 step, the implicit presets "
-        "(backward Euler, Newton with conjugate gradients) at their own step; at most "
-        f"{REAL_TIME:g} is real time. Each timing sample is checked for a blow-up (one stops "
+        "(backward Euler, Newton with conjugate gradients) at their own step"
+        + ("; Newton's solvers (the physics engine, single precision on Warp's CPU backend) "
+           "at their own step through pbcm's adapter, each iteration count its own model, "
+           "their equilibrium run to rest (docs/simulators.md)"
+           if any(r["model"].startswith("newton-") for r in runs) else "")
+        + f"; at most {REAL_TIME:g} is real time. Each timing sample is checked for a blow-up (one stops "
         "the bench), over the steps the samples take from the push's start, not over the "
         "whole push. The accuracy is each model's static equilibrium under the same push "
         "(how far a timed run lags it at the push's end is not measured here): its distance "
@@ -331,7 +349,7 @@ def build(out, study, s, doc):
             d.p(f"Beside the ranking, the yardstick: FEM P1 with the continuum's law ({P1}), "
                 "model-form error 0 by definition, runs in real time up to "
                 f"{y['tets']} tetrahedra, at distance {err(y['distance'])} from the continuum.")
-        none = [m for m in RANKED if v["reach"].get(m) is None]
+        none = [m for m in ranked_laws(runs) if v["reach"].get(m) is None]
         if none:
             d.p("Not in real time at any size timed: " + ", ".join(none) + ".")
         if v.get("cancels"):
@@ -353,7 +371,7 @@ def build(out, study, s, doc):
         "the errors are the model's law's static equilibrium. Sizes at which the bench did "
         "not time a model and no error was computed are left out: "
         + (", ".join(f"{m} above {max(r['tets'] for r in shown if r['model'] == m)}"
-                     for m in MODELS if any(r["model"] == m for r in shown)
+                     for m in models(runs) if any(r["model"] == m for r in shown)
                      and any(r["model"] == m and r not in shown for r in runs)) or "none")
         + ".")
     d.table(["model", "tets", "wall s/s serial", "wall s/s two threads", "real time",
@@ -367,7 +385,7 @@ def build(out, study, s, doc):
               _judged(r["disp_rel_l2"], v) if r["accuracy"] else "not computed",
               r["load_steps"] or "-", r["failed"] or "-"] for r in shown])
     series = []
-    for m in LAWS:
+    for m in laws(runs):
         pts = []
         for r in runs:
             if r["model"] != m or not r["accuracy"]:

@@ -26,7 +26,6 @@ from ...reporting import costs as bench_costs
 
 BC = "clamped"                  # the paper's base
 P1 = "fem-neohookean"           # FEM P1 with the continuum's law: the model-form twin
-MODELS = bench_costs.FAMILY_MODELS              # the bench's real-time family's models
 REF_MESH = ("six", 5)           # the continuum: neo-Hookean P2 on this cube, refined
 REF_LEVELS, QUICK_REF_LEVELS = 2, 1
 STATIC_RTOL = 1e-10
@@ -38,7 +37,9 @@ def statics_of(model):
     return "fem-corotated" if model in IMPLICIT_STEP else model
 
 
-LAWS = tuple(dict.fromkeys(statics_of(m) for m in MODELS))   # one static solve each
+def laws(quick):
+    """One static solve each: the laws of the family's models."""
+    return tuple(dict.fromkeys(statics_of(m) for m in bench_costs.family_models(quick)))
 
 
 @dataclass
@@ -55,7 +56,7 @@ class RealtimeSettings(MaterialSettings):
     def units(self):
         """Work units a pool could share: each static solve of the quick family (the full
         run's count depends on the bench)."""
-        return len(bench_costs.sizes(True)) * len(LAWS)
+        return len(bench_costs.sizes(True)) * len(laws(True))
 
     def problem(self):
         return {**self.material_record(), "size_mm": P.SIZE_MM, "push_mm": P.PUSH_MM,
@@ -64,7 +65,8 @@ class RealtimeSettings(MaterialSettings):
                                         "refinements": self.ref_levels}}
 
     def describe(self):
-        return {**self.problem(), "quick": self.quick, "models": list(MODELS)}
+        return {**self.problem(), "quick": self.quick,
+                "models": list(bench_costs.family_models(self.quick))}
 
 
 def cost_rows(bench, quick):
@@ -72,7 +74,7 @@ def cost_rows(bench, quick):
     the quick run's two sizes whether or not the bench timed them)."""
     got = {(r["model"], r["tets"]): r for r in (bench or {}).get("realtime_rows", [])}
     return {(m, t): got.get((m, t), {"model": m, "tets": t, "timed": False})
-            for t in bench_costs.sizes(quick) for m in MODELS}
+            for t in bench_costs.sizes(quick) for m in bench_costs.family_models(quick)}
 
 
 def solved_pairs(costs, quick):
@@ -80,10 +82,11 @@ def solved_pairs(costs, quick):
     the full run each law where the bench timed any model with its statics there, and FEM P1
     wherever another law is solved (the model-form twin)."""
     if quick:
-        return [(t, m) for t in bench_costs.sizes(True) for m in LAWS]
+        return [(t, m) for t in bench_costs.sizes(True) for m in laws(True)]
     pairs = {(t, statics_of(m)) for (m, t), r in costs.items() if r.get("timed")}
     pairs |= {(t, P1) for t, _ in pairs}
-    return sorted(pairs, key=lambda p: (p[0], LAWS.index(p[1])))
+    order = laws(False)
+    return sorted(pairs, key=lambda p: (p[0], order.index(p[1])))
 
 
 def reference(s):
