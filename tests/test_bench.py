@@ -276,3 +276,22 @@ def test_the_real_time_family_times_newtons_solvers_up_their_ladder_where_instal
         assert r["dt_us"] == pytest.approx(sim.stable_dt() * 1e6)
     monkeypatch.setattr(newton, "installed", lambda: False)
     assert costs.family_models() == costs.FAMILY_MODELS
+
+
+def test_bench_rewrite_draws_the_report_again_without_timing(tmp_path):
+    """`pbcm bench --rewrite` draws bench.md and the figure again from the bench.json in
+    --out, which it leaves byte for byte as it was; with a timing option, or without a
+    bench.json, it fails before writing anything."""
+    from pathlib import Path
+    import shutil
+    src = Path(__file__).resolve().parents[1] / "reports" / "bench"
+    out = tmp_path / "bench"
+    shutil.copytree(src, out)
+    (out / "bench.md").write_text("stale\n")
+    before = (out / "bench.json").read_bytes()
+    assert main(["bench", "--rewrite", "--out", str(out)]) == 0
+    assert (out / "bench.json").read_bytes() == before
+    assert (out / "bench.md").read_text().startswith("# ")
+    assert main(["bench", "--rewrite", "--family", "--out", str(out)]) == 2
+    assert main(["bench", "--rewrite", "--out", str(tmp_path / "none")]) == 2
+    assert not (tmp_path / "none").exists()

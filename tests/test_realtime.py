@@ -116,8 +116,8 @@ def test_no_model_measured_at_real_time_is_not_decided():
 def test_the_quick_run_is_a_preview_with_every_size_and_no_ranking(tmp_path, capsys):
     """`pbcm run realtime --quick` writes metrics.json and a report that says 'quick: not
     decided' and ranks nothing; every law on its two sizes has finite errors against FEM P1 (0
-    for FEM P1 itself) and the continuum, the implicit presets read their law's, the gate
-    reads each law once and holds the committed quick gold."""
+    for FEM P1 itself) and the continuum, and so has its top force, the implicit presets read
+    their law's, the gate reads each law once and holds the committed quick gold."""
     out = tmp_path / "realtime"
     assert main(["run", "realtime", "--quick", "--out", str(out)]) == 0
     doc = json.loads((out / "metrics.json").read_text())
@@ -127,7 +127,9 @@ def test_the_quick_run_is_a_preview_with_every_size_and_no_ranking(tmp_path, cap
     assert {t for _, t in runs} == {320, 1080}
     for (m, t), r in runs.items():
         assert r["disp_rel_l2"] > 0 and r["disp_form_rel_l2"] >= 0, (m, t)
+        assert r["force_rel"] is not None and r["force_form_rel"] is not None, (m, t)
     assert runs[("fem-neohookean", 320)]["disp_form_rel_l2"] == 0
+    assert runs[("fem-neohookean", 320)]["force_form_rel"] == 0
     twin = runs[("fem-corotated", 1080)]
     imp = runs[("fem-corotated-implicit-frame", 1080)]
     assert imp["disp_rel_l2"] == twin["disp_rel_l2"]
@@ -200,3 +202,24 @@ def test_a_reach_the_timing_rounds_do_not_settle_widens_the_tie():
     settled = {**data, "runs": runs[:4] + [_run("pbcm-balanced", 5000, 0.96, 0.03, 0.004)]
                + runs[5:]}
     assert R.verdict(settled)["best"] == ["pbcm-balanced"]
+
+
+def test_the_pick_is_among_the_tied_whose_top_force_is_within_five_percent_of_fem_p1s():
+    """Two models tied at the top of the ranking, one with more headroom but a top force 30 %
+    off FEM P1's (a law too stiff, which the displacement bound under a prescribed push
+    hardly sees): the other, within 0.05, is picked, and the answer states both forces;
+    without any force within 0.05 the pick falls back to the headroom among all the tied."""
+    def run(model, cost, force):
+        r = _run(model, 1080, cost, 0.05, form=0.004)
+        return {**r, "force_form_rel": force, "force_rel": force}
+    data = {"runs": [run("msm+volume", 0.3, 0.30), run("pbcm-variational", 0.9, 0.01),
+                     run("fem-neohookean", 0.5, 0.0)],
+            "error_estimate": 0.001, "machine": {"cpu": "X", "cores": 2}}
+    v = R.verdict(data)
+    assert sorted(v["best"]) == ["msm+volume", "pbcm-variational"]
+    assert v["pick"] == "pbcm-variational" and v["pick_stiff"]
+    text = R.answer_line(data, v, quick=False)
+    assert "msm+volume 0.3" in text and "pbcm-variational 0.01" in text
+    data["runs"][1] = run("pbcm-variational", 0.9, 0.2)
+    v = R.verdict(data)
+    assert v["pick"] == "msm+volume" and not v["pick_stiff"]

@@ -31,6 +31,9 @@ def add(sub):
                     help="time only the real-time family (the paper's push on cubes of 320 to "
                          "1.1e5 tetrahedra, read by `pbcm run realtime`) and put its rows into "
                          "the bench.json in --out, keeping every other row")
+    bn.add_argument("--rewrite", action="store_true",
+                    help="draw bench.md and step_time.png again from the bench.json in --out "
+                         "without timing anything (after a change of the report's code)")
     bn.add_argument("--device", help="also time the Warp kernels of the covered presets on this "
                                       "Warp device (cpu, cuda, cuda:0 ...), float32 and "
                                       "float64; needs warp-lang (default: not timed)")
@@ -60,6 +63,20 @@ def run(args):
     if args.device is not None:
         check_device(args.device)
     old = None
+    if args.rewrite:
+        if args.family or args.merge or args.models or args.sizes or args.device or args.quick:
+            raise UsageError("--rewrite times nothing: drop --family, --merge, --models, "
+                             "--sizes, --device and --quick, or drop --rewrite")
+        where = Path(args.out) / costs.FILE
+        if not where.is_file():
+            raise UsageError(f"--rewrite draws the report from {where}, which does not exist; "
+                             "run `pbcm bench` first")
+        data = costs.read(where)
+        with StagedFolder(Path(args.out), mark=costs.FILE) as out:
+            bench.write(data, out.path)
+            keep_folders(Path(args.out), out.path)
+            print(f"bench rewritten from its bench.json in {out.commit()}")
+        return 0
     if args.family and (args.merge or args.models or args.sizes or args.device):
         raise UsageError("--family times the real-time family alone: drop --merge, --models, "
                          "--sizes and --device, or drop --family")

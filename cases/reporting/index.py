@@ -256,9 +256,10 @@ def index_documents(root, cases, studies=(), missing=()):
                     + [Cell(cells[m][0], BANDS[cells[m][1]][1]) if m in cells else ""
                        for m in columns])
     if len(columns) > len(models):
-        doc.p(", ".join(columns[len(models):]) + ": measured by a study on its own meshes, "
-              "not in the library's cases (their cells there are empty); their rows are the "
-              "study's, at each model's default settings, and are not ranked with the cases'.")
+        doc.p(", ".join(columns[len(models):]) + ": measured by a study, on the meshes its "
+              "rows name, not in the library's cases (their cells there are empty); their "
+              "rows are the study's, at each model's default settings, and are not ranked "
+              "with the cases'.")
     doc.table(["case/bc", "error", "FEM P1 vs continuum", "u_val"] + columns, rows, keys=4)
     recorded = {n: (read_study(root / n, declared()[n]), declared()[n].runs_recorded)
                 for n in shown}

@@ -296,9 +296,10 @@ def write(data, out):
                   "threads: `pbcm run realtime` reads it.")
     if data.get("realtime_rows"):
         _family_table(doc, data)
-    doc.p("Optional engines, timed on the same meshes in the same rounds (`pip install "
-          "'pbcm[engines]'`), with the ratio of their force evaluation to pbcm's "
-          f"{ENGINE_REFERENCE} kernel taken in-round:")
+    doc.p("Optional engines' force evaluations, timed on the same meshes in the same rounds "
+          "as the force evaluations above (`pip install 'pbcm[engines]'`; as that run found "
+          "them, whatever the real-time family, timed apart, found), with the ratio of their "
+          f"force evaluation to pbcm's {ENGINE_REFERENCE} kernel taken in-round:")
     doc.ul([f"{name}: {state}" for name, state in sorted(data["engines"].items())])
     if data.get("engine_rows"):
         doc.table(["engine", "tets", "ns/tet (force)", f"force vs pbcm {ENGINE_REFERENCE}"],

@@ -116,6 +116,8 @@ def _row(name, mesh, timer, got, rounds):
     if not np.all(np.isnan(got[:, 1])):
         row.update(two_thread_wall_s_per_simulated_s=float(np.median(got[:, 1])),
                    two_thread_range=[float(got[:, 1].min()), float(got[:, 1].max())])
+    if getattr(timer, "sim", None) is not None:       # an engine: which one, which version
+        row["engine"] = timer.sim.info.get("engine")
     if got.shape[1] > 2:
         row.update(newton_per_step=float(np.median(got[:, 2])),
                    cg_per_newton=float(np.median(got[:, 3])))

@@ -14,7 +14,8 @@ class Engines(Study):
     takes = ()
     runs_recorded = ("runs",)
     recorded_keys = ("installed", "engine", "runs", "dynamic", "costs", "cost_tets", "machine")
-    title = "today's fast models: Newton's XPBD, VBD and semi-implicit FEM against the continuum"
+    title = ("today's fast models: Newton's XPBD, VBD and semi-implicit FEM against the "
+             "continuum, on the cases' quick meshes and references")
     settings_class = EngineSettings
 
     def run(self, s, workers=None, log=True, bench=None, store=None):

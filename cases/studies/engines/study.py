@@ -98,6 +98,9 @@ def case_rows(case, runs):
                 "bc": r["bc"], "model": r["model"], "solver": solver, "iterations": n,
                 "substeps": info.get("substeps"), "dt_s": info.get("dt"),
                 "value_rel": _over(r.get(q.key), r.get(q.continuum)),
+                # the continuum's value on this mesh's reference: its spread over the meshes
+                # is part of u_num
+                "continuum": _largest(r.get(q.continuum)),
                 "estimate": r.get("nh_error_estimate" if regime == "at the load"
                                   else "p2_error_estimate"),
                 # the largest free-node force of the engine's own law where it came to rest
@@ -110,6 +113,14 @@ def case_rows(case, runs):
                 "total": None if failed or p is None else p.total,
                 "failed": failed or (None if p is not None else f"no {q.label}")})
     return rows
+
+
+def _largest(q):
+    """A quantity's largest-magnitude component (a sequence over load steps), or None."""
+    if q is None:
+        return None
+    q = np.atleast_1d(np.asarray(q, float))
+    return float(q[np.argmax(np.abs(q))])
 
 
 def _over(q, q_c):

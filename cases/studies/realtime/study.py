@@ -89,42 +89,57 @@ def solved_pairs(costs, quick):
     return sorted(pairs, key=lambda p: (p[0], order.index(p[1])))
 
 
+def reference_mesh():
+    """The cube the continuum is solved on (refined ``ref_levels`` times)."""
+    from model.mesh import cube
+    return cube(REF_MESH[1], P.SIZE_MM * P.MM, REF_MESH[0])
+
+
 def reference(s):
     """The continuum under the paper's push on the clamped cube, and its error estimate."""
-    from model.mesh import cube
-    mesh = cube(REF_MESH[1], P.SIZE_MM * P.MM, REF_MESH[0])
+    mesh = reference_mesh()
     return hyperelastic.converged(mesh, s.material, P.static_bc(mesh, BC, P.PUSH_MM),
                                   levels=s.ref_levels, mixed="auto")
 
 
+def top_force(mesh, reaction):
+    """The force the push needs [N]: the reaction on the cube's top nodes along the push
+    (None where the model gives no forces)."""
+    from ...running.runner import reaction_along
+    value = float(reaction_along(reaction, (P.boundary_sets(mesh, BC)[0], 1)))
+    return value if np.isfinite(value) else None
+
+
 def _solve(job):
     """One model's static equilibrium on one mesh with every tetrahedron upright: its
-    displacement field [m], or why it failed."""
+    displacement field [m] and the top force, or why it failed."""
     model, mesh, s = job
     try:
         pm = build(model, mesh, s.material)
         st, steps = solve_split(pm, P.static_bc(mesh, BC, P.PUSH_MM), splits=LOAD_SPLITS,
                                 upright=True, rtol=STATIC_RTOL, stall=STALL)
     except FINDINGS as exc:
-        return {"u": None, "failed": str(exc), "load_steps": None}
-    return {"u": st.u, "failed": None, "load_steps": steps}
+        return {"u": None, "failed": str(exc), "load_steps": None, "reaction": None}
+    return {"u": st.u, "failed": None, "load_steps": steps,
+            "reaction": top_force(mesh, st.reaction)}
 
 
 def _reference_at(s, meshes, store, progress):
     """{tets: the continuum at that mesh's nodes} and the reference's error estimate, each
     mesh's values kept under its own key (the family grows with the bench)."""
     keys = {t: key(kind="realtime-reference", **s.problem(), tets=t) for t in meshes}
-    est_key = key(kind="realtime-reference", **s.problem(), what="estimate")
+    est_key = key(kind="realtime-reference", **s.problem(), what="estimate and top force")
     at = {t: store.get(k) for t, k in keys.items()}
     est = store.get(est_key)
     if est is None or any(v is None for v in at.values()):
         r = reference(s)
-        est = store.put(est_key, {"error_estimate": r.error_estimate})
+        est = store.put(est_key, {"error_estimate": r.error_estimate,
+                                  "reaction": top_force(reference_mesh(), r.result.reaction)})
         for t, v in at.items():
             if v is None:
                 at[t] = store.put(keys[t], {"u": r.result.at(meshes[t].points)})
     progress.advance(1, "reference")
-    return {t: v["u"] for t, v in at.items()}, est["error_estimate"]
+    return {t: v["u"] for t, v in at.items()}, est["error_estimate"], est["reaction"]
 
 
 def run(s, workers=None, log=True, bench=None, store=OFF):
@@ -134,8 +149,9 @@ def run(s, workers=None, log=True, bench=None, store=OFF):
     jobs = solved_pairs(costs, s.quick)
     meshes = {t: bench_mesh(t) for t in sorted({t for t, _ in jobs})}
     with Progress("realtime", 1 + len(jobs), log=log) as progress:
-        ref_at, estimate = _reference_at(s, meshes, store, progress)
-        keys = [key(kind="realtime-run", **s.problem(), tets=t, model=m) for t, m in jobs]
+        ref_at, estimate, force_c = _reference_at(s, meshes, store, progress)
+        keys = [key(kind="realtime-run", **s.problem(), tets=t, model=m, top_force=True)
+                for t, m in jobs]
         found = [store.get(k) for k in keys]
         todo = [i for i, f in enumerate(found) if f is None]
         progress.advance(len(jobs) - len(todo))
@@ -150,17 +166,31 @@ def run(s, workers=None, log=True, bench=None, store=OFF):
         law = statics_of(m)
         row = {"mesh": f"five-{t}", "tets": t, "bc": BC, "model": m, "law": law,
                "cost": cost, "accuracy": (t, law) in fields, "failed": None,
-               "disp_rel_l2": None, "disp_form_rel_l2": None, "load_steps": None}
+               "disp_rel_l2": None, "disp_form_rel_l2": None, "force_rel": None,
+               "force_form_rel": None, "load_steps": None}
         if row["accuracy"]:
             got, p1 = fields[(t, law)], fields.get((t, P1))
             row.update(failed=got["failed"], load_steps=got["load_steps"])
             if got["u"] is not None:
                 row.update(_errors(got["u"], None if p1 is None else p1["u"], ref_at[t],
                                    meshes[t]))
+                row.update(_force_errors(got["reaction"], None if p1 is None
+                                         else p1["reaction"], force_c))
         rows.append(row)
-    return jsonable({"runs": rows, "error_estimate": estimate,
+    return jsonable({"runs": rows, "error_estimate": estimate, "top_force_n": force_c,
                      "machine": (bench or {}).get("realtime_machine")
                      or (bench or {}).get("machine")})
+
+
+def _force_errors(f, f_p1, f_c):
+    """The top force's distance from the continuum's (f - f_c) / |f_c| and its model-form
+    error against FEM P1's (f - f_p1) / |f_c|, signed: what the displacement field, which the
+    push prescribes, hardly sees (a law's stiffness)."""
+    if f is None or not f_c:
+        return {}
+    return {"force_rel": M.finite("force_rel", (f - f_c) / abs(f_c)),
+            "force_form_rel": None if f_p1 is None
+            else M.finite("force_form_rel", (f - f_p1) / abs(f_c))}
 
 
 def _errors(u, u_p1, u_c, mesh):
