@@ -549,6 +549,17 @@ declare("model_form", "1", "model-form error (signed)",
          "tetrahedra, relative to the continuum's value (the engines study).")
 declare("total", "1", "distance from the continuum (signed)",
          "(Q - Q_c) / |Q_c| of one run: model-form plus FEM P1's discretisation error.")
+declare("u_num", "1", "u_num",
+         "the reference's numerical uncertainty for one case and regime (the engines study): "
+         "its largest estimate over the meshes and the relative spread of the continuum's "
+         "value over them, in quadrature; u_val, with no unmeasured input or data.")
+declare("force_rel", "1", "top force from the continuum (signed)",
+         "(f - f_c) / |f_c| for the top force f the paper's push needs (the reaction on the "
+         "cube's top along the push; the real-time study).")
+declare("force_form_rel", "1", "top force model-form error (signed)",
+         "(f - f_P1) / |f_c| for the top force: a law's stiffness against FEM P1's with the "
+         "continuum's law on the same tetrahedra, which the displacement field under a "
+         "prescribed push hardly sees (the real-time study).")
 declare("discretisation", "1", "P1 discretisation",
          "FEM P1's discretisation error of the case's decomposed quantity on the run's mesh, "
          "against the converged continuum (the extensions study's failure criterion).")

@@ -14,7 +14,7 @@ import numpy as np
 
 from model.simulators.newton import LADDER, SOLVERS, installed, ladder_models
 from ...framework import MaterialSettings
-from ...measuring.error_model import P1_FINITE, P1_LINEAR, at_load, decomposed
+from ...measuring.error_model import P1_FINITE, P1_LINEAR, at_load, decomposed, u_num
 from ...running.runner import jsonable, run as run_case
 from ...running.store import OFF
 
@@ -84,6 +84,11 @@ def case_rows(case, runs):
     for q, regime in ((case.decomposed, "linear regime"), (at_load(case.decomposed), "at the load")):
         if q is None or q not in case.decompositions():
             continue
+        # the reference's u_num: its estimate and the continuum's spread over the meshes
+        est = "nh_error_estimate" if regime == "at the load" else "p2_error_estimate"
+        by_mesh = {r["mesh"]: r for r in runs}
+        u_nums = {regime: u_num(max((r.get(est) or 0.0) for r in by_mesh.values()),
+                                [_largest(r.get(q.continuum)) for r in by_mesh.values()])[0]}
         parts = decomposed(runs, q)
         p1 = {r["mesh"]: parts[(r["mesh"], r["bc"], r["model"])] for r in runs
               if r["model"] == q.p1}
@@ -98,9 +103,7 @@ def case_rows(case, runs):
                 "bc": r["bc"], "model": r["model"], "solver": solver, "iterations": n,
                 "substeps": info.get("substeps"), "dt_s": info.get("dt"),
                 "value_rel": _over(r.get(q.key), r.get(q.continuum)),
-                # the continuum's value on this mesh's reference: its spread over the meshes
-                # is part of u_num
-                "continuum": _largest(r.get(q.continuum)),
+                "u_num": u_nums.get(regime),
                 "estimate": r.get("nh_error_estimate" if regime == "at the load"
                                   else "p2_error_estimate"),
                 # the largest free-node force of the engine's own law where it came to rest

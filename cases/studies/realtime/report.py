@@ -239,9 +239,13 @@ def answer_line(data, v, quick):
     beside = (f". FEM P1 with the continuum's law ({P1}), the yardstick, runs "
               f"{y['tets']} tetrahedra at distance {err(y['distance'])}" if y else "")
     engines = v.get("engines") or {}
-    newton = ("; Newton's solvers in real time: " + ", ".join(
-        f"{m} up to {t} tetrahedra" if t else f"{m} at no size timed"
-        for m, t in engines.items()) if engines else "")
+    newton = ("; Newton's solvers (single precision on one core of Warp's CPU backend, "
+              "through pbcm's adapter) in real time: " + ", ".join(
+                  f"{m} up to {t} tetrahedra" + (
+                      f" (top force {fmt(force[m], 2)} from FEM P1's there)"
+                      if force.get(m) is not None else "")
+                  if t else f"{m} at none of the sizes timed"
+                  for m, t in engines.items()) if engines else "")
     return (f"At real time on this machine ({machine(data)}, wall clock, the paper's push on "
             f"its cube), {head}. {stiff}Pick {p}: {why} "
             f"({fmt(v['reach'][p]['range'][1])} s per simulated s in its slowest round)"
