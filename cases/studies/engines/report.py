@@ -422,7 +422,7 @@ def findings_rows(doc, ladder, quick):
             res = [v for v in c["residual_n"] if v is not None]
             cost = c.get("cost")
             rows.append([solver, _where(key), _signed(c["model_form"]), top,
-                         _signed(c["total"]) + _tie(c), _signed(c["discretisation"]),
+                         _signed(c["total"]) + _cancellation(c), _signed(c["discretisation"]),
                          fmt(c["u_num"], 2) if c.get("u_num") is not None else "n/a",
                          fmt(max(res), 2) if res else "n/a", conv,
                          "-" if c.get("cost_model") is None else
@@ -432,7 +432,7 @@ def findings_rows(doc, ladder, quick):
     return rows
 
 
-def _tie(c):
+def _cancellation(c):
     """Beside a solver's distance from the continuum: '; cancellation on k of n meshes' where,
     on a mesh, it is smaller than FEM P1's own and of the other sign (its error and the
     mesh's cancel: not accuracy). Two distances on one mesh share the continuum's value, so
