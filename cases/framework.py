@@ -611,7 +611,8 @@ class Study(abc.ABC):
     def scorecard(self, metrics):
         """Rows the index's scorecard adds for this study, from its ``metrics``
         (metrics.json): ``[(label, metric, {model: (text, band)})]`` with band 0 (good), 1 or
-        2 (bad); none by default (the scorecard's rows are the cases')."""
+        2 (bad), each optionally with a fourth item (FEM P1 vs continuum, u_val) for the
+        row's shared columns; none by default (the scorecard's rows are the cases')."""
         return []
 
     def recorded(self, metrics):

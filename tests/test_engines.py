@@ -199,7 +199,9 @@ def test_the_scorecard_rows_band_each_solver_by_its_worst_mesh_and_count_failure
     ladder = {"newton-xpbd": (2,), "newton-vbd": (10, 40)}
     doc = {"installed": True, "parameters": {"quick": False, "meshes": ["five"]},
            "findings": findings({"runs": _two_cases()}, ladder)}
-    rows = {label.split(" (")[0]: cells for label, _, cells in scorecard(doc)}
+    got = scorecard(doc)
+    rows = {label.split(" (")[0]: cells for label, _, cells, _ in got}
+    assert all(len(shared) == 2 for *_, shared in got)     # FEM P1 vs continuum, u_val
     assert rows["paper-cube/clamped"]["newton-vbd"][1] == 0
     assert rows["cantilever/clamped"]["newton-vbd"][1] == 2
     assert rows["paper-cube/clamped"]["newton-xpbd"] == ("failed, 0 of 1", 2)

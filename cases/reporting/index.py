@@ -247,12 +247,13 @@ def index_documents(root, cases, studies=(), missing=()):
              for r in declared()[n].scorecard(json.loads((root / n / "metrics.json").read_text()))]
     # a model only a study measures (an engine) gets a column of its own, empty in the cases'
     # rows: the library's cases do not run it
-    columns = models + [m for _, (_, _, cells) in extra for m in cells if m not in models]
+    columns = models + [m for _, (_, _, cells, *_) in extra for m in cells if m not in models]
     columns = list(dict.fromkeys(columns))
     rows = [row + [""] * (len(columns) - len(models))
             for row in scorecard_rows(pops, data, models)]
-    for n, (label, metric, cells) in extra:
-        rows.append([Link(label, f"{n}/report.md", f"{n}/report.html"), metric, "", ""]
+    for n, (label, metric, cells, *shared) in extra:   # shared: (FEM P1 vs continuum, u_val)
+        rows.append([Link(label, f"{n}/report.md", f"{n}/report.html"), metric,
+                     *(shared[0] if shared else ("", ""))]
                     + [Cell(cells[m][0], BANDS[cells[m][1]][1]) if m in cells else ""
                        for m in columns])
     if len(columns) > len(models):
