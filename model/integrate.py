@@ -295,7 +295,7 @@ def simulate(model, bc_of_t, t_end, dt=None, damping=0.0, f_ext=None, frames=101
             if status:
                 step = done + at
                 what = ("NaN or inf in the state" if status == 1 else
-                        f"tetrahedron {model.terms[term].degenerate_tets(bad)[0]} inverted"
+                        f"tetrahedron {model.units[term].degenerate_tets(bad)[0]} inverted"
                         if status == 2 else f"tetrahedron {bad} inverted" if status == 3 else
                         f"a particle moves at {speed:.3g} m/s, faster than the P-wave speed "
                         f"{vmax:.3g} m/s")

@@ -5,7 +5,7 @@ import numpy as np
 from .calibrate import calibrate
 from .geometry import smallest_heights
 from .errors import ModelError
-from .terms import make_term
+from .terms import fused_units, make_term
 from .integrate import simulate as rk4_simulate
 from .simulators.base import Simulator
 from .static import RTOL as STATIC_RTOL, JacobianPattern, jacobian, solve as static_solve
@@ -35,6 +35,8 @@ class ParticleModel(Simulator):
         fit = calibrate(self.terms, mesh, material)
         self._strain_probe = None   # built on the first tet_stress: 24 strains per tet
         self._jacobian_pattern = None
+        # what the kernels run: the terms, two of them in one pass where they fuse
+        self.units = fused_units(self.terms)
         self.info = {"model": name, "terms": [{"term": t.describe(), **t.info()}
                                               for t in self.terms], **fit}
         for t in self.terms:
@@ -51,19 +53,20 @@ class ParticleModel(Simulator):
         if x.shape != self.mesh.points.shape:
             raise ModelError(f"positions must have shape {self.mesh.points.shape}, got {x.shape}")
         out = np.zeros_like(x)
-        for term, (fn, args) in zip(self.terms, self.kernels()):
+        for unit, (fn, args) in zip(self.units, self.kernels()):
             bad = fn(x, *args, out)
             if bad >= 0:
-                raise term.degenerate(bad)
+                raise unit.degenerate(bad)
         return out
 
     def kernels(self):
-        """The terms' kernels as a tuple of ``(fn, args)`` for the compiled integrator; with
-        ``threads`` > 1 a term's threaded kernel where it has one (same bits as serial)."""
+        """The kernels of ``units`` (the terms, fused where they fuse) as a tuple of ``(fn,
+        args)`` for the compiled integrator; with ``threads`` > 1 a unit's threaded kernel
+        where it has one (same bits as serial)."""
         if self.threads == 1:
-            return tuple(t.kernel() for t in self.terms)
+            return tuple(u.kernel() for u in self.units)
         numba.set_num_threads(self.threads)
-        return tuple(t.threaded_kernel() or t.kernel() for t in self.terms)
+        return tuple(u.threaded_kernel() or u.kernel() for u in self.units)
 
     def energy(self, x):
         """Total stored energy [J]; an error for a model with a non-conservative term."""

@@ -1,7 +1,8 @@
 """The blocked force kernels (model/terms/_blocks.py) against the tetrahedron-by-tetrahedron
 kernels they replaced, kept as each term's ``reference_kernel()``: the same forces to round-off
-on lattice and unstructured meshes at random deformations, the two-thread mode the same bits
-as the serial kernel, and the same first flattened element."""
+on lattice and unstructured meshes at random deformations, the threaded mode the same bits
+as the serial kernel for any number of shares, the shear and volume terms fused into one pass
+the same forces as the two, and the same first flattened element."""
 import numba
 import numpy as np
 import pytest
@@ -21,6 +22,8 @@ TERMS = {
     "variational": ("shear", {"reading": "variational", "c": 0.3}),
     "normal_edge": ("normal_edge", {"c": 0.7}),
     "fem_corotated": ("fem_corotated", {}),
+    "fem_linear": ("fem_linear", {}),
+    "fem_neohookean": ("fem_neohookean", {}),
 }
 # the terms whose kernel reports an edge of zero length rather than a flattened tetrahedron
 COLLAPSED_EDGE = {"normal_edge"}
@@ -181,3 +184,125 @@ def test_every_fem_baseline_has_a_two_thread_mode_equal_to_serial_bit_for_bit(na
     assert np.array_equal(two, forces(t.kernel(), x, start))
     serial, sargs = t.kernel()
     assert got >= 0 and got == serial(bad, *sargs, np.zeros_like(x))
+
+
+def fused_pair(mesh, reading):
+    """A shear term of ``reading`` and a volume term on ``mesh``, and their fused unit."""
+    shear = make_term("shear", mesh, MAT, reading=reading, c=0.5)
+    volume = make_term("volume", mesh, MAT, scale=0.8)
+    return shear, volume, shear.fuse(volume)
+
+
+@pytest.mark.parametrize("reading", ["corner", "balanced", "variational"])
+@pytest.mark.parametrize("family", MESHES)
+def test_shear_and_volume_fused_equal_the_two_references(reading, family):
+    """The fused shear-and-volume kernel adds, into a non-zero output, the shear reference's
+    forces plus the volume term's own (scalar) kernel's to 1e-12 of their scale, on every
+    mesh family."""
+    mesh = mesh_of(family)
+    shear, volume, fused = fused_pair(mesh, reading)
+    assert fused is not None and fused.terms == (shear, volume)
+    x = perturbed(mesh, 0.02, seed=4)
+    want = forces(shear.reference_kernel(), x, np.zeros_like(x))
+    want = forces(volume.kernel(), x, want)
+    scale = np.abs(want).max()
+    start = np.random.default_rng(4).standard_normal(x.shape) * scale
+    got = forces(fused.kernel(), x, start) - start
+    assert np.abs(got - want).max() <= 1e-12 * scale
+
+
+def test_a_model_runs_shear_and_volume_as_one_unit_with_the_same_forces():
+    """A preset of shear, normal and volume terms runs the shear and volume terms as one
+    fused unit and the normal term alone; its forces equal the sum of its terms' own kernels
+    to 1e-12 of their scale, and a term that does not fuse stays a unit of its own."""
+    from model import build
+    mesh = mesh_of("six")
+    pm = build("pbcm-variational+normal", mesh, MAT)
+    assert [u.name for u in pm.units] == ["shear + volume", "normal_edge"]
+    x = perturbed(mesh, 0.02, seed=6)
+    want = np.zeros_like(x)
+    for term in pm.terms:
+        want = forces(term.kernel(), x, want)
+    assert np.abs(pm.forces(x) - want).max() <= 1e-12 * np.abs(want).max()
+    assert [u.name for u in build("msm+volume", mesh, MAT).units] == ["springs", "volume"]
+
+
+def test_a_fused_unit_reports_a_flattened_tetrahedron_as_the_shear_term():
+    """A flattened tetrahedron met by the fused kernel is reported as the shear reference
+    reports it: the same first index, in an error naming the shear term."""
+    from model.errors import DegenerateTetError
+    mesh = cube(6, 0.02, "five")
+    shear, _, fused = fused_pair(mesh, "variational")
+    x = mesh.points.copy()
+    for k in (3 * B + 5, 40):
+        x[mesh.tets[k, 3]] = x[mesh.tets[k, :3]].mean(axis=0)
+    fn, args = fused.kernel()
+    ref, ref_args = shear.reference_kernel()
+    got = fn(x, *args, np.zeros_like(x))
+    assert got >= 0 and got == ref(x, *ref_args, np.zeros_like(x))
+    with pytest.raises(DegenerateTetError, match="term 'shear'"):
+        raise fused.degenerate(got)
+
+
+@pytest.mark.parametrize("shares", [3, 7])
+@pytest.mark.parametrize("key", ["variational", "fem_linear", "volume", "springs"])
+def test_threaded_mode_is_the_serial_bits_for_any_number_of_shares(key, shares):
+    """Cut into 3 or 7 shares (more than the threads that run them), the threaded kernel
+    adds the serial kernel's forces bit for bit into a non-zero output, on an unstructured
+    mesh."""
+    from model.terms._blocks import blocked_tets
+    from model.terms._threads import SplitBlocks
+    mesh = mesh_of("unstructured")
+    name, params = TERMS.get(key, (key, {}))
+    t = make_term(name, mesh, MAT, **params)
+    elements = t.edge if key == "springs" else mesh.tets
+    split = SplitBlocks(blocked_tets(elements), len(elements), mesh.n_nodes, shares=shares)
+    _, (kernel_range, args, *_) = t.threaded_kernel()
+    fn, args = split.kernel(kernel_range, args)
+    x = perturbed(mesh, 0.02, seed=8)
+    start = np.full_like(x, -0.5)
+    was = numba.get_num_threads()
+    numba.set_num_threads(2)
+    try:
+        got = forces((fn, args), x, start)
+    finally:
+        numba.set_num_threads(was)
+    assert len(split.dest) > 0          # some forces did wait for an earlier share
+    assert np.array_equal(got, forces(t.kernel(), x, start))
+
+
+_SERIAL_THEN_THREADED = """
+import sys, numpy as np
+from model import Material
+from model.mesh import cube
+from model.terms import make_term
+mesh, mat = cube(6, 0.02, "unstructured", seed=3), Material(E=1e4, nu=0.45, rho=1000.0)
+rng = np.random.default_rng(7)
+x = mesh.points + 1e-4 * rng.standard_normal(mesh.points.shape)
+got = []
+for name, params in [("fem_linear", {}), ("fem_neohookean", {}), ("normal_edge", {"c": 0.5}),
+                     ("springs", {}), ("volume", {})]:
+    t = make_term(name, mesh, mat, **params)
+    fn, args = t.threaded_kernel() if sys.argv[1] == "threaded" else t.kernel()
+    out = np.full_like(x, 0.25)
+    assert fn(x, *args, out) == -1
+    got.append(out)
+np.save(sys.argv[2], np.array(got))
+"""
+
+
+@pytest.mark.skipif(numba.config.NUMBA_NUM_THREADS < 2, reason="one thread")
+def test_threaded_bits_do_not_hang_on_which_process_compiled_the_serial_kernel(tmp_path):
+    """With an empty numba cache, one process compiles and runs the serial kernels (and caches
+    them); a second process, which loads the cached serial pieces, compiles and runs the
+    threaded kernels: their forces are the same bits, for the small kernels (FEM blocks, the
+    edge normal term, the springs, the volume term) a compiler may inline in one process and
+    not in the other."""
+    import os
+    import subprocess
+    import sys
+    env = {**os.environ, "NUMBA_CACHE_DIR": str(tmp_path / "cache")}
+    for mode in ("serial", "threaded"):
+        subprocess.run([sys.executable, "-c", _SERIAL_THEN_THREADED, mode,
+                        str(tmp_path / f"{mode}.npy")], env=env, check=True)
+    assert np.array_equal(np.load(tmp_path / "serial.npy"), np.load(tmp_path / "threaded.npy"))

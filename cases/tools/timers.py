@@ -57,12 +57,12 @@ class Timed:
         self.calibration = time.perf_counter() - t0 if any(
             getattr(t, "calibrate", False) for t in self.pm.terms) else 0.0
         self.kernels = self.pm.kernels()
-        # the two-thread mode of the terms that have one (model.terms._threads)
-        threaded = [t.threaded_kernel() for t in self.pm.terms]
+        # the two-thread mode of the kernel units that have one (model.terms._threads)
+        threaded = [u.threaded_kernel() for u in self.pm.units]
         self.kernels_2 = None
         if any(threaded) and numba.config.NUMBA_NUM_THREADS >= 2:
             numba.set_num_threads(2)
-            self.kernels_2 = tuple(k or t.kernel() for k, t in zip(threaded, self.pm.terms))
+            self.kernels_2 = tuple(k or u.kernel() for k, u in zip(threaded, self.pm.units))
         ramp = ramp or _push(mesh)
         mask, start, moving = ramp.parts(mesh.n_nodes)
         self.x, self.v = mesh.points.copy(), np.zeros_like(mesh.points)

@@ -9,9 +9,9 @@ The registry holds, on first use:
 * every file in the environment variable ``PBCM_TERMS`` (paths separated by ``os.pathsep``),
   which ``pbcm --term FILE`` sets, so that worker processes load the same files.
 """
-from .base import CalibratedTerm, Term
+from .base import CalibratedTerm, Fused, Term, fused_units
 from .registry import (ENTRY_POINT_GROUP, TERMS, add_user_file, load_file, make_term, register,
                        registered, user_files)
 
-__all__ = ["CalibratedTerm", "Term", "ENTRY_POINT_GROUP", "TERMS", "add_user_file",
+__all__ = ["CalibratedTerm", "Fused", "Term", "fused_units", "ENTRY_POINT_GROUP", "TERMS", "add_user_file",
            "load_file", "make_term", "register", "registered", "user_files"]

@@ -14,8 +14,13 @@ gather. Here each block of ``B`` tetrahedra takes three passes:
    ``B``, so LLVM turns the loop into SIMD code over the lanes (no remainder loop: every
    tetrahedron goes through the same instructions);
 3. :func:`scatter`: the forces added into ``out`` in increasing tetrahedron order, corner by
-   corner, as the serial kernels always did; or, in the two-thread mode, :func:`put` into
-   ft (m, 4, 3), which ``model.terms._threads.gather`` sums per node in the same order.
+   corner, as the serial kernels always did; or, in the threaded mode, :func:`scatter_routed`
+   for one thread's share of the blocks (``model.terms._threads.SplitBlocks``).
+
+A kernel whose maths per element is a few dozen operations (the volume term alone, the
+springs) loses more to the scratch array's round trip than the lanes win, and stays a scalar
+loop; its threaded twin takes its elements ``B`` at a time all the same (the routes of
+``model.terms._threads.SplitBlocks``).
 
 The last block is padded with copies of the last tetrahedron (its index and its data), so
 its lanes compute a real element; only the first ``m`` lanes are ever added or stored.
@@ -39,6 +44,11 @@ SCRATCH = 25 * B   # the scratch array's length
 FAST = {"nnan", "ninf", "nsz", "arcp", "contract", "afn"}
 # division by zero gives inf rather than a Python exception: no branch in the lanes
 OPTIONS = dict(cache=True, fastmath=FAST, error_model="numpy", boundscheck=False)
+# a block function small enough for LLVM to inline is inlined by numba into each driver
+# instead: LLVM inlines a callee compiled in the same process but not one loaded from numba's
+# cache, and its fused multiply-adds differ between the two, so a driver's bits would hang on
+# which process compiled what (the shear blocks are too large for LLVM to inline)
+INLINED = dict(OPTIONS, inline="always")
 
 
 @njit(inline="always", fastmath=FAST, error_model="numpy")
@@ -68,7 +78,8 @@ def blocked(a, dtype=np.float64):
 
 
 def blocked_tets(tets):
-    """The corner indices (n_blocks * 4 * B,) int32 in the blocked layout."""
+    """The corner indices (n_blocks * k * B,) int32 in the blocked layout, of tetrahedra
+    (m, 4) or of any elements (m, k) (the threaded mode's routes of edges)."""
     if tets.max(initial=0) >= 2**31:
         raise ValueError("more than 2**31 nodes")
     return blocked(tets, np.int32)
@@ -76,42 +87,67 @@ def blocked_tets(tets):
 
 @njit(**OPTIONS)
 def gather(x, tb, blk, s):
-    """The positions of block blk's corners into rows 0..11 of s."""
+    """The positions of block blk's corners into rows 0..11 of s. A lane's twelve values are
+    loaded before any is stored: the compiler cannot tell s from x, and would otherwise
+    order every load after the previous store."""
     base = blk * 4 * B
-    for c in range(4):
-        for i in range(B):
-            n = tb[base + c * B + i]
-            s[(3 * c) * B + i] = x[n, 0]
-            s[(3 * c + 1) * B + i] = x[n, 1]
-            s[(3 * c + 2) * B + i] = x[n, 2]
+    for i in range(B):
+        n0, n1, n2, n3 = tb[base + i], tb[base + B + i], tb[base + 2 * B + i], \
+            tb[base + 3 * B + i]
+        a0, a1, a2 = x[n0, 0], x[n0, 1], x[n0, 2]
+        b0, b1, b2 = x[n1, 0], x[n1, 1], x[n1, 2]
+        c0, c1, c2 = x[n2, 0], x[n2, 1], x[n2, 2]
+        d0, d1, d2 = x[n3, 0], x[n3, 1], x[n3, 2]
+        s[i], s[B + i], s[2 * B + i] = a0, a1, a2
+        s[3 * B + i], s[4 * B + i], s[5 * B + i] = b0, b1, b2
+        s[6 * B + i], s[7 * B + i], s[8 * B + i] = c0, c1, c2
+        s[9 * B + i], s[10 * B + i], s[11 * B + i] = d0, d1, d2
 
 
 @njit(**OPTIONS)
 def scatter(out, tb, blk, m, s):
-    """out += the block's corner forces, tetrahedron by tetrahedron, corners in order."""
+    """out += the block's corner forces, tetrahedron by tetrahedron, corners in order (a
+    lane's forces loaded before any addition, as in :func:`gather`)."""
     base = blk * 4 * B
     for i in range(min(B, m - blk * B)):
-        for c in range(4):
-            n = tb[base + c * B + i]
-            out[n, 0] += s[OUT + (3 * c) * B + i]
-            out[n, 1] += s[OUT + (3 * c + 1) * B + i]
-            out[n, 2] += s[OUT + (3 * c + 2) * B + i]
+        n0, n1, n2, n3 = tb[base + i], tb[base + B + i], tb[base + 2 * B + i], \
+            tb[base + 3 * B + i]
+        a0, a1, a2 = s[OUT + i], s[OUT + B + i], s[OUT + 2 * B + i]
+        b0, b1, b2 = s[OUT + 3 * B + i], s[OUT + 4 * B + i], s[OUT + 5 * B + i]
+        c0, c1, c2 = s[OUT + 6 * B + i], s[OUT + 7 * B + i], s[OUT + 8 * B + i]
+        d0, d1, d2 = s[OUT + 9 * B + i], s[OUT + 10 * B + i], s[OUT + 11 * B + i]
+        out[n0, 0] += a0
+        out[n0, 1] += a1
+        out[n0, 2] += a2
+        out[n1, 0] += b0
+        out[n1, 1] += b1
+        out[n1, 2] += b2
+        out[n2, 0] += c0
+        out[n2, 1] += c1
+        out[n2, 2] += c2
+        out[n3, 0] += d0
+        out[n3, 1] += d1
+        out[n3, 2] += d2
 
 
 @njit(**OPTIONS)
-def put(ft, flat, blk, first, stop, s):
-    """The block's corner forces into ft (m, 4, 3) and its flags into flat, for the
-    tetrahedra of the block in [first, stop); returns how many are flattened."""
-    n_flat = 0
-    for t in range(max(first, blk * B), min(stop, blk * B + B)):
-        i = t - blk * B
+def scatter_routed(out, tb, blk, m, s, route, buf):
+    """scatter for one thread's share of the blocks: a corner whose slot has a route r >= 0
+    (its node is also touched by an earlier share) is stored into buf[r], to be added after
+    the earlier shares in the serial order; the others are added into out."""
+    base = blk * 4 * B
+    for i in range(min(B, m - blk * B)):
         for c in range(4):
-            for k in range(3):
-                ft[t, c, k] = s[OUT + (3 * c + k) * B + i]
-        if s[FLAG + i] <= 0.0:
-            flat[t] = 1
-            n_flat += 1
-    return n_flat
+            slot = base + c * B + i
+            n, r = tb[slot], route[slot]
+            f0, f1, f2 = s[OUT + (3 * c) * B + i], s[OUT + (3 * c + 1) * B + i], \
+                s[OUT + (3 * c + 2) * B + i]
+            if r < 0:
+                out[n, 0] += f0
+                out[n, 1] += f1
+                out[n, 2] += f2
+            else:
+                buf[r, 0], buf[r, 1], buf[r, 2] = f0, f1, f2
 
 
 @njit(**OPTIONS)

@@ -60,14 +60,6 @@ def add_to(out, n, f):
     out[n, 2] += f[2]
 
 
-@njit(cache=True, inline="always")
-def put(ft, t, i, f):
-    """ft[t, i] = f."""
-    ft[t, i, 0] = f[0]
-    ft[t, i, 1] = f[1]
-    ft[t, i, 2] = f[2]
-
-
 def volume_gradient_numpy(x, tets):
     """Vectorised signed volumes (m,) and dV/dx (m, 4, 3)."""
     x0, x1, x2, x3 = (x[tets[:, i]] for i in range(4))
@@ -118,19 +110,6 @@ def add_piola_forces(P, Dinv, vol0, tets, t, out):
         add_to(out, tets[t, c + 1], f)
         f0 = sub(f0, f)
     add_to(out, tets[t, 0], f0)
-
-
-@njit(cache=True, inline="always")
-def put_piola_forces(P, Dinv, vol0, t, ft):
-    """:func:`add_piola_forces`'s four corner forces of tetrahedron t stored into ft[t]
-    (m, 4, 3) instead of added into the nodes: the same values, bit for bit."""
-    f0 = (0.0, 0.0, 0.0)
-    for c in range(3):
-        r = vec(Dinv[t], c)
-        f = (-vol0[t] * dot(P[0], r), -vol0[t] * dot(P[1], r), -vol0[t] * dot(P[2], r))
-        ft[t, c + 1, 0], ft[t, c + 1, 1], ft[t, c + 1, 2] = f
-        f0 = sub(f0, f)
-    ft[t, 0, 0], ft[t, 0, 1], ft[t, 0, 2] = f0
 
 
 def deformation_gradients_numpy(x, tets, Dinv):

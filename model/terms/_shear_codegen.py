@@ -10,7 +10,7 @@ tests/test_terms.py fails while the generated file is stale (and its changed tex
 recompile the cached kernels).
 
 The force kernels run over blocks of tetrahedra (``_blocks.py``): ``blocked`` writes each
-reading's block function, its serial driver and its two-thread twin; ``reference`` writes the
+reading's block function, its serial driver and its threaded twin; ``reference`` writes the
 same maths tetrahedron by tetrahedron as ``*_reference``, the kernels the tests hold them to.
 
 Notation of the generated code, for the tetrahedron's corners 0..3:
@@ -89,10 +89,11 @@ def edge_forces(coef):
 
 FLATTENED = "V6 <= FLAT * 6.0 * vol0[t]"
 # what the serial and the per-tetrahedron (threaded) variants do at these two places
-FLATTENED_ACTION, SCATTER = "@flattened@", "@scatter@"
+FLATTENED_ACTION, SCATTER, VOLUME = "@flattened@", "@scatter@", "@volume@"
 INVERSE_LENGTH, FACE_NORM = "@inverse_length@", "@face_norm@"
 SERIAL = {**{f"{FACE_NORM}{j}": [f"cn{j} = np.sqrt(dot(c{j}, c{j}))"] for j in range(4)},
           FLATTENED_ACTION: ["    return t"],
+          VOLUME: [],
           SCATTER: [f"add_to(out, n{i}, f{i})" for i in range(4)],
           **{f"{INVERSE_LENGTH}{p}{q}": [f"iL{p}{q} = 1.0 / np.sqrt(l{p}{q})"] for p, q in PAIRS}}
 # in a block (model/terms/_blocks.py): the corners from the scratch array, the flattening
@@ -100,10 +101,15 @@ SERIAL = {**{f"{FACE_NORM}{j}": [f"cn{j} = np.sqrt(dot(c{j}, c{j}))"] for j in r
 BLOCK = {"n0, n1, n2, n3 = tets[t, 0], tets[t, 1], tets[t, 2], tets[t, 3]": [],
          "x0, x1, x2, x3 = vec(x, n0), vec(x, n1), vec(x, n2), vec(x, n3)":
          [f"x{c} = (s[{3 * c} * B + i], s[{3 * c + 1} * B + i], s[{3 * c + 2} * B + i])"
-          for c in range(4)],
+          for c in range(4)] + ["@rest_frame@"],
          f"if {FLATTENED}:": ["margin = V6 - FLAT * 6.0 * vol0[t]", "s[FLAG + i] = margin",
                               "n_flat += margin <= 0.0"],
          FLATTENED_ACTION: [],
+         # the volume term's pressure forces p dV/dx_j = p c_j / 6, p = -K (V - V0) / V, in
+         # the same pass (K = 0 where the model has no volume term): c_j and 6V are the
+         # shear's own, and a second gather and scatter is saved
+         VOLUME: ["p6 = K6 * (V6 - 6.0 * vol0[t]) * iV6"]
+         + [f"f{j} = axpy(p6, c{j}, f{j})" for j in range(4)],
          SCATTER: [f"s[OUT + {3 * c + k} * B + i] = f{c}[{k}]"
                    for c in range(4) for k in range(3)],
          **{f"{INVERSE_LENGTH}{p}{q}": [f"iL{p}{q} = rsqrt(l{p}{q})"] for p, q in PAIRS},
@@ -123,7 +129,7 @@ def corner():
             "Literal eq. 5: f_a += (1/4) tau S_F e, tau = G gamma, S_F = cn_j / 2, "
             "e = d_am / L_am; returns the first flattened tetrahedron, or -1.",
             ["G8 = 0.125 * G"], frame(FLATTENED) + init + body
-            + edge_forces(lambda p, q: f"K{p}{q}") + [SCATTER])
+            + edge_forces(lambda p, q: f"K{p}{q}") + [VOLUME, SCATTER])
 
 
 def balanced():
@@ -149,7 +155,7 @@ def balanced():
     return ("shear_balanced", "x, tets, vol0, gamma0, G, out",
             "f_j -= tau S_F e on the tip, + tau S_F e / 3 on each base vertex a, m, l; returns "
             "the first flattened tetrahedron, or -1.",
-            ["G2 = 0.5 * G"], frame(FLATTENED) + init + body + forces + [SCATTER])
+            ["G2 = 0.5 * G"], frame(FLATTENED) + init + body + forces + [VOLUME, SCATTER])
 
 
 def variational():
@@ -184,7 +190,7 @@ def variational():
     return ("shear_variational", "x, tets, vol0, gamma0, cG, out",
             "f = -dW/dx, W = (c/2) G V0 sum_s gamma_s^2 (cG = c G); returns the first "
             "flattened tetrahedron, or -1.",
-            [], frame(FLATTENED) + init + body + faces + forces + [SCATTER])
+            [], frame(FLATTENED) + init + body + faces + forces + [VOLUME, SCATTER])
 
 
 def expand(lines, variant):
@@ -201,21 +207,48 @@ def reference(name, args, doc, before, per_tet):
                             before, per_tet)
 
 
+def rest_frame():
+    """The rest shape's reciprocal lengths and reciprocal heights of one lane, from its six
+    rest squared lengths ``z01 .. z23`` (what a block streams instead of 24 rest strains: a
+    quarter of the bytes): 36 V0^2 is the Gram determinant of the edges at corner 0, and a
+    face's doubled area follows from its lengths, |u x w|^2 = |u|^2 |w|^2 - (u . w)^2."""
+    lines = [f"z{p}{q} = r0[{k} * B + i]" for k, (p, q) in enumerate(PAIRS)]
+    lines += [f"iZ{p}{q} = rsqrt(z{p}{q})" for p, q in PAIRS]
+    gram = {(p, q): f"0.5 * (z0{p} + z0{q} - z{p}{q})" for p, q in ((1, 2), (1, 3), (2, 3))}
+    lines += [f"G{p}{q} = {g}" for (p, q), g in gram.items()]
+    lines += ["Vz = z01 * (z02 * z03 - G23 * G23) - G12 * (G12 * z03 - G23 * G13)"
+              " + G13 * (G12 * G23 - z02 * G13)", "iVz6 = rsqrt(Vz)"]
+    for j in range(4):
+        a, m, l = FACE[j]
+        lines += [f"Ez = 0.5 * (z{e(a, m)} + z{e(a, l)} - z{e(m, l)})",
+                  f"ccz{j} = z{e(a, m)} * z{e(a, l)} - Ez * Ez",
+                  f"hz{j} = ccz{j} * rsqrt(ccz{j}) * iVz6"]
+    return lines
+
+
+def rest_strain(s):
+    """gamma0 of combination s from the lane's rest frame (:func:`rest_frame`)."""
+    a, j, m, _ = COMBOS[int(s)]
+    return (f"0.5 * (z{e(a, j)} + z{e(a, m)} - z{e(j, m)}) * iZ{e(a, m)} * hz{j}")
+
+
 def in_block(line):
     """A line of the per-tetrahedron maths as it reads lane i of block blk (_blocks.py)."""
-    line = re.sub(r"gamma0\[t, (\d+)\]", r"g0[\1 * B + i]", line)
+    line = re.sub(r"gamma0\[t, (\d+)\]", lambda g: f"({rest_strain(g.group(1))})", line)
     return line.replace("vol0[t]", "v0[i]")
 
 
 def blocked(name, args, doc, before, per_tet):
     """The kernel ``name`` over blocks of tetrahedra (model/terms/_blocks.py): ``name_block``
-    computes one block's lanes (what the compiler vectorises), ``name`` gathers, computes and
-    adds into ``out`` block by block, and ``name_tets`` is its twin for the two-thread mode
-    (the blocks holding the tetrahedra [first, stop) into ft (m, 4, 3), flattened ones flagged
-    in ``flat``; it returns their count). Per-tetrahedron data are in the blocked layout."""
+    computes one block's lanes (what the compiler vectorises), with the volume term's forces
+    for its factor ``K`` (0: none), ``name`` gathers, computes and adds into ``out`` block by
+    block, and ``name_range`` is its twin for the threaded mode (the blocks [first, stop),
+    scattered with ``scatter_routed``; model.terms._threads.SplitBlocks). Per-tetrahedron
+    data are in the blocked layout."""
     pad = " " * 8
-    data = args[len("x, tets, "):-len(", out")]
-    lane = [in_block(x) for x in expand(per_tet, BLOCK)]
+    # the block streams the rest squared lengths (m, 6) in place of gamma0 (m, 24)
+    data = args[len("x, tets, "):-len(", out")].replace("gamma0", "rest") + ", K"
+    lane = [in_block(x) for x in expand(expand(per_tet, BLOCK), {"@rest_frame@": rest_frame()})]
     compute = "\n".join(
         ["", "", "", "@njit(**OPTIONS)", f"def {name}_block(s, blk, {data}):",
          f'    """{name} on the lanes of block blk: positions from s, forces and flattening '
@@ -223,12 +256,12 @@ def blocked(name, args, doc, before, per_tet):
         + [f"    {line}" for line in before]
         # the block's own slices: an index the compiler sees is never negative (so no
         # wraparound select, and SIMD loads rather than gathers)
-        + ["    g0 = gamma0[blk * 24 * B:(blk + 1) * 24 * B]",
+        + ["    K6 = -K / 6.0", "    r0 = rest[blk * 6 * B:(blk + 1) * 6 * B]",
            "    v0 = vol0[blk * B:(blk + 1) * B]", "    n_flat = 0", "    for i in range(B):"]
         + [pad + x for x in lane] + ["    return n_flat"])
     serial = "\n".join(
         ["", "", "", "@njit(**OPTIONS)", f"def {name}(x, tb, m, {data}, out):",
-         f'    """{doc}"""',
+         f'    """{doc} With the volume term\'s forces for K > 0."""',
          "    s = np.empty(SCRATCH)",
          "    for blk in range((m + B - 1) // B):",
          "        gather(x, tb, blk, s)",
@@ -238,16 +271,19 @@ def blocked(name, args, doc, before, per_tet):
          "    return -1"])
     twin = "\n".join(
         ["", "", "", "@njit(**OPTIONS)",
-         f"def {name}_tets(x, tb, m, {data}, ft, flat, first, stop):",
-         f'    """{name} for the tetrahedra [first, stop) into ft (m, 4, 3); flattened ones '
-         'flagged in flat."""',
+         f"def {name}_range(x, tb, m, {data}, first, stop, late, route, buf, out):",
+         f'    """{name} over the blocks [first, stop), the forces of routed corners into '
+         'buf."""',
          "    s = np.empty(SCRATCH)",
-         "    n_flat = 0",
-         "    for blk in range(first // B, (stop + B - 1) // B):",
+         "    for blk in range(first, stop):",
          "        gather(x, tb, blk, s)",
-         f"        {name}_block(s, blk, {data})",
-         "        n_flat += put(ft, flat, blk, first, stop, s)",
-         "    return n_flat"])
+         f"        if {name}_block(s, blk, {data}) > 0:",
+         "            return first_flat(s, blk, m)",
+         "        if late[blk]:",
+         "            scatter_routed(out, tb, blk, m, s, route, buf)",
+         "        else:",
+         "            scatter(out, tb, blk, m, s)",
+         "    return -1"])
     return compute + serial + twin
 
 
@@ -271,8 +307,8 @@ def source():
             "", "Each reading's derivation is in the docstring of its writer there.", "",
             f"_kernels.py sha256 {helpers}", f"_blocks.py sha256 {blocks}", '"""',
             "import numpy as np", "from numba import njit", "",
-            "from ._blocks import (B, FLAG, OPTIONS, OUT, SCRATCH, first_flat, gather, put,",
-            "                      rsqrt, scatter)",
+            "from ._blocks import (B, FLAG, OPTIONS, OUT, SCRATCH, first_flat, gather, rsqrt,",
+            "                      scatter, scatter_routed)",
             "from ._kernels import add_to, axpy, cross, dot, lin, sub, vec",
             "from .volume import FLAT", "",
             "# fast maths without reassociation: the serial and the per-tetrahedron twins then",

@@ -2,14 +2,14 @@
 
 Each reading's derivation is in the docstring of its writer there.
 
-_kernels.py sha256 8257983fdd878c7c
-_blocks.py sha256 a0a01f096ad04838
+_kernels.py sha256 2590f8733ea1afed
+_blocks.py sha256 f2e63b50a33c0609
 """
 import numpy as np
 from numba import njit
 
-from ._blocks import (B, FLAG, OPTIONS, OUT, SCRATCH, first_flat, gather, put,
-                      rsqrt, scatter)
+from ._blocks import (B, FLAG, OPTIONS, OUT, SCRATCH, first_flat, gather, rsqrt,
+                      scatter, scatter_routed)
 from ._kernels import add_to, axpy, cross, dot, lin, sub, vec
 from .volume import FLAT
 
@@ -158,10 +158,11 @@ def shear_strains(x, tets, gamma0, gamma_out):
 
 
 @njit(**OPTIONS)
-def shear_corner_block(s, blk, vol0, gamma0, G):
+def shear_corner_block(s, blk, vol0, rest, G, K):
     """shear_corner on the lanes of block blk: positions from s, forces and flattening margins into s; returns the count of flattened lanes."""
     G8 = 0.125 * G
-    g0 = gamma0[blk * 24 * B:(blk + 1) * 24 * B]
+    K6 = -K / 6.0
+    r0 = rest[blk * 6 * B:(blk + 1) * 6 * B]
     v0 = vol0[blk * B:(blk + 1) * B]
     n_flat = 0
     for i in range(B):
@@ -169,6 +170,35 @@ def shear_corner_block(s, blk, vol0, gamma0, G):
         x1 = (s[3 * B + i], s[4 * B + i], s[5 * B + i])
         x2 = (s[6 * B + i], s[7 * B + i], s[8 * B + i])
         x3 = (s[9 * B + i], s[10 * B + i], s[11 * B + i])
+        z01 = r0[0 * B + i]
+        z02 = r0[1 * B + i]
+        z03 = r0[2 * B + i]
+        z12 = r0[3 * B + i]
+        z13 = r0[4 * B + i]
+        z23 = r0[5 * B + i]
+        iZ01 = rsqrt(z01)
+        iZ02 = rsqrt(z02)
+        iZ03 = rsqrt(z03)
+        iZ12 = rsqrt(z12)
+        iZ13 = rsqrt(z13)
+        iZ23 = rsqrt(z23)
+        G12 = 0.5 * (z01 + z02 - z12)
+        G13 = 0.5 * (z01 + z03 - z13)
+        G23 = 0.5 * (z02 + z03 - z23)
+        Vz = z01 * (z02 * z03 - G23 * G23) - G12 * (G12 * z03 - G23 * G13) + G13 * (G12 * G23 - z02 * G13)
+        iVz6 = rsqrt(Vz)
+        Ez = 0.5 * (z13 + z12 - z23)
+        ccz0 = z13 * z12 - Ez * Ez
+        hz0 = ccz0 * rsqrt(ccz0) * iVz6
+        Ez = 0.5 * (z02 + z03 - z23)
+        ccz1 = z02 * z03 - Ez * Ez
+        hz1 = ccz1 * rsqrt(ccz1) * iVz6
+        Ez = 0.5 * (z03 + z01 - z13)
+        ccz2 = z03 * z01 - Ez * Ez
+        hz2 = ccz2 * rsqrt(ccz2) * iVz6
+        Ez = 0.5 * (z01 + z02 - z12)
+        ccz3 = z01 * z02 - Ez * Ez
+        hz3 = ccz3 * rsqrt(ccz3) * iVz6
         d01 = sub(x1, x0)
         l01 = dot(d01, d01)
         iL01 = rsqrt(l01)
@@ -222,99 +252,99 @@ def shear_corner_block(s, blk, vol0, gamma0, G):
         K32 = 0.0
         # combination 0: corner 0, tip 1, edge 0 -> 2
         D = 0.5 * (l01 + l02 - l12)
-        gamma = D * iL02 * h1 - g0[0 * B + i]
+        gamma = D * iL02 * h1 - (0.5 * (z01 + z02 - z12) * iZ02 * hz1)
         K02 += G8 * gamma * cn1 * iL02
         # combination 1: corner 0, tip 1, edge 0 -> 3
         D = 0.5 * (l01 + l03 - l13)
-        gamma = D * iL03 * h1 - g0[1 * B + i]
+        gamma = D * iL03 * h1 - (0.5 * (z01 + z03 - z13) * iZ03 * hz1)
         K03 += G8 * gamma * cn1 * iL03
         # combination 2: corner 0, tip 2, edge 0 -> 1
         D = 0.5 * (l02 + l01 - l12)
-        gamma = D * iL01 * h2 - g0[2 * B + i]
+        gamma = D * iL01 * h2 - (0.5 * (z02 + z01 - z12) * iZ01 * hz2)
         K01 += G8 * gamma * cn2 * iL01
         # combination 3: corner 0, tip 2, edge 0 -> 3
         D = 0.5 * (l02 + l03 - l23)
-        gamma = D * iL03 * h2 - g0[3 * B + i]
+        gamma = D * iL03 * h2 - (0.5 * (z02 + z03 - z23) * iZ03 * hz2)
         K03 += G8 * gamma * cn2 * iL03
         # combination 4: corner 0, tip 3, edge 0 -> 1
         D = 0.5 * (l03 + l01 - l13)
-        gamma = D * iL01 * h3 - g0[4 * B + i]
+        gamma = D * iL01 * h3 - (0.5 * (z03 + z01 - z13) * iZ01 * hz3)
         K01 += G8 * gamma * cn3 * iL01
         # combination 5: corner 0, tip 3, edge 0 -> 2
         D = 0.5 * (l03 + l02 - l23)
-        gamma = D * iL02 * h3 - g0[5 * B + i]
+        gamma = D * iL02 * h3 - (0.5 * (z03 + z02 - z23) * iZ02 * hz3)
         K02 += G8 * gamma * cn3 * iL02
         # combination 6: corner 1, tip 0, edge 1 -> 2
         D = 0.5 * (l01 + l12 - l02)
-        gamma = D * iL12 * h0 - g0[6 * B + i]
+        gamma = D * iL12 * h0 - (0.5 * (z01 + z12 - z02) * iZ12 * hz0)
         K12 += G8 * gamma * cn0 * iL12
         # combination 7: corner 1, tip 0, edge 1 -> 3
         D = 0.5 * (l01 + l13 - l03)
-        gamma = D * iL13 * h0 - g0[7 * B + i]
+        gamma = D * iL13 * h0 - (0.5 * (z01 + z13 - z03) * iZ13 * hz0)
         K13 += G8 * gamma * cn0 * iL13
         # combination 8: corner 1, tip 2, edge 1 -> 0
         D = 0.5 * (l12 + l01 - l02)
-        gamma = D * iL01 * h2 - g0[8 * B + i]
+        gamma = D * iL01 * h2 - (0.5 * (z12 + z01 - z02) * iZ01 * hz2)
         K10 += G8 * gamma * cn2 * iL01
         # combination 9: corner 1, tip 2, edge 1 -> 3
         D = 0.5 * (l12 + l13 - l23)
-        gamma = D * iL13 * h2 - g0[9 * B + i]
+        gamma = D * iL13 * h2 - (0.5 * (z12 + z13 - z23) * iZ13 * hz2)
         K13 += G8 * gamma * cn2 * iL13
         # combination 10: corner 1, tip 3, edge 1 -> 0
         D = 0.5 * (l13 + l01 - l03)
-        gamma = D * iL01 * h3 - g0[10 * B + i]
+        gamma = D * iL01 * h3 - (0.5 * (z13 + z01 - z03) * iZ01 * hz3)
         K10 += G8 * gamma * cn3 * iL01
         # combination 11: corner 1, tip 3, edge 1 -> 2
         D = 0.5 * (l13 + l12 - l23)
-        gamma = D * iL12 * h3 - g0[11 * B + i]
+        gamma = D * iL12 * h3 - (0.5 * (z13 + z12 - z23) * iZ12 * hz3)
         K12 += G8 * gamma * cn3 * iL12
         # combination 12: corner 2, tip 0, edge 2 -> 1
         D = 0.5 * (l02 + l12 - l01)
-        gamma = D * iL12 * h0 - g0[12 * B + i]
+        gamma = D * iL12 * h0 - (0.5 * (z02 + z12 - z01) * iZ12 * hz0)
         K21 += G8 * gamma * cn0 * iL12
         # combination 13: corner 2, tip 0, edge 2 -> 3
         D = 0.5 * (l02 + l23 - l03)
-        gamma = D * iL23 * h0 - g0[13 * B + i]
+        gamma = D * iL23 * h0 - (0.5 * (z02 + z23 - z03) * iZ23 * hz0)
         K23 += G8 * gamma * cn0 * iL23
         # combination 14: corner 2, tip 1, edge 2 -> 0
         D = 0.5 * (l12 + l02 - l01)
-        gamma = D * iL02 * h1 - g0[14 * B + i]
+        gamma = D * iL02 * h1 - (0.5 * (z12 + z02 - z01) * iZ02 * hz1)
         K20 += G8 * gamma * cn1 * iL02
         # combination 15: corner 2, tip 1, edge 2 -> 3
         D = 0.5 * (l12 + l23 - l13)
-        gamma = D * iL23 * h1 - g0[15 * B + i]
+        gamma = D * iL23 * h1 - (0.5 * (z12 + z23 - z13) * iZ23 * hz1)
         K23 += G8 * gamma * cn1 * iL23
         # combination 16: corner 2, tip 3, edge 2 -> 0
         D = 0.5 * (l23 + l02 - l03)
-        gamma = D * iL02 * h3 - g0[16 * B + i]
+        gamma = D * iL02 * h3 - (0.5 * (z23 + z02 - z03) * iZ02 * hz3)
         K20 += G8 * gamma * cn3 * iL02
         # combination 17: corner 2, tip 3, edge 2 -> 1
         D = 0.5 * (l23 + l12 - l13)
-        gamma = D * iL12 * h3 - g0[17 * B + i]
+        gamma = D * iL12 * h3 - (0.5 * (z23 + z12 - z13) * iZ12 * hz3)
         K21 += G8 * gamma * cn3 * iL12
         # combination 18: corner 3, tip 0, edge 3 -> 1
         D = 0.5 * (l03 + l13 - l01)
-        gamma = D * iL13 * h0 - g0[18 * B + i]
+        gamma = D * iL13 * h0 - (0.5 * (z03 + z13 - z01) * iZ13 * hz0)
         K31 += G8 * gamma * cn0 * iL13
         # combination 19: corner 3, tip 0, edge 3 -> 2
         D = 0.5 * (l03 + l23 - l02)
-        gamma = D * iL23 * h0 - g0[19 * B + i]
+        gamma = D * iL23 * h0 - (0.5 * (z03 + z23 - z02) * iZ23 * hz0)
         K32 += G8 * gamma * cn0 * iL23
         # combination 20: corner 3, tip 1, edge 3 -> 0
         D = 0.5 * (l13 + l03 - l01)
-        gamma = D * iL03 * h1 - g0[20 * B + i]
+        gamma = D * iL03 * h1 - (0.5 * (z13 + z03 - z01) * iZ03 * hz1)
         K30 += G8 * gamma * cn1 * iL03
         # combination 21: corner 3, tip 1, edge 3 -> 2
         D = 0.5 * (l13 + l23 - l12)
-        gamma = D * iL23 * h1 - g0[21 * B + i]
+        gamma = D * iL23 * h1 - (0.5 * (z13 + z23 - z12) * iZ23 * hz1)
         K32 += G8 * gamma * cn1 * iL23
         # combination 22: corner 3, tip 2, edge 3 -> 0
         D = 0.5 * (l23 + l03 - l02)
-        gamma = D * iL03 * h2 - g0[22 * B + i]
+        gamma = D * iL03 * h2 - (0.5 * (z23 + z03 - z02) * iZ03 * hz2)
         K30 += G8 * gamma * cn2 * iL03
         # combination 23: corner 3, tip 2, edge 3 -> 1
         D = 0.5 * (l23 + l13 - l12)
-        gamma = D * iL13 * h2 - g0[23 * B + i]
+        gamma = D * iL13 * h2 - (0.5 * (z23 + z13 - z12) * iZ13 * hz2)
         K31 += G8 * gamma * cn2 * iL13
         f0 = (0.0, 0.0, 0.0)
         f1 = (0.0, 0.0, 0.0)
@@ -332,6 +362,11 @@ def shear_corner_block(s, blk, vol0, gamma0, G):
         f3 = axpy(-(K31), d13, f3)
         f2 = axpy(K23, d23, f2)
         f3 = axpy(-(K32), d23, f3)
+        p6 = K6 * (V6 - 6.0 * v0[i]) * iV6
+        f0 = axpy(p6, c0, f0)
+        f1 = axpy(p6, c1, f1)
+        f2 = axpy(p6, c2, f2)
+        f3 = axpy(p6, c3, f3)
         s[OUT + 0 * B + i] = f0[0]
         s[OUT + 1 * B + i] = f0[1]
         s[OUT + 2 * B + i] = f0[2]
@@ -348,34 +383,38 @@ def shear_corner_block(s, blk, vol0, gamma0, G):
 
 
 @njit(**OPTIONS)
-def shear_corner(x, tb, m, vol0, gamma0, G, out):
-    """Literal eq. 5: f_a += (1/4) tau S_F e, tau = G gamma, S_F = cn_j / 2, e = d_am / L_am; returns the first flattened tetrahedron, or -1."""
+def shear_corner(x, tb, m, vol0, rest, G, K, out):
+    """Literal eq. 5: f_a += (1/4) tau S_F e, tau = G gamma, S_F = cn_j / 2, e = d_am / L_am; returns the first flattened tetrahedron, or -1. With the volume term's forces for K > 0."""
     s = np.empty(SCRATCH)
     for blk in range((m + B - 1) // B):
         gather(x, tb, blk, s)
-        if shear_corner_block(s, blk, vol0, gamma0, G) > 0:
+        if shear_corner_block(s, blk, vol0, rest, G, K) > 0:
             return first_flat(s, blk, m)
         scatter(out, tb, blk, m, s)
     return -1
 
 
 @njit(**OPTIONS)
-def shear_corner_tets(x, tb, m, vol0, gamma0, G, ft, flat, first, stop):
-    """shear_corner for the tetrahedra [first, stop) into ft (m, 4, 3); flattened ones flagged in flat."""
+def shear_corner_range(x, tb, m, vol0, rest, G, K, first, stop, late, route, buf, out):
+    """shear_corner over the blocks [first, stop), the forces of routed corners into buf."""
     s = np.empty(SCRATCH)
-    n_flat = 0
-    for blk in range(first // B, (stop + B - 1) // B):
+    for blk in range(first, stop):
         gather(x, tb, blk, s)
-        shear_corner_block(s, blk, vol0, gamma0, G)
-        n_flat += put(ft, flat, blk, first, stop, s)
-    return n_flat
+        if shear_corner_block(s, blk, vol0, rest, G, K) > 0:
+            return first_flat(s, blk, m)
+        if late[blk]:
+            scatter_routed(out, tb, blk, m, s, route, buf)
+        else:
+            scatter(out, tb, blk, m, s)
+    return -1
 
 
 @njit(**OPTIONS)
-def shear_balanced_block(s, blk, vol0, gamma0, G):
+def shear_balanced_block(s, blk, vol0, rest, G, K):
     """shear_balanced on the lanes of block blk: positions from s, forces and flattening margins into s; returns the count of flattened lanes."""
     G2 = 0.5 * G
-    g0 = gamma0[blk * 24 * B:(blk + 1) * 24 * B]
+    K6 = -K / 6.0
+    r0 = rest[blk * 6 * B:(blk + 1) * 6 * B]
     v0 = vol0[blk * B:(blk + 1) * B]
     n_flat = 0
     for i in range(B):
@@ -383,6 +422,35 @@ def shear_balanced_block(s, blk, vol0, gamma0, G):
         x1 = (s[3 * B + i], s[4 * B + i], s[5 * B + i])
         x2 = (s[6 * B + i], s[7 * B + i], s[8 * B + i])
         x3 = (s[9 * B + i], s[10 * B + i], s[11 * B + i])
+        z01 = r0[0 * B + i]
+        z02 = r0[1 * B + i]
+        z03 = r0[2 * B + i]
+        z12 = r0[3 * B + i]
+        z13 = r0[4 * B + i]
+        z23 = r0[5 * B + i]
+        iZ01 = rsqrt(z01)
+        iZ02 = rsqrt(z02)
+        iZ03 = rsqrt(z03)
+        iZ12 = rsqrt(z12)
+        iZ13 = rsqrt(z13)
+        iZ23 = rsqrt(z23)
+        G12 = 0.5 * (z01 + z02 - z12)
+        G13 = 0.5 * (z01 + z03 - z13)
+        G23 = 0.5 * (z02 + z03 - z23)
+        Vz = z01 * (z02 * z03 - G23 * G23) - G12 * (G12 * z03 - G23 * G13) + G13 * (G12 * G23 - z02 * G13)
+        iVz6 = rsqrt(Vz)
+        Ez = 0.5 * (z13 + z12 - z23)
+        ccz0 = z13 * z12 - Ez * Ez
+        hz0 = ccz0 * rsqrt(ccz0) * iVz6
+        Ez = 0.5 * (z02 + z03 - z23)
+        ccz1 = z02 * z03 - Ez * Ez
+        hz1 = ccz1 * rsqrt(ccz1) * iVz6
+        Ez = 0.5 * (z03 + z01 - z13)
+        ccz2 = z03 * z01 - Ez * Ez
+        hz2 = ccz2 * rsqrt(ccz2) * iVz6
+        Ez = 0.5 * (z01 + z02 - z12)
+        ccz3 = z01 * z02 - Ez * Ez
+        hz3 = ccz3 * rsqrt(ccz3) * iVz6
         d01 = sub(x1, x0)
         l01 = dot(d01, d01)
         iL01 = rsqrt(l01)
@@ -436,99 +504,99 @@ def shear_balanced_block(s, blk, vol0, gamma0, G):
         B3_12 = 0.0
         # combination 0: corner 0, tip 1, edge 0 -> 2
         D = 0.5 * (l01 + l02 - l12)
-        gamma = D * iL02 * h1 - g0[0 * B + i]
+        gamma = D * iL02 * h1 - (0.5 * (z01 + z02 - z12) * iZ02 * hz1)
         B1_02 += G2 * gamma * cn1 * iL02
         # combination 1: corner 0, tip 1, edge 0 -> 3
         D = 0.5 * (l01 + l03 - l13)
-        gamma = D * iL03 * h1 - g0[1 * B + i]
+        gamma = D * iL03 * h1 - (0.5 * (z01 + z03 - z13) * iZ03 * hz1)
         B1_03 += G2 * gamma * cn1 * iL03
         # combination 2: corner 0, tip 2, edge 0 -> 1
         D = 0.5 * (l02 + l01 - l12)
-        gamma = D * iL01 * h2 - g0[2 * B + i]
+        gamma = D * iL01 * h2 - (0.5 * (z02 + z01 - z12) * iZ01 * hz2)
         B2_01 += G2 * gamma * cn2 * iL01
         # combination 3: corner 0, tip 2, edge 0 -> 3
         D = 0.5 * (l02 + l03 - l23)
-        gamma = D * iL03 * h2 - g0[3 * B + i]
+        gamma = D * iL03 * h2 - (0.5 * (z02 + z03 - z23) * iZ03 * hz2)
         B2_03 += G2 * gamma * cn2 * iL03
         # combination 4: corner 0, tip 3, edge 0 -> 1
         D = 0.5 * (l03 + l01 - l13)
-        gamma = D * iL01 * h3 - g0[4 * B + i]
+        gamma = D * iL01 * h3 - (0.5 * (z03 + z01 - z13) * iZ01 * hz3)
         B3_01 += G2 * gamma * cn3 * iL01
         # combination 5: corner 0, tip 3, edge 0 -> 2
         D = 0.5 * (l03 + l02 - l23)
-        gamma = D * iL02 * h3 - g0[5 * B + i]
+        gamma = D * iL02 * h3 - (0.5 * (z03 + z02 - z23) * iZ02 * hz3)
         B3_02 += G2 * gamma * cn3 * iL02
         # combination 6: corner 1, tip 0, edge 1 -> 2
         D = 0.5 * (l01 + l12 - l02)
-        gamma = D * iL12 * h0 - g0[6 * B + i]
+        gamma = D * iL12 * h0 - (0.5 * (z01 + z12 - z02) * iZ12 * hz0)
         B0_12 += G2 * gamma * cn0 * iL12
         # combination 7: corner 1, tip 0, edge 1 -> 3
         D = 0.5 * (l01 + l13 - l03)
-        gamma = D * iL13 * h0 - g0[7 * B + i]
+        gamma = D * iL13 * h0 - (0.5 * (z01 + z13 - z03) * iZ13 * hz0)
         B0_13 += G2 * gamma * cn0 * iL13
         # combination 8: corner 1, tip 2, edge 1 -> 0
         D = 0.5 * (l12 + l01 - l02)
-        gamma = D * iL01 * h2 - g0[8 * B + i]
+        gamma = D * iL01 * h2 - (0.5 * (z12 + z01 - z02) * iZ01 * hz2)
         B2_01 -= G2 * gamma * cn2 * iL01
         # combination 9: corner 1, tip 2, edge 1 -> 3
         D = 0.5 * (l12 + l13 - l23)
-        gamma = D * iL13 * h2 - g0[9 * B + i]
+        gamma = D * iL13 * h2 - (0.5 * (z12 + z13 - z23) * iZ13 * hz2)
         B2_13 += G2 * gamma * cn2 * iL13
         # combination 10: corner 1, tip 3, edge 1 -> 0
         D = 0.5 * (l13 + l01 - l03)
-        gamma = D * iL01 * h3 - g0[10 * B + i]
+        gamma = D * iL01 * h3 - (0.5 * (z13 + z01 - z03) * iZ01 * hz3)
         B3_01 -= G2 * gamma * cn3 * iL01
         # combination 11: corner 1, tip 3, edge 1 -> 2
         D = 0.5 * (l13 + l12 - l23)
-        gamma = D * iL12 * h3 - g0[11 * B + i]
+        gamma = D * iL12 * h3 - (0.5 * (z13 + z12 - z23) * iZ12 * hz3)
         B3_12 += G2 * gamma * cn3 * iL12
         # combination 12: corner 2, tip 0, edge 2 -> 1
         D = 0.5 * (l02 + l12 - l01)
-        gamma = D * iL12 * h0 - g0[12 * B + i]
+        gamma = D * iL12 * h0 - (0.5 * (z02 + z12 - z01) * iZ12 * hz0)
         B0_12 -= G2 * gamma * cn0 * iL12
         # combination 13: corner 2, tip 0, edge 2 -> 3
         D = 0.5 * (l02 + l23 - l03)
-        gamma = D * iL23 * h0 - g0[13 * B + i]
+        gamma = D * iL23 * h0 - (0.5 * (z02 + z23 - z03) * iZ23 * hz0)
         B0_23 += G2 * gamma * cn0 * iL23
         # combination 14: corner 2, tip 1, edge 2 -> 0
         D = 0.5 * (l12 + l02 - l01)
-        gamma = D * iL02 * h1 - g0[14 * B + i]
+        gamma = D * iL02 * h1 - (0.5 * (z12 + z02 - z01) * iZ02 * hz1)
         B1_02 -= G2 * gamma * cn1 * iL02
         # combination 15: corner 2, tip 1, edge 2 -> 3
         D = 0.5 * (l12 + l23 - l13)
-        gamma = D * iL23 * h1 - g0[15 * B + i]
+        gamma = D * iL23 * h1 - (0.5 * (z12 + z23 - z13) * iZ23 * hz1)
         B1_23 += G2 * gamma * cn1 * iL23
         # combination 16: corner 2, tip 3, edge 2 -> 0
         D = 0.5 * (l23 + l02 - l03)
-        gamma = D * iL02 * h3 - g0[16 * B + i]
+        gamma = D * iL02 * h3 - (0.5 * (z23 + z02 - z03) * iZ02 * hz3)
         B3_02 -= G2 * gamma * cn3 * iL02
         # combination 17: corner 2, tip 3, edge 2 -> 1
         D = 0.5 * (l23 + l12 - l13)
-        gamma = D * iL12 * h3 - g0[17 * B + i]
+        gamma = D * iL12 * h3 - (0.5 * (z23 + z12 - z13) * iZ12 * hz3)
         B3_12 -= G2 * gamma * cn3 * iL12
         # combination 18: corner 3, tip 0, edge 3 -> 1
         D = 0.5 * (l03 + l13 - l01)
-        gamma = D * iL13 * h0 - g0[18 * B + i]
+        gamma = D * iL13 * h0 - (0.5 * (z03 + z13 - z01) * iZ13 * hz0)
         B0_13 -= G2 * gamma * cn0 * iL13
         # combination 19: corner 3, tip 0, edge 3 -> 2
         D = 0.5 * (l03 + l23 - l02)
-        gamma = D * iL23 * h0 - g0[19 * B + i]
+        gamma = D * iL23 * h0 - (0.5 * (z03 + z23 - z02) * iZ23 * hz0)
         B0_23 -= G2 * gamma * cn0 * iL23
         # combination 20: corner 3, tip 1, edge 3 -> 0
         D = 0.5 * (l13 + l03 - l01)
-        gamma = D * iL03 * h1 - g0[20 * B + i]
+        gamma = D * iL03 * h1 - (0.5 * (z13 + z03 - z01) * iZ03 * hz1)
         B1_03 -= G2 * gamma * cn1 * iL03
         # combination 21: corner 3, tip 1, edge 3 -> 2
         D = 0.5 * (l13 + l23 - l12)
-        gamma = D * iL23 * h1 - g0[21 * B + i]
+        gamma = D * iL23 * h1 - (0.5 * (z13 + z23 - z12) * iZ23 * hz1)
         B1_23 -= G2 * gamma * cn1 * iL23
         # combination 22: corner 3, tip 2, edge 3 -> 0
         D = 0.5 * (l23 + l03 - l02)
-        gamma = D * iL03 * h2 - g0[22 * B + i]
+        gamma = D * iL03 * h2 - (0.5 * (z23 + z03 - z02) * iZ03 * hz2)
         B2_03 -= G2 * gamma * cn2 * iL03
         # combination 23: corner 3, tip 2, edge 3 -> 1
         D = 0.5 * (l23 + l13 - l12)
-        gamma = D * iL13 * h2 - g0[23 * B + i]
+        gamma = D * iL13 * h2 - (0.5 * (z23 + z13 - z12) * iZ13 * hz2)
         B2_13 -= G2 * gamma * cn2 * iL13
         U0 = axpy(B0_23, d23, axpy(B0_13, d13, axpy(B0_12, d12, (0.0, 0.0, 0.0))))
         U1 = axpy(B1_23, d23, axpy(B1_03, d03, axpy(B1_02, d02, (0.0, 0.0, 0.0))))
@@ -539,6 +607,11 @@ def shear_balanced_block(s, blk, vol0, gamma0, G):
         f1 = lin(1.0 / 3.0, T, -4.0 / 3.0, U1)
         f2 = lin(1.0 / 3.0, T, -4.0 / 3.0, U2)
         f3 = lin(1.0 / 3.0, T, -4.0 / 3.0, U3)
+        p6 = K6 * (V6 - 6.0 * v0[i]) * iV6
+        f0 = axpy(p6, c0, f0)
+        f1 = axpy(p6, c1, f1)
+        f2 = axpy(p6, c2, f2)
+        f3 = axpy(p6, c3, f3)
         s[OUT + 0 * B + i] = f0[0]
         s[OUT + 1 * B + i] = f0[1]
         s[OUT + 2 * B + i] = f0[2]
@@ -555,33 +628,37 @@ def shear_balanced_block(s, blk, vol0, gamma0, G):
 
 
 @njit(**OPTIONS)
-def shear_balanced(x, tb, m, vol0, gamma0, G, out):
-    """f_j -= tau S_F e on the tip, + tau S_F e / 3 on each base vertex a, m, l; returns the first flattened tetrahedron, or -1."""
+def shear_balanced(x, tb, m, vol0, rest, G, K, out):
+    """f_j -= tau S_F e on the tip, + tau S_F e / 3 on each base vertex a, m, l; returns the first flattened tetrahedron, or -1. With the volume term's forces for K > 0."""
     s = np.empty(SCRATCH)
     for blk in range((m + B - 1) // B):
         gather(x, tb, blk, s)
-        if shear_balanced_block(s, blk, vol0, gamma0, G) > 0:
+        if shear_balanced_block(s, blk, vol0, rest, G, K) > 0:
             return first_flat(s, blk, m)
         scatter(out, tb, blk, m, s)
     return -1
 
 
 @njit(**OPTIONS)
-def shear_balanced_tets(x, tb, m, vol0, gamma0, G, ft, flat, first, stop):
-    """shear_balanced for the tetrahedra [first, stop) into ft (m, 4, 3); flattened ones flagged in flat."""
+def shear_balanced_range(x, tb, m, vol0, rest, G, K, first, stop, late, route, buf, out):
+    """shear_balanced over the blocks [first, stop), the forces of routed corners into buf."""
     s = np.empty(SCRATCH)
-    n_flat = 0
-    for blk in range(first // B, (stop + B - 1) // B):
+    for blk in range(first, stop):
         gather(x, tb, blk, s)
-        shear_balanced_block(s, blk, vol0, gamma0, G)
-        n_flat += put(ft, flat, blk, first, stop, s)
-    return n_flat
+        if shear_balanced_block(s, blk, vol0, rest, G, K) > 0:
+            return first_flat(s, blk, m)
+        if late[blk]:
+            scatter_routed(out, tb, blk, m, s, route, buf)
+        else:
+            scatter(out, tb, blk, m, s)
+    return -1
 
 
 @njit(**OPTIONS)
-def shear_variational_block(s, blk, vol0, gamma0, cG):
+def shear_variational_block(s, blk, vol0, rest, cG, K):
     """shear_variational on the lanes of block blk: positions from s, forces and flattening margins into s; returns the count of flattened lanes."""
-    g0 = gamma0[blk * 24 * B:(blk + 1) * 24 * B]
+    K6 = -K / 6.0
+    r0 = rest[blk * 6 * B:(blk + 1) * 6 * B]
     v0 = vol0[blk * B:(blk + 1) * B]
     n_flat = 0
     for i in range(B):
@@ -589,6 +666,35 @@ def shear_variational_block(s, blk, vol0, gamma0, cG):
         x1 = (s[3 * B + i], s[4 * B + i], s[5 * B + i])
         x2 = (s[6 * B + i], s[7 * B + i], s[8 * B + i])
         x3 = (s[9 * B + i], s[10 * B + i], s[11 * B + i])
+        z01 = r0[0 * B + i]
+        z02 = r0[1 * B + i]
+        z03 = r0[2 * B + i]
+        z12 = r0[3 * B + i]
+        z13 = r0[4 * B + i]
+        z23 = r0[5 * B + i]
+        iZ01 = rsqrt(z01)
+        iZ02 = rsqrt(z02)
+        iZ03 = rsqrt(z03)
+        iZ12 = rsqrt(z12)
+        iZ13 = rsqrt(z13)
+        iZ23 = rsqrt(z23)
+        G12 = 0.5 * (z01 + z02 - z12)
+        G13 = 0.5 * (z01 + z03 - z13)
+        G23 = 0.5 * (z02 + z03 - z23)
+        Vz = z01 * (z02 * z03 - G23 * G23) - G12 * (G12 * z03 - G23 * G13) + G13 * (G12 * G23 - z02 * G13)
+        iVz6 = rsqrt(Vz)
+        Ez = 0.5 * (z13 + z12 - z23)
+        ccz0 = z13 * z12 - Ez * Ez
+        hz0 = ccz0 * rsqrt(ccz0) * iVz6
+        Ez = 0.5 * (z02 + z03 - z23)
+        ccz1 = z02 * z03 - Ez * Ez
+        hz1 = ccz1 * rsqrt(ccz1) * iVz6
+        Ez = 0.5 * (z03 + z01 - z13)
+        ccz2 = z03 * z01 - Ez * Ez
+        hz2 = ccz2 * rsqrt(ccz2) * iVz6
+        Ez = 0.5 * (z01 + z02 - z12)
+        ccz3 = z01 * z02 - Ez * Ez
+        hz3 = ccz3 * rsqrt(ccz3) * iVz6
         d01 = sub(x1, x0)
         l01 = dot(d01, d01)
         iL01 = rsqrt(l01)
@@ -641,7 +747,7 @@ def shear_variational_block(s, blk, vol0, gamma0, cG):
         half = 0.5 * cG * v0[i]
         # combination 0: corner 0, tip 1, edge 0 -> 2
         D = 0.5 * (l01 + l02 - l12)
-        gamma = D * iL02 * h1 - g0[0 * B + i]
+        gamma = D * iL02 * h1 - (0.5 * (z01 + z02 - z12) * iZ02 * hz1)
         E = half * gamma * iL02 * h1
         P = E * D
         W01 += E
@@ -650,7 +756,7 @@ def shear_variational_block(s, blk, vol0, gamma0, cG):
         P1 += P
         # combination 1: corner 0, tip 1, edge 0 -> 3
         D = 0.5 * (l01 + l03 - l13)
-        gamma = D * iL03 * h1 - g0[1 * B + i]
+        gamma = D * iL03 * h1 - (0.5 * (z01 + z03 - z13) * iZ03 * hz1)
         E = half * gamma * iL03 * h1
         P = E * D
         W01 += E
@@ -659,7 +765,7 @@ def shear_variational_block(s, blk, vol0, gamma0, cG):
         P1 += P
         # combination 2: corner 0, tip 2, edge 0 -> 1
         D = 0.5 * (l02 + l01 - l12)
-        gamma = D * iL01 * h2 - g0[2 * B + i]
+        gamma = D * iL01 * h2 - (0.5 * (z02 + z01 - z12) * iZ01 * hz2)
         E = half * gamma * iL01 * h2
         P = E * D
         W02 += E
@@ -668,7 +774,7 @@ def shear_variational_block(s, blk, vol0, gamma0, cG):
         P2 += P
         # combination 3: corner 0, tip 2, edge 0 -> 3
         D = 0.5 * (l02 + l03 - l23)
-        gamma = D * iL03 * h2 - g0[3 * B + i]
+        gamma = D * iL03 * h2 - (0.5 * (z02 + z03 - z23) * iZ03 * hz2)
         E = half * gamma * iL03 * h2
         P = E * D
         W02 += E
@@ -677,7 +783,7 @@ def shear_variational_block(s, blk, vol0, gamma0, cG):
         P2 += P
         # combination 4: corner 0, tip 3, edge 0 -> 1
         D = 0.5 * (l03 + l01 - l13)
-        gamma = D * iL01 * h3 - g0[4 * B + i]
+        gamma = D * iL01 * h3 - (0.5 * (z03 + z01 - z13) * iZ01 * hz3)
         E = half * gamma * iL01 * h3
         P = E * D
         W03 += E
@@ -686,7 +792,7 @@ def shear_variational_block(s, blk, vol0, gamma0, cG):
         P3 += P
         # combination 5: corner 0, tip 3, edge 0 -> 2
         D = 0.5 * (l03 + l02 - l23)
-        gamma = D * iL02 * h3 - g0[5 * B + i]
+        gamma = D * iL02 * h3 - (0.5 * (z03 + z02 - z23) * iZ02 * hz3)
         E = half * gamma * iL02 * h3
         P = E * D
         W03 += E
@@ -695,7 +801,7 @@ def shear_variational_block(s, blk, vol0, gamma0, cG):
         P3 += P
         # combination 6: corner 1, tip 0, edge 1 -> 2
         D = 0.5 * (l01 + l12 - l02)
-        gamma = D * iL12 * h0 - g0[6 * B + i]
+        gamma = D * iL12 * h0 - (0.5 * (z01 + z12 - z02) * iZ12 * hz0)
         E = half * gamma * iL12 * h0
         P = E * D
         W01 += E
@@ -704,7 +810,7 @@ def shear_variational_block(s, blk, vol0, gamma0, cG):
         P0 += P
         # combination 7: corner 1, tip 0, edge 1 -> 3
         D = 0.5 * (l01 + l13 - l03)
-        gamma = D * iL13 * h0 - g0[7 * B + i]
+        gamma = D * iL13 * h0 - (0.5 * (z01 + z13 - z03) * iZ13 * hz0)
         E = half * gamma * iL13 * h0
         P = E * D
         W01 += E
@@ -713,7 +819,7 @@ def shear_variational_block(s, blk, vol0, gamma0, cG):
         P0 += P
         # combination 8: corner 1, tip 2, edge 1 -> 0
         D = 0.5 * (l12 + l01 - l02)
-        gamma = D * iL01 * h2 - g0[8 * B + i]
+        gamma = D * iL01 * h2 - (0.5 * (z12 + z01 - z02) * iZ01 * hz2)
         E = half * gamma * iL01 * h2
         P = E * D
         W12 += E
@@ -722,7 +828,7 @@ def shear_variational_block(s, blk, vol0, gamma0, cG):
         P2 += P
         # combination 9: corner 1, tip 2, edge 1 -> 3
         D = 0.5 * (l12 + l13 - l23)
-        gamma = D * iL13 * h2 - g0[9 * B + i]
+        gamma = D * iL13 * h2 - (0.5 * (z12 + z13 - z23) * iZ13 * hz2)
         E = half * gamma * iL13 * h2
         P = E * D
         W12 += E
@@ -731,7 +837,7 @@ def shear_variational_block(s, blk, vol0, gamma0, cG):
         P2 += P
         # combination 10: corner 1, tip 3, edge 1 -> 0
         D = 0.5 * (l13 + l01 - l03)
-        gamma = D * iL01 * h3 - g0[10 * B + i]
+        gamma = D * iL01 * h3 - (0.5 * (z13 + z01 - z03) * iZ01 * hz3)
         E = half * gamma * iL01 * h3
         P = E * D
         W13 += E
@@ -740,7 +846,7 @@ def shear_variational_block(s, blk, vol0, gamma0, cG):
         P3 += P
         # combination 11: corner 1, tip 3, edge 1 -> 2
         D = 0.5 * (l13 + l12 - l23)
-        gamma = D * iL12 * h3 - g0[11 * B + i]
+        gamma = D * iL12 * h3 - (0.5 * (z13 + z12 - z23) * iZ12 * hz3)
         E = half * gamma * iL12 * h3
         P = E * D
         W13 += E
@@ -749,7 +855,7 @@ def shear_variational_block(s, blk, vol0, gamma0, cG):
         P3 += P
         # combination 12: corner 2, tip 0, edge 2 -> 1
         D = 0.5 * (l02 + l12 - l01)
-        gamma = D * iL12 * h0 - g0[12 * B + i]
+        gamma = D * iL12 * h0 - (0.5 * (z02 + z12 - z01) * iZ12 * hz0)
         E = half * gamma * iL12 * h0
         P = E * D
         W02 += E
@@ -758,7 +864,7 @@ def shear_variational_block(s, blk, vol0, gamma0, cG):
         P0 += P
         # combination 13: corner 2, tip 0, edge 2 -> 3
         D = 0.5 * (l02 + l23 - l03)
-        gamma = D * iL23 * h0 - g0[13 * B + i]
+        gamma = D * iL23 * h0 - (0.5 * (z02 + z23 - z03) * iZ23 * hz0)
         E = half * gamma * iL23 * h0
         P = E * D
         W02 += E
@@ -767,7 +873,7 @@ def shear_variational_block(s, blk, vol0, gamma0, cG):
         P0 += P
         # combination 14: corner 2, tip 1, edge 2 -> 0
         D = 0.5 * (l12 + l02 - l01)
-        gamma = D * iL02 * h1 - g0[14 * B + i]
+        gamma = D * iL02 * h1 - (0.5 * (z12 + z02 - z01) * iZ02 * hz1)
         E = half * gamma * iL02 * h1
         P = E * D
         W12 += E
@@ -776,7 +882,7 @@ def shear_variational_block(s, blk, vol0, gamma0, cG):
         P1 += P
         # combination 15: corner 2, tip 1, edge 2 -> 3
         D = 0.5 * (l12 + l23 - l13)
-        gamma = D * iL23 * h1 - g0[15 * B + i]
+        gamma = D * iL23 * h1 - (0.5 * (z12 + z23 - z13) * iZ23 * hz1)
         E = half * gamma * iL23 * h1
         P = E * D
         W12 += E
@@ -785,7 +891,7 @@ def shear_variational_block(s, blk, vol0, gamma0, cG):
         P1 += P
         # combination 16: corner 2, tip 3, edge 2 -> 0
         D = 0.5 * (l23 + l02 - l03)
-        gamma = D * iL02 * h3 - g0[16 * B + i]
+        gamma = D * iL02 * h3 - (0.5 * (z23 + z02 - z03) * iZ02 * hz3)
         E = half * gamma * iL02 * h3
         P = E * D
         W23 += E
@@ -794,7 +900,7 @@ def shear_variational_block(s, blk, vol0, gamma0, cG):
         P3 += P
         # combination 17: corner 2, tip 3, edge 2 -> 1
         D = 0.5 * (l23 + l12 - l13)
-        gamma = D * iL12 * h3 - g0[17 * B + i]
+        gamma = D * iL12 * h3 - (0.5 * (z23 + z12 - z13) * iZ12 * hz3)
         E = half * gamma * iL12 * h3
         P = E * D
         W23 += E
@@ -803,7 +909,7 @@ def shear_variational_block(s, blk, vol0, gamma0, cG):
         P3 += P
         # combination 18: corner 3, tip 0, edge 3 -> 1
         D = 0.5 * (l03 + l13 - l01)
-        gamma = D * iL13 * h0 - g0[18 * B + i]
+        gamma = D * iL13 * h0 - (0.5 * (z03 + z13 - z01) * iZ13 * hz0)
         E = half * gamma * iL13 * h0
         P = E * D
         W03 += E
@@ -812,7 +918,7 @@ def shear_variational_block(s, blk, vol0, gamma0, cG):
         P0 += P
         # combination 19: corner 3, tip 0, edge 3 -> 2
         D = 0.5 * (l03 + l23 - l02)
-        gamma = D * iL23 * h0 - g0[19 * B + i]
+        gamma = D * iL23 * h0 - (0.5 * (z03 + z23 - z02) * iZ23 * hz0)
         E = half * gamma * iL23 * h0
         P = E * D
         W03 += E
@@ -821,7 +927,7 @@ def shear_variational_block(s, blk, vol0, gamma0, cG):
         P0 += P
         # combination 20: corner 3, tip 1, edge 3 -> 0
         D = 0.5 * (l13 + l03 - l01)
-        gamma = D * iL03 * h1 - g0[20 * B + i]
+        gamma = D * iL03 * h1 - (0.5 * (z13 + z03 - z01) * iZ03 * hz1)
         E = half * gamma * iL03 * h1
         P = E * D
         W13 += E
@@ -830,7 +936,7 @@ def shear_variational_block(s, blk, vol0, gamma0, cG):
         P1 += P
         # combination 21: corner 3, tip 1, edge 3 -> 2
         D = 0.5 * (l13 + l23 - l12)
-        gamma = D * iL23 * h1 - g0[21 * B + i]
+        gamma = D * iL23 * h1 - (0.5 * (z13 + z23 - z12) * iZ23 * hz1)
         E = half * gamma * iL23 * h1
         P = E * D
         W13 += E
@@ -839,7 +945,7 @@ def shear_variational_block(s, blk, vol0, gamma0, cG):
         P1 += P
         # combination 22: corner 3, tip 2, edge 3 -> 0
         D = 0.5 * (l23 + l03 - l02)
-        gamma = D * iL03 * h2 - g0[22 * B + i]
+        gamma = D * iL03 * h2 - (0.5 * (z23 + z03 - z02) * iZ03 * hz2)
         E = half * gamma * iL03 * h2
         P = E * D
         W23 += E
@@ -848,7 +954,7 @@ def shear_variational_block(s, blk, vol0, gamma0, cG):
         P2 += P
         # combination 23: corner 3, tip 2, edge 3 -> 1
         D = 0.5 * (l23 + l13 - l12)
-        gamma = D * iL13 * h2 - g0[23 * B + i]
+        gamma = D * iL13 * h2 - (0.5 * (z23 + z13 - z12) * iZ13 * hz2)
         E = half * gamma * iL13 * h2
         P = E * D
         W23 += E
@@ -896,6 +1002,11 @@ def shear_variational_block(s, blk, vol0, gamma0, cG):
         f1 = axpy(A, c1, f1)
         f2 = axpy(A, c2, f2)
         f3 = axpy(A, c3, f3)
+        p6 = K6 * (V6 - 6.0 * v0[i]) * iV6
+        f0 = axpy(p6, c0, f0)
+        f1 = axpy(p6, c1, f1)
+        f2 = axpy(p6, c2, f2)
+        f3 = axpy(p6, c3, f3)
         s[OUT + 0 * B + i] = f0[0]
         s[OUT + 1 * B + i] = f0[1]
         s[OUT + 2 * B + i] = f0[2]
@@ -912,27 +1023,30 @@ def shear_variational_block(s, blk, vol0, gamma0, cG):
 
 
 @njit(**OPTIONS)
-def shear_variational(x, tb, m, vol0, gamma0, cG, out):
-    """f = -dW/dx, W = (c/2) G V0 sum_s gamma_s^2 (cG = c G); returns the first flattened tetrahedron, or -1."""
+def shear_variational(x, tb, m, vol0, rest, cG, K, out):
+    """f = -dW/dx, W = (c/2) G V0 sum_s gamma_s^2 (cG = c G); returns the first flattened tetrahedron, or -1. With the volume term's forces for K > 0."""
     s = np.empty(SCRATCH)
     for blk in range((m + B - 1) // B):
         gather(x, tb, blk, s)
-        if shear_variational_block(s, blk, vol0, gamma0, cG) > 0:
+        if shear_variational_block(s, blk, vol0, rest, cG, K) > 0:
             return first_flat(s, blk, m)
         scatter(out, tb, blk, m, s)
     return -1
 
 
 @njit(**OPTIONS)
-def shear_variational_tets(x, tb, m, vol0, gamma0, cG, ft, flat, first, stop):
-    """shear_variational for the tetrahedra [first, stop) into ft (m, 4, 3); flattened ones flagged in flat."""
+def shear_variational_range(x, tb, m, vol0, rest, cG, K, first, stop, late, route, buf, out):
+    """shear_variational over the blocks [first, stop), the forces of routed corners into buf."""
     s = np.empty(SCRATCH)
-    n_flat = 0
-    for blk in range(first // B, (stop + B - 1) // B):
+    for blk in range(first, stop):
         gather(x, tb, blk, s)
-        shear_variational_block(s, blk, vol0, gamma0, cG)
-        n_flat += put(ft, flat, blk, first, stop, s)
-    return n_flat
+        if shear_variational_block(s, blk, vol0, rest, cG, K) > 0:
+            return first_flat(s, blk, m)
+        if late[blk]:
+            scatter_routed(out, tb, blk, m, s, route, buf)
+        else:
+            scatter(out, tb, blk, m, s)
+    return -1
 
 
 @njit(cache=True, fastmath=FAST)

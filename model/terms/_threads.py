@@ -1,66 +1,80 @@
-"""The two-thread mode of a force kernel, equal bit for bit to the serial kernel.
+"""The threaded mode of a force kernel, equal bit for bit to the serial kernel.
 
-A serial kernel adds each tetrahedron's four forces into ``out`` in increasing tetrahedron
-order. Here the tetrahedra are computed in parallel into ft (m, 4, 3) by the kernel's
-``_tets`` twin (the same generated lines), then every node sums its contributions in the same
-increasing order (parallel over nodes): the same additions in the same order, so the same
-bits, whatever the number of threads. Off by default; ``model.build(..., threads=2)``.
+A serial kernel adds each element's forces into ``out`` in increasing element order. Its
+threaded mode (:class:`SplitBlocks`) makes the same additions in the same order, whatever the
+number of threads: the elements are taken in blocks of ``B`` (``model.terms._blocks``), every
+thread runs the kernel's ``_range`` twin over its share of the blocks (a contiguous range) and
+adds straight into ``out``, except at the nodes an earlier share also touches: those forces are
+stored into a buffer (``scatter_routed``) and added after every share has finished, in the
+serial order. Only the nodes where two shares meet (a layer, for a mesh ordered in space)
+wait, and only the blocks that hold one (``late``) take the routed scatter.
+
+Off by default; ``model.build(..., threads=2)``.
 """
+import numba
 import numpy as np
 from numba import njit, prange
 
-
-def node_slots(tets, n_nodes):
-    """CSR of node -> its slots t * 4 + i (corner i of tetrahedron t), in increasing t."""
-    slot = np.argsort(tets.ravel(), kind="stable")
-    ptr = np.zeros(n_nodes + 1, dtype=np.int64)
-    np.cumsum(np.bincount(tets.ravel(), minlength=n_nodes), out=ptr[1:])
-    return ptr, slot.astype(np.int64)
+from ._blocks import B, n_blocks
 
 
-@njit(cache=True, parallel=True)
-def gather(ft, ptr, slot, out):
-    """out[n] += the stored forces of node n, in increasing tetrahedron order."""
-    f = ft.reshape(-1, 3)
-    for n in prange(out.shape[0]):
-        for k in range(ptr[n], ptr[n + 1]):
-            s = slot[k]
-            out[n, 0] += f[s, 0]
-            out[n, 1] += f[s, 1]
-            out[n, 2] += f[s, 2]
-
-
-CHUNKS = 64   # ranges of tetrahedra handed to the threads (any count gives the same bits)
-
-
-@njit(parallel=True)  # not cached: it takes a kernel (see model.integrate)
-def per_tet(x, kernel_tets, args, ft, flat):
-    m = ft.shape[0]
-    n_flat = 0
-    for c in prange(CHUNKS):
-        n_flat += kernel_tets(x, *args, ft, flat, c * m // CHUNKS, (c + 1) * m // CHUNKS)
-    return n_flat
-
-
-@njit  # not cached: it takes a kernel
-def per_tet_then_gather(x, kernel_tets, args, ft, flat, ptr, slot, out):
-    """A force kernel's contract (add into out, return the first flattened element or -1)
-    from its per-tetrahedron twin and :func:`gather`."""
-    flat[:] = 0
-    if per_tet(x, kernel_tets, args, ft, flat) > 0:
-        return np.argmax(flat)
-    gather(ft, ptr, slot, out)
+@njit(parallel=True)  # not cached: it takes a kernel
+def split_blocks(x, kernel_range, args, bounds, late, route, buf, dest, firsts, out):
+    """A force kernel's contract from its ``_range`` twin run on the shares of blocks
+    ``bounds`` in parallel, then the routed forces ``buf`` added at ``dest`` in order."""
+    shares = bounds.shape[0] - 1
+    for c in prange(shares):
+        firsts[c] = kernel_range(x, *args, bounds[c], bounds[c + 1], late, route, buf, out)
+    for c in range(shares):
+        if firsts[c] >= 0:
+            return firsts[c]
+    for r in range(dest.shape[0]):
+        n = dest[r]
+        out[n, 0] += buf[r, 0]
+        out[n, 1] += buf[r, 1]
+        out[n, 2] += buf[r, 2]
     return -1
 
 
-class TwoThreads:
-    """The buffers of the two-thread mode for one term: ft, the flags and the node CSR, over
-    its elements (tetrahedra, or a spring term's edges)."""
+class SplitBlocks:
+    """The routes of the threaded mode of one blocked kernel (the module docstring): the
+    blocks cut into ``shares`` ranges (default: numba's thread count, at least 2); for every
+    corner slot of the blocked index array ``tb`` (m elements) ``route``, -1 where its
+    node's force is added at once, else its place in the buffer of delayed additions; and
+    ``late``, the blocks that hold a delayed slot (only they take ``scatter_routed``)."""
 
-    def __init__(self, tets, n_nodes):
-        self.ft = np.empty((len(tets), tets.shape[1], 3))    # a tetrahedron's 4, an edge's 2
-        self.flat = np.zeros(len(tets), dtype=np.int8)
-        self.ptr, self.slot = node_slots(tets, n_nodes)
+    def __init__(self, tb, m, n_nodes, shares=None):
+        shares = max(2, numba.get_num_threads()) if shares is None else shares
+        nb = n_blocks(m)
+        corners = len(tb) // (nb * B)         # a tetrahedron's 4, an edge's 2
+        self.bounds = np.linspace(0, nb, shares + 1).round().astype(np.int64)
+        # every slot in the serial kernel's order of additions: block, lane, corner
+        blk, lane, corner = np.meshgrid(np.arange(nb), np.arange(B), np.arange(corners),
+                                        indexing="ij")
+        slot = (blk * corners * B + corner * B + lane).ravel()
+        real = (blk * B + lane).ravel() < m
+        slot, share = slot[real], np.searchsorted(self.bounds, blk.ravel()[real], "right") - 1
+        node = tb[slot]
+        first = np.full(n_nodes, shares, dtype=np.int64)
+        np.minimum.at(first, node, share)
+        late = share > first[node]
+        self.route = np.full(len(tb), -1, dtype=np.int32)
+        self.route[slot[late]] = np.arange(late.sum())
+        # the blocks with a delayed corner (the others take the plain scatter)
+        self.late = np.zeros(nb, dtype=np.bool_)
+        self.late[slot[late] // (corners * B)] = True
+        self.dest = node[late].astype(np.int64)
+        self.buf = np.empty((len(self.dest), 3))
+        self.firsts = np.empty(shares, dtype=np.int64)
 
-    def kernel(self, kernel_tets, args):
-        return per_tet_then_gather, (kernel_tets, args, self.ft, self.flat, self.ptr, self.slot)
+    def kernel(self, kernel_range, args):
+        return split_blocks, (kernel_range, args, self.bounds, self.late, self.route,
+                              self.buf, self.dest, self.firsts)
+
+
+def split_of(owner, tb, m, n_nodes):
+    """The :class:`SplitBlocks` of a term's blocked index array ``tb``, built once (kept on
+    the term)."""
+    if getattr(owner, "_split_blocks", None) is None:
+        owner._split_blocks = SplitBlocks(tb, m, n_nodes)
+    return owner._split_blocks

@@ -30,6 +30,10 @@ class Term:
     ``threaded_kernel()``
         optional: the same contract run on several threads with a result equal bit for bit
         to ``kernel()`` (model.terms._threads); None, the default, runs the serial kernel;
+    ``fuse(other)``
+        optional: a :class:`Fused` unit whose one kernel adds this term's forces and those of
+        ``other``, a later term of the same model, in one pass over the tetrahedra (equal to
+        the two kernels to round-off); None, the default, where it cannot;
     ``forces_numpy(x)``
         the same forces in plain numpy, written from the formula, for the tests;
     ``tangent(x)``
@@ -94,6 +98,9 @@ class Term:
         return None
 
     def reference_kernel(self):
+        return None
+
+    def fuse(self, other):
         return None
 
     def degenerate_tets(self, bad):
@@ -164,3 +171,44 @@ class CalibratedTerm(Term):
 
     def energy(self, x):
         return self.scale * self.coef * self.unit_energy(x)
+
+
+class Fused:
+    """Two terms of a model whose forces one kernel computes in one pass (``Term.fuse``): what
+    a model runs in their place, with a term's kernel contract. A flattened tetrahedron is
+    reported as the first term's (the fused terms test flattening alike)."""
+
+    def __init__(self, first, second, kernel, threaded_kernel):
+        self.terms = (first, second)
+        self.name = f"{first.name} + {second.name}"
+        self.checks_inversion = first.checks_inversion or second.checks_inversion
+        self._kernel, self._threaded = kernel, threaded_kernel
+
+    def kernel(self):
+        return self._kernel()
+
+    def threaded_kernel(self):
+        return self._threaded(self)
+
+    def degenerate_tets(self, bad):
+        return self.terms[0].degenerate_tets(bad)
+
+    def degenerate(self, bad):
+        return self.terms[0].degenerate(bad)
+
+
+def fused_units(terms):
+    """The kernel units of a model's ``terms``, in order: a term, or a :class:`Fused` unit
+    where a term fuses with a later one (which is then not run on its own)."""
+    units, taken = [], set()
+    for i, term in enumerate(terms):
+        if i in taken:
+            continue
+        unit = term
+        for j in range(i + 1, len(terms)):
+            if j not in taken and (fused := term.fuse(terms[j])) is not None:
+                taken.add(j)
+                unit = fused
+                break
+        units.append(unit)
+    return units

@@ -20,13 +20,13 @@ from numba import njit
 
 from . import Term, register
 from ..material import neohookean_energy, neohookean_stress
-from ._blocks import B, FLAG, OPTIONS, OUT, SCRATCH, blocked, blocked_tets, first_flat, gather, \
-    put, scatter
+from ._blocks import B, FAST, FLAG, INLINED, OPTIONS, OUT, SCRATCH, blocked, blocked_tets, first_flat, gather, \
+    scatter, scatter_routed
 from ._constant_strain import RestShape
 from ._kernels import (add_piola_forces, cofactor, cross, deformation_gradient,
-                       dot, lin, piola_forces_numpy, put_piola_forces,
+                       dot, lin, piola_forces_numpy,
                        sub)
-from ._threads import TwoThreads
+from ._threads import split_of
 from .volume import FLAT
 
 
@@ -50,18 +50,65 @@ def linear_forces(x, tets, Dinv, vol0, lam, mu, out):
     return -1
 
 
-@njit(cache=True, fastmath=True)
-def linear_tets(x, tets, Dinv, vol0, lam, mu, ft, flat, first, stop):
-    """linear_forces for the tetrahedra [first, stop) into ft (m, 4, 3); flattened ones
-    flagged in flat (the two-thread mode's twin: the same forces, bit for bit)."""
+@njit(inline="always", fastmath=FAST, error_model="numpy")
+def lane_gradient(s, p, i):
+    """F = Ds Dm^-1 of lane i of a block (corners in s, Dm^-1 row by row in p) and its
+    flattening margin det F - FLAT."""
+    x0 = (s[i], s[B + i], s[2 * B + i])
+    e1 = sub((s[3 * B + i], s[4 * B + i], s[5 * B + i]), x0)
+    e2 = sub((s[6 * B + i], s[7 * B + i], s[8 * B + i]), x0)
+    e3 = sub((s[9 * B + i], s[10 * B + i], s[11 * B + i]), x0)
+    r0, r1, r2 = ((p[i], p[B + i], p[2 * B + i]), (p[3 * B + i], p[4 * B + i], p[5 * B + i]),
+                  (p[6 * B + i], p[7 * B + i], p[8 * B + i]))
+    F = (lin(e1[0], r0, 1.0, lin(e2[0], r1, e3[0], r2)),
+         lin(e1[1], r0, 1.0, lin(e2[1], r1, e3[1], r2)),
+         lin(e1[2], r0, 1.0, lin(e2[2], r1, e3[2], r2)))
+    return F, dot(F[0], cross(F[1], F[2])) - FLAT
+
+
+@njit(inline="always", fastmath=FAST, error_model="numpy")
+def lane_forces(s, p, i, P):
+    """The forces -V0 P Dm^-T of lane i into the block's output rows of s: corners 1..3
+    -V0 P (row c of Dm^-1), corner 0 minus their sum."""
+    v = p[9 * B + i]
+    f0 = (0.0, 0.0, 0.0)
+    for c in range(3):
+        rc = (p[3 * c * B + i], p[(3 * c + 1) * B + i], p[(3 * c + 2) * B + i])
+        f = (-v * dot(P[0], rc), -v * dot(P[1], rc), -v * dot(P[2], rc))
+        for k in range(3):
+            s[OUT + (3 * c + 3 + k) * B + i] = f[k]
+        f0 = sub(f0, f)
+    for k in range(3):
+        s[OUT + k * B + i] = f0[k]
+
+
+@njit(**INLINED)
+def linear_block(s, blk, data, lam, mu):
+    """Small-strain forces of block blk's lanes (``data``: Dm^-1 and V0 per tetrahedron in
+    the blocked layout, as the co-rotated block's); returns the count of lanes with
+    det F <= FLAT."""
+    p = data[blk * 10 * B:(blk + 1) * 10 * B]
     n_flat = 0
-    for t in range(first, stop):
-        F, J = deformation_gradient(x, tets, t, Dinv)
-        if J <= FLAT:
-            flat[t] = 1
-            n_flat += 1
-            continue
-        put_piola_forces(linear_piola(F, lam, mu), Dinv, vol0, t, ft)
+    for i in range(B):
+        F, margin = lane_gradient(s, p, i)
+        s[FLAG + i] = margin
+        n_flat += margin <= 0.0
+        lane_forces(s, p, i, linear_piola(F, lam, mu))
+    return n_flat
+
+
+@njit(**INLINED)
+def neohookean_block(s, blk, data, lam, mu):
+    """Neo-Hookean forces of block blk's lanes (as :func:`linear_block`); a flattened lane's
+    stress is not used (its log is taken of a clamped J)."""
+    p = data[blk * 10 * B:(blk + 1) * 10 * B]
+    n_flat = 0
+    for i in range(B):
+        F, margin = lane_gradient(s, p, i)
+        s[FLAG + i] = margin
+        n_flat += margin <= 0.0
+        J = max(margin + FLAT, FLAT)
+        lane_forces(s, p, i, neohookean_piola(F, J, lam, mu))
     return n_flat
 
 
@@ -86,7 +133,7 @@ def polar_rotation(F):
 POLAR = 19 * B     # the co-rotated block's own scratch: F (9 rows), R (9 rows), converged
 
 
-@njit(**OPTIONS)
+@njit(**INLINED)
 def corotated_block(s, r, blk, data, lam, mu):
     """Co-rotated forces of block blk's lanes (model/terms/_blocks.py): ``data`` holds each
     tetrahedron's Dm^-1 (row by row) and V0 in the blocked layout, F = Ds Dm^-1, P = 2 mu
@@ -159,38 +206,54 @@ def corotated_block(s, r, blk, data, lam, mu):
     return n_flat
 
 
+LINEAR, COROTATED, NEOHOOKEAN = 0, 1, 2     # the laws of the constant-strain kernels
+
+
+@njit(**INLINED)
+def law_block(s, r, blk, data, lam, mu, law):
+    """Block blk's lanes under ``law`` (LINEAR, COROTATED or NEOHOOKEAN)."""
+    if law == LINEAR:
+        return linear_block(s, blk, data, lam, mu)
+    if law == COROTATED:
+        return corotated_block(s, r, blk, data, lam, mu)
+    return neohookean_block(s, blk, data, lam, mu)
+
+
 @njit(**OPTIONS)
-def corotated_forces(x, tb, m, data, lam, mu, out):
-    """Co-rotated constant-strain tetrahedra, block by block; returns the first flattened
-    one, or -1."""
+def constant_strain_forces(x, tb, m, data, lam, mu, law, out):
+    """Constant-strain tetrahedra under ``law``, block by block; returns the first one with
+    det F <= FLAT, or -1."""
     s = np.empty(SCRATCH)
     r = np.empty(POLAR)
     for blk in range((m + B - 1) // B):
         gather(x, tb, blk, s)
-        if corotated_block(s, r, blk, data, lam, mu) > 0:
+        if law_block(s, r, blk, data, lam, mu, law) > 0:
             return first_flat(s, blk, m)
         scatter(out, tb, blk, m, s)
     return -1
 
 
 @njit(**OPTIONS)
-def corotated_tets(x, tb, m, data, lam, mu, ft, flat, first, stop):
-    """corotated_forces for the tetrahedra [first, stop) into ft (m, 4, 3); flattened ones
-    flagged in flat (the two-thread mode's twin: the same forces, bit for bit)."""
+def constant_strain_range(x, tb, m, data, lam, mu, law, first, stop, late, route, buf, out):
+    """constant_strain_forces over the blocks [first, stop), the forces of routed corners into
+    buf (the threaded mode's twin: model.terms._threads.SplitBlocks)."""
     s = np.empty(SCRATCH)
     r = np.empty(POLAR)
-    n_flat = 0
-    for blk in range(first // B, (stop + B - 1) // B):
+    for blk in range(first, stop):
         gather(x, tb, blk, s)
-        corotated_block(s, r, blk, data, lam, mu)
-        n_flat += put(ft, flat, blk, first, stop, s)
-    return n_flat
+        if law_block(s, r, blk, data, lam, mu, law) > 0:
+            return first_flat(s, blk, m)
+        if late[blk]:
+            scatter_routed(out, tb, blk, m, s, route, buf)
+        else:
+            scatter(out, tb, blk, m, s)
+    return -1
 
 
 @njit(cache=True, fastmath=True)
 def corotated_forces_reference(x, tets, Dinv, vol0, lam, mu, out):
     """Co-rotated constant-strain tetrahedra; returns the first flattened one, or -1.
-    Tetrahedron by tetrahedron (the reference of ``corotated_forces``)."""
+    Tetrahedron by tetrahedron (the reference of ``constant_strain_forces``)."""
     for t in range(tets.shape[0]):
         F, J = deformation_gradient(x, tets, t, Dinv)
         if J <= FLAT:
@@ -226,42 +289,33 @@ def neohookean_forces(x, tets, Dinv, vol0, lam, mu, out):
     return -1
 
 
-@njit(cache=True, fastmath=True)
-def neohookean_tets(x, tets, Dinv, vol0, lam, mu, ft, flat, first, stop):
-    """neohookean_forces for the tetrahedra [first, stop) into ft (m, 4, 3); flattened ones
-    flagged in flat (the two-thread mode's twin: the same forces, bit for bit)."""
-    n_flat = 0
-    for t in range(first, stop):
-        F, J = deformation_gradient(x, tets, t, Dinv)
-        if J <= FLAT:
-            flat[t] = 1
-            n_flat += 1
-            continue
-        put_piola_forces(neohookean_piola(F, J, lam, mu), Dinv, vol0, t, ft)
-    return n_flat
-
-
 class _ConstantStrain(RestShape, Term):
-    """What the three baselines share: Dm^-1 and F (``RestShape``), V0 and the Lame
-    constants."""
+    """What the three baselines share: Dm^-1 and F (``RestShape``), V0, the Lame constants,
+    and the kernels' data in the blocked layout (Dm^-1 row by row and V0, 10 per
+    tetrahedron). A law gives its blocked kernel, its threaded twin and its
+    tetrahedron-by-tetrahedron reference."""
 
     conservative = True
-    _kernel = None
-    _per_tet = None       # the two-thread mode's per-tetrahedron twin of _kernel
+    law = None            # LINEAR, COROTATED or NEOHOOKEAN
+    _reference = None     # the law's tetrahedron-by-tetrahedron kernel
 
     def __init__(self, mesh, material, scale=1.0, **params):
         super().__init__(mesh, material, scale, **params)
         self.vol0 = mesh.volumes
         self.lam, self.mu = self.scale * material.lam, self.scale * material.G
-        self._threads = None
+        self._blocked = (blocked_tets(mesh.tets), mesh.n_tets, blocked(
+            np.concatenate([self.Dinv.reshape(-1, 9), self.vol0[:, None]], axis=1)))
 
     def kernel(self):
-        return type(self)._kernel, (self.mesh.tets, self.Dinv, self.vol0, self.lam, self.mu)
+        return constant_strain_forces, (*self._blocked, self.lam, self.mu, self.law)
 
     def threaded_kernel(self):
-        if self._threads is None:
-            self._threads = TwoThreads(self.mesh.tets, self.mesh.n_nodes)
-        return self._threads.kernel(type(self)._per_tet, self.kernel()[1])
+        return split_of(self, self._blocked[0], self.mesh.n_tets, self.mesh.n_nodes).kernel(
+            constant_strain_range, self.kernel()[1])
+
+    def reference_kernel(self):
+        return type(self)._reference, (self.mesh.tets, self.Dinv, self.vol0, self.lam,
+                                       self.mu)
 
     def forces_numpy(self, x):
         return piola_forces_numpy(self.piola(self.F(x)), self.Dinv, self.vol0, self.mesh.tets,
@@ -288,8 +342,8 @@ class FemLinear(_ConstantStrain):
     rotation_invariant = False
     angular_momentum = False
 
-    _kernel = staticmethod(linear_forces)
-    _per_tet = staticmethod(linear_tets)
+    law = LINEAR
+    _reference = staticmethod(linear_forces)
 
     def _eps(self, F):
         return 0.5 * (F + np.transpose(F, (0, 2, 1))) - np.eye(3)
@@ -330,19 +384,8 @@ class FemCorotated(_ConstantStrain):
 
     name = "fem_corotated"
 
-    def __init__(self, mesh, material, scale=1.0, **params):
-        super().__init__(mesh, material, scale, **params)
-        self._blocked = (blocked_tets(mesh.tets), mesh.n_tets, blocked(
-            np.concatenate([self.Dinv.reshape(-1, 9), self.vol0[:, None]], axis=1)))
-
-    _per_tet = staticmethod(corotated_tets)
-
-    def kernel(self):
-        return corotated_forces, (*self._blocked, self.lam, self.mu)
-
-    def reference_kernel(self):
-        return corotated_forces_reference, (self.mesh.tets, self.Dinv, self.vol0, self.lam,
-                                            self.mu)
+    law = COROTATED
+    _reference = staticmethod(corotated_forces_reference)
 
     def piola(self, F):
         R, S = polar_numpy(F)
@@ -376,8 +419,8 @@ class FemNeoHookean(_ConstantStrain):
     """Compressible neo-Hookean tetrahedra."""
 
     name = "fem_neohookean"
-    _kernel = staticmethod(neohookean_forces)
-    _per_tet = staticmethod(neohookean_tets)
+    law = NEOHOOKEAN
+    _reference = staticmethod(neohookean_forces)
 
     def piola(self, F):
         m, b = neohookean_stress(np.log(np.linalg.det(F)), self.lam, self.mu)

@@ -13,9 +13,9 @@ import numpy as np
 from numba import njit
 
 from . import CalibratedTerm, register
-from ._blocks import (B, FLAG, OPTIONS, OUT, SCRATCH, blocked, blocked_tets, first_flat, gather,
-                      put, rsqrt, scatter)
-from ._threads import TwoThreads
+from ._blocks import (B, FLAG, INLINED, OPTIONS, OUT, SCRATCH, blocked, blocked_tets, first_flat, gather,
+                      rsqrt, scatter, scatter_routed)
+from ._threads import split_of
 from ._kernels import axpy, dot, sub
 
 # the three edges at each corner: (corner, other end)
@@ -24,7 +24,7 @@ CORNER_EDGES = np.array([[(a, j) for j in range(4) if j != a] for a in range(4)]
 PAIRS = np.array([(0, 1), (0, 2), (0, 3), (1, 2), (1, 3), (2, 3)], dtype=np.int64)
 
 
-@njit(**OPTIONS)
+@njit(**INLINED)
 def normal_block(s, blk, vol0, inv_rest, coef_G):
     """The forces of block blk's lanes (model/terms/_blocks.py). Each edge pq's strain
     eps_pq = L_pq / R_pq - 1 belongs to both its corners, so the edge carries
@@ -91,16 +91,19 @@ def normal_forces(x, tb, m, vol0, inv_rest, coef_G, out):
 
 
 @njit(**OPTIONS)
-def normal_tets(x, tb, m, vol0, inv_rest, coef_G, ft, flat, first, stop):
-    """normal_forces for the tetrahedra [first, stop) into ft (m, 4, 3); collapsed ones
-    flagged in flat (the two-thread mode's twin: the same forces, bit for bit)."""
+def normal_range(x, tb, m, vol0, inv_rest, coef_G, first, stop, late, route, buf, out):
+    """normal_forces over the blocks [first, stop), the forces of routed corners into buf (the
+    threaded mode's twin: model.terms._threads.SplitBlocks)."""
     s = np.empty(SCRATCH)
-    n_flat = 0
-    for blk in range(first // B, (stop + B - 1) // B):
+    for blk in range(first, stop):
         gather(x, tb, blk, s)
-        normal_block(s, blk, vol0, inv_rest, coef_G)
-        n_flat += put(ft, flat, blk, first, stop, s)
-    return n_flat
+        if normal_block(s, blk, vol0, inv_rest, coef_G) > 0:
+            return first_flat(s, blk, m)
+        if late[blk]:
+            scatter_routed(out, tb, blk, m, s, route, buf)
+        else:
+            scatter(out, tb, blk, m, s)
+    return -1
 
 
 @njit(cache=True, fastmath=True)
@@ -171,9 +174,8 @@ class NormalEdge(CalibratedTerm):
         return normal_forces, (*self._blocked, k * self.G)
 
     def threaded_kernel(self):
-        if getattr(self, "_threads", None) is None:
-            self._threads = TwoThreads(self.mesh.tets, self.mesh.n_nodes)
-        return self._threads.kernel(normal_tets, self.kernel()[1])
+        return split_of(self, self._blocked[0], self.mesh.n_tets, self.mesh.n_nodes).kernel(
+            normal_range, self.kernel()[1])
 
     def reference_kernel(self):
         k = self.kernel()[1][-1]          # the same checks (calibrated)

@@ -21,16 +21,18 @@ Every reading takes tau = c G gamma, c the factor ``c`` (1: the paper's literal 
 """
 import numpy as np
 
-from . import CalibratedTerm, Term, register
+from . import CalibratedTerm, Fused, Term, register
 from ._kernels import COMBOS, volume_gradient_numpy
 from ._blocks import blocked, blocked_tets
-from ._shear_kernels import (shear_balanced, shear_balanced_reference, shear_balanced_tets,
-                             shear_corner, shear_corner_reference, shear_corner_tets,
-                             shear_strains, shear_variational, shear_variational_reference,
-                             shear_variational_tets)
-from ._threads import TwoThreads
+from ._shear_kernels import (shear_balanced, shear_balanced_range, shear_balanced_reference,
+                             shear_corner, shear_corner_range, shear_corner_reference,
+                             shear_strains, shear_variational, shear_variational_range,
+                             shear_variational_reference)
+from ._threads import split_of
 from ..errors import ModelError, DegenerateTetError
 
+# the six edges p < q of a tetrahedron, in the order of the kernels' rest lengths
+PAIRS = np.array([(p, q) for p in range(4) for q in range(p + 1, 4)])
 # +1 when (a, m, l, j) is an even permutation of (0, 1, 2, 3)
 _PARITY = np.array([round(np.linalg.det(np.eye(4)[[a, m, l, j]])) for a, j, m, l in COMBOS])
 READINGS = {"corner": 0, "balanced": 1, "variational": 2}
@@ -42,7 +44,7 @@ READINGS = {"corner": 0, "balanced": 1, "variational": 2}
 # The kernels run over blocks of tetrahedra (model/terms/_blocks.py); the references, the same
 # maths tetrahedron by tetrahedron, are what the tests hold them to.
 KERNELS = {0: shear_corner, 1: shear_balanced, 2: shear_variational}
-PER_TET = {0: shear_corner_tets, 1: shear_balanced_tets, 2: shear_variational_tets}
+RANGE = {0: shear_corner_range, 1: shear_balanced_range, 2: shear_variational_range}
 REFERENCE = {0: shear_corner_reference, 1: shear_balanced_reference,
              2: shear_variational_reference}
 
@@ -96,10 +98,11 @@ class Shear(CalibratedTerm):
         self.angular_momentum = self.p["reading"] == "variational"
         self.gamma0 = np.zeros((mesh.n_tets, 24))
         self.gamma0 = self.strains(mesh.points)
-        self._threads = None
-        # the kernels' data in the blocked layout (model/terms/_blocks.py)
+        # the kernels' data in the blocked layout (model/terms/_blocks.py): the rest squared
+        # edge lengths, from which a block computes gamma0 (a quarter of its bytes to stream)
+        d = mesh.points[mesh.tets[:, PAIRS[:, 1]]] - mesh.points[mesh.tets[:, PAIRS[:, 0]]]
         self._blocked = (blocked_tets(mesh.tets), mesh.n_tets, blocked(self.vol0),
-                         blocked(self.gamma0))
+                         blocked(np.einsum("tpk,tpk->tp", d, d)))
 
     def describe(self):
         return f"shear/{self.p['reading']}"
@@ -117,8 +120,19 @@ class Shear(CalibratedTerm):
         """Maximum |tau| = G max |gamma| per tetrahedron (the paper's Figure 1), material G."""
         return self.material.G * np.abs(self.strains(x)).max(axis=1)
 
-    def kernel_args(self, k):
-        return KERNELS[self.reading], (*self._blocked, self.G * k)
+    def kernel_args(self, k, K=0.0):
+        return KERNELS[self.reading], (*self._blocked, self.G * k, K)
+
+    def fuse(self, other):
+        """The volume term's forces in the shear kernel's pass (its 6V and face vectors are
+        the shear's own; the flattening test is the same), or None for another term."""
+        if other.name != "volume" or other.mesh is not self.mesh:
+            return None
+        return Fused(self, other, lambda: self.kernel_args(self.scale * self.coef, other.K),
+                     lambda fused: self._split().kernel(RANGE[self.reading], fused.kernel()[1]))
+
+    def _split(self):
+        return split_of(self, self._blocked[0], self.mesh.n_tets, self.mesh.n_nodes)
 
     def _factor(self):
         """The kernels' factor G c scale (kernel_args's, for the reference kernels)."""
@@ -129,9 +143,7 @@ class Shear(CalibratedTerm):
         return REFERENCE[self.reading], (self.mesh.tets, self.vol0, self.gamma0, self._factor())
 
     def threaded_kernel(self):
-        if self._threads is None:
-            self._threads = TwoThreads(self.mesh.tets, self.mesh.n_nodes)
-        return self._threads.kernel(PER_TET[self.reading], self.kernel()[1])
+        return self._split().kernel(RANGE[self.reading], self.kernel()[1])
 
     def forces_numpy(self, x):
         tets = self.mesh.tets

@@ -14,47 +14,82 @@ from numba import njit
 
 from . import Term, register
 from ..geometry import edges
-from ._threads import TwoThreads
+from ._blocks import B, blocked_tets
+from ._threads import split_of
 
 
-@njit(cache=True, fastmath=True)
+# fast maths without contraction or reciprocals: a product rounds before it is added, in the
+# serial kernel as in the threaded twin that stores it, whether or not the compiler inlines the
+# one into the other (the twin's bit-for-bit promise); a collapsed edge divides by zero (inf,
+# then reported) rather than raising
+FAST = {"nnan", "ninf", "nsz", "afn"}
+
+
+@njit(inline="always", fastmath=FAST, error_model="numpy")
+def spring_force(x, edge, rest, k, s):
+    """Edge s's force f = k (l - l0) / l d on its first node (minus that on its second), and
+    its length l (0: collapsed)."""
+    i, j = edge[s, 0], edge[s, 1]
+    d0, d1, d2 = x[j, 0] - x[i, 0], x[j, 1] - x[i, 1], x[j, 2] - x[i, 2]
+    ln = np.sqrt(d0 * d0 + d1 * d1 + d2 * d2)
+    f = k[s] * (ln - rest[s]) / ln  # tension pulls j towards i
+    return ln, (f * d0, f * d1, f * d2)
+
+
+@njit(cache=True, fastmath=FAST, error_model="numpy")
 def spring_forces(x, edge, rest, k, out):
     """Linear springs f = k (l - l0) on every edge; returns the first collapsed edge, or -1."""
     for s in range(edge.shape[0]):
-        i, j = edge[s, 0], edge[s, 1]
-        d0, d1, d2 = x[j, 0] - x[i, 0], x[j, 1] - x[i, 1], x[j, 2] - x[i, 2]
-        ln = np.sqrt(d0 * d0 + d1 * d1 + d2 * d2)
+        ln, g = spring_force(x, edge, rest, k, s)
         if ln <= 0.0:
             return s
-        f = k[s] * (ln - rest[s]) / ln  # tension pulls j towards i
-        out[i, 0] += f * d0
-        out[i, 1] += f * d1
-        out[i, 2] += f * d2
-        out[j, 0] -= f * d0
-        out[j, 1] -= f * d1
-        out[j, 2] -= f * d2
+        i, j = edge[s, 0], edge[s, 1]
+        out[i, 0] += g[0]
+        out[i, 1] += g[1]
+        out[i, 2] += g[2]
+        out[j, 0] -= g[0]
+        out[j, 1] -= g[1]
+        out[j, 2] -= g[2]
     return -1
 
 
-@njit(cache=True, fastmath=True)
-def spring_edges(x, edge, rest, k, fe, flat, first, stop):
-    """spring_forces for the edges [first, stop) into fe (m, 2, 3), collapsed ones flagged in
-    flat (the two-thread mode's twin: node j's force is stored negated, which the gather adds
-    to the same bits as the serial kernel's subtraction)."""
-    n_flat = 0
-    for s in range(first, stop):
-        i, j = edge[s, 0], edge[s, 1]
-        d0, d1, d2 = x[j, 0] - x[i, 0], x[j, 1] - x[i, 1], x[j, 2] - x[i, 2]
-        ln = np.sqrt(d0 * d0 + d1 * d1 + d2 * d2)
-        if ln <= 0.0:
-            flat[s] = 1
-            n_flat += 1
+@njit(cache=True, fastmath=FAST, error_model="numpy")
+def spring_range(x, edge, rest, k, first, stop, late, route, buf, out):
+    """spring_forces over the edges of blocks [first, stop) of B edges, the forces of routed
+    ends into buf (the threaded mode's twin: model.terms._threads.SplitBlocks; a second
+    end's force is stored negated, which adds to the bits of the serial subtraction)."""
+    blk = first
+    while blk < stop:
+        lo = blk * B
+        if not late[blk]:       # a run of blocks without a routed end: the serial kernel
+            while blk < stop and not late[blk]:
+                blk += 1
+            hi = min(blk * B, edge.shape[0])
+            bad = spring_forces(x, edge[lo:hi], rest[lo:hi], k[lo:hi], out)
+            if bad >= 0:
+                return lo + bad
             continue
-        f = k[s] * (ln - rest[s]) / ln
-        g0, g1, g2 = f * d0, f * d1, f * d2
-        fe[s, 0, 0], fe[s, 0, 1], fe[s, 0, 2] = g0, g1, g2
-        fe[s, 1, 0], fe[s, 1, 1], fe[s, 1, 2] = -g0, -g1, -g2
-    return n_flat
+        hi = min(lo + B, edge.shape[0])
+        for s in range(lo, hi):
+            ln, g = spring_force(x, edge, rest, k, s)
+            if ln <= 0.0:
+                return s
+            i, j = edge[s, 0], edge[s, 1]
+            ri, rj = route[blk * 2 * B + s - lo], route[blk * 2 * B + B + s - lo]
+            if ri < 0:
+                out[i, 0] += g[0]
+                out[i, 1] += g[1]
+                out[i, 2] += g[2]
+            else:
+                buf[ri, 0], buf[ri, 1], buf[ri, 2] = g[0], g[1], g[2]
+            if rj < 0:
+                out[j, 0] -= g[0]
+                out[j, 1] -= g[1]
+                out[j, 2] -= g[2]
+            else:
+                buf[rj, 0], buf[rj, 1], buf[rj, 2] = -g[0], -g[1], -g[2]
+        blk += 1
+    return -1
 
 
 def van_gelder_stiffness(mesh):
@@ -86,9 +121,9 @@ class Springs(Term):
         return spring_forces, (self.edge, self.rest, self.k)
 
     def threaded_kernel(self):
-        if getattr(self, "_threads", None) is None:
-            self._threads = TwoThreads(self.edge, self.mesh.n_nodes)
-        return self._threads.kernel(spring_edges, self.kernel()[1])
+        # the routes of the edges taken B at a time, as the blocked kernels' elements
+        return split_of(self, blocked_tets(self.edge), len(self.edge), self.mesh.n_nodes).kernel(
+            spring_range, self.kernel()[1])
 
     def degenerate_tets(self, bad):
         """The tetrahedra around the collapsed edge ``bad``."""

@@ -7,8 +7,9 @@ import numpy as np
 from numba import njit
 
 from . import Term, register
-from ._kernels import add_to, cross, dot, put, sub, vec, volume_gradient_numpy
-from ._threads import TwoThreads
+from ._blocks import B, blocked_tets
+from ._kernels import add_to, cross, dot, sub, vec, volume_gradient_numpy
+from ._threads import split_of
 
 # V / V0 below this is a flattened tetrahedron (the energy's log barrier is meaningless there)
 FLAT = 1e-6
@@ -52,21 +53,33 @@ def volume_forces(x, tets, vol0, K, out):
 
 
 @njit(cache=True)
-def volume_tets(x, tets, vol0, K, ft, flat, first, stop):
-    """volume_forces for the tetrahedra [first, stop) into ft (m, 4, 3); flattened ones
-    flagged in flat (the two-thread mode's twin: the same forces, bit for bit)."""
-    n_flat = 0
-    for t in range(first, stop):
-        bad, f0, f1, f2, f3 = volume_tet(x, tets, vol0, K, t)
-        if bad:
-            flat[t] = 1
-            n_flat += 1
+def volume_range(x, tets, vol0, K, first, stop, late, route, buf, out):
+    """volume_forces over the tetrahedra of blocks [first, stop) of B, the forces of routed
+    corners into buf (the threaded mode's twin: model.terms._threads.SplitBlocks); a run of
+    blocks without a routed corner is the serial kernel's."""
+    blk = first
+    while blk < stop:
+        lo = blk * B
+        if not late[blk]:
+            while blk < stop and not late[blk]:
+                blk += 1
+            hi = min(blk * B, tets.shape[0])
+            bad = volume_forces(x, tets[lo:hi], vol0[lo:hi], K, out)
+            if bad >= 0:
+                return lo + bad
             continue
-        put(ft, t, 0, f0)
-        put(ft, t, 1, f1)
-        put(ft, t, 2, f2)
-        put(ft, t, 3, f3)
-    return n_flat
+        for t in range(lo, min(lo + B, tets.shape[0])):
+            flat, f0, f1, f2, f3 = volume_tet(x, tets, vol0, K, t)
+            if flat:
+                return t
+            for c, f in enumerate((f0, f1, f2, f3)):
+                r = route[blk * 4 * B + c * B + t - lo]
+                if r < 0:
+                    add_to(out, tets[t, c], f)
+                else:
+                    buf[r, 0], buf[r, 1], buf[r, 2] = f
+        blk += 1
+    return -1
 
 
 @register
@@ -86,9 +99,9 @@ class Volume(Term):
         return volume_forces, (self.mesh.tets, self.vol0, self.K)
 
     def threaded_kernel(self):
-        if getattr(self, "_threads", None) is None:
-            self._threads = TwoThreads(self.mesh.tets, self.mesh.n_nodes)
-        return self._threads.kernel(volume_tets, self.kernel()[1])
+        # the routes of the tetrahedra taken B at a time, as the blocked kernels'
+        return split_of(self, blocked_tets(self.mesh.tets), self.mesh.n_tets,
+                        self.mesh.n_nodes).kernel(volume_range, self.kernel()[1])
 
     def forces_numpy(self, x):
         V, dV = volume_gradient_numpy(x, self.mesh.tets)
