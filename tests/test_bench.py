@@ -295,3 +295,27 @@ def test_bench_rewrite_draws_the_report_again_without_timing(tmp_path):
     assert main(["bench", "--rewrite", "--family", "--out", str(out)]) == 2
     assert main(["bench", "--rewrite", "--out", str(tmp_path / "none")]) == 2
     assert not (tmp_path / "none").exists()
+
+
+def test_an_implicit_step_is_timed_with_blas_on_one_thread(monkeypatch):
+    """The implicit presets' step runs with BLAS limited to one thread: its thread CPU time
+    is then a serial model's, and no BLAS thread is left spinning on the second core when the
+    next model's two-thread speed-up is sampled."""
+    from types import SimpleNamespace
+    from threadpoolctl import threadpool_info
+    from cases.framework import DEFAULT_MATERIAL
+    from cases.tools import timers
+    from model.mesh import cube
+    seen = []
+
+    def step(pm, ramp, t_end, dt, damping, frames, x0, v0, t0, stats):
+        seen.append([i["num_threads"] for i in threadpool_info() if i["user_api"] == "blas"])
+        stats.update(newton_iterations=1, cg_iterations=1)
+        return SimpleNamespace(x=[x0], v=v0)
+
+    monkeypatch.setattr(timers, "backward_euler", step)
+    t = timers.ImplicitTimed("fem-corotated-implicit-frame", cube(3, 0.032, "five"),
+                             DEFAULT_MATERIAL)
+    t.sample()
+    assert len(seen) == 2 and all(n == [1] * len(n) for n in seen)
+    assert any(seen)            # numpy's BLAS was seen, on one thread
