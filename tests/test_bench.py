@@ -319,3 +319,28 @@ def test_an_implicit_step_is_timed_with_blas_on_one_thread(monkeypatch):
     t.sample()
     assert len(seen) == 2 and all(n == [1] * len(n) for n in seen)
     assert any(seen)            # numpy's BLAS was seen, on one thread
+
+
+
+def test_a_target_verdict_reads_the_rounds_range():
+    """Against an upper target: a range below it is met, above it missed, holding it not
+    resolved; without a range, a value within UNRESOLVED of the target is not resolved and
+    one farther off is met or missed; a lower target (a speed-up) the same way round."""
+    v = bench.verdict
+    assert v(24.0, [23.0, 25.0], 30.0, True) == "met"
+    assert v(34.0, [31.0, 35.0], 30.0, True) == "missed"
+    assert v(29.0, [28.0, 31.0], 30.0, True).startswith("not resolved")
+    assert v(29.0, None, 30.0, True).startswith("not resolved")
+    assert v(20.0, None, 30.0, True) == "met" and v(40.0, None, 30.0, True) == "missed"
+    assert v(1.9, [1.85, 1.95], 1.8, False) == "met"
+    assert v(1.7, [1.6, 1.75], 1.8, False) == "missed"
+    assert v(1.82, [1.78, 1.86], 1.8, False).startswith("not resolved")
+    rows = bench.target_rows({"rows": [
+        {"model": "pbcm-corner", "tets": bench.bench_mesh(1e5).n_tets, "ns_per_tet": 33.0,
+         "ns_per_tet_range": [32.0, 34.0], "two_thread_speedup": 1.9,
+         "two_thread_speedup_range": [1.85, 1.95], "roofline_fraction": 0.3,
+         "step_over_4_forces": 1.0, "step_over_4_forces_range": [0.99, 1.01]},
+        {"model": "pbcm-corner", "tets": 1080, "ns_per_tet": 99.0}]})
+    assert [(r[0], r[-1]) for r in rows] == [
+        ("serial ns/tet", "missed"), ("two-thread speed-up", "met"),
+        ("fraction of attainable", "missed"), ("step / 4 forces", "met")]

@@ -37,6 +37,15 @@ ENGINE_REFERENCE = "fem-neohookean"   # what the optional engines' forces are co
 # the implicit presets' steps are timed up to this size: each solves a Newton system by
 # conjugate gradients whose iterations grow with the mesh
 IMPLICIT_TETS = 2e5
+# what the kernels are held to (serial ns per tetrahedron per force evaluation from the bench's
+# 1e5 cube up; every preset's two-thread speed-up there; its fraction of the attainable
+# rate there; its RK4 step over four force evaluations from the 1e4 cube up)
+KERNEL_TARGETS = {"pbcm-corner": 30.0, "pbcm-balanced": 30.0, "pbcm-variational": 40.0,
+                  "pbcm-variational+normal": 60.0, "fem-linear": 10.0, "fem-corotated": 25.0,
+                  "msm": 4.0}
+TWO_THREAD_TARGET, ROOFLINE_TARGET, STEP_TARGET = 1.8, 0.5, 1.1
+# a value without its rounds' range is not resolved this close to a target (a fraction of it)
+UNRESOLVED = 0.05
 
 
 def implicit_row(name, mesh, samples, rounds):
@@ -169,11 +178,18 @@ def run(sizes=SIZES, models=None, rounds=7, progress=print, with_engines=True, d
             own = np.array(samples[name])
             row = {"model": name, "tets": mesh.n_tets, "nodes": mesh.n_nodes,
                    "ns_per_tet": float(np.median(own[:, 0]) / mesh.n_tets * 1e9),
+                   "ns_per_tet_range": [float(own[:, 0].min() / mesh.n_tets * 1e9),
+                                        float(own[:, 0].max() / mesh.n_tets * 1e9)],
                    "us_per_step": float(np.median(own[:, 1]) * 1e6),
                    "step_over_4_forces": float(np.median(own[:, 1] / (4 * own[:, 0]))),
+                   "step_over_4_forces_range": [float(np.min(own[:, 1] / (4 * own[:, 0]))),
+                                                float(np.max(own[:, 1] / (4 * own[:, 0])))],
                    "calibration_s": timed[name].calibration,
                    "two_thread_speedup": (float(np.median(own[:, 2]))
                                           if timed[name].kernels_2 is not None else None),
+                   "two_thread_speedup_range": ([float(own[:, 2].min()), float(own[:, 2].max())]
+                                                if timed[name].kernels_2 is not None
+                                                else None),
                    "memory_mb": timed[name].memory / 1e6, "rounds": rounds,
                    "flops_per_tet": flop_counts.get(name),
                    "bytes_per_tet": roofline.bytes_per_tet(timed[name].pm)}
@@ -264,6 +280,7 @@ def write(data, out):
           "force evaluation run back to back; '-' where a model has no threaded term.")
     for line in summary(data):
         doc.p(line)
+    _targets_table(doc, data)
     doc.table(["model", "tets", "ns/tet (force)", "us/step", "step / 4 forces",
                "step vs msm", "step vs fem-linear", "calibration [s]", "memory [MB]",
                "2-thread force speed-up"],
@@ -320,6 +337,77 @@ def write(data, out):
                    for r in data["device_rows"]])
     doc.img("step_time.png", "RK4 step time against tetrahedra, every model")
     doc.write(out, stem="bench")
+
+
+def verdict(value, spread, target, at_most):
+    """'met', 'missed' or 'not resolved' for ``value`` against ``target`` (``at_most``: the
+    value must not exceed it, else not fall below it): not resolved where the rounds' range
+    ``spread`` straddles the target, or, without a range, within UNRESOLVED of it."""
+    lo, hi = spread if spread else (value, value)
+    if not spread and abs(value - target) <= UNRESOLVED * target:
+        return "not resolved (no spread recorded)"
+    if lo <= target <= hi and lo != hi:
+        return "not resolved (its range holds the target)"
+    return "met" if (value <= target if at_most else value >= target) else "missed"
+
+
+def target_rows(data):
+    """[quantity, target, model, tets, measured [range], verdict] for every preset against
+    the kernel targets, at every bench size they apply to."""
+    rows = data["rows"]
+    big, mid = bench_mesh(1e5).n_tets, bench_mesh(1e4).n_tets
+    out = []
+
+    def add(what, target, at_most, r, key, spread_key, digits=3):
+        value, spread = r.get(key), r.get(spread_key)
+        if value is None:
+            return
+        shown = fmt(value, digits) + (f" [{fmt(spread[0], digits)}-{fmt(spread[1], digits)}]"
+                                      if spread else "")
+        out.append([what, ("<= " if at_most else ">= ") + fmt(target), r["model"], r["tets"],
+                    shown, verdict(value, spread, target, at_most)])
+
+    for r in rows:
+        if r["model"] not in PRESETS:
+            continue
+        if r["tets"] >= big and r["model"] in KERNEL_TARGETS:
+            add("serial ns/tet", KERNEL_TARGETS[r["model"]], True, r, "ns_per_tet",
+                "ns_per_tet_range")
+        if r["tets"] >= big:
+            add("two-thread speed-up", TWO_THREAD_TARGET, False, r, "two_thread_speedup",
+                "two_thread_speedup_range")
+            add("fraction of attainable", ROOFLINE_TARGET, False, r, "roofline_fraction",
+                None, 2)
+        if r["tets"] >= mid:
+            add("step / 4 forces", STEP_TARGET, True, r, "step_over_4_forces",
+                "step_over_4_forces_range")
+    order = ["serial ns/tet", "two-thread speed-up", "fraction of attainable",
+             "step / 4 forces"]
+    return sorted(out, key=lambda row: (order.index(row[0]), row[3]))
+
+
+def _targets_table(doc, data):
+    """The presets against the kernel targets, each verdict with its criterion."""
+    got = target_rows(data)
+    if not got:
+        return
+    counts = {v: sum(1 for r in got if r[-1].startswith(v))
+              for v in ("met", "missed", "not resolved")}
+    m = data["machine"]
+    doc.p(f"Against the kernel targets on this machine ({m['cpu']}, {m['cores']} cores): "
+          f"{counts['met']} met, {counts['missed']} missed, {counts['not resolved']} not "
+          "resolved. The targets: serial ns per tetrahedron per force evaluation ("
+          + ", ".join(f"{k} {fmt(v)}" for k, v in KERNEL_TARGETS.items())
+          + f") and a two-thread speed-up of at least {fmt(TWO_THREAD_TARGET)} and at least "
+          f"{fmt(ROOFLINE_TARGET)} of the attainable rate (the roofline below) from the "
+          f"bench's 1e5 cube ({bench_mesh(1e5).n_tets} tetrahedra) up; an RK4 step of at "
+          f"most {fmt(STEP_TARGET)} times four force evaluations from its 1e4 cube "
+          f"({bench_mesh(1e4).n_tets}) up. A verdict is not resolved where the rounds' "
+          "[smallest-largest] holds the target, or, where this bench did not record the "
+          f"rounds' range, within {UNRESOLVED:.0%} of it. A step ratio below 1 means the "
+          "step's own four force evaluations ran faster than the standalone one timed for "
+          "ns/tet (the two are compiled apart); its cause is not measured here.")
+    doc.table(["quantity", "target", "model", "tets", "measured [range]", "verdict"], got)
 
 
 def _roofline_table(doc, data):
