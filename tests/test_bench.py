@@ -324,23 +324,28 @@ def test_an_implicit_step_is_timed_with_blas_on_one_thread(monkeypatch):
 
 def test_a_target_verdict_reads_the_rounds_range():
     """Against an upper target: a range below it is met, above it missed, holding it not
-    resolved; without a range, a value within UNRESOLVED of the target is not resolved and
-    one farther off is met or missed; a lower target (a speed-up) the same way round."""
+    resolved; without a range, the value is read against a relative band (the bench's spread
+    at its size); a lower target (a speed-up) the same way round; a step ratio below 1 is not
+    resolved."""
     v = bench.verdict
     assert v(24.0, [23.0, 25.0], 30.0, True) == "met"
     assert v(34.0, [31.0, 35.0], 30.0, True) == "missed"
     assert v(29.0, [28.0, 31.0], 30.0, True).startswith("not resolved")
-    assert v(29.0, None, 30.0, True).startswith("not resolved")
-    assert v(20.0, None, 30.0, True) == "met" and v(40.0, None, 30.0, True) == "missed"
+    assert v(29.0, None, 30.0, True, band=0.1).startswith("not resolved")
+    assert v(20.0, None, 30.0, True, band=0.1) == "met"
+    assert v(40.0, None, 30.0, True, band=0.1) == "missed"
     assert v(1.9, [1.85, 1.95], 1.8, False) == "met"
     assert v(1.7, [1.6, 1.75], 1.8, False) == "missed"
     assert v(1.82, [1.78, 1.86], 1.8, False).startswith("not resolved")
-    rows = bench.target_rows({"rows": [
-        {"model": "pbcm-corner", "tets": bench.bench_mesh(1e5).n_tets, "ns_per_tet": 33.0,
+    big = bench.bench_mesh(1e5).n_tets
+    data = {"rows": [
+        {"model": "pbcm-corner", "tets": big, "ns_per_tet": 33.0,
          "ns_per_tet_range": [32.0, 34.0], "two_thread_speedup": 1.9,
          "two_thread_speedup_range": [1.85, 1.95], "roofline_fraction": 0.3,
-         "step_over_4_forces": 1.0, "step_over_4_forces_range": [0.99, 1.01]},
-        {"model": "pbcm-corner", "tets": 1080, "ns_per_tet": 99.0}]})
-    assert [(r[0], r[-1]) for r in rows] == [
+         "step_over_4_forces": 0.95, "step_over_4_forces_range": [0.94, 0.96],
+         "step_vs_msm_range": [4.0, 4.4]},
+        {"model": "pbcm-corner", "tets": 1080, "ns_per_tet": 99.0}]}
+    assert bench.spread_band(data, big) == pytest.approx(0.1)
+    assert [(r[0], r[-1][:12]) for r in bench.target_rows(data)] == [
         ("serial ns/tet", "missed"), ("two-thread speed-up", "met"),
-        ("fraction of attainable", "missed"), ("step / 4 forces", "met")]
+        ("fraction of attainable", "missed"), ("step / 4 forces", "not resolved")]

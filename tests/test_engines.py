@@ -237,3 +237,20 @@ def test_the_dynamic_push_counts_failures_and_says_where_float32_cannot_resolve_
     assert "newton-vbd 0.06 (not resolved from the finite-strain share)" in line
     nh["reaction_time_rel_l2"] = 0.05
     assert "not resolved" not in dynamic_line(dyn + [nh])
+
+
+def test_a_redrawn_report_reads_its_costs_from_the_checkouts_bench(monkeypatch):
+    """Drawn again from its record, the engines report takes each engine's cost from the
+    checkout's bench (as every other report's cost), not the one recorded by its run."""
+    from cases.reporting import costs as bench_costs
+    from cases.studies.engines.study import EngineSettings
+    s = EngineSettings(quick=True)
+    model = s.models()[0]
+    tets = bench_costs.sizes(True)[0]
+    row = {"model": model, "tets": tets, "timed": True, "wall_s_per_simulated_s": 0.5}
+    monkeypatch.setattr(bench_costs, "load", lambda *a: {
+        "realtime_rows": [row], "realtime_machine": {"cpu": "X", "cores": 2}})
+    got = STUDY.redrawn(s, {"costs": {model: None}, "machine": None}, {})
+    assert got["costs"][model] == row and got["machine"] == {"cpu": "X", "cores": 2}
+    monkeypatch.setattr(bench_costs, "load", lambda *a: None)
+    assert STUDY.redrawn(s, {"costs": {model: None}}, {})["costs"] == {model: None}

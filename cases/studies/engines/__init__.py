@@ -5,7 +5,7 @@ counts. Needs the engines extra; without it the report says so and runs nothing.
 from ...framework import Study
 from ...running.store import OFF
 from . import report
-from .study import EngineSettings, run
+from .study import EngineSettings, costs, run
 
 
 class Engines(Study):
@@ -23,6 +23,15 @@ class Engines(Study):
 
     def write(self, out, s, data):
         return report.write(out, self, s, data)
+
+    def redrawn(self, s, data, metrics):
+        # the costs are the checkout's bench, the numbers every other report prints; the
+        # recorded ones only where the checkout has no bench
+        from ...reporting.costs import load
+        bench = load()
+        if bench:
+            data.update(costs(bench, s.models()))
+        return data
 
     def scorecard(self, metrics):
         return report.scorecard(metrics)
