@@ -44,8 +44,6 @@ KERNEL_TARGETS = {"pbcm-corner": 30.0, "pbcm-balanced": 30.0, "pbcm-variational"
                   "pbcm-variational+normal": 60.0, "fem-linear": 10.0, "fem-corotated": 25.0,
                   "msm": 4.0}
 TWO_THREAD_TARGET, ROOFLINE_TARGET, STEP_TARGET = 1.8, 0.5, 1.1
-# a value without its rounds' range is not resolved this close to a target (a fraction of it)
-UNRESOLVED = 0.05
 
 
 def implicit_row(name, mesh, samples, rounds):

@@ -145,16 +145,7 @@ def corotated_block(s, r, blk, data, lam, mu):
     p = data[blk * 10 * B:(blk + 1) * 10 * B]
     n_flat = 0
     for i in range(B):
-        x0 = (s[i], s[B + i], s[2 * B + i])
-        e1 = sub((s[3 * B + i], s[4 * B + i], s[5 * B + i]), x0)
-        e2 = sub((s[6 * B + i], s[7 * B + i], s[8 * B + i]), x0)
-        e3 = sub((s[9 * B + i], s[10 * B + i], s[11 * B + i]), x0)
-        r0, r1, r2 = ((p[i], p[B + i], p[2 * B + i]), (p[3 * B + i], p[4 * B + i], p[5 * B + i]),
-                      (p[6 * B + i], p[7 * B + i], p[8 * B + i]))
-        F = (lin(e1[0], r0, 1.0, lin(e2[0], r1, e3[0], r2)),
-             lin(e1[1], r0, 1.0, lin(e2[1], r1, e3[1], r2)),
-             lin(e1[2], r0, 1.0, lin(e2[2], r1, e3[2], r2)))
-        margin = dot(F[0], cross(F[1], F[2])) - FLAT
+        F, margin = lane_gradient(s, p, i)
         s[FLAG + i] = margin
         n_flat += margin <= 0.0
         for a in range(3):
@@ -193,16 +184,7 @@ def corotated_block(s, r, blk, data, lam, mu):
         P = (lin(2.0 * mu, F[0], lam * tr - 2.0 * mu, R[0]),
              lin(2.0 * mu, F[1], lam * tr - 2.0 * mu, R[1]),
              lin(2.0 * mu, F[2], lam * tr - 2.0 * mu, R[2]))
-        v = p[9 * B + i]
-        f0 = (0.0, 0.0, 0.0)
-        for c in range(3):
-            rc = (p[3 * c * B + i], p[(3 * c + 1) * B + i], p[(3 * c + 2) * B + i])
-            f = (-v * dot(P[0], rc), -v * dot(P[1], rc), -v * dot(P[2], rc))
-            for k in range(3):
-                s[OUT + (3 * c + 3 + k) * B + i] = f[k]
-            f0 = sub(f0, f)
-        for k in range(3):
-            s[OUT + k * B + i] = f0[k]
+        lane_forces(s, p, i, P)
     return n_flat
 
 
