@@ -11,6 +11,7 @@ class Realtime(Study):
     selections = ()            # its models and meshes are the bench's
     title = "accuracy at a real-time budget: the largest mesh each model runs in real time"
     settings_class = RealtimeSettings
+    recorded_keys = ("runs", "error_estimate", "top_force_n", "machine")
 
     def run(self, s, workers=None, log=True, bench=None, store=None):
         return run(s, workers=workers, log=log, bench=bench, store=store or OFF)

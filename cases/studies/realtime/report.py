@@ -99,13 +99,15 @@ def pair_u(a, b, estimate):
 
 
 def rank(scores, at, estimate, spans=None):
-    """[(rank, law, [laws tied with it])], best first: ``scores`` {law: error bound or None
-    (counts as failed, last)}; two bounds are tied where their difference is within
-    ``pair_u``, where both are below JUDGES times the reference's estimate (it cannot order
-    them), or where their ``spans`` {law: (lo, hi)} overlap within ``pair_u`` (the bound over
-    the reach's range in the bench's rounds: which of the two is further ahead depends on
-    the round); a law shares the rank of the first group whose first it is tied with, pair by
-    pair."""
+    """[(rank, law, [laws tied with it], [laws resolved ahead of it])], in rank order:
+    ``scores`` {law: error bound or None (counts as failed, behind every bound)}; two bounds
+    are tied where their difference is within ``pair_u``, where both are below JUDGES times
+    the reference's estimate (it cannot order them), or where their ``spans`` {law: (lo, hi)}
+    overlap within ``pair_u`` (the bound over the reach's range in the bench's rounds: which
+    of the two is further ahead depends on the round). A tie is not transitive (two laws on
+    one mesh are ordered within round-off, each tied with a third on another mesh), so a
+    law's rank is one more than the number of laws resolved ahead of it (a smaller bound, not
+    tied): the first are those no law is resolved ahead of, every two of them tied."""
     order = sorted(scores, key=lambda m: (scores[m] is None, scores[m] or 0.0, m))
     spans = spans or {}
 
@@ -121,14 +123,15 @@ def rank(scores, at, estimate, spans=None):
                                                                     estimate)
         return (abs(sa - sb) <= u or (sa < small and sb < small)
                 or max(lo_a, lo_b) <= min(hi_a, hi_b) + u_span)
-    out, heads = [], []
-    for k, m in enumerate(order):
-        r = next((r for r, h in heads if tied(m, h)), None)
-        if r is None:
-            r = k + 1
-            heads.append((r, m))
-        out.append((r, m, [o for o in order if o != m and tied(m, o)]))
-    return out
+
+    def ahead(o, m):
+        if tied(o, m) or scores[o] is None:
+            return False
+        return scores[m] is None or scores[o] < scores[m]
+    out = [(1 + sum(ahead(o, m) for o in order), m,
+            [o for o in order if o != m and tied(m, o)],
+            [o for o in order if ahead(o, m)]) for m in order]
+    return sorted(out, key=lambda x: x[0])          # stable: by bound within a rank
 
 
 def span(runs, law, reach_):
@@ -160,7 +163,7 @@ def verdict(data):
     bounds = {m: bound(runs, r["run"]) for m, r in measured.items()}
     spans = {m: span(runs, m, r) for m, r in measured.items() if bounds[m] is not None}
     ranked = rank(bounds, measured, e, spans)
-    first = [m for k, m, _ in ranked if k == 1 and bounds[m] is not None]
+    first = [m for k, m, _, _ in ranked if k == 1 and bounds[m] is not None]
     yard = at.get(P1)
     cautious = reach(runs, MARGIN)
     # the top force at each reach against FEM P1's: the stiffness the displacement bound
@@ -183,8 +186,8 @@ def verdict(data):
             "u_two_meshes": u_val(math.sqrt(2.0) * e), "bounds": bounds, "spans": spans,
             "reach": {m: None if r is None else {k: v for k, v in r.items() if k != "run"}
                       for m, r in at.items()},
-            "ranks": [{"rank": k, "model": m, "tied": tied, "score": bounds[m]}
-                      for k, m, tied in ranked],
+            "ranks": [{"rank": k, "model": m, "tied": tied, "behind": behind,
+                       "score": bounds[m]} for k, m, tied, behind in ranked],
             "yardstick": None if yard is None else {
                 "model": P1, "tets": yard["tets"], "distance": yard["run"]["disp_rel_l2"]},
             "cancels": [m for m, r in measured.items()
@@ -213,7 +216,7 @@ def answer_line(data, v, quick):
     for m in v["best"]:
         reach_ = v["reach"][m]
         mode = reach_["model"] if reach_["model"] != m else reach_["mode"]
-        said.append(f"{m} ({mode}, {reach_['tets']} tetrahedra, {err(v['bounds'][m])})")
+        said.append(f"{m} ({mode}, {_reach_words(reach_)}, {err(v['bounds'][m])})")
     y, p = v.get("yardstick"), v["pick"]
     if len(said) > 1:
         head = (f"the smallest error bound (model-form error plus FEM P1's discretisation "
@@ -224,6 +227,12 @@ def answer_line(data, v, quick):
     else:
         head = ("the smallest error bound (model-form error plus FEM P1's discretisation "
                 f"error at the model's reach) is {said[0]}")
+    # the runners-up: tied with some of the first, resolved behind first ones only
+    nearly = [k for k in v["ranks"] if k["rank"] > 1 and set(k["tied"]) & set(v["best"])
+              and set(k["behind"]) <= set(v["best"])]
+    if nearly:
+        head += ("; tied with some of them but resolved behind another: "
+                 + "; ".join(_behind_words(k, v) for k in nearly))
     why = ("real time in every timing round at its reach, with the most headroom"
            if v["pick_sure"] else "the most headroom, though no tied model is real time in "
            "every round at its reach")
@@ -240,7 +249,9 @@ def answer_line(data, v, quick):
               f"{y['tets']} tetrahedra at distance {err(y['distance'])}" if y else "")
     engines = v.get("engines") or {}
     newton = ("; Newton's solvers (single precision on one core of Warp's CPU backend, "
-              "through pbcm's adapter) in real time: " + ", ".join(
+              "through pbcm's adapter; their cost is one core's, the models' above two "
+              "threads', so their reaches are not compared with those) in real time: "
+              + ", ".join(
                   f"{m} up to {t} tetrahedra" + (
                       f" (top force {fmt(force[m], 2)} from FEM P1's there)"
                       if force.get(m) is not None else "")
@@ -250,6 +261,23 @@ def answer_line(data, v, quick):
             f"its cube), {head}. {stiff}Pick {p}: {why} "
             f"({fmt(v['reach'][p]['range'][1])} s per simulated s in its slowest round)"
             f"{beside}{newton}.")
+
+
+def _behind_words(k, v):
+    """'pbcm-variational (0.0275, behind pbcm-balanced on the same mesh, 0.0269)'."""
+    tets = v["reach"][k["model"]]["tets"]
+    return f"{k['model']} ({err(k['score'])}, behind " + ", ".join(
+        f"{b}{' on the same mesh' if v['reach'][b]['tets'] == tets else ''}, "
+        f"{err(v['bounds'][b])}" for b in k["behind"]) + ")"
+
+
+def _reach_words(reach_):
+    """'10985 tetrahedra (8640 in every timing round)', or '6655 tetrahedra' where every
+    round is real time there."""
+    if reach_["sure"] == reach_["tets"]:
+        return f"{reach_['tets']} tetrahedra"
+    sure = reach_["sure"] or "none"
+    return f"{reach_['tets']} tetrahedra ({sure} in every timing round)"
 
 
 def write(out, study, s, data):
@@ -337,6 +365,8 @@ def build(out, study, s, doc):
             m, reach_ = k["model"], v["reach"][k["model"]]
             r = _law_run(runs, m, reach_["tets"])
             mode = reach_["model"] if reach_["model"] != m else reach_["mode"]
+            if r["cost"].get("engine"):
+                mode += " (one core: its cost not compared)"
             p1 = k["score"] - r["disp_form_rel_l2"] if k["score"] is not None else None
             rows.append([k["rank"], m, mode,
                          f"{reach_['tets']} ({reach_['sure'] or 'none'}-{reach_['maybe']})",
@@ -344,25 +374,33 @@ def build(out, study, s, doc):
                          f"{fmt(reach_['range'][1])}]", err(k["score"]),
                          _span_cell(v.get("spans", {}).get(m)),
                          err(r["disp_form_rel_l2"]), err(p1),
-                         ", ".join(k["tied"]) or "-"])
+                         ", ".join(k["tied"]) or "-", ", ".join(k["behind"]) or "-"])
         d.p(f"Each model at the largest mesh it runs in real time on {where}, ranked by its "
             "error bound there: its model-form error plus FEM P1's distance from the continuum "
             "on that mesh (the discretisation error every model there shares; the bound of its "
             "own distance by the triangle inequality, which a model whose error cancels FEM "
             "P1's on a coarse mesh cannot undercut); a failed run or an error not computed "
             "counts against it. Two bounds on different meshes are tied within "
-            f"{err(v['u_two_meshes'])} (the reference's estimate {err(v['estimate'])} on each "
-            "mesh's FEM P1 distance, in quadrature); two on one mesh differ only in model-form "
+            f"u_val = {err(v['u_two_meshes'])}: u_num the reference's estimate "
+            f"{err(v['estimate'])} on each mesh's FEM P1 distance, in quadrature (one "
+            "reference serves every mesh, so there is no spread over references); u_input 0 "
+            "(every model has the same push, material and meshes: no input differs between "
+            "two of them); u_D, the timing's noise, enters through the reach's range over the "
+            "rounds (below), not as a number. Two on one mesh differ only in model-form "
             "error, tied within round-off; bounds both below "
             f"{err(JUDGES * v['estimate'])} ({JUDGES} times the estimate) are not resolved. "
             "The reach's range: from the largest size real time in every round to the "
             "largest real time in some round; the bound over it runs from the bound there to "
             "the bound here, and two models whose bounds over their ranges overlap (within "
-            "the same uncertainty) are tied: which is ahead depends on the timing round.")
+            "the same uncertainty) are tied: which is ahead depends on the timing round. "
+            "A tie is not transitive (two models on one mesh are ordered within round-off "
+            "while each is tied with a third on another mesh): a model's rank is one more "
+            "than the number of models resolved ahead of it, so the first are those no model "
+            "is resolved ahead of, and every two of them are tied.")
         d.table(["rank", "model", "mode at its reach", "tets (over the rounds)",
                  f"wall s per simulated s ({where})", "error bound",
                  "bound over the reach's range", "model-form error",
-                 "+ FEM P1's distance there", "tied with"], rows)
+                 "+ FEM P1's distance there", "tied with", "resolved behind"], rows)
         d.p("How firm the reaches are, and each model's own distance from the continuum at "
             f"its reach (a bound's slack is larger than {err(v['u_two_meshes'])}, so these "
             "distances do not order the models): the reach at a step "
@@ -381,7 +419,10 @@ def build(out, study, s, doc):
         d.p("The top force is the reaction the push needs, which the displacement bound "
             "hardly sees (the push prescribes the top): its model-form error (f - f_P1) / "
             "|f_c| is a law's stiffness against FEM P1's on the same tetrahedra; the pick is "
-            f"among the tied first whose force is within {STIFF:g} of FEM P1's, where any is.")
+            f"among the tied first whose force is within {STIFF:g} of FEM P1's, where any is. "
+            f"The {STIFF:g} is a tolerance of use (a force {100 * STIFF:g} % off), not an "
+            "uncertainty: on "
+            "one mesh the force's model-form error carries round-off only.")
         if v.get("modes"):
             d.p("fem-corotated's implicit modes on their own: " + "; ".join(
                 f"{m} " + (f"real time up to {t} tetrahedra" if t else
