@@ -349,3 +349,15 @@ def test_a_target_verdict_reads_the_rounds_range():
     assert [(r[0], r[-1][:12]) for r in bench.target_rows(data)] == [
         ("serial ns/tet", "missed"), ("two-thread speed-up", "met"),
         ("fraction of attainable", "missed"), ("step / 4 forces", "not resolved")]
+
+
+def test_the_machine_is_named_with_what_a_bare_processor_name_leaves_out():
+    """A virtual machine's bare 'AMD EPYC' is printed with its family and model, its clock and
+    its widest SIMD from /proc/cpuinfo, each left out where cpuinfo lacks it."""
+    from cases.tools.bench import cpu_name
+    info = {"model name": "AMD EPYC", "cpu family": "26", "model": "2", "cpu MHz": "2596.1",
+            "flags": "fpu sse2 avx2 avx512f fma"}
+    assert cpu_name(info) == "AMD EPYC (family 26 model 2, 2.6 GHz, AVX-512)"
+    assert cpu_name({"model name": "X", "flags": "sse2 avx2"}) == "X (AVX2)"
+    assert cpu_name({"model name": "X"}) == "X"
+    assert cpu_name({}) is None

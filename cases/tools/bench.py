@@ -237,17 +237,36 @@ def merge(old, new):
 
 
 def machine():
+    """The processor as /proc/cpuinfo names it, with what a virtual machine's bare name leaves
+    out (family and model, clock, the widest SIMD), its cores and the Python version."""
     import os
     import platform
     cpu = platform.processor() or platform.machine()
     try:
+        info = {}
         for line in open("/proc/cpuinfo"):
-            if line.startswith("model name"):
-                cpu = line.split(":", 1)[1].strip()
-                break
+            k, _, v = line.partition(":")
+            info.setdefault(k.strip(), v.strip())
+        cpu = cpu_name(info) or cpu
     except OSError:
         pass
     return {"cpu": cpu, "cores": os.cpu_count(), "python": platform.python_version()}
+
+
+def cpu_name(info):
+    """'AMD EPYC (family 26 model 2, 2.6 GHz, AVX-512)' from /proc/cpuinfo's first entries
+    ``info``; None without a model name."""
+    name = info.get("model name")
+    if not name:
+        return None
+    flags = set(info.get("flags", "").split())
+    simd = next((w for f, w in (("avx512f", "AVX-512"), ("avx2", "AVX2"), ("sse2", "SSE2"))
+                 if f in flags), None)
+    said = [f"family {info['cpu family']} model {info['model']}"
+            if "cpu family" in info and "model" in info else None,
+            f"{float(info['cpu MHz']) / 1000:.1f} GHz" if info.get("cpu MHz") else None, simd]
+    said = [x for x in said if x]
+    return f"{name} ({', '.join(said)})" if said else name
 
 
 def _ranged(row, key):
