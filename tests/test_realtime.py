@@ -81,7 +81,9 @@ def test_the_ranking_leaves_the_yardstick_beside_and_ties_by_the_pair_s_uncertai
     assert v["cancels"] == ["pbcm-corner"]
     said = R.answer_line(data, v, quick=False)
     assert said.startswith("At real time on this machine (X, 2 cores, wall clock, the paper's "
-                           "push on its cube), the smallest error bound (model-form error plus "
+                           "push on its cube; the errors are each model's static equilibrium "
+                           "under the push, how far a timed run lags it not measured), the "
+                           "smallest error bound (model-form error plus "
                            "FEM P1's discretisation error at the model's reach) is "
                            "pbcm-variational (serial, 1715 tetrahedra, 0.0526). Pick "
                            "pbcm-variational: real time in every timing round")
@@ -192,8 +194,8 @@ def test_a_reach_the_timing_rounds_do_not_settle_widens_the_tie():
     assert sorted(v["best"]) == ["fem-linear", "pbcm-balanced"]
     said = R.answer_line(data, v, quick=False)
     assert "what their reach spans over the timing rounds" in said
-    assert "pbcm-balanced (serial, 5000 tetrahedra (2560 in every timing round), 0.0310)" \
-        in said
+    assert "pbcm-balanced (serial, 5000 tetrahedra (2560 in every timing round, bound " \
+        "0.0440 there), 0.0310)" in said
     # the pick: the tied model real time in every round at its reach
     assert v["pick"] == "fem-linear" and "Pick fem-linear: real time in every timing round" \
         in said
@@ -251,3 +253,28 @@ def test_a_model_resolved_behind_one_of_the_first_ranks_after_every_one_of_them(
     said = R.answer_line(data, v, quick=False)
     assert "is tied between 2 models" in said
     assert "pbcm-variational (0.0275, behind pbcm-balanced on the same mesh, 0.0269)" in said
+
+
+def test_a_reach_range_that_ends_on_the_other_models_mesh_is_compared_there_within_round_off():
+    """A law real time at 10985 tetrahedra in some rounds and at 8640 in every round, against
+    one whose reach is 8640: at 8640 the two differ only in model-form error (round-off
+    resolves 0.0345 against 0.0398), at 10985 by more than the two-mesh u_val (0.0322 against
+    0.0398), and every round agrees which is ahead: not tied, however far the two-mesh
+    uncertainty would reach from the range's end. Newton's solvers (one core) are named
+    beside the ranking, never ranked."""
+    e = 0.0051
+    runs = [_run("fem-neohookean", 8640, 2.0, 0.0207, 0.0),
+            _run("fem-neohookean", 10985, 2.0, 0.0185, 0.0),
+            _run("fem-linear", 8640, 0.8, 0.03, 0.0138),
+            _run("fem-linear", 10985, 0.95, 0.03, 0.0137, spread=0.1),
+            _run("msm+volume", 8640, 0.8, 0.03, 0.0191),
+            _run("newton-xpbd", 8640, 0.5, 0.3, 0.2)]
+    data = {"runs": runs, "error_estimate": e, "machine": {"cpu": "X", "cores": 2}}
+    v = R.verdict(data)
+    ranks = {k["model"]: k for k in v["ranks"]}
+    assert "msm+volume" not in ranks["fem-linear"]["tied"]
+    assert ranks["msm+volume"]["behind"] == ["fem-linear"]
+    assert "newton-xpbd" not in ranks and v["engines"] == {"newton-xpbd": 8640}
+    # with the two meshes' reference errors added (2e = 0.0102), the range's far end is tied
+    assert v["worst_case_first"] == ["fem-linear", "msm+volume"]
+    assert "also msm+volume" in R.answer_line(data, v, quick=False)

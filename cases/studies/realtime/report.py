@@ -4,6 +4,7 @@ is computed from the data it is written with."""
 import math
 from pathlib import Path
 
+from model.compose import simulator
 from ...measuring import catalogue
 from ...measuring.error_model import JUDGES, ROUND_OFF, u_val
 from ...reporting import figures
@@ -28,8 +29,14 @@ def models(runs):
 
 
 def ranked_laws(runs):
-    """The laws ranked: every one but FEM P1 with the continuum's law, the yardstick."""
-    return tuple(m for m in laws(runs) if m != P1)
+    """The laws ranked: every one but FEM P1 with the continuum's law, the yardstick, and
+    the engines' solvers (timed on one core, the others on two: their costs not compared)."""
+    return tuple(m for m in laws(runs) if m != P1 and not engine(m))
+
+
+def engine(model):
+    """Whether ``model`` is an engine's solver run through pbcm's adapter (Newton's)."""
+    return simulator(model) is not None
 
 
 def err(v):
@@ -89,61 +96,76 @@ def bound(runs, run):
     return run["disp_form_rel_l2"] + p1["disp_rel_l2"]
 
 
-def pair_u(a, b, estimate):
+def pair_u(a, b, u_two):
     """The uncertainty of the difference of two error bounds: on one mesh they differ only in
     their model-form errors, which the reference does not enter (round-off); on two meshes
-    each carries the reference's estimate through FEM P1's distance (the two in quadrature)."""
-    if a["tets"] == b["tets"]:
-        return ROUND_OFF
-    return u_val(math.sqrt(2.0) * estimate)
+    ``u_two``, what the reference's estimate carries through each FEM P1 distance."""
+    return ROUND_OFF if a["tets"] == b["tets"] else u_two
 
 
-def rank(scores, at, estimate, spans=None):
+def u_two_meshes(estimate, worst=False):
+    """u_val of two bounds on two meshes: u_num the reference's estimate on each mesh's FEM
+    P1 distance, in quadrature (the two meshes' errors of the one reference taken as
+    independent), or added (``worst``: the triangle inequality's bound, whatever their
+    correlation); u_input and u_D as ``verdict`` states them (not estimated; round-off)."""
+    return u_val(2.0 * estimate if worst else math.sqrt(2.0) * estimate, 0.0, ROUND_OFF)
+
+
+def rank(scores, at, estimate, points=None, u_two=None):
     """[(rank, law, [laws tied with it], [laws resolved ahead of it])], in rank order:
-    ``scores`` {law: error bound or None (counts as failed, behind every bound)}; two bounds
-    are tied where their difference is within ``pair_u``, where both are below JUDGES times
-    the reference's estimate (it cannot order them), or where their ``spans`` {law: (lo, hi)}
-    overlap within ``pair_u`` (the bound over the reach's range in the bench's rounds: which
-    of the two is further ahead depends on the round). A tie is not transitive (two laws on
-    one mesh are ordered within round-off, each tied with a third on another mesh), so a
-    law's rank is one more than the number of laws resolved ahead of it (a smaller bound, not
-    tied): the first are those no law is resolved ahead of, every two of them tied."""
+    ``scores`` {law: error bound at its reach, or None (counts as failed, behind every
+    bound)}; ``points`` {law: [(tets, bound)]} the bounds over its reach's range in the
+    bench's rounds (a round's reach is one of those sizes; default the reach alone). Two laws
+    are tied where some pair of their points differ within ``pair_u`` (of those two meshes),
+    where the pairs do not agree on which is ahead (that depends on the timing round), or
+    where both bounds are below JUDGES times the reference's estimate (it cannot order them).
+    A tie is not transitive (two laws on one mesh are ordered within round-off, each tied with
+    a third on another mesh), so a law's rank is one more than the number of laws resolved
+    ahead of it (a smaller bound, not tied): the first are those no law is resolved ahead of,
+    every two of them tied."""
     order = sorted(scores, key=lambda m: (scores[m] is None, scores[m] or 0.0, m))
-    spans = spans or {}
+    points = points or {}
+    u_two = u_two_meshes(estimate) if u_two is None else u_two
 
     def tied(a, b):
         sa, sb = scores[a], scores[b]
         if sa is None or sb is None:
             return sa is None and sb is None
-        small, u = JUDGES * estimate, pair_u(at[a], at[b], estimate)
-        lo_a, hi_a = spans.get(a, (sa, sa))
-        lo_b, hi_b = spans.get(b, (sb, sb))
-        # a span's ends lie on other meshes than the reach: they carry the two-mesh u
-        u_span = u if (lo_a == hi_a and lo_b == hi_b) else pair_u({"tets": 0}, {"tets": 1},
-                                                                    estimate)
-        return (abs(sa - sb) <= u or (sa < small and sb < small)
-                or max(lo_a, lo_b) <= min(hi_a, hi_b) + u_span)
+        small = JUDGES * estimate
+        if sa < small and sb < small:
+            return True
+        pa = points.get(a) or [(at[a]["tets"], sa)]
+        pb = points.get(b) or [(at[b]["tets"], sb)]
+        ahead = set()
+        for ta, ba in pa:
+            for tb, bb in pb:
+                if abs(ba - bb) <= pair_u({"tets": ta}, {"tets": tb}, u_two):
+                    return True
+                ahead.add(ba < bb)
+        return len(ahead) > 1
 
-    def ahead(o, m):
+    def resolved_ahead(o, m):
         if tied(o, m) or scores[o] is None:
             return False
         return scores[m] is None or scores[o] < scores[m]
-    out = [(1 + sum(ahead(o, m) for o in order), m,
+    out = [(1 + sum(resolved_ahead(o, m) for o in order), m,
             [o for o in order if o != m and tied(m, o)],
-            [o for o in order if ahead(o, m)]) for m in order]
+            [o for o in order if resolved_ahead(o, m)]) for m in order]
     return sorted(out, key=lambda x: x[0])          # stable: by bound within a rank
 
 
-def span(runs, law, reach_):
-    """(lo, hi) of a law's error bound over its reach's range in the bench's rounds: at the
-    largest size real time in some round, and at the largest real time in every round
-    (infinite where no size is)."""
-    def at(tets):
-        if tets is None:
-            return math.inf
-        b = bound(runs, _law_run(runs, law, tets))
-        return math.inf if b is None else b
-    return at(reach_["maybe"]), at(reach_["sure"])
+def reach_points(runs, law, reach_):
+    """[(tets, bound)] of a law over its reach's range in the bench's rounds, smallest size
+    first: each size of the family from the largest real time in every round to the largest
+    real time in some round at which it was timed (a round's reach is one of them), led by
+    (None, inf) where no size is real time in every round (a round without a reach); a size
+    without a bound counts as failed there (inf)."""
+    lo, hi = reach_["sure"], reach_["maybe"]
+    sizes = sorted({r["tets"] for r in runs if r["law"] == law and _cost(r)[0] is not None
+                    and lo is not None and lo <= r["tets"] <= hi} | {hi})
+    out = [(t, next((b for r in runs if r["model"] == law and r["tets"] == t
+                     for b in [bound(runs, r)] if b is not None), math.inf)) for t in sizes]
+    return ([(None, math.inf)] if lo is None else []) + out
 
 
 def verdict(data):
@@ -161,14 +183,19 @@ def verdict(data):
                 "reach": {m: None for m in laws(runs)}, "ranks": []}
     e = data["error_estimate"] or 0.0
     bounds = {m: bound(runs, r["run"]) for m, r in measured.items()}
-    spans = {m: span(runs, m, r) for m, r in measured.items() if bounds[m] is not None}
-    ranked = rank(bounds, measured, e, spans)
+    points = {m: reach_points(runs, m, r) for m, r in measured.items()
+              if bounds[m] is not None}
+    spans = {m: (bounds[m], p[0][1]) for m, p in points.items()}
+    ranked = rank(bounds, measured, e, points)
     first = [m for k, m, _, _ in ranked if k == 1 and bounds[m] is not None]
+    # the first had the two meshes' reference errors added, not taken in quadrature
+    worst = [m for k, m, _, _ in rank(bounds, measured, e, points, u_two_meshes(e, True))
+             if k == 1 and bounds[m] is not None]
     yard = at.get(P1)
     cautious = reach(runs, MARGIN)
     # the top force at each reach against FEM P1's: the stiffness the displacement bound
     # hardly sees; the pick is among the tied first whose force is within STIFF of FEM P1's
-    force = {m: r["run"].get("force_form_rel") for m, r in measured.items()}
+    force = {m: r["run"].get("force_form_rel") for m, r in at.items() if r is not None}
     stiff = [m for m in first if force[m] is not None and abs(force[m]) <= STIFF]
     # then real time in every round at its reach, with the most headroom (the smallest
     # cost there), so that the machine's jitter does not break it
@@ -181,9 +208,12 @@ def verdict(data):
     return {"decided": bool(first), "best": first, "estimate": e, "pick": pick,
             "pick_sure": bool(sure), "modes": modes, "force": force, "pick_stiff": bool(stiff),
             "engines": {m: None if r is None else r["tets"] for m, r in at.items()
-                        if m.startswith("newton-")},
+                        if engine(m)},
+            "worst_case_first": worst, "u_worst": u_two_meshes(e, True),
+            "engine_bounds": {m: bound(runs, r["run"]) for m, r in at.items()
+                              if engine(m) and r is not None},
             "cautious": {m: None if r is None else r["tets"] for m, r in cautious.items()},
-            "u_two_meshes": u_val(math.sqrt(2.0) * e), "bounds": bounds, "spans": spans,
+            "u_two_meshes": u_two_meshes(e), "bounds": bounds, "spans": spans,
             "reach": {m: None if r is None else {k: v for k, v in r.items() if k != "run"}
                       for m, r in at.items()},
             "ranks": [{"rank": k, "model": m, "tied": tied, "behind": behind,
@@ -216,7 +246,8 @@ def answer_line(data, v, quick):
     for m in v["best"]:
         reach_ = v["reach"][m]
         mode = reach_["model"] if reach_["model"] != m else reach_["mode"]
-        said.append(f"{m} ({mode}, {_reach_words(reach_)}, {err(v['bounds'][m])})")
+        said.append(f"{m} ({mode}, {_reach_words(reach_, v['spans'].get(m))}, "
+                    f"{err(v['bounds'][m])})")
     y, p = v.get("yardstick"), v["pick"]
     if len(said) > 1:
         head = (f"the smallest error bound (model-form error plus FEM P1's discretisation "
@@ -233,6 +264,10 @@ def answer_line(data, v, quick):
     if nearly:
         head += ("; tied with some of them but resolved behind another: "
                  + "; ".join(_behind_words(k, v) for k in nearly))
+    more = [m for m in v.get("worst_case_first") or [] if m not in v["best"]]
+    if more:
+        head += (f"; with the two meshes' reference errors added (u_val {err(v['u_worst'])}, "
+                 "the worst case) rather than in quadrature, also " + ", ".join(more))
     why = ("real time in every timing round at its reach, with the most headroom"
            if v["pick_sure"] else "the most headroom, though no tied model is real time in "
            "every round at its reach")
@@ -258,7 +293,8 @@ def answer_line(data, v, quick):
                   if t else f"{m} at none of the sizes timed"
                   for m, t in engines.items()) if engines else "")
     return (f"At real time on this machine ({machine(data)}, wall clock, the paper's push on "
-            f"its cube), {head}. {stiff}Pick {p}: {why} "
+            f"its cube; the errors are each model's static equilibrium under the push, how "
+            f"far a timed run lags it not measured), {head}. {stiff}Pick {p}: {why} "
             f"({fmt(v['reach'][p]['range'][1])} s per simulated s in its slowest round)"
             f"{beside}{newton}.")
 
@@ -271,13 +307,15 @@ def _behind_words(k, v):
         f"{err(v['bounds'][b])}" for b in k["behind"]) + ")"
 
 
-def _reach_words(reach_):
-    """'10985 tetrahedra (8640 in every timing round)', or '6655 tetrahedra' where every
-    round is real time there."""
+def _reach_words(reach_, span_=None):
+    """'10985 tetrahedra (8640 in every timing round, bound 0.0345 there)', or '6655
+    tetrahedra' where every round is real time there."""
     if reach_["sure"] == reach_["tets"]:
         return f"{reach_['tets']} tetrahedra"
-    sure = reach_["sure"] or "none"
-    return f"{reach_['tets']} tetrahedra ({sure} in every timing round)"
+    if reach_["sure"] is None:
+        return f"{reach_['tets']} tetrahedra (none in every timing round)"
+    there = "" if span_ is None else f", bound {err(span_[1])} there"
+    return f"{reach_['tets']} tetrahedra ({reach_['sure']} in every timing round{there})"
 
 
 def write(out, study, s, data):
@@ -374,7 +412,10 @@ def build(out, study, s, doc):
                          f"{fmt(reach_['range'][1])}]", err(k["score"]),
                          _span_cell(v.get("spans", {}).get(m)),
                          err(r["disp_form_rel_l2"]), err(p1),
-                         ", ".join(k["tied"]) or "-", ", ".join(k["behind"]) or "-"])
+                         "; ".join(x for x in (
+                             k["tied"] and "tied with " + ", ".join(k["tied"]),
+                             k["behind"] and "behind " + ", ".join(k["behind"])) if x)
+                         or "-"])
         d.p(f"Each model at the largest mesh it runs in real time on {where}, ranked by its "
             "error bound there: its model-form error plus FEM P1's distance from the continuum "
             "on that mesh (the discretisation error every model there shares; the bound of its "
@@ -382,12 +423,16 @@ def build(out, study, s, doc):
             "P1's on a coarse mesh cannot undercut); a failed run or an error not computed "
             "counts against it. Two bounds on different meshes are tied within "
             f"u_val = {err(v['u_two_meshes'])}: u_num the reference's estimate "
-            f"{err(v['estimate'])} on each mesh's FEM P1 distance, in quadrature (one "
-            "reference serves every mesh, so there is no spread over references); u_input 0 "
-            "(every model has the same push, material and meshes: no input differs between "
-            "two of them); u_D, the timing's noise, enters through the reach's range over the "
-            "rounds (below), not as a number. Two on one mesh differ only in model-form "
-            "error, tied within round-off; bounds both below "
+            f"{err(v['estimate'])} on each mesh's FEM P1 distance, in quadrature (the two "
+            "meshes' errors of the one reference taken as independent; added, the worst "
+            f"case, u_val would be {err(v['u_worst'])}, and the first would hold "
+            + (", ".join(v["worst_case_first"]) or "none") + "); u_input not estimated (every "
+            "model has the same E, nu, push and meshes, so the ranking holds at those "
+            "inputs; how they move each model is the Truth Cube study's); u_D the static "
+            f"solve's tolerance, round-off ({fmt(ROUND_OFF)}). The cost's noise enters "
+            "through the reach's range over the timing rounds (below), not as a number. Two "
+            "bounds on one mesh differ only in model-form error, tied within round-off; "
+            "bounds both below "
             f"{err(JUDGES * v['estimate'])} ({JUDGES} times the estimate) are not resolved. "
             "The reach's range: from the largest size real time in every round to the "
             "largest real time in some round; the bound over it runs from the bound there to "
@@ -400,10 +445,12 @@ def build(out, study, s, doc):
         d.table(["rank", "model", "mode at its reach", "tets (over the rounds)",
                  f"wall s per simulated s ({where})", "error bound",
                  "bound over the reach's range", "model-form error",
-                 "+ FEM P1's distance there", "tied with", "resolved behind"], rows)
+                 "+ FEM P1's distance there", "tied with; resolved behind"], rows)
         d.p("How firm the reaches are, and each model's own distance from the continuum at "
-            f"its reach (a bound's slack is larger than {err(v['u_two_meshes'])}, so these "
-            "distances do not order the models): the reach at a step "
+            "its reach (beside the bound, not an order: a distance below FEM P1's own on "
+            "that mesh is partly its error cancelling P1's, and one below "
+            f"{err(JUDGES * v['estimate'])}, {JUDGES} times the reference's estimate, is not "
+            "resolved): the reach at a step "
             f"{100 * MARGIN:g} % of the own stable step (the cost divided by {MARGIN:g}), "
             "and whether the reach is real time in every timing round.")
         d.table(["model", "reach", f"reach at {100 * MARGIN:g} % of the step",
@@ -412,7 +459,7 @@ def build(out, study, s, doc):
                 [[k["model"], v["reach"][k["model"]]["tets"],
                   v["cautious"].get(k["model"]) or "none",
                   fmt(v["reach"][k["model"]]["sure"] == v["reach"][k["model"]]["tets"]),
-                  err(lr["disp_rel_l2"]), _signed(lr.get("force_form_rel")),
+                  _judged(lr["disp_rel_l2"], v), _signed(lr.get("force_form_rel")),
                   _signed(lr.get("force_rel"))]
                  for k in v["ranks"]
                  for lr in [_law_run(runs, k["model"], v["reach"][k["model"]]["tets"])]])
@@ -423,6 +470,18 @@ def build(out, study, s, doc):
             f"The {STIFF:g} is a tolerance of use (a force {100 * STIFF:g} % off), not an "
             "uncertainty: on "
             "one mesh the force's model-form error carries round-off only.")
+        if v.get("engines"):
+            d.p("Not ranked: Newton's solvers, timed on one core of Warp's CPU backend (the "
+                "ranked models on two threads), so their reaches are not compared with the "
+                "ranked ones'; each at its own reach, its error bound and top force there.")
+            d.table(["solver", "reach (tets)", "wall s per simulated s (one core)",
+                     "error bound", "top force: model-form error (signed)"],
+                    [[m, t or "none", "-" if not t else
+                      f"{fmt(v['reach'][m]['cost'])} [{fmt(v['reach'][m]['range'][0])}-"
+                      f"{fmt(v['reach'][m]['range'][1])}]",
+                      err(v["engine_bounds"].get(m)) if t else "-",
+                      _signed(v["force"].get(m)) if t else "-"]
+                     for m, t in v["engines"].items()])
         if v.get("modes"):
             d.p("fem-corotated's implicit modes on their own: " + "; ".join(
                 f"{m} " + (f"real time up to {t} tetrahedra" if t else
@@ -450,8 +509,9 @@ def build(out, study, s, doc):
     if v.get("estimate") is not None:
         d.p(f"Errors below {err(JUDGES * v['estimate'])} ({JUDGES} times the reference's "
             "estimate) are marked 'not resolved': the reference cannot judge them.")
+    rounds = sorted({r["cost"].get("rounds") for r in shown if r["cost"].get("rounds")})
     d.p(f"Wall-clock seconds per simulated second on {where} (median [smallest-largest over "
-        "the bench's rounds]), serial and in the two-thread mode ('-': the model has none); "
+        f"the bench's {' or '.join(map(str, rounds)) or 'n/a'} rounds]), serial and in the two-thread mode ('-': the model has none); "
         "the errors are the model's law's static equilibrium. Sizes at which the bench did "
         "not time a model and no error was computed are left out: "
         + (", ".join(f"{m} above {max(r['tets'] for r in shown if r['model'] == m)}"
