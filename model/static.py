@@ -213,31 +213,6 @@ def _backtracked(x, du, rn, s, free, residual):
         alpha *= 0.5
 
 
-def _tangent_start(model, x, r, s, free, residual, factorised):
-    """The first load step's start: the rest state moved by its linear response to the load
-    (K0 du = -(r0 + K0 u_p) on the free components: K0 the Jacobian at rest, r0 the residual
-    at rest under the applied forces, u_p the prescribed increment), where its residual is
-    below that of ``x`` (the rest state with the boundary moved alone, whose layer next to the
-    boundary takes the whole increment); with the factorised rest Jacobian, which the step's
-    chord steps try first."""
-    rest = model.mesh.points
-    k0 = model.jacobian(rest).tocsc()
-    lu = factorised(k0[free][:, free])
-    try:
-        linear = residual(rest, s) + k0 @ (x - rest).ravel()
-    except DegenerateTetError:
-        return x, r, lu
-    xt = x.copy()
-    xt.ravel()[free] = rest.ravel()[free] + lu.solve(-linear[free])
-    try:
-        rt = residual(xt, s)
-    except DegenerateTetError:
-        return x, r, lu
-    if np.all(np.isfinite(rt)) and np.abs(rt[free]).max() < np.abs(r[free]).max():
-        return xt, rt, lu
-    return x, r, lu
-
-
 def _predicted(x, r, before, last, s, free, residual):
     """The start of a load step: the last two converged states ``before`` and ``last``
     (load, positions) extrapolated linearly to the load ``s``, prescribed components kept
@@ -305,9 +280,6 @@ def solve(model, bc, f_ext=None, rtol=RTOL, max_iter=50, load_steps=1, on_step=N
                 "mesh; increase load_steps") from exc
         if before is not None:
             x, r = _predicted(x, r, before, (s_last, x_last), s, free, residual)
-        elif step == 1:
-            x, r, lu = _tangent_start(model, x, r, s, free, residual, factorised)
-            jacobians += lu is not None
         anchor, watched, monotone = None, 0, False
         mark, since = np.inf, 0     # the residual last halved to, and iterations since
         for _ in range(max_iter):

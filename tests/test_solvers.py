@@ -54,9 +54,8 @@ def test_a_free_interior_node_stays_affine_under_uniform_compression(mat):
 
 
 def test_a_load_step_starts_from_the_last_two_equilibria_extrapolated(mat, monkeypatch):
-    """A linear model's equilibria extrapolate exactly: its first load step starts at its
-    equilibrium (the linear response to the load), so four load steps take no Newton
-    iteration and the one Jacobian at rest, as one does, and land where one step does. A
+    """A linear model's equilibria extrapolate exactly: four load steps take the Newton
+    iterations of one (each later step starts converged) and land where one step does. A
     nonlinear one (pbcm-variational at 20 % compression) forms fewer Jacobians than when each
     step starts from the last state with the boundary moved, to the same equilibrium."""
     import model.static as static
@@ -64,7 +63,7 @@ def test_a_load_step_starts_from_the_last_two_equilibria_extrapolated(mat, monke
     _, _, bc = cube_bc(mesh, -1.7e-3)
     pm = build("fem-linear", mesh, mat)
     one, four = pm.solve_static(bc), pm.solve_static(bc, load_steps=4)
-    assert four.iterations == one.iterations == 0 and four.jacobians == one.jacobians == 1
+    assert four.iterations == one.iterations >= 1 and four.jacobians == one.jacobians
     assert np.abs(four.u - one.u).max() < 1e-9 * np.abs(one.u).max()
     _, _, bc = cube_bc(mesh, -0.2 * L)
     pm = build("pbcm-variational", mesh, mat)
@@ -73,24 +72,6 @@ def test_a_load_step_starts_from_the_last_two_equilibria_extrapolated(mat, monke
     plain = pm.solve_static(bc, load_steps=4)
     assert predicted.jacobians < plain.jacobians
     assert np.abs(predicted.u - plain.u).max() < 1e-7 * np.abs(plain.u).max()
-
-
-def test_the_first_load_step_starts_from_the_linear_response(mat, monkeypatch):
-    """The paper's push (1.7 mm) on a 9-node cube, clamped: from the rest state moved by its
-    linear response, a nonlinear model forms fewer Jacobians (the one at rest counted) than
-    from the rest state with the top moved alone (its top layer squeezed by 42 %), to the
-    same equilibrium."""
-    import model.static as static
-    mesh = cube(9, L, "six")
-    top = mesh.nodes_on_plane("z", L)
-    bc = {**{int(i): (0.0, 0.0, 0.0) for i in mesh.nodes_on_plane("z", 0.0)},
-          **{int(i): (0.0, 0.0, -1.7e-3) for i in top}}
-    pm = build("pbcm-balanced", mesh, mat)
-    tangent = pm.solve_static(bc, rtol=1e-10)
-    monkeypatch.setattr(static, "_tangent_start", lambda m, x, r, *rest: (x, r, None))
-    moved = pm.solve_static(bc, rtol=1e-10)
-    assert tangent.jacobians < moved.jacobians
-    assert np.abs(tangent.u - moved.u).max() < 1e-7 * np.abs(moved.u).max()
 
 
 def test_a_full_newton_step_that_raises_the_residual_is_watched_not_cut(mat, monkeypatch):
