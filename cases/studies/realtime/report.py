@@ -195,16 +195,21 @@ def verdict(data):
     # hardly sees; the pick is among the tied first whose force is within STIFF of FEM P1's
     force = {m: r["run"].get("force_form_rel") for m, r in at.items() if r is not None}
     stiff = [m for m in first if force[m] is not None and abs(force[m]) <= STIFF]
-    # then real time in every round at its reach, with the most headroom (the smallest
-    # cost there), so that the machine's jitter does not break it
+    # then real time in every round at its reach; then not costlier on every mesh both
+    # were timed on than another such (like with like: reaches on different meshes are not
+    # costs of one problem); then the most headroom (the smallest cost there in its
+    # slowest round), so that the machine's jitter does not break it
     pool = stiff or first
-    sure = [m for m in pool if measured[m]["sure"] == measured[m]["tets"]]
-    pick = min(sure or pool, key=lambda m: measured[m]["range"][1])
+    sure = [m for m in pool if measured[m]["sure"] == measured[m]["tets"]] or pool
+    cheaper = [m for m in sure if not any(dearer(runs, m, o) for o in sure if o != m)]
+    pick = min(cheaper or sure, key=lambda m: measured[m]["range"][1])
     modes = {m: max((r["tets"] for r in runs if r["model"] == m and _cost(r)[0] is not None
                      and _cost(r)[0] <= REAL_TIME), default=None)
              for m in models(runs) if m not in laws(runs)}
     return {"decided": bool(first), "best": first, "estimate": e, "pick": pick,
-            "pick_sure": bool(sure), "modes": modes, "force": force, "pick_stiff": bool(stiff),
+            "pick_sure": measured[pick]["sure"] == measured[pick]["tets"],
+            "pick_cheaper": [o for o in sure if o != pick and dearer(runs, o, pick)],
+            "modes": modes, "force": force, "pick_stiff": bool(stiff),
             "engines": {m: None if r is None else r["tets"] for m, r in at.items()
                         if engine(m)},
             "engine_bounds": {m: bound(runs, r["run"]) for m, r in at.items()
@@ -221,6 +226,24 @@ def verdict(data):
                         if r["run"]["disp_form_rel_l2"] is not None
                         and r["run"]["disp_rel_l2"] is not None
                         and r["run"]["disp_rel_l2"] + e < r["run"]["disp_form_rel_l2"]]}
+
+
+def _fails_above(runs, model, tets):
+    """'; failed at 1715, 2560 tetrahedra' for a model whose runs above ``tets`` failed."""
+    failed = sorted(r["tets"] for r in runs if r["model"] == model and r["tets"] > tets
+                    and r.get("failed"))
+    return f" (failed at {', '.join(map(str, failed))} tetrahedra)" if failed else ""
+
+
+def dearer(runs, a, b):
+    """Whether law ``a`` costs more than law ``b`` (median wall time per simulated second in
+    its faster mode) on every mesh both were timed on, there being one."""
+    def costs(law):
+        return {r["tets"]: c for r in runs if r["model"] == law
+                for c in [_cost(r)[0]] if c is not None}
+    ca, cb = costs(a), costs(b)
+    shared = set(ca) & set(cb)
+    return bool(shared) and all(ca[t] > cb[t] for t in shared)
 
 
 def machine(data):
@@ -244,7 +267,7 @@ def answer_line(data, v, quick):
         reach_ = v["reach"][m]
         mode = reach_["model"] if reach_["model"] != m else reach_["mode"]
         said.append(f"{m} ({mode}, {_reach_words(reach_, v['spans'].get(m))}, "
-                    f"{err(v['bounds'][m])})")
+                    f"{_judged(v['bounds'][m], v)})")
     y, p = v.get("yardstick"), v["pick"]
     if len(said) > 1:
         head = (f"the smallest error bound (model-form error plus FEM P1's discretisation "
@@ -261,9 +284,11 @@ def answer_line(data, v, quick):
     if nearly:
         head += ("; tied with some of them but resolved behind another: "
                  + "; ".join(_behind_words(k, v) for k in nearly))
-    why = ("real time in every timing round at its reach, with the most headroom"
-           if v["pick_sure"] else "the most headroom, though no tied model is real time in "
-           "every round at its reach")
+    why = ("real time in every timing round at its reach" if v["pick_sure"] else
+           "no tied model is real time in every round at its reach")
+    beaten = v.get("pick_cheaper") or []
+    why += ((", cheaper than " + ", ".join(beaten) + " on every mesh both were timed on")
+            if beaten else "") + ", with the most headroom"
     force = v.get("force") or {}
     stiff = ("The bound reads the displacement field, which the push prescribes and a law's "
              "stiffness hardly moves; the force the push needs (the top reaction) against FEM "
@@ -274,7 +299,7 @@ def answer_line(data, v, quick):
                 else f"; none within {STIFF:g}, so the pick is among all the tied") + ". "
              if any(f is not None for f in force.values()) else "")
     beside = (f". FEM P1 with the continuum's law ({P1}), the yardstick (ranked), runs "
-              f"{y['tets']} tetrahedra at distance {err(y['distance'])}" if y else "")
+              f"{y['tets']} tetrahedra at distance {_judged(y['distance'], v)}" if y else "")
     engines = v.get("engines") or {}
     newton = ("; Newton's solvers (single precision on one core of Warp's CPU backend, "
               "through pbcm's adapter; their cost is one core's, the models' above two "
@@ -283,8 +308,11 @@ def answer_line(data, v, quick):
                   f"{m} up to {t} tetrahedra" + (
                       f" (top force {fmt(force[m], 2)} from FEM P1's there)"
                       if force.get(m) is not None else "")
-                  if t else f"{m} at none of the sizes timed"
-                  for m, t in engines.items()) if engines else "")
+                  + _fails_above(data["runs"], m, t)
+                  for m, t in engines.items() if t)
+              + ("; at none of the sizes timed: " + ", ".join(
+                  m for m, t in engines.items() if not t) if not all(engines.values())
+                 else "") if engines else "")
     return (f"At real time on this machine ({machine(data)}, wall clock, the paper's push on "
             f"its cube; the errors are each model's static equilibrium under the push, how "
             f"far a timed run lags it not measured), {head}. {stiff}Pick {p}: {why} "
@@ -402,7 +430,7 @@ def build(out, study, s, doc):
             rows.append([k["rank"], m, mode,
                          f"{reach_['tets']} ({reach_['sure'] or 'none'}-{reach_['maybe']})",
                          f"{fmt(reach_['cost'])} [{fmt(reach_['range'][0])}-"
-                         f"{fmt(reach_['range'][1])}]", err(k["score"]),
+                         f"{fmt(reach_['range'][1])}]", _judged(k["score"], v),
                          _span_cell(v.get("spans", {}).get(m)),
                          err(r["disp_form_rel_l2"]), _judged(p1, v),
                          "; ".join(x for x in (
@@ -483,7 +511,8 @@ def build(out, study, s, doc):
         if y:
             d.p(f"The yardstick, ranked with the others: FEM P1 with the continuum's law "
                 f"({P1}), model-form error 0 by definition, runs in real time up to "
-                f"{y['tets']} tetrahedra, at distance {err(y['distance'])} from the continuum.")
+                f"{y['tets']} tetrahedra, at distance {_judged(y['distance'], v)} from the "
+                "continuum.")
         none = [m for m in ranked_laws(runs) if v["reach"].get(m) is None]
         if none:
             d.p("Not in real time at any size timed: " + ", ".join(none) + ".")
