@@ -1,6 +1,7 @@
 """The real-time study: each model's reach on the bench's real-time family (its faster mode,
 its implicit modes counted as its law's), its errors there, the ranking with ties read against
-the right uncertainty, the yardstick beside the ranking, and the quick run a preview."""
+the right uncertainty, the yardstick ranked with the others and Newton's one-core solvers
+beside them, the pick, and the quick run a preview."""
 import json
 from pathlib import Path
 

@@ -229,7 +229,8 @@ def verdict(data):
 
 
 def _fails_above(runs, model, tets):
-    """'; failed at 1715, 2560 tetrahedra' for a model whose runs above ``tets`` failed."""
+    """' (failed at 1715, 2560 tetrahedra)' for a model whose runs above ``tets`` failed,
+    '' where none did."""
     failed = sorted(r["tets"] for r in runs if r["model"] == model and r["tets"] > tets
                     and r.get("failed"))
     return f" (failed at {', '.join(map(str, failed))} tetrahedra)" if failed else ""
@@ -424,8 +425,6 @@ def build(out, study, s, doc):
             m, reach_ = k["model"], v["reach"][k["model"]]
             r = _law_run(runs, m, reach_["tets"])
             mode = reach_["model"] if reach_["model"] != m else reach_["mode"]
-            if r["cost"].get("engine"):
-                mode += " (one core: its cost not compared)"
             p1 = k["score"] - r["disp_form_rel_l2"] if k["score"] is not None else None
             rows.append([k["rank"], m, mode,
                          f"{reach_['tets']} ({reach_['sure'] or 'none'}-{reach_['maybe']})",
@@ -456,8 +455,9 @@ def build(out, study, s, doc):
             f"{err(JUDGES * v['estimate'])} ({JUDGES} times the estimate) are not resolved. "
             "The reach's range: from the largest size real time in every round to the "
             "largest real time in some round; the bound over it runs from the bound there to "
-            "the bound here, and two models whose bounds over their ranges overlap (within "
-            "the same uncertainty) are tied: which is ahead depends on the timing round. "
+            "the bound here, and two models are tied where the sizes their reaches take over "
+            "the rounds give bounds within the uncertainty of those two meshes, or disagree "
+            "on which is ahead: that depends on the timing round. "
             "A tie is not transitive (two models on one mesh are ordered within round-off "
             "while each is tied with a third on another mesh): a model's rank is one more "
             "than the number of models resolved ahead of it, so the first are those no model "
@@ -488,8 +488,7 @@ def build(out, study, s, doc):
             "|f_c| is a law's stiffness against FEM P1's on the same tetrahedra; the pick is "
             f"among the tied first whose force is within {STIFF:g} of FEM P1's, where any is. "
             f"The {STIFF:g} is a tolerance of use (a force {100 * STIFF:g} % off), not an "
-            "uncertainty: on "
-            "one mesh the force's model-form error carries round-off only.")
+            "uncertainty: on one mesh the force's model-form error carries round-off only.")
         if v.get("engines"):
             d.p("Not ranked: Newton's solvers, timed on one core of Warp's CPU backend (the "
                 "ranked models on two threads), so their reaches are not compared with the "
@@ -532,7 +531,8 @@ def build(out, study, s, doc):
             "estimate) are marked 'not resolved': the reference cannot judge them.")
     rounds = sorted({r["cost"].get("rounds") for r in shown if r["cost"].get("rounds")})
     d.p(f"Wall-clock seconds per simulated second on {where} (median [smallest-largest over "
-        f"the bench's {' or '.join(map(str, rounds)) or 'n/a'} rounds]), serial and in the two-thread mode ('-': the model has none); "
+        f"the bench's {' or '.join(map(str, rounds)) or 'n/a'} rounds]), serial and in the "
+        "two-thread mode ('-': the model has none); "
         "the errors are the model's law's static equilibrium. Sizes at which the bench did "
         "not time a model and no error was computed are left out: "
         + (", ".join(f"{m} above {max(r['tets'] for r in shown if r['model'] == m)}"
