@@ -148,6 +148,20 @@ class Ramp:
         return moving / self.t_ramp if 0.0 <= t < self.t_ramp else np.zeros_like(moving)
 
 
+class Proportional(Ramp):
+    """A ``bc_of_t`` whose every prescribed value grows in proportion, from zero at t = 0 to
+    the mapping ``bc`` at ``t_ramp``, and then holds: a whole boundary condition ramped (a
+    problem whose nodes move by different amounts)."""
+
+    def __init__(self, bc, t_ramp):
+        super().__init__((), (None, None, None), t_ramp)
+        self.final = merge(bc.items() if hasattr(bc, "items") else bc)
+
+    def __call__(self, t):
+        s = self.scale(t)
+        return {i: tuple(None if d is None else s * d for d in u) for i, u in self.final.items()}
+
+
 def ramp(nodes, displacement, t_ramp, fixed=(), held=None):
     """Shorthand for :class:`Ramp`."""
     return Ramp(nodes, displacement, t_ramp, fixed, held)

@@ -164,10 +164,39 @@ def parent_of(m_fine, W, coarse_tets):
     return order[np.searchsorted(coarse_key[order], fine_key)]
 
 
+INSIDE = 1e-12     # how far inside its tetrahedron a point on a face is moved to be probed
+PROBE_CHUNK = 256  # points probed at once (scikit-fem searches every element for a batch it
+                   # cannot place: the chunk bounds that search's memory)
+
+
 def probe(basis, dofs, points):
     """The vector field ``dofs`` of ``basis`` at arbitrary ``points`` (k, 3) inside the mesh:
-    its basis functions evaluated there (k, 3), not nodal values interpolated."""
-    pts = np.asarray(points, dtype=float)
-    values = basis.probes(np.ascontiguousarray(pts.T)) @ dofs
-    return check_finite("displacement at the probed points",
-                        values.reshape(3, len(pts)).T.copy())
+    its basis functions evaluated there (k, 3), not nodal values interpolated. scikit-fem
+    places a point in a tetrahedron to machine epsilon, so that a point on a face can fall
+    outside every tetrahedron by round-off; in a chunk of points where that happens, the
+    points within INSIDE of a face are moved INSIDE into the tetrahedron that holds them
+    (``TetMesh.locate``; barycentric coordinates, a move far below the field's round-off),
+    the other chunks probed as given."""
+    pts = np.asarray(points, dtype=float).reshape(-1, 3)
+    values = np.empty((len(pts), 3))
+    for lo in range(0, len(pts), PROBE_CHUNK):
+        chunk = pts[lo:lo + PROBE_CHUNK]
+        try:
+            matrix = basis.probes(np.ascontiguousarray(chunk.T))
+        except ValueError:
+            matrix = basis.probes(np.ascontiguousarray(_inside(basis.mesh, chunk).T))
+        values[lo:lo + PROBE_CHUNK] = (matrix @ dofs).reshape(3, len(chunk)).T
+    return check_finite("displacement at the probed points", values)
+
+
+def _inside(m, points):
+    """``points`` moved into the tetrahedra of ``m`` that hold them (a MeshError for a point
+    outside the mesh beyond round-off)."""
+    from model.mesh import TetMesh
+    mesh = TetMesh(m.p.T, m.t.T)
+    tets, bary = mesh.locate(points)
+    near = bary.min(axis=1) < INSIDE
+    bary = np.maximum(bary, INSIDE)
+    bary /= bary.sum(axis=1, keepdims=True)
+    moved = np.einsum("kj,kjd->kd", bary, mesh.points[mesh.tets[tets]])
+    return np.where(near[:, None], moved, points)

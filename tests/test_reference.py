@@ -550,3 +550,23 @@ def test_numba_stiffness_energy_of_a_homogeneous_strain_is_the_closed_form(eleme
     w = np.array([[0.0, -2e-3, 1e-3], [2e-3, 0.0, -3e-3], [-1e-3, 3e-3, 0.0]])  # skew
     r = np.einsum("ij,jn->in", w, X)[comp, np.arange(basis.N)]
     assert np.abs(K @ r).max() <= 1e-12 * np.abs(K).max() * np.abs(r).max()
+
+
+def test_a_field_is_probed_at_every_node_of_a_finer_mesh():
+    """A P2 field is read at any point of its mesh, those that fall outside every
+    tetrahedron by round-off included (nodes on the base of a faceted cylinder in metres,
+    refined once, read at the nodes of the cylinder refined three times): a linear field is
+    itself there to 1e-12 of its size."""
+    from pathlib import Path
+    from model.mesh import TetMesh, read_with_sets
+    from reference.discretisation import element_basis, probe, refined, skfem_mesh
+    mesh, _ = read_with_sets(Path(__file__).resolve().parents[1] / "examples" / "cylinder"
+                             / "cylinder.msh")
+    coarse = skfem_mesh(TetMesh(mesh.points * 1e-3, mesh.tets))
+    basis = element_basis(refined(coarse), "P2")
+    H = np.array([[0.1, -0.2, 0.3], [0.05, 0.4, -0.1], [-0.3, 0.2, 0.1]])
+    # P2's dofs are the field's values at their locations, interleaved x, y, z
+    dofs = np.einsum("kj,jk->k", H[np.arange(basis.N) % 3], basis.doflocs)
+    points = refined(refined(refined(coarse))).p.T
+    got = probe(basis, dofs, points)
+    assert np.abs(got - points @ H.T).max() <= 1e-12 * np.abs(points @ H.T).max()

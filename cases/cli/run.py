@@ -1,5 +1,6 @@
 """`pbcm run CASE`: one case or study, written to its folder; `pbcm run --problem FILE`: a
 user's problem, declared in a TOML file, run as a case."""
+import json
 from pathlib import Path
 
 import model
@@ -22,7 +23,9 @@ def add(sub):
                         "a cases.framework.Case); then run it by its name (repeatable)")
     r.add_argument("--problem", metavar="FILE",
                    help="run the problem this TOML file declares instead of a library case "
-                        "(output: reports/problems/NAME, NAME its name)")
+                        "(output: reports/problems/NAME, NAME its name); with the study "
+                        "realtime, that study on the problem's mesh refined (output: "
+                        "reports/problems/NAME.realtime)")
     r.add_argument("--out", help="output folder (default reports/CASE, or "
                                  "reports/problems/NAME for --problem)")
     r.add_argument("--rewrite", action="store_true",
@@ -35,6 +38,8 @@ def add(sub):
 
 def run(args):
     from ..registry import STUDY_MODULES, studies
+    if args.problem and args.case == "realtime":
+        return _run_realtime_problem(args)
     if args.problem or not args.case:
         return _run_problem(args)
     if args.case in STUDY_MODULES and args.rewrite:
@@ -84,7 +89,8 @@ def _run_problem(args):
         raise UsageError("give a case or study name (see `pbcm list`), or --problem FILE.toml")
     if args.case:
         raise UsageError(f"give either the case {args.case} or --problem {args.problem}, not "
-                         "both")
+                         "both (a problem runs as a case, or in the study realtime: `pbcm run "
+                         "realtime --problem FILE`)")
     for option, key in FROM_THE_TOML.items():
         if getattr(args, option, None):
             where = f"set {key} in the TOML" if key else "rerun the problem"
@@ -103,6 +109,64 @@ def _run_problem(args):
         written = out.commit()
     print(f"{case.name}: {len(runs)} runs written to {written}")
     return 0
+
+
+def _run_realtime_problem(args):
+    """`pbcm run realtime --problem FILE`: the real-time study on the problem's refinement
+    family, timed on this machine first (alone: wall clock), then its static solves; with
+    ``--rewrite`` drawn again from the runs its folder's metrics.json recorded."""
+    from ..library.problem import load
+    from ..registry import studies
+    from ..reporting.costs import family_models
+    from ..studies.realtime.problem import ProblemRealtimeSettings, timings
+    for option, key in FROM_THE_TOML.items():
+        if key and getattr(args, option, None):
+            raise UsageError(f"--{option} does not apply to realtime --problem: set {key} in "
+                             "the TOML")
+    check_executor(args)
+    spec = load(Path(args.problem))          # every error of the TOML, before any computing
+    models = chosen_models(args.models, family_models(args.quick) + tuple(model.PRESETS))
+    study = studies()["realtime"]
+    folder = Path(args.out) if args.out else \
+        Path("reports") / "problems" / f"{spec.name}.realtime"
+    if args.rewrite:
+        cfg, data = _recorded_problem_study(study, spec, folder)
+    else:
+        cfg = ProblemRealtimeSettings.of(spec, quick=args.quick, models=models)
+    with StagedFolder(folder, owner=cfg.case_name) as out:
+        if not args.rewrite:
+            store = run_store(args)
+            bench = timings(cfg, store)
+            with worker_pool(args, {cfg.case_name: cfg}) as workers:
+                data = study.run(cfg, workers=workers, bench=bench, store=store)
+        study.write(out.path, cfg, data)
+        (out.path / Path(args.problem).name).write_bytes(spec.source)
+        _write_glossary(out.path)
+        written = out.commit()
+    print(f"realtime on {spec.name}: written to {written}")
+    print(json.loads((written / "metrics.json").read_text())["answer"])
+    return 0
+
+
+def _recorded_problem_study(study, spec, folder):
+    """(settings, data) of the real-time study of ``spec`` recorded in ``folder``'s
+    metrics.json, refused where the TOML's problem has changed since."""
+    from ..running.runner import jsonable
+    from ..studies.realtime.problem import ProblemRealtimeSettings
+    path = folder / "metrics.json"
+    try:
+        metrics = json.loads(path.read_text())
+        params = metrics["parameters"]
+        cfg = ProblemRealtimeSettings.of(spec, quick=params["quick"],
+                                         models=tuple(params["models"]))
+        data = {k: metrics[k] for k in study.recorded_keys}
+    except (OSError, ValueError, KeyError, TypeError) as exc:
+        raise UsageError(f"--rewrite reads the real-time study of {spec.name} in {folder}: "
+                         f"{exc}; run it first (without --rewrite)") from None
+    if jsonable(cfg.problem()) != metrics.get("problem"):
+        raise UsageError(f"the problem {spec.name} has changed since {path} was written (its "
+                         "TOML or mesh): rerun the study")
+    return cfg, data
 
 
 def _write_glossary(folder):

@@ -290,8 +290,9 @@ def lines(root, models, pops=(), quick=False):
         fl = rows["fem-linear"]
         out.append(f"**At what cost?** One simulated second at about "
                    f"{fmt(rows['fem-linear']['tets'])} "
-                   "tetrahedra, at each model's own stable RK4 step, over fem-linear's "
-                   "(the median over rounds of the in-round step-time ratio, times the "
+                   "tetrahedra, at each model's own stable RK4 step, over fem-linear's, in "
+                   "serial CPU time (the median over rounds of the in-round step-time ratio, "
+                   "times the "
                    "stable-step ratio [its range over the rounds]; not a ratio of median "
                    "times): "
                    + ", ".join(f"{m} {ratio_text(r, fl)}"

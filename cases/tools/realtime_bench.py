@@ -11,8 +11,12 @@ through their adapter (model.simulators.newton). Times are wall clock (a simulat
 rounds taken round-robin across the models at one size, with the rounds' range beside them.
 A model is timed up the family until it is over real time at two sizes in a row: the
 larger ones cannot be its reach (its cost grows with the mesh), and are marked as not timed.
+
+A user's problem has its own family (``Loading``: each mesh, its boundary condition ramped
+and its constant loads, and the problem's material), timed the same way.
 """
 import time
+from dataclasses import dataclass
 
 import numpy as np
 
@@ -34,12 +38,30 @@ def _ramp(mesh):
     return paper_push(mesh, "clamped")
 
 
+@dataclass
+class Loading:
+    """One mesh of a family as timed: its prescribed displacements as a ramp (a ``bc_of_t``),
+    its constant loads (n, 3) [N] or None, and the material."""
+
+    mesh: object
+    ramp: object
+    f_ext: object = None
+    material: object = DEFAULT_MATERIAL
+
+
+def cube_family(quick=False):
+    """The bench's family: the paper's push on the 'five' cubes, built one at a time."""
+    for tets in sizes(quick):
+        mesh = bench_mesh(tets)
+        yield Loading(mesh, _ramp(mesh))
+
+
 class _Explicit:
     """An explicit model on one mesh: its own stable step, and wall-clock seconds per RK4
     step serial and in its two-thread mode (None without one)."""
 
-    def __init__(self, name, mesh):
-        self.t = Timed(name, mesh, DEFAULT_MATERIAL, ramp=_ramp(mesh))
+    def __init__(self, name, ld):
+        self.t = Timed(name, ld.mesh, ld.material, ramp=ld.ramp, f_ext=ld.f_ext)
         self.dt = own_stable_step(self.t.pm)
         if self.t.kernels_2 is not None:
             self.t._steps(1, self.t.kernels_2)       # compile outside the timings
@@ -61,8 +83,8 @@ class _Implicit:
     """An implicit preset at its own step on one mesh: wall-clock seconds per step, and its
     Newton and CG iterations (each sample goes on from the last state along the push)."""
 
-    def __init__(self, name, mesh):
-        self.t = ImplicitTimed(name, mesh, DEFAULT_MATERIAL, ramp=_ramp(mesh))
+    def __init__(self, name, ld):
+        self.t = ImplicitTimed(name, ld.mesh, ld.material, ramp=ld.ramp, f_ext=ld.f_ext)
         self.dt = self.t.dt
 
     def sample(self):
@@ -78,8 +100,8 @@ class _Engine:
     wall-clock seconds per step through its adapter's ``simulate``, the push set around every
     step as in its equilibrium runs, each sample going on from the last state."""
 
-    def __init__(self, name, mesh):
-        self.sim, self.ramp = build(name, mesh, DEFAULT_MATERIAL), _ramp(mesh)
+    def __init__(self, name, ld):
+        self.sim, self.ramp, self.f_ext = build(name, ld.mesh, ld.material), ld.ramp, ld.f_ext
         self.dt = self.sim.stable_dt()
         self.x = self.v = None
         self.t = 0.0
@@ -89,7 +111,7 @@ class _Engine:
     def _wall(self, n):
         w0 = time.perf_counter()
         tr = self.sim.simulate(self.ramp, self.t + n * self.dt, dt=self.dt, damping=DAMPING,
-                               frames=2, x0=self.x, v0=self.v, t0=self.t)
+                               f_ext=self.f_ext, frames=2, x0=self.x, v0=self.v, t0=self.t)
         wall = time.perf_counter() - w0
         self.x, self.v, self.t = tr.x[-1], tr.v, self.t + n * self.dt
         return wall / n
@@ -98,10 +120,10 @@ class _Engine:
         return self._wall(self.reps) / self.dt, np.nan
 
 
-def _timer(name, mesh):
+def _timer(name, ld):
     if name in IMPLICIT_STEP:
-        return _Implicit(name, mesh)
-    return (_Engine if simulator(name) else _Explicit)(name, mesh)
+        return _Implicit(name, ld)
+    return (_Engine if simulator(name) else _Explicit)(name, ld)
 
 
 def _row(name, mesh, timer, got, rounds):
@@ -124,26 +146,41 @@ def _row(name, mesh, timer, got, rounds):
     return row
 
 
-def run(models=None, quick=False, rounds=5, progress=print):
+def run(models=None, quick=False, rounds=5, progress=print, family=None, failures=(),
+        over_in_a_row=OVER_IN_A_ROW):
     """The family's rows: one per (model, size), timed or marked not timed (over real time at
-    OVER_IN_A_ROW smaller sizes in a row); ``models`` default the family's."""
+    OVER_IN_A_ROW smaller sizes in a row); ``models`` default the family's, ``family`` (an
+    iterable of Loading, smallest first) the bench's cube family. A model whose set-up or
+    sample raises one of ``failures`` is recorded as failed there (its ``failed`` the reason)
+    and not timed further up; any other error stops the run. ``over_in_a_row``: the sizes
+    over real time in a row after which a model is not timed up (one where each size is
+    several times the last: its cost cannot come back under real time)."""
     models = models or family_models(quick)
     over = {m: 0 for m in models}
+    failed = {}
     rows = []
-    for tets in sizes(quick):
-        mesh = bench_mesh(tets)
-        live = [m for m in models if over[m] < OVER_IN_A_ROW]
+    for ld in (cube_family(quick) if family is None else family):
+        mesh = ld.mesh
+        live = [m for m in models if over[m] < over_in_a_row and m not in failed]
         progress(f"bench: real-time family, {mesh.n_tets} tetrahedra, {len(live)} models")
-        timers = {m: _timer(m, mesh) for m in live}
-        got = {m: [] for m in live}
+        timers, got, here = {}, {m: [] for m in live}, {}
+        for m in live:
+            try:
+                timers[m] = _timer(m, ld)
+            except failures as exc:
+                here[m] = failed[m] = f"{type(exc).__name__}: {exc}"
         for _ in range(rounds):
             stop.checkpoint()
-            for m, timer in timers.items():
-                got[m].append(timer.sample())
+            for m, timer in list(timers.items()):
+                try:
+                    got[m].append(timer.sample())
+                except failures as exc:
+                    here[m] = failed[m] = f"{type(exc).__name__}: {exc}"
+                    del timers[m]
         for m in models:
             if m not in timers:
                 rows.append({"model": m, "tets": mesh.n_tets, "nodes": mesh.n_nodes,
-                             "timed": False})
+                             "timed": False, **({"failed": here[m]} if m in here else {})})
                 continue
             row = _row(m, mesh, timers[m], got[m], rounds)
             rows.append(row)

@@ -46,9 +46,9 @@ def own_stable_step(pm):
 class Timed:
     """One preset on one mesh, ready to be timed: its kernels, a state and the step's
     buffers, under ``ramp`` (default the bench's push: 1 % of the side over 1 s, the base
-    held)."""
+    held) and the constant loads ``f_ext`` (n, 3) [N] (default none)."""
 
-    def __init__(self, name, mesh, mat, ramp=None):
+    def __init__(self, name, mesh, mat, ramp=None, f_ext=None):
         tracemalloc.start()
         self.pm = build(name, mesh, mat)
         self.memory = tracemalloc.get_traced_memory()[1]
@@ -68,7 +68,8 @@ class Timed:
         mask, start, moving = ramp.parts(mesh.n_nodes)
         self.x, self.v = mesh.points.copy(), np.zeros_like(mesh.points)
         self.out = np.zeros_like(mesh.points)
-        self.step_args = (mesh.points, self.pm.mass, np.zeros_like(mesh.points), DAMPING, mask,
+        f_ext = np.zeros_like(mesh.points) if f_ext is None else np.asarray(f_ext, float)
+        self.step_args = (mesh.points, self.pm.mass, f_ext, DAMPING, mask,
                           start, moving, ramp.t_ramp, mesh.tets,
                           not any(t.checks_inversion for t in self.pm.terms),
                           self.pm.material.p_wave_speed, np.empty((STEP_BUFFERS,) + mesh.points.shape))
@@ -124,10 +125,10 @@ class ImplicitTimed:
     """An implicit preset (backward Euler at its own step) on the bench's push, timed one
     step per sample, each sample going on from the last state: thread CPU time per step, and
     the Newton and conjugate-gradient iterations it took; under ``ramp`` (default the bench's
-    push)."""
+    push) and the constant loads ``f_ext`` (default none)."""
 
-    def __init__(self, name, mesh, mat, ramp=None):
-        self.pm = build(name, mesh, mat)
+    def __init__(self, name, mesh, mat, ramp=None, f_ext=None):
+        self.pm, self.f_ext = build(name, mesh, mat), f_ext
         self.dt, self.ramp = IMPLICIT_STEP[name], ramp or _push(mesh)
         self.x, self.v, self.t = mesh.points.copy(), np.zeros_like(mesh.points), 0.0
         self._step()       # the first step builds the Jacobian's pattern: outside the timings
@@ -139,8 +140,8 @@ class ImplicitTimed:
         # the second core from the next model's two-thread sample
         with threadpool_limits(limits=1, user_api="blas"):
             run = backward_euler(self.pm, self.ramp, self.t + self.dt, self.dt,
-                                 damping=DAMPING, frames=2, x0=self.x, v0=self.v, t0=self.t,
-                                 stats=stats)
+                                 damping=DAMPING, f_ext=self.f_ext, frames=2, x0=self.x,
+                                 v0=self.v, t0=self.t, stats=stats)
         self.x, self.v, self.t = run.x[-1], run.v, self.t + self.dt
         return stats
 

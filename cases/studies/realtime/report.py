@@ -13,7 +13,7 @@ from ...reporting.document import Document, fmt
 from ...reporting.report import environment, write_study
 from ...running.runner import jsonable
 from ...reporting import costs as bench_costs
-from .study import P1
+from .study import P1, CubePush
 
 GATED = catalogue.gated("disp_rel_l2", "disp_form_rel_l2")
 
@@ -55,6 +55,9 @@ def _cost(run):
     return cost, mode, run["cost"][key]
 
 
+# FEM P1 this close to the continuum on every mesh reproduces it (to the static solve's
+# tolerance, a hundredth of the four decimals the errors are given to): an identity check
+IDENTITY = 1e-6
 MARGIN = 0.9       # the step a cautious user takes: 90 % of the own stable step
 STIFF = 0.05       # a top force within this of FEM P1's (relative to the continuum's): stiff right
 
@@ -169,7 +172,7 @@ def reach_points(runs, law, reach_):
     return ([(None, math.inf)] if lo is None else []) + out
 
 
-def verdict(data):
+def verdict(data, family="the bench's real-time family (run `pbcm bench` on this machine)"):
     """The most accurate model at real time: the laws other than the yardstick ranked by their
     error bound at their own reach (``bound``; a failed run or an error not computed counts as
     failed), ties by ``rank``; the yardstick's reach and distance beside; the laws whose
@@ -179,8 +182,7 @@ def verdict(data):
     at = reach(runs)
     measured = {m: r for m, r in at.items() if r is not None and m in ranked_laws(runs)}
     if not measured:
-        return {"decided": False, "why": "no model was measured at real time on the bench's "
-                "real-time family (run `pbcm bench` on this machine)",
+        return {"decided": False, "why": f"no model was measured at real time on {family}",
                 "reach": {m: None for m in laws(runs)}, "ranks": []}
     e = data["error_estimate"] or 0.0
     bounds = {m: bound(runs, r["run"]) for m, r in measured.items()}
@@ -199,6 +201,11 @@ def verdict(data):
     # were timed on than another such (like with like: reaches on different meshes are not
     # costs of one problem); then the most headroom (the smallest cost there in its
     # slowest round), so that the machine's jitter does not break it
+    if not first:
+        return {"decided": False, "why": "no model measured at real time has an error bound "
+                "at its reach (FEM P1's run or its own failed there)",
+                "reach": {m: None if r is None else {k: v for k, v in r.items() if k != "run"}
+                          for m, r in at.items()}, "ranks": []}
     pool = stiff or first
     sure = [m for m in pool if measured[m]["sure"] == measured[m]["tets"]] or pool
     cheaper = [m for m in sure if not any(dearer(runs, m, o) for o in sure if o != m)]
@@ -222,10 +229,23 @@ def verdict(data):
                        "score": bounds[m]} for k, m, tied, behind in ranked],
             "yardstick": None if yard is None else {
                 "model": P1, "tets": yard["tets"], "distance": yard["run"]["disp_rel_l2"]},
+            "p1_exact": p1_exact(runs),
             "cancels": [m for m, r in measured.items()
                         if r["run"]["disp_form_rel_l2"] is not None
                         and r["run"]["disp_rel_l2"] is not None
-                        and r["run"]["disp_rel_l2"] + e < r["run"]["disp_form_rel_l2"]]}
+                        and r["run"]["disp_rel_l2"] + u_val(e, 0.0, ROUND_OFF)
+                        < r["run"]["disp_form_rel_l2"]]}
+
+
+def p1_exact(runs):
+    """FEM P1's largest distance from the continuum over the family where it is below
+    IDENTITY on every mesh it was solved on (the problem's field is one every P1 element
+    reproduces: its distance is an identity check, and every bound a model-form error
+    alone), else None."""
+    got = [r["disp_rel_l2"] for r in runs if r["model"] == P1 and r["accuracy"]]
+    if got and all(d is not None and d <= IDENTITY for d in got):
+        return max(got)
+    return None
 
 
 def _fails_above(runs, model, tets):
@@ -256,11 +276,12 @@ def _law_run(runs, law, tets):
     return next(r for r in runs if r["model"] == law and r["tets"] == tets)
 
 
-def answer_line(data, v, quick):
-    """The index's one line: the most accurate model at real time on the bench's machine."""
+def answer_line(data, v, quick, words=None):
+    """The index's one line: the most accurate model at real time on the bench's machine
+    (``words``: how the loading is named, ``study.CubePush.words`` by default)."""
+    w = words or CubePush.words
     if quick:
-        return ("Quick: not decided (two mesh sizes; `pbcm run realtime` reads the bench's "
-                "whole real-time family).")
+        return f"Quick: not decided (two mesh sizes; {w['quick']})."
     if not v["decided"]:
         return f"Not decided: {v.get('why', 'no model has an error at its real-time reach')}."
     said = []
@@ -291,9 +312,9 @@ def answer_line(data, v, quick):
     why += ((", cheaper than " + ", ".join(beaten) + " on every mesh both were timed on")
             if beaten else "") + ", with the most headroom"
     force = v.get("force") or {}
-    stiff = ("The bound reads the displacement field, which the push prescribes and a law's "
-             "stiffness hardly moves; the force the push needs (the top reaction) against FEM "
-             "P1's at the reach: " + ", ".join(
+    stiff = (f"The bound reads {w['field']}; {w['force_detail']} against FEM P1's at the "
+             "reach: "
+             + ", ".join(
                  f"{m} {'n/a' if force.get(m) is None else fmt(force[m], 2)}"
                  for m in v["best"])
              + (f"; the pick is among those within {STIFF:g} there" if v.get("pick_stiff")
@@ -307,18 +328,28 @@ def answer_line(data, v, quick):
               "threads', so their reaches are not compared with those) in real time: "
               + ", ".join(
                   f"{m} up to {t} tetrahedra" + (
-                      f" (top force {fmt(force[m], 2)} from FEM P1's there)"
+                      f" ({w['force']} {fmt(force[m], 2)} from FEM P1's there)"
                       if force.get(m) is not None else "")
                   + _fails_above(data["runs"], m, t)
                   for m, t in engines.items() if t)
               + ("; at none of the sizes timed: " + ", ".join(
                   m for m, t in engines.items() if not t) if not all(engines.values())
                  else "") if engines else "")
-    return (f"At real time on this machine ({machine(data)}, wall clock, the paper's push on "
-            f"its cube; the errors are each model's static equilibrium under the push, how "
+    return (f"At real time on this machine ({machine(data)}, wall clock, {w['loading']}; "
+            f"the errors are each model's static equilibrium under {w['load']}, how "
             f"far a timed run lags it not measured), {head}. {stiff}Pick {p}: {why} "
             f"({fmt(v['reach'][p]['range'][1])} s per simulated s in its slowest round)"
-            f"{beside}{newton}.")
+            f"{beside}{newton}.{_exact_words(v)}")
+
+
+def _exact_words(v):
+    """' FEM P1 reproduces the continuum ...' where it does on every mesh, else ''."""
+    if v.get("p1_exact") is None:
+        return ""
+    return (f" FEM P1 reproduces the continuum on every mesh (its largest distance "
+            f"{fmt(v['p1_exact'])}, below {IDENTITY:g}): a field every P1 element is exact for, "
+            "so its distance is an identity check, each bound is the model's model-form error "
+            "alone, and this problem does not test what a coarse mesh costs.")
 
 
 def _behind_words(k, v):
@@ -341,10 +372,11 @@ def _reach_words(reach_, span_=None):
 
 
 def write(out, study, s, data):
-    v = verdict(data)
-    doc = jsonable({"case": study.name, "study": True, "parameters": s.describe(),
+    w = s.loading.words
+    v = verdict(data, w["family"])
+    doc = jsonable({"case": getattr(s, "case_name", study.name), "study": True, "parameters": s.describe(),
                     "problem": s.problem(), "gated": GATED, "environment": environment(),
-                    **data, "verdict": v, "answer": answer_line(data, v, s.quick),
+                    **data, "verdict": v, "answer": answer_line(data, v, s.quick, w),
                     "gate_runs": [{"mesh": r["mesh"], "bc": r["bc"], "model": r["model"],
                                    "disp_rel_l2": r["disp_rel_l2"],
                                    "disp_form_rel_l2": r["disp_form_rel_l2"]}
@@ -355,11 +387,14 @@ def write(out, study, s, data):
 
 def _judged(value, v):
     """An error against the continuum, 'not resolved' beside it where the reference's
-    estimate is more than a fifth of it."""
+    estimate is more than a fifth of it, 'round-off' where it is within the static solve's
+    round-off (an identity: the reference reproduced)."""
     e = v.get("estimate")
-    if value is None or e is None or value >= JUDGES * e:
+    if value is None or e is None:
         return err(value)
-    return f"{err(value)} (not resolved)"
+    if value < JUDGES * e:
+        return f"{err(value)} (not resolved)"
+    return f"{err(value)} (round-off)" if value <= ROUND_OFF else err(value)
 
 
 def _span_cell(span_):
@@ -397,28 +432,30 @@ def build(out, study, s, doc):
     v = doc["verdict"]
     runs = doc["runs"]
     where = machine(doc)
-    d.opening([f"**At a real-time budget.** {doc['answer']}"])
+    w = s.loading.words
+    d.opening([f"**At a real-time budget.** {doc['answer']}"], w["glossary"])
     d.p("The question the paper leaves open: at real time, how large a mesh can each model "
-        "run, and how far from the continuum is it there? The cost is what `pbcm bench` "
-        f"measured on {where}: wall-clock seconds per simulated second under the paper's push "
-        "(1.7 mm on the 32 mm cube at 1.7 mm/s, clamped base) on the 'five' cubes of its "
-        "real-time family, each model in its faster mode (serial or two threads), the "
+        f"run, and how far from the continuum is it there? The cost is what {w['timer']} "
+        f"measured on {where}: wall-clock seconds per simulated second under "
+        f"{w['loads_detail']}, each model in its faster mode (serial or two threads), the "
         "explicit models at their own largest stable RK4 step, the implicit presets "
         "(backward Euler, Newton with conjugate gradients) at their own step"
         + (f"; Newton's solvers ({_engines(runs)}, single precision on Warp's CPU backend, "
            "serial: its CPU kernels take one core; no GPU here) at their own step through "
            "pbcm's adapter, each iteration count its own model, their equilibrium run to rest "
            "(docs/simulators.md)" if _engines(runs) else "")
-        + f"; at most {REAL_TIME:g} is real time. Each timing sample is checked for a blow-up (one stops "
-        "the bench), over the steps the samples take from the push's start, not over the "
-        "whole push. The accuracy is each model's static equilibrium under the same push "
-        "(how far a timed run lags it at the push's end is not measured here): its distance "
+        + f"; at most {REAL_TIME:g} is real time. Each timing sample is checked for a blow-up "
+        f"({w['blowup']}), over the steps the samples take from the start of "
+        f"{w['load']}, not over the whole of it. The accuracy is each model's static "
+        f"equilibrium under {w['load']} (how far a timed run lags it at the end is not "
+        "measured here): its distance "
         "from the converged continuum (||u - u_c|| / ||u_c||, "
         "neo-Hookean P2) and its model-form error against FEM P1 with the continuum's law on "
         f"the same tetrahedra ({P1}). The implicit presets have fem-corotated's equilibrium: "
         "they are fem-corotated's other modes, and fem-corotated is ranked once, at the "
-        "largest reach of any of its modes. The accuracy is computed where the bench timed a "
-        "model: it stops timing a model above two sizes in a row over real time.")
+        f"largest reach of any of its modes. The accuracy is computed where {w['timing']} "
+        f"timed a model: it stops timing a model above {w['stops']} over real time"
+        f"{w['solved']}.")
     if v.get("ranks") and not doc["parameters"]["quick"]:
         rows = []
         for k in v["ranks"]:
@@ -446,7 +483,8 @@ def build(out, study, s, doc):
             f"{err(v['estimate'])} on each mesh's FEM P1 distance, added (the two meshes' "
             "errors come from one reference, so they are not independent: the triangle "
             "inequality's bound); u_input not estimated (every model has the same E, nu and "
-            "push on the same family of meshes, so the ranking holds at those inputs; how "
+            f"{w['load'].removeprefix('the ')} on the same family of meshes, so the ranking "
+            "holds at those inputs; how "
             "they move each model is the Truth Cube study's); u_D the static "
             f"solve's tolerance, round-off ({fmt(ROUND_OFF)}). The cost's noise enters "
             "through the reach's range over the timing rounds (below), not as a number. Two "
@@ -475,7 +513,8 @@ def build(out, study, s, doc):
             "and whether the reach is real time in every timing round.")
         d.table(["model", "reach", f"reach at {100 * MARGIN:g} % of the step",
                  "real time in every round there", "own distance from the continuum",
-                 "top force: model-form error (signed)", "top force: from the continuum"],
+                 f"{w['force']}: model-form error (signed)",
+                 f"{w['force']}: from the continuum"],
                 [[k["model"], v["reach"][k["model"]]["tets"],
                   v["cautious"].get(k["model"]) or "none",
                   fmt(v["reach"][k["model"]]["sure"] == v["reach"][k["model"]]["tets"]),
@@ -483,8 +522,8 @@ def build(out, study, s, doc):
                   _signed(lr.get("force_rel"))]
                  for k in v["ranks"]
                  for lr in [_law_run(runs, k["model"], v["reach"][k["model"]]["tets"])]])
-        d.p("The top force is the reaction the push needs, which the displacement bound "
-            "hardly sees (the push prescribes the top): its model-form error (f - f_P1) / "
+        d.p(f"The {w['force']} is {w['force_is']}, which the displacement bound "
+            f"hardly sees ({w['force_why']}): its model-form error (f - f_P1) / "
             "|f_c| is a law's stiffness against FEM P1's on the same tetrahedra; the pick is "
             f"among the tied first whose force is within {STIFF:g} of FEM P1's, where any is. "
             f"The {STIFF:g} is a tolerance of use (a force {100 * STIFF:g} % off), not an "
@@ -492,9 +531,9 @@ def build(out, study, s, doc):
         if v.get("engines"):
             d.p("Not ranked: Newton's solvers, timed on one core of Warp's CPU backend (the "
                 "ranked models on two threads), so their reaches are not compared with the "
-                "ranked ones'; each at its own reach, its error bound and top force there.")
+                f"ranked ones'; each at its own reach, its error bound and {w['force']} there.")
             d.table(["solver", "reach (tets)", "wall s per simulated s (one core)",
-                     "error bound", "top force: model-form error (signed)"],
+                     "error bound", f"{w['force']}: model-form error (signed)"],
                     [[m, t or "none", "-" if not t else
                       f"{fmt(v['reach'][m]['cost'])} [{fmt(v['reach'][m]['range'][0])}-"
                       f"{fmt(v['reach'][m]['range'][1])}]",
@@ -520,28 +559,31 @@ def build(out, study, s, doc):
                 "cancels part of FEM P1's discretisation error there, a coarse mesh's luck, "
                 "not a property of the model): " + ", ".join(v["cancels"]) + ".")
     d.h(2, "Every size")
+    exact = _exact_words({"p1_exact": p1_exact(runs)})
+    if exact:
+        d.p(exact.strip())
     shown = [r for r in runs if r["cost"].get("timed") or r["accuracy"]]
     untimed = sorted({r["tets"] for r in runs} - {r["tets"] for r in shown})
     if untimed:
         d.p("Sizes of the family at which no model was timed (every model was over real time "
-            "at two smaller sizes in a row) and nothing was computed: "
+            f"{w['stopped']}) and nothing was computed: "
             + ", ".join(map(str, untimed)) + " tetrahedra.")
     if v.get("estimate") is not None:
         d.p(f"Errors below {err(JUDGES * v['estimate'])} ({JUDGES} times the reference's "
             "estimate) are marked 'not resolved': the reference cannot judge them.")
     rounds = sorted({r["cost"].get("rounds") for r in shown if r["cost"].get("rounds")})
     d.p(f"Wall-clock seconds per simulated second on {where} (median [smallest-largest over "
-        f"the bench's {' or '.join(map(str, rounds)) or 'n/a'} rounds]), serial and in the "
+        f"{w['timing']}'s {' or '.join(map(str, rounds)) or 'n/a'} rounds]), serial and in the "
         "two-thread mode ('-': the model has none); "
-        "the errors are the model's law's static equilibrium. Sizes at which the bench did "
-        "not time a model and no error was computed are left out: "
+        f"the errors are the model's law's static equilibrium. Sizes at which {w['timing']} "
+        "did not time a model and no error was computed are left out: "
         + (", ".join(f"{m} above {max(r['tets'] for r in shown if r['model'] == m)}"
                      for m in models(runs) if any(r["model"] == m for r in shown)
                      and any(r["model"] == m and r not in shown for r in runs)) or "none")
         + ".")
     d.table(["model", "tets", "wall s/s serial", "wall s/s two threads", "real time",
              "error bound", "model-form error", "distance from continuum",
-             "top force: model-form error", "load steps", "failed"],
+             f"{w['force']}: model-form error", "load steps", "failed"],
             [[r["model"], r["tets"], _cost_cell(r, "wall_s_per_simulated_s"),
               _cost_cell(r, "two_thread_wall_s_per_simulated_s"),
               "not timed" if _cost(r)[0] is None else fmt(_cost(r)[0] <= REAL_TIME),
@@ -550,6 +592,11 @@ def build(out, study, s, doc):
               _judged(r["disp_rel_l2"], v) if r["accuracy"] else "not computed",
               _signed(r.get("force_form_rel")) if r["accuracy"] else "not computed",
               r["load_steps"] or "-", r["failed"] or "-"] for r in shown])
+    broke = [r for r in runs if r["cost"].get("failed")]
+    if broke:
+        d.p(f"Failed in {w['timing']} (not timed there nor above): " + "; ".join(
+            f"{r['model']} at {r['tets']} tetrahedra: {r['cost']['failed']}" for r in broke)
+            + ".")
     series = []
     for m in laws(runs):
         pts = []
@@ -569,7 +616,7 @@ def build(out, study, s, doc):
         figures.error_against_cost(out / "error_vs_cost.png", series, REAL_TIME,
                                    f"wall s per simulated s, faster mode ({where})",
                                    "error bound (model-form + FEM P1's distance)",
-                                   "Accuracy against cost, the paper's push")
+                                   f"Accuracy against cost, {w['figure']}")
         d.img("error_vs_cost.png", "each model's error bound against its wall-clock seconds "
               "per simulated second in its faster mode, every size timed; the yardstick's "
               "distance from the continuum; the dashed line is real time")

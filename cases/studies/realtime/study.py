@@ -7,6 +7,7 @@ Nothing is timed here: every cost is the bench's, measured in one process on the
 bench names, so that the accuracy runs stay deterministic. The accuracy is computed where the
 bench timed a model (and FEM P1 there): above the sizes where a model was over real time twice
 in a row, neither is measured, since those sizes cannot be its reach."""
+import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -42,11 +43,61 @@ def laws(quick):
     return tuple(dict.fromkeys(statics_of(m) for m in bench_costs.family_models(quick)))
 
 
+class CubePush:
+    """The library's loading: the paper's push on the clamped 'five' cubes of the bench's
+    real-time family, the continuum neo-Hookean P2 on a finer cube. A user's problem has the
+    same methods (``cases.studies.realtime.problem.ProblemLoading``)."""
+
+    bc = BC
+    above_reach = True          # every timed size solved (the family steps by 1.5 at most)
+    # how the report names the loading, its family, its timing and its force
+    words = {"loading": "the paper's push on its cube", "load": "the push",
+             "loads_detail": "the paper's push (1.7 mm on the 32 mm cube at 1.7 mm/s, clamped "
+                             "base) on the 'five' cubes of its real-time family",
+             "family": "the bench's real-time family (run `pbcm bench` on this machine)",
+             "quick": "`pbcm run realtime` reads the bench's whole real-time family",
+             "timer": "`pbcm bench`", "timing": "the bench", "blowup": "one stops the bench",
+             "stops": "two sizes in a row", "stopped": "at two smaller sizes in a row",
+             "solved": "",
+             "field": "the displacement field, which the push prescribes and a law's "
+                      "stiffness hardly moves",
+             "force": "top force", "force_detail": "the force the push needs (the top reaction)",
+             "force_is": "the reaction the push needs",
+             "force_why": "the push prescribes the top", "figure": "the paper's push",
+             "glossary": "../glossary.md"}
+
+    def sizes(self, quick):
+        return bench_costs.sizes(quick)
+
+    def mesh(self, tets):
+        return bench_mesh(tets)
+
+    def label(self, tets):
+        return f"five-{tets}"
+
+    def dirichlet(self, mesh):
+        return P.static_bc(mesh, BC, P.PUSH_MM)
+
+    def f_ext(self, mesh):
+        return None
+
+    def reference(self, s):
+        """The continuum under the push and its error estimate (``reference``)."""
+        return reference(s)
+
+    def force_where(self, mesh):
+        return top_where(mesh)
+
+    def reference_force(self, result):
+        return top_force(reference_mesh(), result.reaction)
+
+
 @dataclass
 class RealtimeSettings(MaterialSettings):
     """Material (the paper cube's) and the mode."""
 
     quick: bool = False
+    loading = CubePush()
 
     @property
     def ref_levels(self):
@@ -69,24 +120,40 @@ class RealtimeSettings(MaterialSettings):
                 "models": list(bench_costs.family_models(self.quick))}
 
 
-def cost_rows(bench, quick):
+def cost_rows(bench, quick, sizes=None, models=None):
     """{(model, tets): the bench's real-time family row} (every model and size of the family;
-    the quick run's two sizes whether or not the bench timed them)."""
+    the quick run's two sizes whether or not the bench timed them); ``sizes`` and ``models``
+    default the bench's family's."""
     got = {(r["model"], r["tets"]): r for r in (bench or {}).get("realtime_rows", [])}
     return {(m, t): got.get((m, t), {"model": m, "tets": t, "timed": False})
-            for t in bench_costs.sizes(quick) for m in bench_costs.family_models(quick)}
+            for t in sizes or bench_costs.sizes(quick)
+            for m in models or bench_costs.family_models(quick)}
 
 
-def solved_pairs(costs, quick):
+def solved_pairs(costs, quick, above_reach=True):
     """The (law, tets) whose static equilibrium is solved: every law on the quick family; in
-    the full run each law where the bench timed any model with its statics there, and FEM P1
-    wherever another law is solved (the model-form twin)."""
+    the full run each law where the bench timed any model with its statics there (without
+    ``above_reach``, only up to the largest size any of them was real time at in some
+    round, or the smallest timed where none was: what its reach and the ranking read), and
+    FEM P1 wherever another law is solved (the model-form twin)."""
+    order = tuple(dict.fromkeys([statics_of(m) for m, _ in costs] + [P1]))
     if quick:
-        return [(t, m) for t in bench_costs.sizes(True) for m in laws(True)]
+        return [(t, m) for t in sorted({t for _, t in costs}) for m in order]
     pairs = {(t, statics_of(m)) for (m, t), r in costs.items() if r.get("timed")}
+    if not above_reach:
+        pairs = {(t, law) for t, law in pairs if t <= _last_needed(costs, law)}
     pairs |= {(t, P1) for t, _ in pairs}
-    order = laws(False)
     return sorted(pairs, key=lambda p: (p[0], order.index(p[1])))
+
+
+def _last_needed(costs, law):
+    """The largest size at which a model with ``law``'s statics was real time in some timing
+    round, or the smallest at which one was timed where none was."""
+    timed = [(t, r) for (m, t), r in costs.items() if r.get("timed") and statics_of(m) == law]
+    fast = [t for t, r in timed
+            if min(r["wall_range"][0], (r.get("two_thread_range") or [math.inf])[0])
+            <= bench_costs.REAL_TIME]
+    return max(fast) if fast else min(t for t, _ in timed)
 
 
 def reference_mesh():
@@ -105,23 +172,37 @@ def reference(s):
 def top_force(mesh, reaction):
     """The force the push needs [N]: the reaction on the cube's top nodes along the push
     (None where the model gives no forces)."""
-    from ...running.runner import reaction_along
-    value = float(reaction_along(reaction, (P.boundary_sets(mesh, BC)[0], 1)))
-    return value if np.isfinite(value) else None
+    return force_along(reaction, top_where(mesh))
+
+
+def top_where(mesh):
+    """(the cube's top nodes, the push's axis): where the push's force is summed."""
+    return P.boundary_sets(mesh, BC)[0], 1
 
 
 def _solve(job):
-    """One model's static equilibrium on one mesh with every tetrahedron upright: its
-    displacement field [m] and the top force, or why it failed."""
-    model, mesh, s = job
+    """One model's static equilibrium on one mesh (its prescribed displacements and loads
+    given) with every tetrahedron upright: its displacement field [m] and the force summed
+    over ``where`` (nodes, axis; None: no force), or why it failed."""
+    model, mesh, material, dirichlet, f_ext, where = job
     try:
-        pm = build(model, mesh, s.material)
-        st, steps = solve_split(pm, P.static_bc(mesh, BC, P.PUSH_MM), splits=LOAD_SPLITS,
-                                upright=True, rtol=STATIC_RTOL, stall=STALL)
+        pm = build(model, mesh, material)
+        st, steps = solve_split(pm, dirichlet, f_ext=f_ext, splits=LOAD_SPLITS, upright=True,
+                                rtol=STATIC_RTOL, stall=STALL)
     except FINDINGS as exc:
         return {"u": None, "failed": str(exc), "load_steps": None, "reaction": None}
     return {"u": st.u, "failed": None, "load_steps": steps,
-            "reaction": top_force(mesh, st.reaction)}
+            "reaction": force_along(st.reaction, where)}
+
+
+def force_along(reaction, where):
+    """The reaction summed over ``where`` (nodes, axis) [N]; None without ``where`` or where
+    it is not finite."""
+    from ...running.runner import reaction_along
+    if where is None:
+        return None
+    value = float(reaction_along(reaction, where))
+    return value if np.isfinite(value) else None
 
 
 def _reference_at(s, meshes, store, progress):
@@ -132,9 +213,9 @@ def _reference_at(s, meshes, store, progress):
     at = {t: store.get(k) for t, k in keys.items()}
     est = store.get(est_key)
     if est is None or any(v is None for v in at.values()):
-        r = reference(s)
+        r = s.loading.reference(s)
         est = store.put(est_key, {"error_estimate": r.error_estimate,
-                                  "reaction": top_force(reference_mesh(), r.result.reaction)})
+                                  "reaction": s.loading.reference_force(r.result)})
         for t, v in at.items():
             if v is None:
                 at[t] = store.put(keys[t], {"u": r.result.at(meshes[t].points)})
@@ -145,9 +226,10 @@ def _reference_at(s, meshes, store, progress):
 def run(s, workers=None, log=True, bench=None, store=OFF):
     """Every solved (size, law)'s errors, and each (model, size)'s row with the bench's cost
     beside its law's errors."""
-    costs = cost_rows(bench, s.quick)
-    jobs = solved_pairs(costs, s.quick)
-    meshes = {t: bench_mesh(t) for t in sorted({t for t, _ in jobs})}
+    loading = s.loading
+    costs = cost_rows(bench, s.quick, loading.sizes(s.quick), getattr(s, "models", None))
+    jobs = solved_pairs(costs, s.quick, loading.above_reach)
+    meshes = {t: loading.mesh(t) for t in sorted({t for t, _ in jobs})}
     with Progress("realtime", 1 + len(jobs), log=log) as progress:
         ref_at, estimate, force_c = _reference_at(s, meshes, store, progress)
         keys = [key(kind="realtime-run", **s.problem(), tets=t, model=m, top_force=True)
@@ -155,7 +237,10 @@ def run(s, workers=None, log=True, bench=None, store=OFF):
         found = [store.get(k) for k in keys]
         todo = [i for i, f in enumerate(found) if f is None]
         progress.advance(len(jobs) - len(todo))
-        made = dearest_first(_solve, [(jobs[i][1], meshes[jobs[i][0]], s) for i in todo],
+        made = dearest_first(_solve, [(jobs[i][1], meshes[jobs[i][0]], s.material,
+                                       loading.dirichlet(meshes[jobs[i][0]]),
+                                       loading.f_ext(meshes[jobs[i][0]]),
+                                       loading.force_where(meshes[jobs[i][0]])) for i in todo],
                              workers, lambda i: progress.advance(1, " ".join(
                                  map(str, jobs[todo[i]]))), [jobs[i][0] for i in todo])
         for i, got in zip(todo, made):
@@ -164,7 +249,7 @@ def run(s, workers=None, log=True, bench=None, store=OFF):
     rows = []
     for (m, t), cost in costs.items():
         law = statics_of(m)
-        row = {"mesh": f"five-{t}", "tets": t, "bc": BC, "model": m, "law": law,
+        row = {"mesh": loading.label(t), "tets": t, "bc": loading.bc, "model": m, "law": law,
                "cost": cost, "accuracy": (t, law) in fields, "failed": None,
                "disp_rel_l2": None, "disp_form_rel_l2": None, "force_rel": None,
                "force_form_rel": None, "load_steps": None}
@@ -173,7 +258,7 @@ def run(s, workers=None, log=True, bench=None, store=OFF):
             row.update(failed=got["failed"], load_steps=got["load_steps"])
             if got["u"] is not None:
                 row.update(_errors(got["u"], None if p1 is None else p1["u"], ref_at[t],
-                                   meshes[t]))
+                                   loading.dirichlet(meshes[t]), meshes[t].n_nodes))
                 row.update(_force_errors(got["reaction"], None if p1 is None
                                          else p1["reaction"], force_c))
         rows.append(row)
@@ -193,10 +278,11 @@ def _force_errors(f, f_p1, f_c):
             else M.finite("force_form_rel", (f - f_p1) / abs(f_c))}
 
 
-def _errors(u, u_p1, u_c, mesh):
+def _errors(u, u_p1, u_c, dirichlet, n_nodes):
     """The distance from the continuum ``u_c`` (||u - u_c|| / ||u_c||) and the model-form
-    error against FEM P1 (||u - u_p1|| / ||u_c||), over the free components."""
-    free = free_components(P.static_bc(mesh, BC, P.PUSH_MM), mesh.n_nodes)
+    error against FEM P1 (||u - u_p1|| / ||u_c||), over the components ``dirichlet`` leaves
+    free."""
+    free = free_components(dirichlet, n_nodes)
     scale = float(np.linalg.norm(np.asarray(u_c)[free]))
     form = None if u_p1 is None else float(np.linalg.norm((u - u_p1)[free])) / scale
     return {"disp_rel_l2": M.rel_l2(u, u_c, free),

@@ -162,8 +162,8 @@ def scorecard(doc):
         u = val["u_val"][m]
         within = v["bead_rms_mm"] <= u
         cells[m] = (f"{fmt(v['bead_rms_rel'])} at {percent(h['strain'])}, "
-                    f"{fmt(v['bead_rms_mm'])} mm {'within' if within else 'beyond'} its u_val "
-                    f"{fmt(u, 2)} mm", 0 if within else 2)
+                    f"{fmt(v['bead_rms_mm'])} mm RMS, {'within' if within else 'above'} its "
+                    f"u_val {fmt(u, 2)} mm", 0 if within else 2)
     return [(f"truth-cube/bonded, {h['mesh']} (measured beads)", "bead_rms_rel", cells)]
 
 
