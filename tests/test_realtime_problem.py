@@ -197,3 +197,30 @@ def test_a_missing_problem_file_is_refused(tmp_path, capsys):
     assert main(["run", "realtime", "--problem", str(tmp_path / "none.toml"), "--out",
                  str(out)]) == 2
     assert "none.toml" in capsys.readouterr().err and not out.exists()
+
+
+def test_an_exact_yardstick_is_an_identity_check_not_a_rank():
+    """Where FEM P1 with the continuum's law reproduces the continuum on every mesh (a
+    homogeneous field), its distance is an identity check: it is not ranked, the others are
+    ranked by their model-form errors, nothing is said to cancel P1's error, and the answer
+    says so; a law more accurate on a smaller real-time mesh than at its reach is named."""
+    from cases.studies.realtime import report as R
+
+    def run(model, tets, form, dist, cost):
+        row = {"model": model, "law": model, "tets": tets, "mesh": f"m-{tets}", "bc": "x",
+               "accuracy": True, "failed": None, "disp_form_rel_l2": form,
+               "disp_rel_l2": dist, "force_form_rel": 0.0, "force_rel": 0.0,
+               "load_steps": 1, "cost": {"timed": True, "model": model, "tets": tets,
+                                         "wall_s_per_simulated_s": cost,
+                                         "wall_range": [cost, cost], "rounds": 5}}
+        return row
+    runs = [run(R.P1, 100, 0.0, 2e-8, 0.1), run(R.P1, 800, 0.0, 1e-8, 0.8),
+            run("a", 100, 0.05, 0.05, 0.1), run("a", 800, 0.09, 0.09, 0.8),
+            run("b", 100, 0.02, 0.02, 0.1), run("b", 800, 0.02, 0.02, 2.0)]
+    data = {"runs": runs, "error_estimate": 1e-13, "top_force_n": 1.0, "machine": None}
+    v = R.verdict(data)
+    assert v["p1_exact"] == 2e-8 and not v["cancels"]
+    assert [k["model"] for k in v["ranks"]] == ["b", "a"] and v["pick"] == "b"
+    assert v["smaller"] == {"a": [100, 0.05 + 2e-8]}
+    answer = R.answer_line(data, v, False)
+    assert "identity check" in answer and "a 100 tetrahedra" in answer

@@ -39,21 +39,28 @@ class ProblemLoading:
         self.spec, self.quick = spec, quick
         self._family = None
         force = next((m for m in spec.measures if m.kind == "reaction"), None)
-        sums = (f"the reaction along {'xyz'[force.axis]} on the nodes of its [[measure]]"
-                if force else "no reaction measured")
+        where = next((n for n, sel in spec.selections.items() if force is not None
+                      and np.array_equal(sel.nodes, force.nodes)), "its nodes")
+        sums = (f"the reaction along {'xyz'[force.axis]} on {where}" if force
+                else "no reaction measured")
+        loads = [w for w, on in (("its tractions", spec.surfaces), ("gravity", spec.gravity))
+                 if on]
+        held = "its prescribed displacements ramped over {RAMP_S:g} s".format(RAMP_S=RAMP_S)
         self.words = {
             "loading": f"the loads of {spec.path.name} on {spec.mesh_file.name} refined",
             "load": "the problem's loading", "field": "the displacement field",
-            "loads_detail": (f"the loads of {spec.path.name} (its prescribed displacements "
-                             f"ramped over {RAMP_S:g} s, its tractions and gravity constant) "
-                             f"on {spec.mesh_file.name} refined uniformly, each tetrahedron "
-                             "into eight"),
+            "loads_detail": (f"the loads of {spec.path.name} ({held}"
+                             + (f", {' and '.join(loads)} constant" if loads else "")
+                             + f") on {spec.mesh_file.name} refined uniformly, each "
+                             "tetrahedron into eight"),
+            "question": f"The question a simulator asks of {spec.name}",
+            "inputs": "not measured here",
             "timer": "this run", "timing": "the timing", "glossary": "glossary.md",
             "stopped": "at a smaller level, or failed there",
             "solved": "; a law is solved up to the largest level at which a model with it "
                       "was real time in some round (the smallest timed where none was)",
-            "stops": "a level (the next has eight times its tetrahedra: its cost cannot "
-                     "come back under real time)",
+            "stops": "its first level over real time (the next has eight times its "
+                     "tetrahedra: its cost cannot come back under real time)",
             "blowup": "one is recorded as the model's failure at that size, and the model is "
                       "not timed further up",
             "quick": "the full run refines the mesh up to at least "

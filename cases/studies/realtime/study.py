@@ -57,12 +57,14 @@ class CubePush:
              "family": "the bench's real-time family (run `pbcm bench` on this machine)",
              "quick": "`pbcm run realtime` reads the bench's whole real-time family",
              "timer": "`pbcm bench`", "timing": "the bench", "blowup": "one stops the bench",
-             "stops": "two sizes in a row", "stopped": "at two smaller sizes in a row",
+             "stops": "two sizes in a row over real time", "stopped": "at two smaller sizes in a row",
              "solved": "",
              "field": "the displacement field, which the push prescribes and a law's "
                       "stiffness hardly moves",
              "force": "top force", "force_detail": "the force the push needs (the top reaction)",
              "force_is": "the reaction the push needs",
+             "question": "The question the paper leaves open",
+             "inputs": "the Truth Cube study's",
              "force_why": "the push prescribes the top", "figure": "the paper's push",
              "glossary": "../glossary.md"}
 
