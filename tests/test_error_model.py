@@ -923,13 +923,15 @@ def test_a_contender_whose_cost_range_lies_below_the_firsts_is_the_cheaper_pick(
 class _Pop:
     """A population stub: its case and each model's score (what the paired comparison reads)."""
 
-    def __init__(self, case, scores, finite=False):
+    def __init__(self, case, scores, finite=False, unordered=()):
         self.case, self.scores, self.finite, self.ranked = case, scores, finite, True
-        self.meshes = {}
+        self.meshes, self.unordered = {}, set(unordered)
 
     def standings(self):
         from types import SimpleNamespace
-        return [(0, SimpleNamespace(model=m, score=s), None) for m, s in self.scores.items()]
+        return [(0, SimpleNamespace(model=m, score=s),
+                 tuple(o for o in self.scores if o != m and {m, o} <= self.unordered))
+                for m, s in self.scores.items()]
 
     def without(self, mesh):
         return self
@@ -948,6 +950,17 @@ def test_a_pair_kept_in_order_when_compared_directly_is_resolved():
     assert not scorecard.paired_ahead(flips, "a", "b")      # without p, b is ahead
     failed = ahead + [_Pop("s", {"a": float("inf"), "b": 0.3})]
     assert not scorecard.paired_ahead(failed, "a", "b")
+
+
+def test_a_pair_no_population_resolves_is_not_resolved_by_pooling():
+    """Two models whose ratio stays below 1 whatever is left out, but which every case's
+    report leaves tied or not resolved, are not resolved in the index either; one population
+    that orders them beyond their uncertainty resolves the pair."""
+    tied = [_Pop("p", {"a": 0.1, "b": 0.11}, unordered="ab"),
+            _Pop("q", {"a": 0.1, "b": 0.12}, unordered="ab")]
+    assert not scorecard.paired_ahead(tied, "a", "b")
+    one = [_Pop("p", {"a": 0.1, "b": 0.11}, unordered="ab"), _Pop("q", {"a": 0.1, "b": 0.5})]
+    assert scorecard.paired_ahead(one, "a", "b")
 
 
 def test_a_growing_stiffness_error_bounds_the_limit_and_fems_nonlinearity_is_no_limit():

@@ -118,7 +118,7 @@ def _run_realtime_problem(args):
     from ..library.problem import load
     from ..registry import studies
     from ..reporting.costs import family_models
-    from ..studies.realtime.problem import ProblemRealtimeSettings, timings
+    from ..studies.realtime.problem import ProblemRealtimeSettings
     for option, key in FROM_THE_TOML.items():
         if key and getattr(args, option, None):
             raise UsageError(f"--{option} does not apply to realtime --problem: set {key} in "
@@ -146,6 +146,32 @@ def _run_realtime_problem(args):
     print(f"realtime on {spec.name}: written to {written}")
     print(json.loads((written / "metrics.json").read_text())["answer"])
     return 0
+
+
+# what a model's timing on a user's mesh may raise and be recorded as failed there (a
+# blow-up, a degenerate or inverted element, a model that does not take the mesh)
+TIMING_FAILURES = (model.errors.PbcmError, ArithmeticError, RuntimeError)
+
+
+def timings(cfg, store, rounds=5):
+    """{"realtime_rows": the problem's family timed, "realtime_machine": this machine}: from
+    the run store where this machine timed this problem before, else timed now (nothing else
+    should run meanwhile: the times are wall clock)."""
+    from numpy.linalg import LinAlgError
+    from ..running.store import key
+    from ..studies.realtime.problem import RAMP_S
+    from ..tools import bench, realtime_bench
+    here = bench.machine()
+    k = key(kind="realtime-problem-timing", **cfg.problem(), quick=cfg.quick,
+            models=list(cfg.models), machine=here, rounds=rounds)
+    got = store.get(k)
+    if got is None:
+        family = realtime_bench.problem_family(cfg.loading.levels, cfg.material, RAMP_S)
+        rows = realtime_bench.run(list(cfg.models), cfg.quick, rounds, print, family=family,
+                                  failures=TIMING_FAILURES + (LinAlgError,),
+                                  over_in_a_row=1)
+        got = store.put(k, {"realtime_rows": rows, "realtime_machine": here})
+    return got
 
 
 def _recorded_problem_study(study, spec, folder):

@@ -278,10 +278,25 @@ def _paired_ratio(subset, a, b, finite):
 def paired_ahead(pops, a, b, finite=False):
     """Whether a's model-form error is below b's paired, population by population: the
     geometric mean of their ratios below 1 on every population and whatever mesh family or
-    case is left out (the two compared directly, not through their ranks among the others)."""
+    case is left out (the two compared directly, not through their ranks among the others),
+    and a resolved ahead of b in at least one population as its case's report orders them
+    (neither tied with the other nor within both medians' spread over the meshes): a
+    difference no population resolves is not resolved by pooling them."""
     ratios = [_paired_ratio(pops, a, b, finite)] + [
         _paired_ratio(subset, a, b, finite) for _, subset in _subsets(pops, finite)]
-    return all(r is not None and r < 1.0 for r in ratios)
+    return all(r is not None and r < 1.0 for r in ratios) and any(
+        _resolved_before(p, a, b) for p in pops if p.finite == finite and p.ranked)
+
+
+def _resolved_before(p, a, b):
+    """Whether population ``p`` orders a before b beyond their uncertainty (not tied, not
+    within both medians' spread over the meshes)."""
+    st = {s.model: (s.score, tie) for _, s, tie in p.standings()}
+    if a not in st or b not in st:
+        return False
+    (sa, ta), (sb, tb) = st[a], st[b]
+    apart = b not in ta and a not in tb
+    return apart and sa < sb
 
 
 def not_resolved_from(pops, models, first, finite=False):

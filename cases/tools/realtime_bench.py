@@ -49,6 +49,15 @@ class Loading:
     material: object = DEFAULT_MATERIAL
 
 
+def problem_family(levels, material, ramp_s):
+    """A problem's refinement family as timed (``cases.library.problem.family.Level``s): each
+    level's prescribed displacements ramped over ``ramp_s`` in proportion, its loads
+    constant."""
+    from model.bc import Proportional
+    return [Loading(lv.mesh, Proportional(lv.dirichlet, ramp_s), lv.f_ext, material)
+            for lv in levels]
+
+
 def cube_family(quick=False):
     """The bench's family: the paper's push on the 'five' cubes, built one at a time."""
     for tets in sizes(quick):

@@ -6,20 +6,17 @@ displacements ramped over RAMP_S, the tractions and gravity constant), and its s
 equilibrium under the whole load against FEM P1 on the same tetrahedra and against the
 converged continuum (neo-Hookean P2 on the problem's mesh, refined).
 
-The timings are measurements of this machine: they are kept in the run store under the
-problem's digests and this machine's name, so that a rerun draws the same report from the
-same timings (``--no-cache`` times again)."""
+The timings are measured by the command (``cases.cli.run``), which keeps them in the run
+store under the problem's digests and this machine's name, so that a rerun draws the same
+report from the same timings (``--no-cache`` times again)."""
 from dataclasses import dataclass
 
 import numpy as np
 
-from model.bc import Proportional
-from model.errors import PbcmError
 from model.presets import PRESETS
 from reference import hyperelastic
 from ...library.problem.family import MIN_TETS, family
 from ...reporting import costs as bench_costs
-from ...running.store import key
 from .study import P1, QUICK_REF_LEVELS, RealtimeSettings, force_along
 
 RAMP_S = 1.0            # the prescribed displacements reach their values over this time [s]
@@ -118,13 +115,6 @@ class ProblemLoading:
         """Pickled without its family (a worker is given its meshes with its jobs)."""
         return {**self.__dict__, "_family": None}
 
-    def timed_family(self):
-        """The family as the timer takes it (``realtime_bench.Loading``)."""
-        from ...tools.realtime_bench import Loading
-        return [Loading(lv.mesh, Proportional(lv.dirichlet, RAMP_S), lv.f_ext,
-                        self.spec.material) for lv in self.levels]
-
-
 @dataclass
 class ProblemRealtimeSettings(RealtimeSettings):
     """The real-time study of one problem: its material, models and references from the
@@ -172,25 +162,3 @@ class ProblemRealtimeSettings(RealtimeSettings):
     def describe(self):
         return {**self.problem(), "quick": self.quick, "models": list(self.models),
                 "meshes": {self.loading.label(t): t for t in self.loading.sizes(self.quick)}}
-
-
-# what a model's timing on a user's mesh may raise and be recorded as failed (a blow-up, a
-# degenerate or inverted element, a model that does not take the mesh)
-TIMING_FAILURES = (PbcmError, ArithmeticError, RuntimeError, np.linalg.LinAlgError)
-
-
-def timings(s, store, progress=print, rounds=5):
-    """{"realtime_rows": the family's timing rows, "realtime_machine": this machine}, from
-    the run store where this machine timed this problem before, else timed now (nothing else
-    should run meanwhile: the times are wall clock)."""
-    from ...tools import bench, realtime_bench
-    here = bench.machine()
-    k = key(kind="realtime-problem-timing", **s.problem(), quick=s.quick,
-            models=list(s.models), machine=here, rounds=rounds)
-    got = store.get(k)
-    if got is None:
-        rows = realtime_bench.run(list(s.models), s.quick, rounds, progress,
-                                  family=s.loading.timed_family(),
-                                  failures=TIMING_FAILURES, over_in_a_row=1)
-        got = store.put(k, {"realtime_rows": rows, "realtime_machine": here})
-    return got
