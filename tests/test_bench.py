@@ -308,7 +308,7 @@ def test_an_implicit_step_is_timed_with_blas_on_one_thread(monkeypatch):
     from model.mesh import cube
     seen = []
 
-    def step(pm, ramp, t_end, dt, damping, frames, x0, v0, t0, stats):
+    def step(pm, ramp, t_end, dt, damping, frames, x0, v0, t0, stats, f_ext=None):
         seen.append([i["num_threads"] for i in threadpool_info() if i["user_api"] == "blas"])
         stats.update(newton_iterations=1, cg_iterations=1)
         return SimpleNamespace(x=[x0], v=v0)

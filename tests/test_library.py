@@ -97,6 +97,14 @@ def test_quick_case_writes_report_and_finite_metrics(library, name):
     for img in [line.split("](")[1].rstrip(")") for line in md.splitlines()
                 if line.startswith("![")]:
         assert (out / img).is_file()
+    # a quick run's every order and verdict says where it is read that it decides nothing;
+    # the bench's costs and the failed runs are facts of the runs, stated as they are
+    findings = md.split("## Findings")[1].split("\n## ")[0]
+    for heading in [line for line in findings.splitlines() if line.startswith("### ")]:
+        facts = any(heading == f"### {t}" for t in ("Cost", "Failures",
+                                                     "Runs that could not start"))
+        assert facts or heading.endswith(f"quick: not decided, `pbcm run {name}` decides)"), \
+            heading
 
 
 def test_quick_library_passes_the_committed_bounds(library, capsys):

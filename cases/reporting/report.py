@@ -144,6 +144,11 @@ def _constants(runs):
         for mesh, cs in meshes.items()) + "." for m, meshes in by.items()]
 
 
+# finding groups a quick run states as the full run does (facts of its runs, not orders):
+# what the bench measured, the runs that failed or could not start
+QUICK_AS_FULL = ("Cost", "Failures", "Runs that could not start")
+
+
 def build_report(case, s, runs, fields, out):
     doc = Document(f"pbcm report: {case.name}")
     story = case.story()
@@ -192,7 +197,11 @@ def build_report(case, s, runs, fields, out):
     doc.h(2, "Findings" + (" (a quick preview: decides nothing)" if s.quick else ""))
     for title, items in groups.items():
         if items:
-            doc.h(3, title)
+            # a quick run's orders and verdicts are these meshes' only: each says so where
+            # it is read, not once above (the full run can reverse any of them)
+            doc.h(3, title + (f" (on {', '.join(s.meshes)} only; quick: not decided, "
+                              f"`{story.command()}` decides)"
+                              if s.quick and title not in QUICK_AS_FULL else ""))
             doc.items(items)
     _tables(doc, case, s, runs)
     story.sections(doc, s, runs, fields, out)
