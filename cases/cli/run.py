@@ -169,7 +169,7 @@ def timings(cfg, store, rounds=5):
         family = realtime_bench.problem_family(cfg.loading.levels, cfg.material, RAMP_S)
         rows = realtime_bench.run(list(cfg.models), cfg.quick, rounds, print, family=family,
                                   failures=TIMING_FAILURES + (LinAlgError,),
-                                  over_in_a_row=1)
+                                  over_in_a_row=1, label=f"realtime: timing {cfg.spec.name}")
         got = store.put(k, {"realtime_rows": rows, "realtime_machine": here})
     return got
 

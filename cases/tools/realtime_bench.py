@@ -156,14 +156,15 @@ def _row(name, mesh, timer, got, rounds):
 
 
 def run(models=None, quick=False, rounds=5, progress=print, family=None, failures=(),
-        over_in_a_row=OVER_IN_A_ROW):
+        over_in_a_row=OVER_IN_A_ROW, label="bench: real-time family"):
     """The family's rows: one per (model, size), timed or marked not timed (over real time at
     OVER_IN_A_ROW smaller sizes in a row); ``models`` default the family's, ``family`` (an
     iterable of Loading, smallest first) the bench's cube family. A model whose set-up or
     sample raises one of ``failures`` is recorded as failed there (its ``failed`` the reason)
     and not timed further up; any other error stops the run. ``over_in_a_row``: the sizes
     over real time in a row after which a model is not timed up (one where each size is
-    several times the last: its cost cannot come back under real time)."""
+    several times the last: its cost cannot come back under real time). ``label`` leads each
+    size's progress line."""
     models = models or family_models(quick)
     over = {m: 0 for m in models}
     failed = {}
@@ -171,7 +172,7 @@ def run(models=None, quick=False, rounds=5, progress=print, family=None, failure
     for ld in (cube_family(quick) if family is None else family):
         mesh = ld.mesh
         live = [m for m in models if over[m] < over_in_a_row and m not in failed]
-        progress(f"bench: real-time family, {mesh.n_tets} tetrahedra, {len(live)} models")
+        progress(f"{label}, {mesh.n_tets} tetrahedra, {len(live)} models")
         timers, got, here = {}, {m: [] for m in live}, {}
         for m in live:
             try:
