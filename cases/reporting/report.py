@@ -199,7 +199,8 @@ def build_report(case, s, runs, fields, out):
         if items:
             # a quick run's orders and verdicts are these meshes' only: each says so where
             # it is read, not once above (the full run can reverse any of them)
-            doc.h(3, title + (f" (on {', '.join(s.meshes)} only; quick: not decided, "
+            doc.h(3, title + (f" (on mesh{'es' if len(s.meshes) > 1 else ''} "
+                              f"{', '.join(s.meshes)} only; quick: not decided, "
                               f"`{story.command()}` decides)"
                               if s.quick and title not in QUICK_AS_FULL else ""))
             doc.items(items)

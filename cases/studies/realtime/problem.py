@@ -49,8 +49,11 @@ class ProblemLoading:
             "loads_detail": (f"the loads of {spec.path.name} ({held}"
                              + (f", {' and '.join(loads)} constant" if loads else "")
                              + f") on {spec.mesh_file.name} refined uniformly, each "
-                             "tetrahedron into eight"),
-            "question": f"The question a simulator asks of {spec.name}",
+                             "tetrahedron into eight; every model judged at the whole load "
+                             "against the neo-Hookean continuum, as every verdict at a finite "
+                             "load is (the problem's own case report judges its linear "
+                             "regime)"),
+            "question": f"The question a simulator builder asks of the problem {spec.name}",
             "inputs": "not measured here",
             "timer": "this run", "timing": "the timing", "glossary": "glossary.md",
             "stopped": "at a smaller level, or failed there",

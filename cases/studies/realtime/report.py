@@ -55,9 +55,6 @@ def _cost(run):
     return cost, mode, run["cost"][key]
 
 
-# FEM P1 this close to the continuum on every mesh reproduces it (to the static solve's
-# tolerance, a hundredth of the four decimals the errors are given to): an identity check
-IDENTITY = 1e-6
 MARGIN = 0.9       # the step a cautious user takes: 90 % of the own stable step
 STIFF = 0.05       # a top force within this of FEM P1's (relative to the continuum's): stiff right
 
@@ -145,7 +142,7 @@ def rank(scores, at, estimate, points=None, u_two=None):
         sa, sb = scores[a], scores[b]
         if sa is None or sb is None:
             return sa is None and sb is None
-        small = JUDGES * estimate
+        small = judged_floor(estimate)
         if sa < small and sb < small:
             return True
         pa = points.get(a) or [(at[a]["tets"], sa)]
@@ -190,14 +187,14 @@ def verdict(data, family="the bench's real-time family (run `pbcm bench` on this
     estimate (their error cancels FEM P1's)."""
     runs = data["runs"]
     at = reach(runs)
-    exact = p1_exact(runs)
+    e = data["error_estimate"] or 0.0
+    exact = p1_exact(runs, e)
     # where FEM P1 reproduces the continuum its distance is an identity check: not ranked
     measured = {m: r for m, r in at.items() if r is not None and m in ranked_laws(runs)
                 and not (exact is not None and m == P1)}
     if not measured:
         return {"decided": False, "why": f"no model was measured at real time on {family}",
                 "reach": {m: None for m in laws(runs)}, "ranks": []}
-    e = data["error_estimate"] or 0.0
     bounds = {m: bound(runs, r["run"]) for m, r in measured.items()}
     points = {m: reach_points(runs, m, r) for m, r in measured.items()
               if bounds[m] is not None}
@@ -269,20 +266,23 @@ def smaller_better(runs, measured, estimate, bounds):
     return out
 
 
-def p1_exact(runs):
-    """FEM P1's largest distance from the continuum over the family where it is below
-    IDENTITY on every mesh it was solved on (the problem's field is one every P1 element
-    reproduces: its distance is an identity check, and every bound a model-form error
-    alone), else None."""
+def p1_exact(runs, estimate):
+    """FEM P1's largest distance from the continuum over the family where it is below the
+    judged floor (``judged_floor``) on every mesh it was solved on and that floor is the
+    solves' round-off (the problem's field is one every P1 element reproduces: its distance
+    is an identity check, and every bound a model-form error alone), else None."""
     got = [r["disp_rel_l2"] for r in runs if r["model"] == P1 and r["accuracy"]]
-    if got and all(d is not None and d <= IDENTITY for d in got):
+    # only a reference that resolves far below the solves (its estimate under round-off)
+    # can say P1 is exact; a coarser one leaves P1's small distances merely not resolved
+    if got and estimate < ROUND_OFF and all(d is not None and d < judged_floor(estimate)
+                                            for d in got):
         return max(got)
     return None
 
 
-def _fails_above(runs, model, tets):
-    """' (failed at 1715, 2560 tetrahedra)' for a model whose runs failed (at its reach
-    ``tets`` or above: no error there), '' where none did."""
+def _failed_at(runs, model):
+    """' (its static run failed at 1715, 2560 tetrahedra: no error there)' for a model whose
+    static runs failed, '' where none did."""
     failed = sorted(r["tets"] for r in runs if r["model"] == model and r.get("failed"))
     return (f" (its static run failed at {', '.join(map(str, failed))} tetrahedra: no error "
             "there)") if failed else ""
@@ -364,10 +364,11 @@ def answer_line(data, v, quick, words=None):
                   f"{m} up to {t} tetrahedra" + (
                       f" ({w['force']} {fmt(force[m], 2)} from FEM P1's there)"
                       if force.get(m) is not None else "")
-                  + _fails_above(data["runs"], m, t)
+                  + _failed_at(data["runs"], m)
                   for m, t in engines.items() if t)
               + ("; at none of the sizes timed: " + ", ".join(
-                  m for m, t in engines.items() if not t) if not all(engines.values())
+                  m + _failed_at(data["runs"], m) for m, t in engines.items() if not t)
+                 if not all(engines.values())
                  else "") if engines else "")
     return (f"At real time on this machine ({machine(data)}, wall clock, {w['loading']}; "
             f"the errors are each model's static equilibrium under {w['load']}, how "
@@ -382,8 +383,8 @@ def _smaller_words(v):
     got = v.get("smaller") or {}
     if not got:
         return ""
-    return (" More accurate on a smaller mesh they run in real time than at their reach (the "
-            "error grows with refinement there): " + ", ".join(
+    return (" Laws more accurate on a smaller mesh they also run in real time than at their "
+            "reach (their error grows with refinement there): " + ", ".join(
                 f"{m} {t} tetrahedra, {err(b)} (at its reach {err(v['bounds'][m])})"
                 for m, (t, b) in got.items()) + ".")
 
@@ -393,9 +394,9 @@ def _exact_words(v):
     if v.get("p1_exact") is None:
         return ""
     return (f" FEM P1 reproduces the continuum on every mesh (its largest distance "
-            f"{fmt(v['p1_exact'])}, below {IDENTITY:g}): a field every P1 element is exact for, "
-            "so its distance is an identity check, each bound is the model's model-form error "
-            "alone, and this problem does not test what a coarse mesh costs.")
+            f"{fmt(v['p1_exact'])}, not resolved from zero): a field every P1 element is exact "
+            "for, so its distance is an identity check, each bound is the model's model-form "
+            "error alone, and this problem does not test what a coarse mesh costs.")
 
 
 def _behind_words(k, v):
@@ -431,6 +432,21 @@ def write(out, study, s, data):
     return write_study(out, doc, lambda folder: build(folder, study, s, doc))
 
 
+def judged_floor(estimate):
+    """The error below which the comparison cannot judge: JUDGES times the reference's
+    estimate, or times the static solve's round-off where that is larger (an exact
+    reference's estimate is its own round-off, far below the models' solves')."""
+    return JUDGES * max(estimate, ROUND_OFF)
+
+
+def _floor_words(estimate, what):
+    """'5 times WHAT', or where the solve's round-off sets the floor, say so."""
+    if estimate >= ROUND_OFF:
+        return f"{JUDGES} times {what}"
+    return (f"{JUDGES} times the static solve's round-off {fmt(ROUND_OFF)}, above the "
+            f"reference's estimate {fmt(estimate, 2)}")
+
+
 def _judged(value, v):
     """An error against the continuum, 'not resolved' beside it where the reference's
     estimate is more than a fifth of it, 'round-off' where it is within the static solve's
@@ -438,7 +454,7 @@ def _judged(value, v):
     e = v.get("estimate")
     if value is None or e is None:
         return err(value)
-    if value < JUDGES * e:
+    if value < judged_floor(e):
         return f"{err(value)} (not resolved)"
     return f"{err(value)} (round-off)" if value <= ROUND_OFF else err(value)
 
@@ -536,7 +552,8 @@ def build(out, study, s, doc):
             "through the reach's range over the timing rounds (below), not as a number. Two "
             "bounds on one mesh differ only in model-form error, tied within round-off; "
             "bounds both below "
-            f"{err(JUDGES * v['estimate'])} ({JUDGES} times the estimate) are not resolved. "
+            f"{err(judged_floor(v['estimate']))} ({_floor_words(v['estimate'], 'the estimate')}) "
+            "are not resolved. "
             "The reach's range: from the largest size real time in every round to the "
             "largest real time in some round; the bound over it runs from the bound there to "
             "the bound here, and two models are tied where the sizes their reaches take over "
@@ -546,19 +563,21 @@ def build(out, study, s, doc):
             "while each is tied with a third on another mesh): a model's rank is one more "
             "than the number of models resolved ahead of it, so the first are those no model "
             "is resolved ahead of, and every two of them are tied.")
-        d.table(["rank", "model", "mode at its reach", "tets (over the rounds)",
+        d.table(["rank", "model", "mode at its reach", "tets (over the rounds, either mode)",
                  f"wall s per simulated s ({where})", "error bound",
                  "bound over the reach's range", "model-form error",
                  "+ FEM P1's distance there", "tied with; resolved behind"], rows)
         d.p("How firm the reaches are, and each model's own distance from the continuum at "
             "its reach (beside the bound, not an order: a distance below FEM P1's own on "
             "that mesh is partly its error cancelling P1's, and one below "
-            f"{err(JUDGES * v['estimate'])}, {JUDGES} times the reference's estimate, is not "
+            f"{err(judged_floor(v['estimate']))}, "
+            f"{_floor_words(v['estimate'], 'the reference' + chr(39) + 's estimate')}, is not "
             "resolved): the reach at a step "
             f"{100 * MARGIN:g} % of the own stable step (the cost divided by {MARGIN:g}), "
             "and whether the reach is real time in every timing round.")
         d.table(["model", "reach", f"reach at {100 * MARGIN:g} % of the step",
-                 "real time in every round there", "own distance from the continuum",
+                 "real time in every round there (either mode)",
+                 "own distance from the continuum",
                  f"{w['force']}: model-form error (signed)",
                  f"{w['force']}: from the continuum"],
                 [[k["model"], v["reach"][k["model"]]["tets"],
@@ -605,7 +624,7 @@ def build(out, study, s, doc):
                 "cancels part of FEM P1's discretisation error there, a coarse mesh's luck, "
                 "not a property of the model): " + ", ".join(v["cancels"]) + ".")
     d.h(2, "Every size")
-    exact = _exact_words({"p1_exact": p1_exact(runs)})
+    exact = _exact_words({"p1_exact": p1_exact(runs, doc["error_estimate"] or 0.0)})
     if exact and doc["parameters"]["quick"]:        # the full run's answer says it
         d.p(exact.strip())
     shown = [r for r in runs if r["cost"].get("timed") or r["accuracy"]]
@@ -615,8 +634,9 @@ def build(out, study, s, doc):
             f"{w['stopped']}) and nothing was computed: "
             + ", ".join(map(str, untimed)) + " tetrahedra.")
     if v.get("estimate") is not None:
-        d.p(f"Errors below {err(JUDGES * v['estimate'])} ({JUDGES} times the reference's "
-            "estimate) are marked 'not resolved': the reference cannot judge them.")
+        d.p(f"Errors below {err(judged_floor(v['estimate']))} "
+            f"({_floor_words(v['estimate'], 'the reference' + chr(39) + 's estimate')}) are "
+            "marked 'not resolved': the reference cannot judge them.")
     rounds = sorted({r["cost"].get("rounds") for r in shown if r["cost"].get("rounds")})
     d.p(f"Wall-clock seconds per simulated second on {where} (median [smallest-largest over "
         f"{w['timing']}'s {' or '.join(map(str, rounds)) or 'n/a'} rounds]), serial and in the "
