@@ -58,12 +58,14 @@ def test_a_proportional_ramp_scales_every_prescribed_value():
 
 def test_the_family_refines_until_its_size_and_carries_the_supports():
     """The example's family: the mesh, then each level eight times its tetrahedra, up to the
-    first with at least min_tets; on every level the sliding ends hold z on exactly the
+    first with at least min_tets (a quick run: at most the first two); on every level the sliding ends hold z on exactly the
     nodes of their planes, the point supports stay single nodes, and the reaction is summed
     over the top plane's nodes."""
     spec = load(EXAMPLE)
     assert levels_for(288) == 4 and levels_for(288, min_tets=2304) == 2
     assert levels_for(288, quick=True) == 2
+    # a mesh already that large is its own family, in a quick run too
+    assert levels_for(150_000) == 1 and levels_for(150_000, quick=True) == 1
     fam = family(spec, min_tets=3000)
     assert [lv.mesh.n_tets for lv in fam] == [288, 2304, 18432]
     assert fam[0].dirichlet == spec.dirichlet and fam[0].mesh is spec.mesh

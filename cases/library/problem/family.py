@@ -40,13 +40,11 @@ class Level:
 
 def levels_for(n_tets, min_tets=MIN_TETS, quick=False):
     """How many meshes the family holds: the mesh and its refinements up to the first with
-    at least ``min_tets`` tetrahedra (a quick run: QUICK_LEVELS)."""
-    if quick:
-        return QUICK_LEVELS
+    at least ``min_tets`` tetrahedra (a quick run: the first QUICK_LEVELS of those)."""
     count = 1
     while n_tets * 8 ** (count - 1) < min_tets:
         count += 1
-    return count
+    return min(count, QUICK_LEVELS) if quick else count
 
 
 def family(spec, quick=False, min_tets=MIN_TETS):
