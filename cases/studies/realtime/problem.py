@@ -42,7 +42,7 @@ class ProblemLoading:
                 else "no reaction measured")
         loads = [w for w, on in (("its tractions", spec.surfaces), ("gravity", spec.gravity))
                  if on]
-        held = "its prescribed displacements ramped over {RAMP_S:g} s".format(RAMP_S=RAMP_S)
+        held = f"its prescribed displacements ramped over {RAMP_S:g} s"
         self.words = {
             "loading": f"the loads of {spec.path.name} on {spec.mesh_file.name} refined",
             "load": "the problem's loading", "field": "the displacement field",
@@ -63,9 +63,9 @@ class ProblemLoading:
                      "tetrahedra: its cost cannot come back under real time)",
             "blowup": "one is recorded as the model's failure at that size, and the model is "
                       "not timed further up",
-            "quick": "the full run refines the mesh up to at least "
-                     f"{MIN_TETS:,} tetrahedra".replace(",", " "), "family":
-                f"the refinement family of {spec.mesh_file.name}",
+            "quick": f"the full run refines the mesh up to at least {MIN_TETS:_} "
+                     "tetrahedra".replace("_", " "),
+            "family": f"the refinement family of {spec.mesh_file.name}",
             "force": force.name if force else "force",
             "force_detail": f"{force.name if force else 'force'} ({sums})", "force_is": sums,
             "force_why": "where displacements are prescribed, a law's stiffness shows in the "
@@ -117,6 +117,7 @@ class ProblemLoading:
     def __getstate__(self):
         """Pickled without its family (a worker is given its meshes with its jobs)."""
         return {**self.__dict__, "_family": None}
+
 
 @dataclass
 class ProblemRealtimeSettings(RealtimeSettings):
