@@ -206,7 +206,8 @@ def test_an_exact_yardstick_is_an_identity_check_not_a_rank():
     homogeneous field), its distance is an identity check: it is not ranked, the others are
     ranked by their model-form errors, nothing is said to cancel P1's error, an error within
     the solves' round-off is not resolved, and the answer says so; a law more accurate on a
-    smaller real-time mesh than at its reach is named."""
+    smaller real-time mesh than at its reach is named; two laws tied on one mesh are tied
+    within round-off there."""
     from cases.studies.realtime import report as R
 
     def run(model, tets, form, dist, cost):
@@ -229,3 +230,8 @@ def test_an_exact_yardstick_is_an_identity_check_not_a_rank():
     assert v["smaller"] == {"a": [100, 0.05 + 2e-8]}
     answer = R.answer_line(data, v, False)
     assert "identity check" in answer and "a 100 tetrahedra" in answer
+    # two laws tied at one mesh, every round: tied within round-off there, no two-mesh u_val
+    twin = {**data, "runs": runs + [run("c", 100, 0.02, 0.02, 0.1), run("c", 800, 0.02, 0.02,
+                                                                        2.0)]}
+    said = R.answer_line(twin, R.verdict(twin), False)
+    assert "is tied between 2 models, within round-off on one mesh: " in said

@@ -324,11 +324,15 @@ def answer_line(data, v, quick, words=None):
                     f"{_judged(v['bounds'][m], v)})")
     y, p = v.get("yardstick"), v["pick"]
     if len(said) > 1:
+        reaches = [v["reach"][m] for m in v["best"]]
+        one_mesh = len({r["tets"] for r in reaches}) == 1 and all(
+            r["sure"] == r["maybe"] == r["tets"] for r in reaches)
+        within = ("within round-off on one mesh" if one_mesh else
+                  f"within {err(v['u_two_meshes'])} or what their reach spans over the timing "
+                  "rounds")
         head = (f"the smallest error bound (model-form error plus FEM P1's discretisation "
-                f"error at the model's reach; the models' own distances are not resolved "
-                f"apart) is tied between {len(said)} models, within "
-                f"{err(v['u_two_meshes'])} or what their reach spans over the timing rounds: "
-                + "; ".join(said))
+                "error at the model's reach; the models' own distances are not resolved "
+                f"apart) is tied between {len(said)} models, {within}: " + "; ".join(said))
     else:
         head = ("the smallest error bound (model-form error plus FEM P1's discretisation "
                 f"error at the model's reach) is {said[0]}")
