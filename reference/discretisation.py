@@ -179,21 +179,23 @@ def probe(basis, dofs, points):
     the other chunks probed as given."""
     pts = np.asarray(points, dtype=float).reshape(-1, 3)
     values = np.empty((len(pts), 3))
+    mesh = None             # the TetMesh that places points, made at the first chunk needing it
     for lo in range(0, len(pts), PROBE_CHUNK):
         chunk = pts[lo:lo + PROBE_CHUNK]
         try:
             matrix = basis.probes(np.ascontiguousarray(chunk.T))
         except ValueError:
-            matrix = basis.probes(np.ascontiguousarray(_inside(basis.mesh, chunk).T))
+            if mesh is None:
+                from model.mesh import TetMesh
+                mesh = TetMesh(basis.mesh.p.T, basis.mesh.t.T)
+            matrix = basis.probes(np.ascontiguousarray(_inside(mesh, chunk).T))
         values[lo:lo + PROBE_CHUNK] = (matrix @ dofs).reshape(3, len(chunk)).T
     return check_finite("displacement at the probed points", values)
 
 
-def _inside(m, points):
-    """``points`` moved into the tetrahedra of ``m`` that hold them (a MeshError for a point
-    outside the mesh beyond round-off)."""
-    from model.mesh import TetMesh
-    mesh = TetMesh(m.p.T, m.t.T)
+def _inside(mesh, points):
+    """``points`` moved into the tetrahedra of the TetMesh ``mesh`` that hold them (a
+    MeshError for a point outside the mesh beyond round-off)."""
     tets, bary = mesh.locate(points)
     near = bary.min(axis=1) < INSIDE
     bary = np.maximum(bary, INSIDE)

@@ -6,6 +6,7 @@ its edge's ends; tractions load the new boundary triangles that lie in the loade
 gravity is a body force on any mesh; a reaction is summed over the nodes the selection's own
 faces and edges hold (a new node whose parents are all selected)."""
 from dataclasses import dataclass
+from functools import cached_property
 
 import numpy as np
 
@@ -32,9 +33,10 @@ class Level:
     loads: SurfaceLoads
     reaction: tuple = None
 
-    @property
+    @cached_property
     def f_ext(self):
-        """Consistent nodal forces (n, 3) [N] of the loads, or None."""
+        """Consistent nodal forces (n, 3) [N] of the loads, or None (computed once: every
+        law solved and timed on the level reads them)."""
         return self.loads.nodal_forces(self.mesh)
 
 

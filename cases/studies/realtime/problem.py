@@ -15,12 +15,12 @@ import numpy as np
 
 from model.presets import PRESETS
 from reference import hyperelastic
+from ...library.problem.case import BC
 from ...library.problem.family import MIN_TETS, family
 from ...reporting import costs as bench_costs
 from .study import P1, QUICK_REF_LEVELS, RealtimeSettings, force_along
 
 RAMP_S = 1.0            # the prescribed displacements reach their values over this time [s]
-BC = "declared"
 
 
 class ProblemLoading:
