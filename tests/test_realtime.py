@@ -292,3 +292,14 @@ def test_a_reach_range_that_ends_on_the_other_models_mesh_is_compared_there_with
     assert ("newton-xpbd up to 8640 tetrahedra (its static run failed at 10985 tetrahedra: "
             "no error there)") in said
     assert "; at none of the sizes timed: newton-vbd" in said
+
+
+def test_a_reach_real_time_in_every_round_of_its_other_mode_is_sure():
+    """A size whose faster mode by median (serial, 0.9 [0.7-1.1]) is over real time in one
+    round while its other mode (two threads, 0.95 every round) never is counts as real time
+    in every round: a user picks the mode."""
+    runs = [_run("msm", 1000, 0.9, 0.3, 0.2, two=0.95, spread=0.2)]
+    r = R.reach(runs)["msm"]
+    assert r["tets"] == 1000 and r["mode"] == "serial"
+    assert r["sure"] == 1000 and r["maybe"] == 1000
+    assert r["range"] == pytest.approx([0.7, 1.1])      # the mode shown keeps its own range
