@@ -225,6 +225,7 @@ def verdict(data, family="the bench's real-time family (run `pbcm bench` on this
              for m in models(runs) if m not in laws(runs)}
     return {"decided": bool(first), "best": first, "estimate": e, "pick": pick,
             "pick_sure": measured[pick]["sure"] == measured[pick]["tets"],
+            "pick_by_headroom": len(cheaper or sure) > 1,
             "pick_cheaper": [o for o in sure if o != pick and dearer(runs, o, pick)],
             "modes": modes, "force": force, "pick_stiff": bool(stiff),
             "engines": {m: None if r is None else r["tets"] for m, r in at.items()
@@ -346,7 +347,8 @@ def answer_line(data, v, quick, words=None):
            "no tied model is real time in every round at its reach")
     beaten = v.get("pick_cheaper") or []
     why += ((", cheaper than " + ", ".join(beaten) + " on every mesh both were timed on")
-            if beaten else "") + (", with the most headroom" if len(v["best"]) > 1 else "")
+            if beaten else "") + (", with the most headroom of those left"
+                                  if v.get("pick_by_headroom") else "")
     force = v.get("force") or {}
     stiff = (f"The bound reads {w['field']}; {w['force_detail']} against FEM P1's at the "
              "reach: "
