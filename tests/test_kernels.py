@@ -68,6 +68,21 @@ def test_rsqrt_is_the_reciprocal_root_to_round_off():
     assert np.abs(all_of(a) * np.sqrt(a) - 1).max() <= 4 * np.finfo(float).eps
 
 
+def test_blocked_drivers_ask_the_caches_for_the_blocks_ahead():
+    """Every blocked force kernel compiles to code that holds prefetch instructions (the hint of
+    model.terms._blocks.ahead), and a prefetch run as plain Python does nothing."""
+    from numba import njit
+    from model.terms._blocks import OPTIONS, prefetch
+
+    x = perturbed(mesh_of("five"), 0.01)
+    for key in ("corner", "variational", "normal_edge", "fem_linear"):
+        fn, args = make_term(TERMS[key][0], mesh_of("five"), MAT, **TERMS[key][1]).kernel()
+        fresh = njit(**dict(OPTIONS, cache=False))(fn.py_func)    # compiled here: its code seen
+        fresh(x, *args, np.zeros_like(x))
+        assert "prefetch" in "".join(fresh.inspect_asm().values()), key
+    assert prefetch(x, 0) is None
+
+
 def test_blocked_layout():
     """The blocked layout puts row t of an n-by-3 array in block t // B at lane t % B, one component
     after another, and fills the padded lanes of the last block with the last row."""

@@ -3,12 +3,12 @@
 Each reading's derivation is in the docstring of its writer there.
 
 _kernels.py sha256 2590f8733ea1afed
-_blocks.py sha256 f2e63b50a33c0609
+_blocks.py sha256 607ef20d1b1f7374
 """
 import numpy as np
 from numba import njit
 
-from ._blocks import (B, FLAG, OPTIONS, OUT, SCRATCH, first_flat, gather, rsqrt,
+from ._blocks import (B, FLAG, OPTIONS, OUT, SCRATCH, ahead, first_flat, gather, rsqrt,
                       scatter, scatter_routed)
 from ._kernels import add_to, axpy, cross, dot, lin, sub, vec
 from .volume import FLAT
@@ -386,7 +386,11 @@ def shear_corner_block(s, blk, vol0, rest, G, K):
 def shear_corner(x, tb, m, vol0, rest, G, K, out):
     """Literal eq. 5: f_a += (1/4) tau S_F e, tau = G gamma, S_F = cn_j / 2, e = d_am / L_am; returns the first flattened tetrahedron, or -1. With the volume term's forces for K > 0."""
     s = np.empty(SCRATCH)
-    for blk in range((m + B - 1) // B):
+    nb = (m + B - 1) // B
+    for blk in range(nb):
+        ahead(tb, blk, nb)
+        ahead(vol0, blk, nb)
+        ahead(rest, blk, nb)
         gather(x, tb, blk, s)
         if shear_corner_block(s, blk, vol0, rest, G, K) > 0:
             return first_flat(s, blk, m)
@@ -398,7 +402,11 @@ def shear_corner(x, tb, m, vol0, rest, G, K, out):
 def shear_corner_range(x, tb, m, vol0, rest, G, K, first, stop, late, route, buf, out):
     """shear_corner over the blocks [first, stop), the forces of routed corners into buf."""
     s = np.empty(SCRATCH)
+    nb = (m + B - 1) // B
     for blk in range(first, stop):
+        ahead(tb, blk, nb)
+        ahead(vol0, blk, nb)
+        ahead(rest, blk, nb)
         gather(x, tb, blk, s)
         if shear_corner_block(s, blk, vol0, rest, G, K) > 0:
             return first_flat(s, blk, m)
@@ -631,7 +639,11 @@ def shear_balanced_block(s, blk, vol0, rest, G, K):
 def shear_balanced(x, tb, m, vol0, rest, G, K, out):
     """f_j -= tau S_F e on the tip, + tau S_F e / 3 on each base vertex a, m, l; returns the first flattened tetrahedron, or -1. With the volume term's forces for K > 0."""
     s = np.empty(SCRATCH)
-    for blk in range((m + B - 1) // B):
+    nb = (m + B - 1) // B
+    for blk in range(nb):
+        ahead(tb, blk, nb)
+        ahead(vol0, blk, nb)
+        ahead(rest, blk, nb)
         gather(x, tb, blk, s)
         if shear_balanced_block(s, blk, vol0, rest, G, K) > 0:
             return first_flat(s, blk, m)
@@ -643,7 +655,11 @@ def shear_balanced(x, tb, m, vol0, rest, G, K, out):
 def shear_balanced_range(x, tb, m, vol0, rest, G, K, first, stop, late, route, buf, out):
     """shear_balanced over the blocks [first, stop), the forces of routed corners into buf."""
     s = np.empty(SCRATCH)
+    nb = (m + B - 1) // B
     for blk in range(first, stop):
+        ahead(tb, blk, nb)
+        ahead(vol0, blk, nb)
+        ahead(rest, blk, nb)
         gather(x, tb, blk, s)
         if shear_balanced_block(s, blk, vol0, rest, G, K) > 0:
             return first_flat(s, blk, m)
@@ -1026,7 +1042,11 @@ def shear_variational_block(s, blk, vol0, rest, cG, K):
 def shear_variational(x, tb, m, vol0, rest, cG, K, out):
     """f = -dW/dx, W = (c/2) G V0 sum_s gamma_s^2 (cG = c G); returns the first flattened tetrahedron, or -1. With the volume term's forces for K > 0."""
     s = np.empty(SCRATCH)
-    for blk in range((m + B - 1) // B):
+    nb = (m + B - 1) // B
+    for blk in range(nb):
+        ahead(tb, blk, nb)
+        ahead(vol0, blk, nb)
+        ahead(rest, blk, nb)
         gather(x, tb, blk, s)
         if shear_variational_block(s, blk, vol0, rest, cG, K) > 0:
             return first_flat(s, blk, m)
@@ -1038,7 +1058,11 @@ def shear_variational(x, tb, m, vol0, rest, cG, K, out):
 def shear_variational_range(x, tb, m, vol0, rest, cG, K, first, stop, late, route, buf, out):
     """shear_variational over the blocks [first, stop), the forces of routed corners into buf."""
     s = np.empty(SCRATCH)
+    nb = (m + B - 1) // B
     for blk in range(first, stop):
+        ahead(tb, blk, nb)
+        ahead(vol0, blk, nb)
+        ahead(rest, blk, nb)
         gather(x, tb, blk, s)
         if shear_variational_block(s, blk, vol0, rest, cG, K) > 0:
             return first_flat(s, blk, m)

@@ -20,8 +20,8 @@ from numba import njit
 
 from . import Term, register
 from ..material import neohookean_energy, neohookean_stress
-from ._blocks import B, FAST, FLAG, INLINED, OPTIONS, OUT, SCRATCH, blocked, blocked_tets, first_flat, gather, \
-    scatter, scatter_routed
+from ._blocks import B, FAST, FLAG, INLINED, OPTIONS, OUT, SCRATCH, ahead, blocked, blocked_tets, first_flat, \
+    gather, scatter, scatter_routed
 from ._constant_strain import RestShape
 from ._kernels import (add_piola_forces, cofactor, cross, deformation_gradient,
                        dot, lin, piola_forces_numpy,
@@ -207,7 +207,10 @@ def constant_strain_forces(x, tb, m, data, lam, mu, law, out):
     det F <= FLAT, or -1."""
     s = np.empty(SCRATCH)
     r = np.empty(POLAR)
-    for blk in range((m + B - 1) // B):
+    nb = (m + B - 1) // B
+    for blk in range(nb):
+        ahead(tb, blk, nb)
+        ahead(data, blk, nb)
         gather(x, tb, blk, s)
         if law_block(s, r, blk, data, lam, mu, law) > 0:
             return first_flat(s, blk, m)
@@ -221,7 +224,10 @@ def constant_strain_range(x, tb, m, data, lam, mu, law, first, stop, late, route
     buf (the threaded mode's twin: model.terms._threads.SplitBlocks)."""
     s = np.empty(SCRATCH)
     r = np.empty(POLAR)
+    nb = (m + B - 1) // B
     for blk in range(first, stop):
+        ahead(tb, blk, nb)
+        ahead(data, blk, nb)
         gather(x, tb, blk, s)
         if law_block(s, r, blk, data, lam, mu, law) > 0:
             return first_flat(s, blk, m)

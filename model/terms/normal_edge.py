@@ -13,7 +13,7 @@ import numpy as np
 from numba import njit
 
 from . import CalibratedTerm, register
-from ._blocks import (B, FLAG, INLINED, OPTIONS, OUT, SCRATCH, blocked, blocked_tets, first_flat, gather,
+from ._blocks import (B, FLAG, INLINED, OPTIONS, OUT, SCRATCH, ahead, blocked, blocked_tets, first_flat, gather,
                       rsqrt, scatter, scatter_routed)
 from ._threads import split_of
 from ._kernels import axpy, dot, sub
@@ -82,7 +82,11 @@ def normal_forces(x, tb, m, vol0, inv_rest, coef_G, out):
     """The per-corner edge-strain deviation forces, block by block; returns the first
     tetrahedron with a collapsed edge, or -1."""
     s = np.empty(SCRATCH)
-    for blk in range((m + B - 1) // B):
+    nb = (m + B - 1) // B
+    for blk in range(nb):
+        ahead(tb, blk, nb)
+        ahead(vol0, blk, nb)
+        ahead(inv_rest, blk, nb)
         gather(x, tb, blk, s)
         if normal_block(s, blk, vol0, inv_rest, coef_G) > 0:
             return first_flat(s, blk, m)
@@ -95,7 +99,11 @@ def normal_range(x, tb, m, vol0, inv_rest, coef_G, first, stop, late, route, buf
     """normal_forces over the blocks [first, stop), the forces of routed corners into buf (the
     threaded mode's twin: model.terms._threads.SplitBlocks)."""
     s = np.empty(SCRATCH)
+    nb = (m + B - 1) // B
     for blk in range(first, stop):
+        ahead(tb, blk, nb)
+        ahead(vol0, blk, nb)
+        ahead(inv_rest, blk, nb)
         gather(x, tb, blk, s)
         if normal_block(s, blk, vol0, inv_rest, coef_G) > 0:
             return first_flat(s, blk, m)
