@@ -565,6 +565,9 @@ class Study(abc.ABC):
 
     name: ClassVar[str]
     title: ClassVar[str]
+    # what the index's mode column says of a run without --quick (a study whose full run is
+    # on coarse meshes says so there)
+    full_mode: ClassVar[str] = "full"
     # the command line's selections the study honours; `pbcm run NAME` refuses the others
     # (`pbcm report` passes them to the studies that take them)
     selections: ClassVar[tuple] = ("models", "meshes")

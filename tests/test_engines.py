@@ -254,3 +254,27 @@ def test_a_redrawn_report_reads_its_costs_from_the_checkouts_bench(monkeypatch):
     assert got["costs"][model] == row and got["machine"] == {"cpu": "X", "cores": 2}
     monkeypatch.setattr(bench_costs, "load", lambda *a: None)
     assert STUDY.redrawn(s, {"costs": {model: None}}, {})["costs"] == {model: None}
+
+
+def test_the_index_names_where_its_numbers_come_from(tmp_path):
+    """The index's studies table says the engines study's full run is on the cases' quick
+    meshes (its own meshes, named), never a bare 'full' beside studies that run finer; the
+    cost at a stated accuracy names the bench cube and the time it reads."""
+    from pathlib import Path
+
+    from cases.cli import main
+    from cases.library.common import bench_mesh
+    from cases.registry import CASES
+    from cases.reporting.costs import COST_TETS
+    from cases.studies.engines.study import MESHES
+    reports = Path(__file__).resolve().parents[1] / "reports"
+    for name in (*CASES, "engines", "bench"):
+        (tmp_path / name).symlink_to(reports / name, target_is_directory=True)
+    assert main(["index", "--out", str(tmp_path)]) == 0
+    row = next(line for line in (tmp_path / "index.md").read_text().splitlines()
+               if line.startswith("| [engines](engines/report.md) |"))
+    assert row.endswith(f"| full, on the cases' quick meshes ({', '.join(MESHES)}) |")
+    cost = (tmp_path / "index.md").read_text().split("- Cost at a stated accuracy")[1]
+    assert "s per simulated s on the bench's machine (serial CPU time at its own stable RK4 " \
+        f"step on the bench's {bench_mesh(COST_TETS).n_tets}-tetrahedron cube" \
+        in cost.split("\n")[0]

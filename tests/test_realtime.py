@@ -101,6 +101,15 @@ def test_the_ranking_holds_the_yardstick_and_ties_by_the_pair_s_uncertainty():
     assert "headroom" not in said
     assert "FEM P1 with the continuum's law (fem-neohookean), the yardstick (ranked), runs " \
         "1080 tetrahedra at distance 0.0520" in said
+    # the index's line: the tied first with their meshes and errors, then the pick
+    assert R.index_line(data, v, quick=False) == (
+        "At real time on this machine (X, 2 cores, wall clock, the paper's push on its cube; "
+        "the error bound is the model-form error plus FEM P1's distance from the continuum at "
+        "the model's reach), the most accurate models are tied (2, within u_val): "
+        "fem-neohookean (serial, 1080 tetrahedra, error bound 0.0520); pbcm-variational "
+        "(serial, 1715 tetrahedra, error bound 0.0526). Pick pbcm-variational: real time in "
+        "every timing round at its reach, cheaper than fem-neohookean on every mesh both were "
+        "timed on.")
     close = {**data, "error_estimate": 0.002}        # 2 e = 0.004 > 0.0024
     v = R.verdict(close)
     assert v["best"] == ["fem-neohookean", "pbcm-variational"]
@@ -115,6 +124,11 @@ def test_the_ranking_holds_the_yardstick_and_ties_by_the_pair_s_uncertainty():
     v = R.verdict(small)
     assert v["best"] == ["fem-neohookean", "pbcm-balanced", "pbcm-variational"]
     assert R.answer_line(data, v, quick=True).startswith("Quick: not decided")
+    assert R.index_line(data, v, quick=True).startswith("Quick: not decided")
+    one = {**data, "runs": data["runs"][:3]}
+    assert R.index_line(one, R.verdict(one), quick=False).endswith(
+        "the most accurate model is fem-neohookean (serial, 1080 tetrahedra, error bound "
+        "0.0520): real time in every timing round at its reach.")
 
 
 def test_no_model_measured_at_real_time_is_not_decided():
@@ -291,9 +305,16 @@ def test_a_reach_range_that_ends_on_the_other_models_mesh_is_compared_there_with
     assert "newton-xpbd" not in ranks
     assert v["engines"] == {"newton-xpbd": 8640, "newton-vbd": None}
     said = R.answer_line(data, v, quick=False)
-    assert ("newton-xpbd up to 8640 tetrahedra (its static run failed at 10985 tetrahedra: "
-            "no error there)") in said
+    # a solver that fails on the next mesh has no decided error at its reach
+    assert ("newton-xpbd up to 8640 tetrahedra (its static run failed at 10985 tetrahedra, "
+            "larger meshes: no error at its reach decided)") in said
     assert "; at none of the sizes timed: newton-vbd" in said
+    below = {**data, "runs": runs[:5] + [
+        {**_run("newton-xpbd", 1080, 0.1, None, None), "failed": "not at rest"},
+        {**_run("newton-xpbd", 8640, 0.5, 0.3, 0.2), "force_form_rel": 2.5}]}
+    said = R.answer_line(below, R.verdict(below), quick=False)
+    assert ("newton-xpbd up to 8640 tetrahedra (top force 2.5 from FEM P1's there) (its "
+            "static run failed at 1080 tetrahedra: no error there)") in said
 
 
 def test_a_reach_real_time_in_every_round_of_its_other_mode_is_sure():

@@ -704,8 +704,10 @@ def recommendation(root, models, pops, quick, bench_rows):
                    "comes within it of FEM P1 on every case, so none replaces it there)"
                    if cheap == p1_lin else f" (at most {fmt(worst_of[cheap])})")
                 + f", {fmt(bench_rows[cheap]['cpu_s_per_simulated_s'])} s per simulated s on "
-                "the bench's machine (its median round; a time moves with the machine, the "
-                "ratios to fem-linear are the comparison)")
+                f"the bench's machine (serial CPU time at its own stable RK4 step on the "
+                f"bench's {bench_rows[cheap]['tets']}-tetrahedron cube, the cost line's; its "
+                "median round; a time moves with the machine, the ratios to fem-linear are "
+                "the comparison)")
         if cheapest and bench_rows[cheapest]["cpu_s_per_simulated_s"] < \
                 bench_rows[cheap]["cpu_s_per_simulated_s"]:
             line += (f"; {cheapest} is cheaper ("
@@ -722,7 +724,8 @@ def recommendation(root, models, pops, quick, bench_rows):
         out.append(line + ".")
     rt = _load(root, "realtime", "metrics.json")
     if rt and not rt["parameters"]["quick"]:
-        out.append(f"- A real-time budget ([realtime](realtime/report.md)): {rt['answer']}")
+        out.append(f"- A real-time budget ([realtime](realtime/report.md)): "
+                   f"{rt.get('index_answer') or rt['answer']}")
     eng = _load(root, "engines", "metrics.json")
     if eng and not eng["parameters"]["quick"]:
         out.append(f"- A physics engine instead (Newton; [engines](engines/report.md)): "

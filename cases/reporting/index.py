@@ -222,7 +222,7 @@ def index_documents(root, cases, studies=(), missing=()):
         doc.table(["study", "what it measures", "mode"], [
             [Link(n, f"{n}/report.md", f"{n}/report.html"), declared()[n].title,
              "quick" if json.loads((root / n / "metrics.json").read_text())["parameters"][
-                 "quick"] else "full"] for n in shown])
+                 "quick"] else declared()[n].full_mode] for n in shown])
     doc.h(2, "Scorecard")
     doc.p("Two rows per case and boundary condition, on the one error model of the glossary: "
           "first each model's model-form error, what replacing FEM P1 (the same law on the "

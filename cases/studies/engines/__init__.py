@@ -5,7 +5,7 @@ counts. Needs the engines extra; without it the report says so and runs nothing.
 from ...framework import Study
 from ...running.store import OFF
 from . import report
-from .study import EngineSettings, costs, run
+from .study import MESHES, EngineSettings, costs, run
 
 
 class Engines(Study):
@@ -17,6 +17,7 @@ class Engines(Study):
     title = ("today's fast models: Newton's XPBD, VBD and semi-implicit FEM against the "
              "continuum, on the cases' quick meshes and references")
     settings_class = EngineSettings
+    full_mode = f"full, on the cases' quick meshes ({', '.join(MESHES)})"
 
     def run(self, s, workers=None, log=True, bench=None, store=None):
         return run(s, workers=workers, log=log, bench=bench, store=store or OFF)

@@ -289,6 +289,26 @@ def _failed_at(runs, model):
             "there)") if failed else ""
 
 
+def _engine_words(runs, model, tets, force, w):
+    """'newton-xpbd up to 1080 tetrahedra (top force 2.5 from FEM P1's there)', or where its
+    static run fails on a larger mesh '... (its static run failed at 1715, 2560 tetrahedra,
+    larger meshes: no error at its reach decided)'."""
+    if _fails_above(runs, model, tets):
+        failed = sorted(r["tets"] for r in runs if r["model"] == model and r.get("failed"))
+        return (f"{model} up to {tets} tetrahedra (its static run failed at "
+                f"{', '.join(map(str, failed))} tetrahedra, larger meshes: no error at its "
+                "reach decided)")
+    return (f"{model} up to {tets} tetrahedra"
+            + (f" ({w['force']} {fmt(force, 2)} from FEM P1's there)" if force is not None
+               else "") + _failed_at(runs, model))
+
+
+def _fails_above(runs, model, tets):
+    """Whether ``model``'s static run failed on a mesh larger than ``tets``: its equilibrium
+    there is that of a solver the next refinements break, so no error of it is decided."""
+    return any(r["tets"] > tets for r in runs if r["model"] == model and r.get("failed"))
+
+
 def dearer(runs, a, b):
     """Whether law ``a`` costs more than law ``b`` (median wall time per simulated second in
     its faster mode) on every mesh both were timed on, there being one."""
@@ -343,12 +363,7 @@ def answer_line(data, v, quick, words=None):
     if nearly:
         head += ("; tied with some of them but resolved behind another: "
                  + "; ".join(_behind_words(k, v) for k in nearly))
-    why = ("real time in every timing round at its reach" if v["pick_sure"] else
-           "no tied model is real time in every round at its reach")
-    beaten = v.get("pick_cheaper") or []
-    why += ((", cheaper than " + ", ".join(beaten) + " on every mesh both were timed on")
-            if beaten else "") + (", with the most headroom of those left"
-                                  if v.get("pick_by_headroom") else "")
+    why = _why_pick(v)
     force = v.get("force") or {}
     stiff = (f"The bound reads {w['field']}; {w['force_detail']} against FEM P1's at the "
              "reach: "
@@ -366,12 +381,8 @@ def answer_line(data, v, quick, words=None):
               "through pbcm's adapter; their cost is one core's, the ranked models' that of "
               "their faster mode, two threads where they have one, so their reaches are not "
               "compared with those) in real time: "
-              + ", ".join(
-                  f"{m} up to {t} tetrahedra" + (
-                      f" ({w['force']} {fmt(force[m], 2)} from FEM P1's there)"
-                      if force.get(m) is not None else "")
-                  + _failed_at(data["runs"], m)
-                  for m, t in engines.items() if t)
+              + ", ".join(_engine_words(data["runs"], m, t, force.get(m), w)
+                          for m, t in engines.items() if t)
               + ("; at none of the sizes timed: " + ", ".join(
                   m + _failed_at(data["runs"], m) for m, t in engines.items() if not t)
                  if not all(engines.values())
@@ -381,6 +392,43 @@ def answer_line(data, v, quick, words=None):
             f"far a timed run lags it not measured), {head}. {stiff}Pick {p}: {why} "
             f"({fmt(v['reach'][p]['range'][1])} s per simulated s in its slowest round)"
             f"{beside}{newton}.{_smaller_words(v)}{_exact_words(v)}")
+
+
+def _why_pick(v):
+    """Why the pick among the tied first: 'real time in every timing round at its reach,
+    cheaper than ... on every mesh both were timed on'."""
+    why = ("real time in every timing round at its reach" if v["pick_sure"] else
+           "no tied model is real time in every round at its reach")
+    beaten = v.get("pick_cheaper") or []
+    return why + ((", cheaper than " + ", ".join(beaten) + " on every mesh both were timed on")
+                  if beaten else "") + (", with the most headroom of those left"
+                                        if v.get("pick_by_headroom") else "")
+
+
+def index_line(data, v, quick, words=None):
+    """The index's line: at real time on the bench's machine, the most accurate model, its mesh
+    and error, those tied with it and the pick among them; the report's opening gives the
+    evidence (the runners-up, the forces, the engines)."""
+    if quick or not v["decided"]:
+        return answer_line(data, v, quick, words)
+    w = words or CubePush.words
+    p = v["pick"]
+
+    def at(m):
+        r = v["reach"][m]
+        return (f"{r['model'] if r['model'] != m else r['mode']}, {r['tets']} tetrahedra, "
+                f"error bound {_judged(v['bounds'][m], v)}")
+    what = (f"({machine(data)}, wall clock, {w['loading']}; the error bound is the model-form "
+            "error plus FEM P1's distance from the continuum at the model's reach"
+            + (", which is round-off here: FEM P1 is exact for this problem's field"
+               if v.get("p1_exact") is not None else "") + ")")
+    if len(v["best"]) == 1:
+        return (f"At real time on this machine {what}, the most accurate model is {p} "
+                f"({at(p)}): {_why_pick(v)}.")
+    return (f"At real time on this machine {what}, the most accurate models are tied "
+            f"({len(v['best'])}, within u_val): "
+            + "; ".join(f"{m} ({at(m)})" for m in v["best"])
+            + f". Pick {p}: {_why_pick(v)}.")
 
 
 def _smaller_words(v):
@@ -430,6 +478,7 @@ def write(out, study, s, data):
     doc = jsonable({"case": getattr(s, "case_name", study.name), "study": True, "parameters": s.describe(),
                     "problem": s.problem(), "gated": GATED, "environment": environment(),
                     **data, "verdict": v, "answer": answer_line(data, v, s.quick, w),
+                    "index_answer": index_line(data, v, s.quick, w),
                     "gate_runs": [{"mesh": r["mesh"], "bc": r["bc"], "model": r["model"],
                                    "disp_rel_l2": r["disp_rel_l2"],
                                    "disp_form_rel_l2": r["disp_form_rel_l2"]}
@@ -602,14 +651,20 @@ def build(out, study, s, doc):
         if v.get("engines"):
             d.p("Not ranked: Newton's solvers, timed on one core of Warp's CPU backend (the "
                 "ranked models on two threads), so their reaches are not compared with the "
-                f"ranked ones'; each at its own reach, its error bound and {w['force']} there.")
+                f"ranked ones'; each at its own reach, its error bound and {w['force']} there"
+                + ("; not decided for a solver whose static run fails on a larger mesh of "
+                   "the family (the equilibrium of a solver the next refinements break)"
+                   if any(t and _fails_above(runs, m, t) for m, t in v["engines"].items())
+                   else "") + ".")
             d.table(["solver", "reach (tets)", "wall s per simulated s (one core)",
                      "error bound", f"{w['force']}: model-form error (signed)"],
                     [[m, t or "none", "-" if not t else
                       f"{fmt(v['reach'][m]['cost'])} [{fmt(v['reach'][m]['range'][0])}-"
                       f"{fmt(v['reach'][m]['range'][1])}]",
-                      err(v["engine_bounds"].get(m)) if t else "-",
-                      _signed(v["force"].get(m)) if t else "-"]
+                      "-" if not t else "not decided" if _fails_above(runs, m, t) else
+                      err(v["engine_bounds"].get(m)),
+                      "-" if not t else "not decided" if _fails_above(runs, m, t) else
+                      _signed(v["force"].get(m))]
                      for m, t in v["engines"].items()])
         if v.get("modes"):
             d.p("fem-corotated's implicit modes on their own: " + "; ".join(
