@@ -325,8 +325,9 @@ def test_an_implicit_step_is_timed_with_blas_on_one_thread(monkeypatch):
 def test_a_target_verdict_reads_the_rounds_range():
     """Against an upper target: a range below it is met, above it missed, holding it not
     resolved; without a range, the value is read against a relative band (the bench's spread
-    at its size); a lower target (a speed-up) the same way round; a step ratio below 1 is not
-    resolved."""
+    at its size); a lower target (a speed-up) the same way round; a step ratio below 1 in any
+    round is not resolved; the fraction of attainable carries its ns/tet's range; a range is
+    printed to four figures."""
     v = bench.verdict
     assert v(24.0, [23.0, 25.0], 30.0, True) == "met"
     assert v(34.0, [31.0, 35.0], 30.0, True) == "missed"
@@ -349,6 +350,17 @@ def test_a_target_verdict_reads_the_rounds_range():
     assert [(r[0], r[-1][:12]) for r in bench.target_rows(data)] == [
         ("serial ns/tet", "missed"), ("two-thread speed-up", "met"),
         ("fraction of attainable", "missed"), ("step / 4 forces", "not resolved")]
+    # the fraction's range is its ns/tet's over the rounds (fraction ~ 1 / ns)
+    frac = next(r for r in bench.target_rows(data) if r[0] == "fraction of attainable")
+    assert frac[4] == "0.3 [0.291-0.309]"
+    # a step ratio whose range dips below 1 is not resolved, whatever its median
+    data["rows"][0].update(step_over_4_forces=1.03, step_over_4_forces_range=[0.98, 1.04])
+    step = next(r for r in bench.target_rows(data) if r[0] == "step / 4 forces")
+    assert step[-1].startswith("not resolved (the step ran faster")
+    # four figures: a range ending just short of the target shows it
+    data["rows"][0].update(two_thread_speedup=1.795, two_thread_speedup_range=[1.13, 1.7966])
+    two = next(r for r in bench.target_rows(data) if r[0] == "two-thread speed-up")
+    assert two[4] == "1.795 [1.13-1.797]" and two[-1] == "missed"
 
 
 def test_the_machine_is_named_with_what_a_bare_processor_name_leaves_out():
