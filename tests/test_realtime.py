@@ -88,8 +88,9 @@ def test_the_ranking_holds_the_yardstick_and_ties_by_the_pair_s_uncertainty():
                            "push on its cube; the errors are each model's static equilibrium "
                            "under the push, how far a timed run lags it not measured), the "
                            "smallest error bound (model-form error plus FEM P1's "
-                           "discretisation error at the model's reach; the models' own "
-                           "distances are not resolved apart) is tied between 2 models, within "
+                           "discretisation error at the model's reach; the tied models' own "
+                           "distances from the continuum differ by more (the second table)) "
+                           "is tied between 2 models, within "
                            "0.0020 or what their reach spans over the timing rounds: "
                            "fem-neohookean (serial, 1080 tetrahedra, 0.0520); pbcm-variational "
                            "(serial, 1715 tetrahedra, 0.0526)")
@@ -123,6 +124,9 @@ def test_the_ranking_holds_the_yardstick_and_ties_by_the_pair_s_uncertainty():
                       _run("pbcm-variational", 1715, 0.5, 0.01, 0.026)]}
     v = R.verdict(small)
     assert v["best"] == ["fem-neohookean", "pbcm-balanced", "pbcm-variational"]
+    # own distances 0.005, 0.01, 0.01 lie within 2 e = 0.016 of each other
+    assert "the tied models' own distances from the continuum lie within the same " \
+        "uncertainty of each other" in R.answer_line(small, v, quick=False)
     assert R.answer_line(data, v, quick=True).startswith("Quick: not decided")
     assert R.index_line(data, v, quick=True).startswith("Quick: not decided")
     one = {**data, "runs": data["runs"][:3]}
@@ -300,14 +304,21 @@ def test_a_reach_range_that_ends_on_the_other_models_mesh_is_compared_there_with
     data = {"runs": runs, "error_estimate": e, "machine": {"cpu": "X", "cores": 2}}
     v = R.verdict(data)
     ranks = {k["model"]: k for k in v["ranks"]}
+    # the bound over the reach's range: every size from 8640 (every round) to 10985
+    assert v["over_range"]["fem-linear"] == pytest.approx((0.0322, 0.0345))
     assert "msm+volume" not in ranks["fem-linear"]["tied"]
     assert ranks["msm+volume"]["behind"] == ["fem-linear"]
     assert "newton-xpbd" not in ranks
     assert v["engines"] == {"newton-xpbd": 8640, "newton-vbd": None}
     said = R.answer_line(data, v, quick=False)
-    # a solver that fails on the next mesh has no decided error at its reach
-    assert ("newton-xpbd up to 8640 tetrahedra (its static run failed at 10985 tetrahedra, "
-            "larger meshes: no error at its reach decided)") in said
+    # a solver that fails on the next mesh: its numbers at its reach shown, not decided
+    assert ("newton-xpbd up to 8640 tetrahedra (not decided: its static run failed at 10985 "
+            "tetrahedra, larger meshes)") in said
+    failing = {**data, "runs": [{**r, "force_form_rel": 2.5} if r["model"] == "newton-xpbd"
+                                and r["tets"] == 8640 else r for r in runs]}
+    assert ("newton-xpbd up to 8640 tetrahedra (top force 2.5 from FEM P1's there, not "
+            "decided: its static run failed at 10985 tetrahedra, larger meshes)") in \
+        R.answer_line(failing, R.verdict(failing), quick=False)
     assert "; at none of the sizes timed: newton-vbd" in said
     below = {**data, "runs": runs[:5] + [
         {**_run("newton-xpbd", 1080, 0.1, None, None), "failed": "not at rest"},

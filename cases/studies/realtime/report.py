@@ -199,6 +199,8 @@ def verdict(data, family="the bench's real-time family (run `pbcm bench` on this
     points = {m: reach_points(runs, m, r) for m, r in measured.items()
               if bounds[m] is not None}
     spans = {m: (bounds[m], p[0][1]) for m, p in points.items()}
+    # every size the reach takes over the rounds, the largest real time in some round too
+    over_range = {m: (min(b for _, b in p), max(b for _, b in p)) for m, p in points.items()}
     ranked = rank(bounds, measured, e, points)
     first = [m for k, m, _, _ in ranked if k == 1 and bounds[m] is not None]
     yard = at.get(P1)
@@ -234,6 +236,7 @@ def verdict(data, family="the bench's real-time family (run `pbcm bench` on this
                               if engine(m) and r is not None},
             "cautious": {m: None if r is None else r["tets"] for m, r in cautious.items()},
             "u_two_meshes": u_two_meshes(e), "bounds": bounds, "spans": spans,
+            "over_range": over_range,
             "reach": {m: None if r is None else {k: v for k, v in r.items() if k != "run"}
                       for m, r in at.items()},
             "ranks": [{"rank": k, "model": m, "tied": tied, "behind": behind,
@@ -295,9 +298,11 @@ def _engine_words(runs, model, tets, force, w):
     larger meshes: no error at its reach decided)'."""
     if _fails_above(runs, model, tets):
         failed = sorted(r["tets"] for r in runs if r["model"] == model and r.get("failed"))
-        return (f"{model} up to {tets} tetrahedra (its static run failed at "
-                f"{', '.join(map(str, failed))} tetrahedra, larger meshes: no error at its "
-                "reach decided)")
+        return (f"{model} up to {tets} tetrahedra ("
+                + (f"{w['force']} {fmt(force, 2)} from FEM P1's there, " if force is not None
+                   else "")
+                + f"not decided: its static run failed at {', '.join(map(str, failed))} "
+                "tetrahedra, larger meshes)")
     return (f"{model} up to {tets} tetrahedra"
             + (f" ({w['force']} {fmt(force, 2)} from FEM P1's there)" if force is not None
                else "") + _failed_at(runs, model))
@@ -351,9 +356,16 @@ def answer_line(data, v, quick, words=None):
         within = ("within round-off on one mesh" if one_mesh else
                   f"within {err(v['u_two_meshes'])} or what their reach spans over the timing "
                   "rounds")
-        head = (f"the smallest error bound (model-form error plus FEM P1's discretisation "
-                "error at the model's reach; the models' own distances are not resolved "
-                f"apart) is tied between {len(said)} models, {within}: " + "; ".join(said))
+        own = [_law_run(data["runs"], m, r["tets"])["disp_rel_l2"]
+               for m, r in zip(v["best"], reaches)]
+        apart = (None in own or max(own) - min(own) > (
+            ROUND_OFF if one_mesh else v["u_two_meshes"]))
+        head = ("the smallest error bound (model-form error plus FEM P1's discretisation "
+                "error at the model's reach; "
+                + ("the tied models' own distances from the continuum differ by more (the "
+                   "second table)" if apart else "the tied models' own distances from the "
+                   "continuum lie within the same uncertainty of each other")
+                + f") is tied between {len(said)} models, {within}: " + "; ".join(said))
     else:
         head = ("the smallest error bound (model-form error plus FEM P1's discretisation "
                 f"error at the model's reach) is {said[0]}")
@@ -529,7 +541,13 @@ def _cost_cell(run, key):
     if value is None:
         return "-"
     lo, hi = c["two_thread_range" if key.startswith("two") else "wall_range"]
-    return f"{fmt(value)} [{fmt(lo)}-{fmt(hi)}]"
+    return f"{_wall(value)} [{_wall(lo)}-{_wall(hi)}]"
+
+
+def _wall(value):
+    """A wall time per simulated second to four figures: a range end just above real time
+    (1.0034) is not printed as 1."""
+    return fmt(value, 4)
 
 
 def _signed(value):
@@ -582,9 +600,9 @@ def build(out, study, s, doc):
             p1 = k["score"] - r["disp_form_rel_l2"] if k["score"] is not None else None
             rows.append([k["rank"], m, mode,
                          f"{reach_['tets']} ({reach_['sure'] or 'none'}-{reach_['maybe']})",
-                         f"{fmt(reach_['cost'])} [{fmt(reach_['range'][0])}-"
-                         f"{fmt(reach_['range'][1])}]", _judged(k["score"], v),
-                         _span_cell(v.get("spans", {}).get(m)),
+                         f"{_wall(reach_['cost'])} [{_wall(reach_['range'][0])}-"
+                         f"{_wall(reach_['range'][1])}]", _judged(k["score"], v),
+                         _span_cell((v.get("over_range") or v.get("spans", {})).get(m)),
                          err(r["disp_form_rel_l2"]), _judged(p1, v),
                          "; ".join(x for x in (
                              k["tied"] and "tied with " + ", ".join(k["tied"]),
@@ -610,8 +628,9 @@ def build(out, study, s, doc):
             f"{err(judged_floor(v['estimate']))} ({_floor_words(v['estimate'], 'the estimate')}) "
             "are not resolved. "
             "The reach's range: from the largest size real time in every round to the "
-            "largest real time in some round; the bound over it runs from the bound there to "
-            "the bound here, and two models are tied where the sizes their reaches take over "
+            "largest real time in some round; the bound over it is the smallest to the "
+            "largest bound at the sizes of that range (failed where none is real time in "
+            "every round), and two models are tied where the sizes their reaches take over "
             "the rounds give bounds within the uncertainty of those two meshes, or disagree "
             "on which is ahead: that depends on the timing round. "
             "A tie is not transitive (two models on one mesh are ordered within round-off "
@@ -659,12 +678,12 @@ def build(out, study, s, doc):
             d.table(["solver", "reach (tets)", "wall s per simulated s (one core)",
                      "error bound", f"{w['force']}: model-form error (signed)"],
                     [[m, t or "none", "-" if not t else
-                      f"{fmt(v['reach'][m]['cost'])} [{fmt(v['reach'][m]['range'][0])}-"
-                      f"{fmt(v['reach'][m]['range'][1])}]",
-                      "-" if not t else "not decided" if _fails_above(runs, m, t) else
-                      err(v["engine_bounds"].get(m)),
-                      "-" if not t else "not decided" if _fails_above(runs, m, t) else
-                      _signed(v["force"].get(m))]
+                      f"{_wall(v['reach'][m]['cost'])} [{_wall(v['reach'][m]['range'][0])}-"
+                      f"{_wall(v['reach'][m]['range'][1])}]",
+                      "-" if not t else err(v["engine_bounds"].get(m)) + (
+                          " (not decided)" if _fails_above(runs, m, t) else ""),
+                      "-" if not t else _signed(v["force"].get(m)) + (
+                          " (not decided)" if _fails_above(runs, m, t) else "")]
                      for m, t in v["engines"].items()])
         if v.get("modes"):
             d.p("fem-corotated's implicit modes on their own: " + "; ".join(
