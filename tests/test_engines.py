@@ -259,7 +259,7 @@ def test_a_redrawn_report_reads_its_costs_from_the_checkouts_bench(monkeypatch):
 def test_the_index_names_where_its_numbers_come_from(tmp_path):
     """The index's studies table says the engines study's full run is on the cases' quick
     meshes (its own meshes, named), never a bare 'full' beside studies that run finer; the
-    cost at a stated accuracy names the bench cube and the time it reads."""
+    costs name the bench cube, the time they read and the machine."""
     from pathlib import Path
 
     from cases.cli import main
@@ -274,6 +274,11 @@ def test_the_index_names_where_its_numbers_come_from(tmp_path):
     row = next(line for line in (tmp_path / "index.md").read_text().splitlines()
                if line.startswith("| [engines](engines/report.md) |"))
     assert row.endswith(f"| full, on the cases' quick meshes ({', '.join(MESHES)}) |")
+    import json
+    machine = json.loads((reports / "bench" / "bench.json").read_text())["machine"]
+    at_cost = (tmp_path / "index.md").read_text().split("**At what cost?**")[1].split("\n")[0]
+    assert f"in serial CPU time on {machine['cpu']} (one of its {machine['cores']} cores" \
+        in at_cost
     cost = (tmp_path / "index.md").read_text().split("- Cost at a stated accuracy")[1]
     assert "s per simulated s on the bench's machine (serial CPU time at its own stable RK4 " \
         f"step on the bench's {bench_mesh(COST_TETS).n_tets}-tetrahedron cube" \

@@ -288,10 +288,13 @@ def lines(root, models, pops=(), quick=False):
     rows = {m: _bench_row(bench, m) for m in models}
     if all(rows.get(k) for k in ("fem-linear", "msm")):
         fl = rows["fem-linear"]
-        out.append(f"**At what cost?** One simulated second at about "
-                   f"{fmt(rows['fem-linear']['tets'])} "
-                   "tetrahedra, at each model's own stable RK4 step, over fem-linear's, in "
-                   "serial CPU time (the median over rounds of the in-round step-time ratio, "
+        where = (bench or {}).get("machine") or {}
+        out.append(f"**At what cost?** One simulated second on the bench's "
+                   f"{fmt(rows['fem-linear']['tets'])}-tetrahedron cube, at each model's own "
+                   "stable RK4 step, over fem-linear's, in serial CPU time on "
+                   f"{where.get('cpu', 'an unnamed processor')} (one of its "
+                   f"{where.get('cores', '?')} cores; the median over rounds of the in-round "
+                   "step-time ratio, "
                    "times the "
                    "stable-step ratio [its range over the rounds]; not a ratio of median "
                    "times): "
