@@ -284,20 +284,25 @@ def p1_exact(runs, estimate):
     return None
 
 
+def _failed_sizes(runs, model):
+    """The sizes where ``model``'s static run failed, smallest first."""
+    return sorted(r["tets"] for r in runs if r["model"] == model and r.get("failed"))
+
+
 def _failed_at(runs, model):
     """' (its static run failed at 1715, 2560 tetrahedra: no error there)' for a model whose
     static runs failed, '' where none did."""
-    failed = sorted(r["tets"] for r in runs if r["model"] == model and r.get("failed"))
+    failed = _failed_sizes(runs, model)
     return (f" (its static run failed at {', '.join(map(str, failed))} tetrahedra: no error "
             "there)") if failed else ""
 
 
 def _engine_words(runs, model, tets, force, w):
     """'newton-xpbd up to 1080 tetrahedra (top force 2.5 from FEM P1's there)', or where its
-    static run fails on a larger mesh '... (its static run failed at 1715, 2560 tetrahedra,
-    larger meshes: no error at its reach decided)'."""
+    static run fails on a larger mesh '... (top force 2.5 from FEM P1's there, not decided:
+    its static run failed at 1715, 2560 tetrahedra, larger meshes)'."""
     if _fails_above(runs, model, tets):
-        failed = sorted(r["tets"] for r in runs if r["model"] == model and r.get("failed"))
+        failed = _failed_sizes(runs, model)
         return (f"{model} up to {tets} tetrahedra ("
                 + (f"{w['force']} {fmt(force, 2)} from FEM P1's there, " if force is not None
                    else "")
@@ -311,7 +316,7 @@ def _engine_words(runs, model, tets, force, w):
 def _fails_above(runs, model, tets):
     """Whether ``model``'s static run failed on a mesh larger than ``tets``: its equilibrium
     there is that of a solver the next refinements break, so no error of it is decided."""
-    return any(r["tets"] > tets for r in runs if r["model"] == model and r.get("failed"))
+    return any(t > tets for t in _failed_sizes(runs, model))
 
 
 def dearer(runs, a, b):
@@ -345,7 +350,7 @@ def answer_line(data, v, quick, words=None):
     said = []
     for m in v["best"]:
         reach_ = v["reach"][m]
-        mode = reach_["model"] if reach_["model"] != m else reach_["mode"]
+        mode = _mode(m, reach_)
         said.append(f"{m} ({mode}, {_reach_words(reach_, v['spans'].get(m))}, "
                     f"{_judged(v['bounds'][m], v)})")
     y, p = v.get("yardstick"), v["pick"]
@@ -406,6 +411,12 @@ def answer_line(data, v, quick, words=None):
             f"{beside}{newton}.{_smaller_words(v)}{_exact_words(v)}")
 
 
+def _mode(law, reach_):
+    """How a law runs at its reach: its mode ('two threads'), or the implicit preset that
+    reaches it for the law."""
+    return reach_["model"] if reach_["model"] != law else reach_["mode"]
+
+
 def _why_pick(v):
     """Why the pick among the tied first: 'real time in every timing round at its reach,
     cheaper than ... on every mesh both were timed on'."""
@@ -428,7 +439,7 @@ def index_line(data, v, quick, words=None):
 
     def at(m):
         r = v["reach"][m]
-        return (f"{r['model'] if r['model'] != m else r['mode']}, {r['tets']} tetrahedra, "
+        return (f"{_mode(m, r)}, {r['tets']} tetrahedra, "
                 f"error bound {_judged(v['bounds'][m], v)}")
     what = (f"({machine(data)}, wall clock, {w['loading']}; the error bound is the model-form "
             "error plus FEM P1's distance from the continuum at the model's reach"
@@ -596,7 +607,7 @@ def build(out, study, s, doc):
         for k in v["ranks"]:
             m, reach_ = k["model"], v["reach"][k["model"]]
             r = _law_run(runs, m, reach_["tets"])
-            mode = reach_["model"] if reach_["model"] != m else reach_["mode"]
+            mode = _mode(m, reach_)
             p1 = k["score"] - r["disp_form_rel_l2"] if k["score"] is not None else None
             rows.append([k["rank"], m, mode,
                          f"{reach_['tets']} ({reach_['sure'] or 'none'}-{reach_['maybe']})",
