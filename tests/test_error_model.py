@@ -134,7 +134,7 @@ def test_scorecard_decomposes_counts_failures_and_names_identity(tmp_path):
     assert "1. a (mean rank 1, geometric " \
         "mean 0.13 [0.12-0.14 leaving one mesh family out])" in lines[0]
     assert "2. b (mean rank 2, geometric mean failed (1 of 1 populations failed at the " \
-        "median), 1 failed runs)" in lines[0]
+        "median), 1 failed run)" in lines[0]
     assert "b in torsion/clamped (1 of 2)" in lines[-1]
     md, _ = index_documents(tmp_path, ["torsion"])
     assert "FEM P1 itself (0 by construction)" in md
@@ -256,6 +256,31 @@ def _three_models(tmp_path, torques):
     _case_folder(tmp_path, "torsion", _torsion_runs(v))
     pops, _ = populations(tmp_path, ["torsion"])
     return pops, ["fem-linear", "a", "b", "c"]
+
+
+def test_a_failure_where_the_ranking_leaves_the_numbers_out_still_ranks_its_model(tmp_path):
+    """A population the ranking leaves out for its numbers (here locking-prone) still counts
+    its failed runs: there the models without one share the first rank and the failing model
+    follows, so its mean rank moves while no score comes from it; a left-out population
+    without a failed run changes nothing."""
+    from dataclasses import replace
+    pops, models = _three_models(tmp_path, {"five": (1.1, 1.3, 2.0), "six": (1.1, 1.3, 2.0)})
+    (p,) = pops
+    before = scorecard.overall(pops, models)
+    clean = replace(p, case="cantilever", locking=True)
+    assert not scorecard.counts_failures(clean)
+    assert scorecard.overall(pops + [clean], models) == before
+    broken = replace(clean, parts={**p.parts, "a": [None, p.parts["a"][1]]})
+    assert scorecard.counts_failures(broken)
+    assert [scorecard.failure_rank(broken, m) for m in "abc"] == [3, 1, 1]
+    after = scorecard.overall(pops + [broken], models)
+    assert after["a"][0] == (before["a"][0] + 3) / 2
+    assert after["b"][0] == (before["b"][0] + 1) / 2
+    assert after["a"][1] == before["a"][1]
+    assert scorecard.failed_text(after["a"]) == "1 failed run where only the failures are ranked"
+    assert [m for _, m, _, _ in scorecard.ranked(after)][0] == "b"
+    # a patch test is the consistency limit's subject: its failures are not ranked here
+    assert not scorecard.counts_failures(replace(broken, locking=False, patch_test=True))
 
 
 def test_an_order_that_one_mesh_reverses_is_not_resolved(tmp_path):
@@ -428,7 +453,7 @@ def test_what_to_pick_is_computed_and_names_what_is_not_decided(tmp_path, monkey
     assert "the closest approximation is a, model-form error 0.1" in lines[1]
     # at finite load a's model-form errors are 0.1, 0.2 and b's 0.1, 0.2 (six reversed)
     assert "not decided on 1 case/bc population between" in lines[2]
-    assert "with failed runs (no converged solve at the load): b (1 failed runs)" in lines[2]
+    assert "with failed runs (no converged solve at the load): b (1 failed run)" in lines[2]
     assert recommendation(tmp_path, ["a"], pops, True, {}) == [
         "**What to pick?** Quick: not decided (`pbcm report` decides)."]
     monkeypatch.undo()                 # the case as declared: its bonded cube locks
@@ -440,8 +465,8 @@ def test_what_to_pick_is_computed_and_names_what_is_not_decided(tmp_path, monkey
             "model-form error ranks closeness to a locked mesh): large-compression/clamped "
             "(FEM P1 up to 0.2 from the continuum there)") in said
     # its failure is said all the same
-    assert ("failed runs in the populations left out (failures all the same): b 1 of 2 in "
-            "large-compression/clamped") in said
+    assert ("failed runs in the populations left out (counted in the mean ranks above): b 1 "
+            "of 2 in large-compression/clamped (no ranking in its regime to count it in)") in said
     # and in b's cell of the summary table, beside its standing
     from cases.reporting.answers import _overall_cell
     from cases.reporting import scorecard
@@ -1003,5 +1028,12 @@ def test_a_studys_failed_runs_are_named_once_per_model_and_cause():
             "mesh3/clamped, mesh4/clamped, mesh5/clamped and 2 more) (build: the fit gave "
             "c = 0)") in line
     assert "model m on study/mesh0/sliding (inverted)" in line and "k on" not in line
+    # one cause whose numbers differ from run to run is one entry, each run named by its case
+    rest = [{"model": "k", "case": case, "mesh": "five", "bc": "sliding",
+             "failed": f"k(n=8) is not coming to rest: motion not shrinking ({x} a period)"}
+            for case, x in (("torsion", 0.011), ("cantilever", 0.0087))]
+    line = failed_checks({}, {"study": ({"cells": rest}, ("cells",))})
+    assert line.endswith("k on study, 2 runs (torsion/five/sliding, cantilever/five/sliding) "
+                         "(k(n=8) is not coming to rest: motion not shrinking).")
     assert failed_checks({}, {"study": ({"cells": []}, ("cells",))}).endswith(
         "Failed runs of the studies (no number; each named in its report): none.")

@@ -106,9 +106,11 @@ def test_the_ranking_holds_the_yardstick_and_ties_by_the_pair_s_uncertainty():
     assert R.index_line(data, v, quick=False) == (
         "At real time on this machine (X, 2 cores, wall clock, the paper's push on its cube; "
         "the error bound is the model-form error plus FEM P1's distance from the continuum at "
-        "the model's reach), the most accurate models are tied (2, within u_val): "
+        "the model's reach), the most accurate models are tied (2, within u_val 0.0020 of two "
+        "bounds on two meshes: the reference's estimate on each; u_input not estimated): "
         "fem-neohookean (serial, 1080 tetrahedra, error bound 0.0520); pbcm-variational "
-        "(serial, 1715 tetrahedra, error bound 0.0526). Pick pbcm-variational: real time in "
+        "(serial, 1715 tetrahedra, error bound 0.0526). Accuracy does not decide among them, "
+        "so the force and the cost do: pick pbcm-variational: real time in "
         "every timing round at its reach, cheaper than fem-neohookean on every mesh both were "
         "timed on.")
     close = {**data, "error_estimate": 0.002}        # 2 e = 0.004 > 0.0024

@@ -213,7 +213,10 @@ def _overall_cell(means, model, pops, finite, spread):
     out = [f"{st.failed} of {st.runs} in {p.label}" for p in pops
            if p.finite == finite and not p.ranked and not p.patch_test
            for _, st, _ in p.standings() if st.model == model and st.failed]
-    return said + (f"; failed outside the ranking: {', '.join(out)}" if out else "")
+    if not out:
+        return said
+    return said + (f"; where only the failures are ranked: {', '.join(out)}"
+                   if model in means else f"; failed outside the ranking: {', '.join(out)}")
 
 
 def _bead(measured, model, u_val=None):
@@ -475,18 +478,22 @@ def _cost_of_replacing(pops, models, quick):
             used = [p for p in pops if p.finite == finite and p.ranked]
             n, c = len(used), len({p.case for p in used})
             us = [p.u_model_form for p in used]
+            checked = [p.label for p in pops
+                       if p.finite == finite and scorecard.counts_failures(p)]
             said.append(f"{regime} (over {c} case{'s' if c > 1 else ''}, {n} case/bc "
                         f"population{'s' if n > 1 else ''}"
                         + (", so one case decides it" if c == 1 else "")
                         + (f"; their u_val {_span(us, ' to ')}, each score floored at "
                            "its own"
-                           if us else "") + "): " + ", ".join(
+                           if us else "")
+                        + (f"; and, ranked by their failed runs alone, {', '.join(checked)}"
+                           if checked else "") + "): " + ", ".join(
                 f"{m} " + (f"failed ({e[3]} of {e[4]} populations failed at the median"
                            + (f"; {fmt(e[1])} over the others" if e[1] is not None else "")
                            + ")" if e[3] else fmt(e[1]) if e[1] is not None else "n/a")
                 + (f" [{fmt(rng[m][0], 2)}-{fmt(rng[m][1], 2)}]" if m in rng and not e[3]
                    else "")
-                + (f" ({e[2]} failed runs)" if e[2] else "")
+                + (f" ({scorecard.failed_text(e)})" if scorecard.failed(e) else "")
                 + (f" (the same mean rank as {tie})" if tie else "")
                 for _, m, e, tie in ranked)
                 # the order where it holds: every pair a unit left out reverses or levels
@@ -500,7 +507,9 @@ def _cost_of_replacing(pops, models, quick):
             "the order), beside it the geometric mean over the cases of the median over the "
             "meshes [its range when one mesh family is left out]; a failed run (no number; at "
             "the load, no converged solve) counts against its model once, as infinitely wrong "
-            "in its population's rank: "
+            "in its population's rank, and where the ranking leaves a population's numbers "
+            "out, its failed runs still rank it there (the models without one share the first "
+            "rank, the others follow by how many failed): "
             + "; ".join(said) + _left_out(pops) + " (the scorecard below).")
 
 
@@ -541,16 +550,21 @@ def _left_out(pops):
             out.append(p.label + (f" (FEM P1 up to {rel(max(d))} from the continuum there)"
                                   if d else ""))
     near = [p.label for p in pops if p.nearly_linear and not p.patch_test and not p.locking]
-    # a failure in a population the ranking leaves out is still a failure: said
-    failed = [f"{st.model} {st.failed} of {st.runs} in {p.label}" for p in pops
-              if not p.ranked and not p.patch_test for _, st, _ in p.standings() if st.failed]
+    # a failure in a population the ranking leaves out is still a failure: counted and said
+    # (where its regime has a ranking to count it in)
+    failed = [f"{st.model} {st.failed} of {st.runs} in {p.label}"
+              + ("" if any(q.ranked and q.finite == p.finite for q in pops) else
+                 " (no ranking in its regime to count it in)")
+              for p in pops if not p.ranked and not p.patch_test
+              for _, st, _ in p.standings() if st.failed]
     return (("; left out of the ranking, locking-prone (FEM P1, the twin, locks there: its "
              "model-form error ranks closeness to a locked mesh): " + ", ".join(out)
              if out else "")
             + (f"; left out at finite load, nearly linear ({P1_LINEAR} within "
                f"{NEARLY_LINEAR:g} of neo-Hookean P1 there: the linear regime's observation "
                "again, which does not test finite strain): " + ", ".join(near) if near else "")
-            + ("; failed runs in the populations left out (failures all the same): "
+            + ("; failed runs in the populations left out (counted in the mean ranks "
+               "above): "
                + ", ".join(failed) if failed else ""))
 
 
@@ -648,7 +662,7 @@ def recommendation(root, models, pops, quick, bench_rows):
         n = len([p for p in pops if p.finite and p.ranked])
         order = [m for _, m, _, _ in scorecard.ranked(lin)] if lin else []
         linear = (f"; in the linear regime it ranks {order.index(b) + 1} of {len(order)}"
-                  + (f" with {lin[b][2]} failed runs" if lin[b][2] else "")
+                  + (f" with {scorecard.failed_text(lin[b])}" if scorecard.failed(lin[b]) else "")
                   if b in order else "")
         said = (f"; not decided on {n} case/bc population{'s' if n > 1 else ''} between "
                 f"{', '.join([b] + others)} (tied, or level or reversed when one mesh family "
@@ -667,11 +681,12 @@ def recommendation(root, models, pops, quick, bench_rows):
                     "disagree, so neither order decides")
         said += _how_finite(pops, p1_lin)
         cands = [b] + others if b else []
-        failing = [f"{m} ({fin[m][2]} failed runs)" for m in cands if fin[m][2]]
+        failing = [f"{m} ({scorecard.failed_text(fin[m])})" for m in cands
+                   if scorecard.failed(fin[m])]
         # the other models with a failed run, named with what they scored elsewhere
         left = [f"{m} (model-form error "
                 + (rel(e[1]) if e[1] is not None and not e[3] else "failed at the median")
-                + f"; {e[2]} failed runs: no converged solve at the load)"
+                + f"; {scorecard.failed_text(e)}: no converged solve at the load)"
                 for m, e in fin.items()
                 if scorecard.failed(e) and m not in cands]
         out.append(f"- Finite strain: {p1_fin} (the reference's law on P1, the identity "
@@ -722,8 +737,8 @@ def recommendation(root, models, pops, quick, bench_rows):
                         "but failed at the median on a case (a run with no number, or an "
                         "unpaired mode)")
                      # a failed run is never left out of what the pick says of a model
-                     + (f", with {lin[cheapest][2]} failed runs (no number, or a mode "
-                        "unpaired)" if lin[cheapest][2] else ""))
+                     + (f", with {scorecard.failed_text(lin[cheapest])} (no number, or a "
+                        "mode unpaired)" if scorecard.failed(lin[cheapest]) else ""))
         out.append(line + ".")
     rt = _load(root, "realtime", "metrics.json")
     if rt and not rt["parameters"]["quick"]:

@@ -3,6 +3,7 @@ condition, its headline error and the metric paired with it, per model, coloured
 HTML) and a five-line conclusion written from the numbers."""
 import json
 import math
+import re
 from pathlib import Path
 
 import numpy as np
@@ -111,7 +112,8 @@ def conclusion(pops, models, quick):
                    "(each model's "
                    "mean rank, a population ranking its models first by unpaired modes, then "
                    "by the median over the meshes with a failed run counted as infinitely "
-                   "wrong; the geometric mean of its "
+                   "wrong, and where a population's numbers are left out but a run failed, "
+                   "by its failed runs alone; the geometric mean of its "
                    "scores beside it, each floored at the comparison's uncertainty; FEM P1 "
                    "itself is the identity check and not ranked; an order that reverses "
                    "when one mesh family or one case is left out is not resolved): " + "; ".join(
@@ -126,8 +128,11 @@ def conclusion(pops, models, quick):
     worst = {}
     # a quick run's farthest holds for its meshes only; a locking-prone population orders
     # closeness to a locked mesh
-    for p in ([] if quick else [p for p in pops if not p.locking]):
+    for p in ([] if quick else pops):
         for _, s, _ in p.standings():
+            # where FEM P1 locks only a failure at the median is the model's own
+            if p.locking and not math.isinf(s.score):
+                continue
             if s.runs and (s.model not in worst or s.score > worst[s.model][0]):
                 worst[s.model] = (s.score, p)
     if quick:
@@ -135,7 +140,8 @@ def conclusion(pops, models, quick):
                    "report` for every mesh).")
     elif worst:
         out.append("Where each model is farthest from FEM P1 (median model-form error, a failed "
-                   "run counted as infinitely wrong; locking-prone problems left out): "
+                   "run counted as infinitely wrong; locking-prone problems left out but for a failure at "
+                   "the median): "
                    + "; ".join(
                        f"{m} in {p.label} ("
                        + ("failed at the median" if math.isinf(v) else rel(v)) + ")"
@@ -175,9 +181,10 @@ def failed_checks(data, studies=None):
         # model everywhere is one fact, not one per mesh
         grouped = {}
         for name, d, r in runs:
-            where = r["mesh"] + (f"/{r['bc']}" if r.get("bc") else "")
+            where = (f"{r['case']}/" if r.get("case") else "") + r["mesh"] + (
+                f"/{r['bc']}" if r.get("bc") else "")
             grouped.setdefault((name, d.get("names", {}).get(r["model"], r["model"]),
-                                str(r["failed"]).split(";")[0]), []).append(where)
+                                _cause(r["failed"])), []).append(where)
         out += (" Failed runs of the studies (no number; each named in its report): "
                 + ("; ".join(f"{model} on " + (
                     f"{name}/{wheres[0]}" if len(wheres) == 1 else
@@ -185,6 +192,13 @@ def failed_checks(data, studies=None):
                     for (name, model, why), wheres in grouped.items())
                    if runs else "none") + ".")
     return out
+
+
+def _cause(failed):
+    """A failure's cause as the index groups it: its first clause without its parenthesised
+    asides (the numbers, which differ from run to run of one cause; a name's own parentheses,
+    'newton-xpbd(iterations=8)', stay)."""
+    return re.sub(r"\s+\([^()]*\)", "", str(failed).split(";")[0])
 
 
 def _listed(wheres, shown=6):

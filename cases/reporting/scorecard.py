@@ -321,7 +321,8 @@ def _subsets(pops, finite):
     """[(what was left out, the populations without it)]: each mesh family, then each case
     where the regime has more than one (the case is a unit too: an order one case decides is
     not resolved)."""
-    cases = sorted({p.case for p in pops if p.finite == finite and p.ranked})
+    cases = sorted({p.case for p in pops if p.finite == finite
+                    and (p.ranked or counts_failures(p))})
     out = [(mesh, [p.without(mesh) for p in pops]) for mesh in _meshes(pops, finite)]
     if len(cases) > 1:
         out += [(case, [p for p in pops if p.case != case]) for case in cases]
@@ -345,35 +346,64 @@ def spread(pops, models, finite=False):
     return out
 
 
+def counts_failures(p):
+    """Whether population ``p``, which the ranking leaves out for its numbers, still counts in
+    it for its failed runs: not a patch test (the consistency limit's subject), and a ranked
+    model's run failed there (a failure is a result wherever it happened)."""
+    return not p.ranked and not p.patch_test and any(
+        _failures(p, st) for _, st, _ in p.standings())
+
+
+def _failures(p, standing):
+    """A model's failed runs in ``p``: runs without a number and runs with an unpaired mode."""
+    return standing.failed + p.unpaired.get(standing.model, 0)
+
+
+def failure_rank(p, model):
+    """``model``'s rank in a population counted for its failed runs alone
+    (``counts_failures``): after every model with fewer failed runs there, so the models
+    without one share the first rank (its numbers order nothing)."""
+    failed = {st.model: _failures(p, st) for _, st, _ in p.standings()}
+    return 1 + sum(f < failed[model] for f in failed.values())
+
+
 def overall(pops, models, finite=False):
     """{model: (mean rank, geometric mean of its finite population scores, failed runs,
-    failed populations, populations)} over the populations of one regime (``finite``): every
-    population counts for every model, a failed run (no number, or at the load no converged
-    solve) against its model; each case weighs one (its boundary conditions are averaged
-    first: two bcs of one case are not two independent observations); each score floored at
-    its population's model-form uncertainty; P1 itself left out (an identity check), and the
-    populations ``Population.ranked`` leaves out (patch tests, locking-prone problems,
-    nearly linear finite loads);
+    failed populations, populations, failed runs where only its failures count)} over the
+    populations of one regime (``finite``): every population counts for every model, a failed
+    run (no number, or at the load no converged solve) against its model; each case weighs one
+    (its boundary conditions are averaged first: two bcs of one case are not two independent
+    observations); each score floored at its population's model-form uncertainty; P1 itself
+    left out (an identity check). The populations ``Population.ranked`` leaves out for their
+    numbers (patch tests, locking-prone problems, nearly linear finite loads) give no score;
+    those where a run failed (``counts_failures``, not patch tests) still give each model a
+    rank by its failed runs (``failure_rank``), so a failure counts wherever it happened;
     a failed run counts once, as infinitely wrong in its population's rank (``_order``)."""
     used = [p for p in pops if p.finite == finite and p.ranked]
+    checked = [p for p in pops if p.finite == finite and counts_failures(p)]
     out = {}
     for m in models:
         mine = [p for p in used if m in p.parts and m not in p.identity]
         if not mine:
             continue
-        by_case = {}
+        by_case, ranks_by_case = {}, {}
         for p in mine:
             rank, st = next((r, s) for r, s, _ in p.standings() if s.model == m)
-            by_case.setdefault(p.case, []).append((rank, st.score, p.u_model_form))
-        ranks = [float(np.mean([r for r, _, _ in c])) for c in by_case.values()]
-        scores = [E.geometric_mean([s for _, s, _ in c if math.isfinite(s)],
-                                   [f for _, s, f in c if math.isfinite(s)])
+            by_case.setdefault(p.case, []).append((st.score, p.u_model_form))
+            ranks_by_case.setdefault(p.case, []).append(rank)
+        outside = [p for p in checked if m in p.parts and m not in p.identity]
+        for p in outside:
+            ranks_by_case.setdefault(p.case, []).append(failure_rank(p, m))
+        ranks = [float(np.mean(c)) for c in ranks_by_case.values()]
+        scores = [E.geometric_mean([s for s, _ in c if math.isfinite(s)],
+                                   [f for s, f in c if math.isfinite(s)])
                   for c in by_case.values()]
         scores = [s for s in scores if s is not None]
         failed = sum(sum(v is None for v in p.parts[m]) for p in mine)
-        lost = sum(not math.isfinite(s) for c in by_case.values() for _, s, _ in c)
+        lost = sum(not math.isfinite(s) for c in by_case.values() for s, _ in c)
+        failed_outside = sum(sum(v is None for v in p.parts[m]) for p in outside)
         out[m] = (E.mean_rank(ranks), E.geometric_mean(scores, [0.0] * len(scores)), failed,
-                  lost, len(mine))
+                  lost, len(mine), failed_outside)
     return out
 
 
@@ -393,8 +423,20 @@ def _order(entry, model):
 
 
 def failed(entry):
-    """Whether an ``overall`` entry has a failed run."""
-    return bool(entry[2])
+    """Whether an ``overall`` entry has a failed run, where its numbers are ranked or not."""
+    return bool(entry[2] or entry[5])
+
+
+def failed_text(entry):
+    """'3 failed runs (2 where only the failures are ranked)' of an ``overall`` entry ('1
+    failed run', '2 failed runs where only the failures are ranked'); '' for none."""
+    n = entry[2] + entry[5]
+    if not n:
+        return ""
+    text = f"{n} failed run{'s' if n != 1 else ''}"
+    if entry[5] and entry[2]:
+        return text + f" ({entry[5]} where only the failures are ranked)"
+    return text + (" where only the failures are ranked" if entry[5] else "")
 
 
 def ranked(means):
@@ -414,7 +456,7 @@ def ranked(means):
 def describe(entry, rng=None):
     """'mean rank r, geometric mean g [range leaving one mesh family out]' with the failed
     runs and populations of ``overall``."""
-    r, g, n_failed, lost, n = entry
+    r, g, _, lost, n, _ = entry
     text = f"mean rank {r:.3g}"
     if lost:    # a failed population scores infinitely wrong: no finite mean exists
         text += (f", geometric mean failed ({lost} of {n} populations failed at the median"
@@ -423,8 +465,8 @@ def describe(entry, rng=None):
         text += f", geometric mean {rel(g)}"
         if rng:
             text += f" [{rel(rng[0])}-{rel(rng[1])} leaving one mesh family out]"
-    if n_failed:
-        text += f", {n_failed} failed runs"
+    if failed(entry):
+        text += f", {failed_text(entry)}"
     return text
 
 

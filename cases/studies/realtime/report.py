@@ -448,10 +448,16 @@ def index_line(data, v, quick, words=None):
     if len(v["best"]) == 1:
         return (f"At real time on this machine {what}, the most accurate model is {p} "
                 f"({at(p)}): {_why_pick(v)}.")
+    force = (v.get("force") or {}).get(p)
+    stiff = ("" if not v.get("pick_stiff") or force is None else
+             f"its top force within {STIFF:g} of FEM P1's ({fmt(force, 2)}"
+             + (", P1's own law: 0 by construction" if p == P1 else "") + "), ")
     return (f"At real time on this machine {what}, the most accurate models are tied "
-            f"({len(v['best'])}, within u_val): "
+            f"({len(v['best'])}, within u_val {err(v['u_two_meshes'])} of two bounds on two "
+            "meshes: the reference's estimate on each; u_input not estimated): "
             + "; ".join(f"{m} ({at(m)})" for m in v["best"])
-            + f". Pick {p}: {_why_pick(v)}.")
+            + f". Accuracy does not decide among them, so the force and the cost do: pick {p}: "
+            f"{stiff}{_why_pick(v)}.")
 
 
 def _smaller_words(v):
