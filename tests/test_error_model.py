@@ -277,10 +277,28 @@ def test_a_failure_where_the_ranking_leaves_the_numbers_out_still_ranks_its_mode
     assert after["a"][0] == (before["a"][0] + 3) / 2
     assert after["b"][0] == (before["b"][0] + 1) / 2
     assert after["a"][1] == before["a"][1]
-    assert scorecard.failed_text(after["a"]) == "1 failed run where only the failures are ranked"
+    assert scorecard.failed_text(after["a"]) == "1 failed run in failure-only rankings"
     assert [m for _, m, _, _ in scorecard.ranked(after)][0] == "b"
     # a patch test is the consistency limit's subject: its failures are not ranked here
     assert not scorecard.counts_failures(replace(broken, locking=False, patch_test=True))
+
+
+def test_a_discretisation_error_is_read_against_the_continuums_u_val(tmp_path):
+    """FEM P1's discretisation error, as the pick names it, is said not resolved from zero
+    where the continuum's u_val is as large as it, and beyond what the reference judges where
+    that u_val exceeds a fifth of it; below, the plain figure."""
+    from dataclasses import replace
+    from cases.reporting.answers import _discretisation
+    from cases.reporting.index import populations
+    _case_folder(tmp_path, "torsion", _torsion_runs({(m, "fem-linear"): 1.2
+                                                     for m in ("five", "six")}))
+    (p,) = populations(tmp_path, ["torsion"])[0]
+    assert _discretisation([p], False).endswith("(median over the meshes, torsion/clamped)")
+    assert _discretisation([replace(p, u_continuum=0.05)], False).endswith(
+        "torsion/clamped, beyond what its reference judges: the continuum's u_val 0.05 "
+        "exceeds a fifth of it)")
+    assert _discretisation([replace(p, u_continuum=0.3)], False).endswith(
+        "torsion/clamped, not resolved from zero: the continuum's u_val 0.3 there is as large)")
 
 
 def test_an_order_that_one_mesh_reverses_is_not_resolved(tmp_path):
@@ -465,7 +483,7 @@ def test_what_to_pick_is_computed_and_names_what_is_not_decided(tmp_path, monkey
             "model-form error ranks closeness to a locked mesh): large-compression/clamped "
             "(FEM P1 up to 0.2 from the continuum there)") in said
     # its failure is said all the same
-    assert ("failed runs in the populations left out (counted in the mean ranks above): b 1 "
+    assert ("failed runs in the populations left out (in the failure-only rankings above): b 1 "
             "of 2 in large-compression/clamped (no ranking in its regime to count it in)") in said
     # and in b's cell of the summary table, beside its standing
     from cases.reporting.answers import _overall_cell
@@ -789,8 +807,8 @@ def test_how_finite_each_load_is_reads_the_linear_laws_error_at_the_load(tmp_pat
     _case_folder(tmp_path, "torsion", runs)
     pops, _ = populations(tmp_path, ["torsion"])
     said = _how_finite(pops, "fem-linear")
-    assert ("nearly linear, within 0.05 (the linear regime's observation again: not pooled "
-            "at finite load): torsion/clamped 0.011") in said
+    assert ("nearly linear, within 0.05 (not pooled at finite load): torsion/clamped "
+            "0.011") in said
     assert [p.ranked for p in pops if p.finite] == [False]
     finite = tmp_path / "finite"
     finite.mkdir()

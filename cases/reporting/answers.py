@@ -90,7 +90,7 @@ def _growing_stiffness(conv, fit):
     d = [abs(r["reaction_ratio"] - 1.0) for r in rs]
     if len(d) < 3 or not all(b > a for a, b in zip(d, d[1:])):
         return None
-    return (d[-1], 1.25 * (d[-1] - d[-2]), "stiffness, growing: at least")
+    return (d[-1], 1.25 * (d[-1] - d[-2]), GROWING)
 
 
 def _pm(v):
@@ -113,7 +113,7 @@ def worst(values):
     if not nums:
         return ", ".join(other) or "n/a"
     k = max(nums, key=lambda k: nums[k][0])
-    return f"{_pm(nums[k])} ({nums[k][2]}, {k})" + (f"; {', '.join(other)}" if other else "")
+    return _limit_text((*nums[k], k)) + (f"; {', '.join(other)}" if other else "")
 
 
 def _median(rows, key):
@@ -215,7 +215,7 @@ def _overall_cell(means, model, pops, finite, spread):
            for _, st, _ in p.standings() if st.model == model and st.failed]
     if not out:
         return said
-    return said + (f"; where only the failures are ranked: {', '.join(out)}"
+    return said + (f"; in failure-only rankings: {', '.join(out)}"
                    if model in means else f"; failed outside the ranking: {', '.join(out)}")
 
 
@@ -266,10 +266,11 @@ def lines(root, models, pops=(), quick=False):
                        "refined (a patch test; per lattice the larger of its displacement "
                        "error and its stiffness error |reaction ratio - 1|, which the "
                        "prescribed top displacement hides; the largest over the lattices, +- the "
-                       "extrapolation's "
-                       "uncertainty; beside it each family where the model has no limit, and "
-                       "what its fit found there): "
-                       + ", ".join(f"{m} {_limit_text(_worst_limit(lim[m]))}" + _no_limit(lim[m])
+                       "extrapolation's uncertainty, its u_val (the reference is exact); beside "
+                       "it each family where the "
+                       "model has no limit, and what its fit found there): "
+                       + ", ".join(f"{m} {_limit_text(_worst_limit(lim[m]), _limit_count(lim[m]))}"
+                                   + _no_limit(lim[m])
                                    for m in rest if _worst_limit(lim[m]))
                        + _limit_ties(ranked, "tied within their +- on the lattices (limits "
                                      "of one quantity only), whatever each does "
@@ -459,9 +460,24 @@ def _worst_limit(lim):
     return max(nums, key=lambda v: v[0]) if nums else None
 
 
-def _limit_text(w):
-    """'0.7 +- 0.02 (stiffness, six)': a limit with what it measures and where."""
-    return f"{_pm(w)} ({w[2]}, {w[3]})"
+GROWING = "stiffness, growing: at least"
+
+
+def _limit_text(w, n=None):
+    """'0.45 +- 3e-05 (stiffness, six; 3 lattices)': the largest limit with what
+    it measures and where, and of how many lattices' limits (``n``) it is the largest; a
+    stiffness error growing under refinement is no limit but a bound from below: 'at least
+    0.7 +- 0.02 (stiffness growing under refinement on six: no limit, its finest value)'."""
+    of = f"; {n} lattices" if n and n > 1 else ""
+    if w[2] == GROWING:
+        return (f"at least {_pm(w)} (stiffness growing under refinement on {w[3]}: no limit, "
+                f"its finest value{of})")
+    return f"{_pm(w)} ({w[2]}, {w[3]}{of})"
+
+
+def _limit_count(lim):
+    """How many lattices give a model a limit or a bound (its entries that are numbers)."""
+    return sum(isinstance(v, tuple) for v in lim.values())
 
 
 def _cost_of_replacing(pops, models, quick):
@@ -478,16 +494,12 @@ def _cost_of_replacing(pops, models, quick):
             used = [p for p in pops if p.finite == finite and p.ranked]
             n, c = len(used), len({p.case for p in used})
             us = [p.u_model_form for p in used]
-            checked = [p.label for p in pops
-                       if p.finite == finite and scorecard.counts_failures(p)]
             said.append(f"{regime} (over {c} case{'s' if c > 1 else ''}, {n} case/bc "
                         f"population{'s' if n > 1 else ''}"
                         + (", so one case decides it" if c == 1 else "")
                         + (f"; their u_val {_span(us, ' to ')}, each score floored at "
                            "its own"
-                           if us else "")
-                        + (f"; and, ranked by their failed runs alone, {', '.join(checked)}"
-                           if checked else "") + "): " + ", ".join(
+                           if us else "") + "): " + ", ".join(
                 f"{m} " + (f"failed ({e[3]} of {e[4]} populations failed at the median"
                            + (f"; {fmt(e[1])} over the others" if e[1] is not None else "")
                            + ")" if e[3] else fmt(e[1]) if e[1] is not None else "n/a")
@@ -503,13 +515,11 @@ def _cost_of_replacing(pops, models, quick):
         return "**What does replacing FEM cost?** No case has a decomposed quantity."
     return ("**What does replacing FEM cost?** The model-form error, each model against FEM P1 "
             "with the same law on the same tetrahedra, in order of mean rank over the cases "
-            "(each case weighing one, its boundary conditions averaged; the mean rank decides "
-            "the order), beside it the geometric mean over the cases of the median over the "
+            "(each case weighing one, its boundary conditions averaged), beside it the geometric mean over the cases of the median over the "
             "meshes [its range when one mesh family is left out]; a failed run (no number; at "
             "the load, no converged solve) counts against its model once, as infinitely wrong "
-            "in its population's rank, and where the ranking leaves a population's numbers "
-            "out, its failed runs still rank it there (the models without one share the first "
-            "rank, the others follow by how many failed): "
+            "in its population's rank, or behind every model with fewer where the "
+            "population's numbers are left out (a failure-only ranking): "
             + "; ".join(said) + _left_out(pops) + " (the scorecard below).")
 
 
@@ -561,9 +571,8 @@ def _left_out(pops):
              "model-form error ranks closeness to a locked mesh): " + ", ".join(out)
              if out else "")
             + (f"; left out at finite load, nearly linear ({P1_LINEAR} within "
-               f"{NEARLY_LINEAR:g} of neo-Hookean P1 there: the linear regime's observation "
-               "again, which does not test finite strain): " + ", ".join(near) if near else "")
-            + ("; failed runs in the populations left out (counted in the mean ranks "
+               f"{NEARLY_LINEAR:g} of neo-Hookean P1 there: no test of finite strain): " + ", ".join(near) if near else "")
+            + ("; failed runs in the populations left out (in the failure-only rankings "
                "above): "
                + ", ".join(failed) if failed else ""))
 
@@ -593,8 +602,8 @@ def _imbalance(root, models):
     if not said:
         return ""
     return (f" Internal forces that do not balance (net force or torque above {BALANCE_TOL:g} "
-            "of their sum, at the continuum's deformed state: the model creates momentum or "
-            "angular momentum, whatever its errors): " + "; ".join(said)
+            "of their sum at the continuum's deformed state: momentum created, whatever the "
+            "errors): " + "; ".join(said)
             + f"; every other model balances both to {BALANCE_TOL:g}.")
 
 
@@ -683,12 +692,10 @@ def recommendation(root, models, pops, quick, bench_rows):
         cands = [b] + others if b else []
         failing = [f"{m} ({scorecard.failed_text(fin[m])})" for m in cands
                    if scorecard.failed(fin[m])]
-        # the other models with a failed run, named with what they scored elsewhere
-        left = [f"{m} (model-form error "
-                + (rel(e[1]) if e[1] is not None and not e[3] else "failed at the median")
-                + f"; {scorecard.failed_text(e)}: no converged solve at the load)"
-                for m, e in fin.items()
-                if scorecard.failed(e) and m not in cands]
+        # the other models with a failed run in a ranked population, named with how many
+        # failed (those failing only where the numbers are left out: the ranking's line)
+        left = [f"{m} ({scorecard.failed_text(e)})"
+                for m, e in fin.items() if e[2] and m not in cands]
         out.append(f"- Finite strain: {p1_fin} (the reference's law on P1, the identity "
                    "check of this comparison, not a measured accuracy"
                    + _discretisation(pops, True)
@@ -696,7 +703,8 @@ def recommendation(root, models, pops, quick, bench_rows):
                    f"continuum; refine before choosing){said}"
                    + ("; with failed runs (no converged solve at the load): " + "; ".join(failing)
                       if failing else "")
-                   + ("; other models with failed runs: " + "; ".join(left)
+                   + ("; other models with failed runs (no converged solve at the load): "
+                      + "; ".join(left)
                       if left else "") + ".")
     truth = _load(root, MEASURED, "metrics.json")
     if truth and truth.get("headline"):
@@ -805,8 +813,7 @@ def _how_finite(pops, linear_law):
             else "")
     return (f"; {linear_law}'s model-form error at each load, on the case's own quantity (its "
             "linearisation there; median over the meshes): "
-            + (f"nearly linear, within {NEARLY_LINEAR:g} (the linear regime's observation "
-               "again: not pooled at finite load): "
+            + (f"nearly linear, within {NEARLY_LINEAR:g} (not pooled at finite load): "
                + ", ".join(f"{short(k)} {rel(at[k])}" for k in near) if near else
                f"none within {NEARLY_LINEAR:g}")
             + (f"; beyond: {', '.join(f'{short(k)} {rel(at[k])}' for k in far)}" if far else ""))
@@ -821,10 +828,12 @@ def _discretisation(pops, finite):
         d = p.discretisation()
         if p.finite != finite or not p.ranked or not d:
             continue
-        meds.append((float(np.median(d)), f"[{rel_range(min(d), max(d))} over the meshes]",
-                     p.label + (", beyond what its reference judges: the continuum's u_num "
-                                "exceeds a "
-                                "fifth of it" if p.u_continuum > np.median(d) / JUDGES else "")))
+        med, u = float(np.median(d)), p.u_continuum
+        meds.append((med, f"[{rel_range(min(d), max(d))} over the meshes]",
+                     p.label + (f", not resolved from zero: the continuum's u_val {rel(u)} "
+                                "there is as large" if u >= med else
+                                f", beyond what its reference judges: the continuum's u_val "
+                                f"{rel(u)} exceeds a fifth of it" if u > med / JUDGES else "")))
     if not meds:
         return ""
     (lo, lo_range, a), (hi, hi_range, b) = min(meds), max(meds)

@@ -112,8 +112,8 @@ def conclusion(pops, models, quick):
                    "(each model's "
                    "mean rank, a population ranking its models first by unpaired modes, then "
                    "by the median over the meshes with a failed run counted as infinitely "
-                   "wrong, and where a population's numbers are left out but a run failed, "
-                   "by its failed runs alone; the geometric mean of its "
+                   "wrong, and, where a population's numbers are left out but a run failed, "
+                   "by its failed runs alone (a failure-only ranking); the geometric mean of its "
                    "scores beside it, each floored at the comparison's uncertainty; FEM P1 "
                    "itself is the identity check and not ranked; an order that reverses "
                    "when one mesh family or one case is left out is not resolved): " + "; ".join(

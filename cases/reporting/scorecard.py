@@ -428,15 +428,16 @@ def failed(entry):
 
 
 def failed_text(entry):
-    """'3 failed runs (2 where only the failures are ranked)' of an ``overall`` entry ('1
-    failed run', '2 failed runs where only the failures are ranked'); '' for none."""
+    """'3 failed runs (2 in failure-only rankings)' of an ``overall`` entry ('1 failed run',
+    '2 failed runs in failure-only rankings': populations ``counts_failures`` ranks); '' for
+    none."""
     n = entry[2] + entry[5]
     if not n:
         return ""
     text = f"{n} failed run{'s' if n != 1 else ''}"
     if entry[5] and entry[2]:
-        return text + f" ({entry[5]} where only the failures are ranked)"
-    return text + (" where only the failures are ranked" if entry[5] else "")
+        return text + f" ({entry[5]} in failure-only rankings)"
+    return text + (" in failure-only rankings" if entry[5] else "")
 
 
 def ranked(means):
