@@ -526,3 +526,13 @@ def test_a_signal_inside_numba_or_llvmlite_is_recorded_and_raised_at_the_next_ch
     with stop.handling():
         with pytest.raises(KeyboardInterrupt):
             stop._handler(signal.SIGINT, own)
+
+
+def test_the_main_jobs_wall_time_is_said_per_case_and_study():
+    """`pbcm report` ends with what its wall time is made of: the cases' sum and each case,
+    the studies' sum and each study, and the whole, from the times measured."""
+    from cases.cli.pipeline import timing_line
+    assert timing_line({"paper-cube": 12.4, "torsion": 3.0, "artefact": 60.2}) == (
+        "wall time: cases 15 s (paper-cube 12, torsion 3), studies 60 s (artefact 60), "
+        "in all 76 s")
+    assert timing_line({"artefact": 1.0}) == "wall time: studies 1 s (artefact 1), in all 1 s"

@@ -3,7 +3,7 @@ from contextlib import ExitStack
 
 from ..running.output import StagedFolder, writable_folder
 from .common import add_selection
-from .pipeline import configs, run_everything
+from .pipeline import configs, run_everything, timing_line
 
 def add(sub):
     """The command's parser."""
@@ -22,10 +22,11 @@ def run(args):
         staged = {name: stack.enter_context(StagedFolder(root / name, owner=name))
                   for name in cfgs}
 
-        def done(name, runs):
+        def done(name, runs, seconds):
             what = "" if runs is None else f"{len(runs)} runs "
-            print(f"{name}: {what}written to {staged[name].commit()}")
-        run_everything(args, cfgs, lambda name: staged[name].path, done)
+            print(f"{name}: {what}written to {staged[name].commit()} in {seconds:.0f} s")
+        spent = run_everything(args, cfgs, lambda name: staged[name].path, done)
     path = write_index(root, list(CASES), [n for n in cfgs if n not in CASES])
     print(f"index written to {path}, with index.html and the glossary")
+    print(timing_line(spent))
     return 0
