@@ -32,6 +32,8 @@ class Engines(Study):
         bench = load()
         if bench:
             data.update(costs(bench, s.models()))
+        else:
+            data["baseline_cost"] = metrics.get("baseline_cost")
         return data
 
     def scorecard(self, metrics):

@@ -6,6 +6,7 @@ import numpy as np
 from model.simulators.newton import LADDER, spec
 
 from ...measuring import catalogue
+from ...measuring.error_model import P1_LINEAR
 from ...reporting.document import Document, fmt
 from ...reporting.report import environment, write_study
 from ...running.runner import jsonable
@@ -151,10 +152,10 @@ def pick(f, ladder, costs):
     return None if best is None else best[1:]
 
 
-def answer(f, ladder, quick, installed, shear=None, costs=None, where=""):
+def answer(f, ladder, quick, installed, shear=None, costs=None, where="", baseline=None):
     """The index's line: per case, which engine replaces FEM P1 there (within MATCH on both
     regimes and every mesh) and from which setting; the pick with its cost on the bench's
-    machine (``where``)."""
+    machine (``where``) beside linear FEM P1's there (``baseline``, its bench row)."""
     if not installed:
         return "not measured: the engines extra is not installed"
     if quick:
@@ -182,9 +183,11 @@ def answer(f, ladder, quick, installed, shear=None, costs=None, where=""):
         early = [_where(k) for k, c in f[solver]["cases"].items() if n is not None
                  and k.split("/")[0] in cases
                  and (c["converged_at"] is None or c["converged_at"] > n)]
-        p1 = [(CASE_NAMES[c], _median(f[solver]["cases"][f"{c}/{REGIMES[0]}"]
-                                      ["discretisation"]))
-              for c in cases if f"{c}/{REGIMES[0]}" in f[solver]["cases"]]
+        # FEM P1's distance as the scorecard reads it (unsigned), with the u_val it is
+        # read against: the quick reference's estimate (a computed comparison)
+        p1 = [(CASE_NAMES[c], _median(_unsigned(got["discretisation"]))
+               + f" (u_val {fmt(got['u_num'], 2)})")
+              for c in cases if (got := f[solver]["cases"].get(f"{c}/{REGIMES[0]}"))]
         said = (f"pick {model} (the setting within {MATCH:g} of FEM P1 on the most cases, then "
                 "the cheapest per simulated second): within it on "
                 + ", ".join(CASE_NAMES[c] for c in cases)
@@ -193,7 +196,8 @@ def answer(f, ladder, quick, installed, shear=None, costs=None, where=""):
                        CASE_NAMES[c] + (" (not decided there: its sliding support)"
                                         if BCS[c] == "sliding" else "")
                        for c in CASE_NAMES if c not in cases))
-                + ", so as far from the continuum as FEM P1 on those meshes ("
+                + ", so as far from the continuum as FEM P1 on those meshes (|Q_P1 - Q_c| / "
+                "|Q_c|, the median over the meshes: "
                 + ", ".join(f"{name} {v}" for name, v in p1) + ", linear regime)"
                 + (f"; not shown converged there within {CONVERGED:.0%} of its answer at the "
                    "ladder's top on " + "; ".join(early) if early else "")
@@ -201,9 +205,16 @@ def answer(f, ladder, quick, installed, shear=None, costs=None, where=""):
                    f"simulated s on the paper's cube ({where}, single precision on Warp's "
                    "CPU backend through pbcm's adapter): "
                    + ("real time there" if cost[0] <= 1.0 else "not real time there")
+                   + (f", against {P1_LINEAR}'s {fmt(base[0], 3)} [{fmt(base[1], 3)}-"
+                      f"{fmt(base[2], 3)}] (double precision, pbcm's kernels, serial)"
+                      if (base := cost_of({P1_LINEAR: baseline}, P1_LINEAR)) else "")
                    if cost else "; its cost not timed (`pbcm bench --family`)"))
     else:
         said = f"no setting comes within {MATCH:g} of FEM P1 on any case: none to pick"
+    failed = failed_counts(f)
+    if failed:      # a failure is a result: counted in the line that picks
+        said += ("; failed runs (not at rest), every setting: "
+                 + ", ".join(f"{sv} {n} of {t}" for sv, (n, t) in failed.items()))
     return (said + f". Within {MATCH:g} of FEM P1 (the difference a fraction of the continuum's "
             "value, both regimes, every mesh), with the material mapped as Newton documents "
             "it: " + "; ".join(parts)
@@ -270,7 +281,8 @@ def write(out, study, s, data):
                     **data, "findings": found,
                     "answer": answer(found, s.ladder, s.quick, data["installed"],
                                      shear_moduli(s.material) if data["installed"] else None,
-                                     data.get("costs"), cost_where(data)),
+                                     data.get("costs"), cost_where(data),
+                                     data.get("baseline_cost")),
                     "gate_runs": gate_rows(data)})
     return write_study(out, doc, lambda folder: build(folder, study, s, doc))
 
@@ -283,6 +295,11 @@ def _signed(values):
 def _where(key):
     case, regime = key.split("/")
     return f"{CASE_NAMES[case]}, {regime}"
+
+
+def _unsigned(values):
+    """``values`` as magnitudes, a failed run (None) kept as one."""
+    return [None if v is None else abs(v) for v in values]
 
 
 def _median(values):
@@ -387,15 +404,23 @@ def dynamic_line(dynamic):
             "nonlinear law shares).")
 
 
+def failed_counts(f):
+    """{solver: (runs failed, runs)} of the solvers with a failed run."""
+    out = {}
+    for solver in SOLVERS:
+        cases = f[solver]["cases"]
+        failed, total = (sum(c["runs_failed"][i] for c in cases.values()) for i in (0, 1))
+        if failed:
+            out[solver] = (failed, total)
+    return out
+
+
 def failures_line(f):
     """The failed runs first: per solver, how many of its runs did not come to rest, where
     every setting failed, and what it settled at elsewhere; None without failures."""
     said = []
-    for solver in SOLVERS:
+    for solver, (failed, total) in failed_counts(f).items():
         cases = f[solver]["cases"]
-        failed, total = (sum(c["runs_failed"][i] for c in cases.values()) for i in (0, 1))
-        if not failed:
-            continue
         every = [_where(k) for k, c in cases.items() if c["runs_failed"][0] == c["runs_failed"][1]]
         rest = {k: c for k, c in cases.items() if c["runs_failed"][0] < c["runs_failed"][1]}
         said.append(f"{solver} {failed} of {total}"

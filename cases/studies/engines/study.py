@@ -177,11 +177,14 @@ def dynamic_rows(case, runs, cfg):
 def costs(bench, models):
     """The bench's wall-clock cost of each engine model on the real-time family's smallest
     cube (the paper's 125 nodes, 320 tetrahedra, under its push, at the model's own step):
-    {"costs": {model: row or None (not timed)}, "cost_tets", "machine"}. Nothing is timed
+    {"costs": {model: row or None (not timed)}, "cost_tets", "machine", "baseline_cost":
+    linear FEM P1's row there or None}. Nothing is timed
     here, so that the runs stay deterministic."""
     from ...reporting.costs import sizes
     tets = sizes(True)[0]
     got = {r["model"]: r for r in (bench or {}).get("realtime_rows", [])
            if r["tets"] == tets and r.get("timed")}
     return {"costs": {m: got.get(m) for m in models}, "cost_tets": tets,
-            "machine": (bench or {}).get("realtime_machine")}
+            "machine": (bench or {}).get("realtime_machine"),
+            # FEM P1's own cost there: what a user replacing it by an engine compares with
+            "baseline_cost": got.get(P1_LINEAR)}
