@@ -10,7 +10,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .costs import COST_TETS, FILE as BENCH_FILE, FOLDER as BENCH_FOLDER
+from .costs import FILE as BENCH_FILE, FOLDER as BENCH_FOLDER, near
 from .document import fmt, rel, rel_range
 from ..measuring.error_model import JUDGES, P1_LINEAR, ROUND_OFF, input_spread
 from ..measuring.metrics import PATCH_TOL
@@ -122,11 +122,9 @@ def _median(rows, key):
 
 
 def _bench_row(bench, model):
-    """The bench row of ``model`` at the size closest to COST_TETS that has the cost per
-    simulated second."""
-    rows = [r for r in (bench or {}).get("rows", []) if r["model"] == model
-            and r.get("cpu_s_per_simulated_s") is not None]
-    return min(rows, key=lambda r: abs(np.log(r["tets"] / COST_TETS))) if rows else None
+    """The bench row of ``model`` at the size closest to the costs' comparison size that has
+    the cost per simulated second."""
+    return near(bench, model, "cpu_s_per_simulated_s")
 
 
 def sim_ratio(row, base):

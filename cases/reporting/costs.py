@@ -40,6 +40,14 @@ def load(root=None):
     return read(here) if here is not None and here.is_file() else read(CHECKOUT)
 
 
+def near(bench, model, key, tets=COST_TETS):
+    """The bench row of ``model`` at the size it ran closest to ``tets`` (in log) among those
+    with ``key``, or None: a size the bench ran, never an interpolation between two."""
+    rows = [r for r in (bench or {}).get("rows", []) if r["model"] == model
+            and r.get(key) is not None]
+    return min(rows, key=lambda r: abs(np.log(r["tets"] / tets))) if rows else None
+
+
 def step_cost_us(bench, model, tets):
     """Microseconds per RK4 step of ``model`` on ``tets`` tetrahedra, or None when the bench
     lacks the model (or there is no bench)."""

@@ -5,7 +5,7 @@ from dataclasses import dataclass, replace
 from model.candidates import BASE, CANDIDATES, NORMAL_FORMS, short  # noqa: F401 (the study's names)
 from ...framework import MaterialSettings
 from ...measuring.catalogue import STATIC, err_name
-from ...reporting.costs import COST_TETS, step_cost_us
+from ...reporting.costs import near
 from ...measuring.error_model import decomposed
 from ...running.store import OFF
 from ...registry import studies
@@ -92,15 +92,21 @@ def case_rows(case, runs):
     return rows
 
 
+STEP_RATIO = f"step_vs_{YARDSTICK}"
+
+
 def costs(bench, models):
-    """Each model's RK4 step time over fem-linear's at COST_TETS tetrahedra, from the bench's
-    in-process ratios (None where the bench lacks the model)."""
-    out = {}
-    base = step_cost_us(bench, YARDSTICK, COST_TETS) if bench else None
-    for m in models:
-        c = step_cost_us(bench, m, COST_TETS) if bench else None
-        out[m] = None if c is None or not base else c / base
-    return out
+    """Each model's RK4 step time over fem-linear's: the bench's in-round ratio (its median over
+    the rounds, the number the bench prints) at the size it ran closest to COST_TETS; None
+    where the bench lacks the model."""
+    rows = {m: near(bench, m, STEP_RATIO) for m in models}
+    return {m: None if r is None else float(r[STEP_RATIO]) for m, r in rows.items()}
+
+
+def cost_size(bench):
+    """The size ``costs`` reads: the bench's size closest to COST_TETS, or None."""
+    r = near(bench, YARDSTICK, STEP_RATIO)
+    return None if r is None else int(r["tets"])
 
 
 # what a run computes (the rest of metrics.json is derived from it by the report); the fits
@@ -139,6 +145,6 @@ def run(s, workers=None, log=True, bench=None, store=OFF):
                      "elasticity": [
         {k: e.get(k) for k in ("model", "mesh", "moduli_rel_err", "anisotropy_AU", "E_x_pa",
                                "nu_xy", "G_xy_pa", "failed")} for e in conv["elasticity"]],
-        "cost_vs_fem_linear": costs(bench, s.models),
+        "cost_vs_fem_linear": costs(bench, s.models), "cost_tets": cost_size(bench),
         # the preset with the same terms as +normal_edge, timed by another bench run
         "cost_same_terms": {TWIN: costs(bench, [TWIN])[TWIN]}})
