@@ -373,3 +373,25 @@ def test_the_machine_is_named_with_what_a_bare_processor_name_leaves_out():
     assert cpu_name({"model name": "X", "flags": "sse2 avx2"}) == "X (AVX2)"
     assert cpu_name({"model name": "X"}) == "X"
     assert cpu_name({}) is None
+
+
+def test_the_bench_report_opens_with_the_targets_and_tabulates_the_largest_size(tmp_path):
+    """bench.md opens with the verdict against the kernel targets, and gives the largest cube
+    as a table row per model (force ns/tet and the step against msm and fem-linear, each with
+    its range over the rounds), saying how much msm's own step exceeds four force
+    evaluations there."""
+    from pathlib import Path
+    from cases.reporting.document import fmt
+    data = json.loads((Path(__file__).resolve().parents[1] / "reports" / "bench" /
+                       "bench.json").read_text())
+    top, table = bench.largest_size(data)
+    row = next(r for r in data["rows"] if r["tets"] == top and r["model"] == "msm")
+    lo, hi = row["ns_per_tet_range"]
+    assert top == max(r["tets"] for r in data["rows"])
+    assert table[[t[0] for t in table].index("msm")][1] == (
+        f"{fmt(row['ns_per_tet'])} [{fmt(lo, 3)}-{fmt(hi, 3)}]")
+    bench.write(data, tmp_path)
+    md = (tmp_path / "bench.md").read_text().split("\n\n")
+    assert md[1].startswith("Against the kernel targets on this machine")
+    said = next(p for p in md if p.startswith(f"At {top} tetrahedra"))
+    assert f"msm's own step costs {fmt(row['step_over_4_forces'])} times its four" in said

@@ -269,11 +269,11 @@ def cpu_name(info):
     return f"{name} ({', '.join(said)})" if said else name
 
 
-def _ranged(row, key):
+def _ranged(row, key, digits=2):
     """'median [smallest-largest over the rounds]' of a ratio (the median alone where the
-    bench predates the range)."""
+    bench predates the range), the range to ``digits`` significant figures."""
     rng = row.get(f"{key}_range")
-    return fmt(row[key]) + (f" [{fmt(rng[0], 2)}-{fmt(rng[1], 2)}]" if rng else "")
+    return fmt(row[key]) + (f" [{fmt(rng[0], digits)}-{fmt(rng[1], digits)}]" if rng else "")
 
 
 def write(data, out):
@@ -289,15 +289,14 @@ def write(data, out):
                    "Step time against mesh size (the paper's Figure 2)")
     doc = Document("pbcm bench")
     m = data["machine"]
+    _targets_table(doc, data)     # the answer first: the presets against their targets
     doc.p(f"Measured on {m['cpu']} ({m['cores']} cores), Python {m['python']}, serial kernels. "
           f"Times are medians over {rows[0]['rounds']} rounds of thread CPU time; ratios are "
           "the medians of per-round ratios (models timed round-robin), so machine drift "
           "cancels; [smallest-largest] over the rounds beside them. The two-thread speed-up (`build(..., threads=2)`, forces equal bit for bit "
           "to serial) is the median ratio of wall-clock times of the serial and the threaded "
           "force evaluation run back to back; '-' where a model has no threaded term.")
-    for line in summary(data):
-        doc.p(line)
-    _targets_table(doc, data)
+    _largest_size(doc, data)
     doc.table(["model", "tets", "ns/tet (force)", "us/step", "step / 4 forces",
                "step vs msm", "step vs fem-linear", "calibration [s]", "memory [MB]",
                "2-thread force speed-up"],
@@ -559,11 +558,24 @@ def real_time_reach(data):
     return reach
 
 
-def summary(data):
-    """Sentences from the largest size measured: each model's step against the baselines."""
+def largest_size(data):
+    """(tetrahedra, rows): the largest size measured and, per model there, its ns/tet and its
+    step against each baseline, each with its [smallest-largest] over the rounds."""
     rows = data["rows"]
     top = max(r["tets"] for r in rows)
-    at = [r for r in rows if r["tets"] == top]
-    return [f"At {top} tetrahedra: " + "; ".join(
-        f"{r['model']} {fmt(r['ns_per_tet'])} ns/tet, step {fmt(r['step_vs_msm'])}x msm and "
-        f"{fmt(r['step_vs_fem-linear'])}x fem-linear" for r in at) + "."]
+    return top, [[r["model"], _ranged(r, "ns_per_tet", 3), _ranged(r, "step_vs_msm"),
+                  _ranged(r, "step_vs_fem-linear")] for r in rows if r["tets"] == top]
+
+
+def _largest_size(doc, data):
+    """The largest size's table, with what an 'x msm' ratio is relative to: msm's step, itself
+    its step over four force evaluations times msm's forces."""
+    top, table = largest_size(data)
+    base = next((r for r in data["rows"] if r["tets"] == top and r["model"] == "msm"), None)
+    doc.p(f"At {top} tetrahedra, the largest cube measured: each model's force evaluation and "
+          "its RK4 step against msm's and fem-linear's [smallest-largest over the rounds]"
+          + (f"; msm's own step costs {fmt(base['step_over_4_forces'])} times its four force "
+             "evaluations, so a step 'x msm' reads lower than the ratio of forces by about "
+             "that factor for a model whose step costs four of its force evaluations"
+             if base and base.get("step_over_4_forces") else "") + ".")
+    doc.table(["model", "ns/tet (force)", "step x msm", "step x fem-linear"], table)
