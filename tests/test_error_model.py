@@ -260,9 +260,10 @@ def _three_models(tmp_path, torques):
 
 def test_a_failure_where_the_ranking_leaves_the_numbers_out_still_ranks_its_model(tmp_path):
     """A population the ranking leaves out for its numbers (here locking-prone) still counts
-    its failed runs: there the models without one share the first rank and the failing model
-    follows, so its mean rank moves while no score comes from it; a left-out population
-    without a failed run changes nothing."""
+    a failure that fails a model's median, as a ranked population would: there the models
+    that did not fail share the first rank and the failing model follows, so its mean rank
+    moves while no score comes from it; a failure that leaves the median to the numbers, or
+    none, changes no rank, and every failed run is still counted."""
     from dataclasses import replace
     pops, models = _three_models(tmp_path, {"five": (1.1, 1.3, 2.0), "six": (1.1, 1.3, 2.0)})
     (p,) = pops
@@ -277,10 +278,24 @@ def test_a_failure_where_the_ranking_leaves_the_numbers_out_still_ranks_its_mode
     assert after["a"][0] == (before["a"][0] + 3) / 2
     assert after["b"][0] == (before["b"][0] + 1) / 2
     assert after["a"][1] == before["a"][1]
-    assert scorecard.failed_text(after["a"]) == "1 failed run in failure-only rankings"
+    assert scorecard.failed_text(after["a"]) == "1 failed run where the numbers are left out"
     assert [m for _, m, _, _ in scorecard.ranked(after)][0] == "b"
     # a patch test is the consistency limit's subject: its failures are not ranked here
     assert not scorecard.counts_failures(replace(broken, locking=False, patch_test=True))
+    # as in a ranked population, a failure ranks only where it fails the median: one of three
+    # runs leaves a median the numbers would decide, two of three do not
+    (tmp_path / "three").mkdir()
+    three, _ = _three_models(tmp_path / "three", {"five": (1.1, 1.3, 2.0),
+                                                  "six": (1.1, 1.3, 2.0),
+                                                  "bcc": (1.1, 1.3, 2.0)})
+    q = replace(three[0], case="cantilever", locking=True)
+    one = replace(q, parts={**q.parts, "a": [None, *q.parts["a"][1:]]})
+    two = replace(q, parts={**q.parts, "a": [None, None, q.parts["a"][2]]})
+    assert not scorecard.counts_failures(one) and scorecard.counts_failures(two)
+    assert scorecard.overall(three + [one], models)["a"][0] == \
+        scorecard.overall(three, models)["a"][0]
+    assert scorecard.failed_text(scorecard.overall(three + [one], models)["a"]) == \
+        "1 failed run where the numbers are left out"
 
 
 def test_a_discretisation_error_is_read_against_the_continuums_u_val(tmp_path):
@@ -482,9 +497,6 @@ def test_what_to_pick_is_computed_and_names_what_is_not_decided(tmp_path, monkey
     assert ("left out of the ranking, locking-prone (FEM P1, the twin, locks there: its "
             "model-form error ranks closeness to a locked mesh): large-compression/clamped "
             "(FEM P1 up to 0.2 from the continuum there)") in said
-    # its failure is said all the same
-    assert ("failed runs in the populations left out (in the failure-only rankings above): b 1 "
-            "of 2 in large-compression/clamped (no ranking in its regime to count it in)") in said
     # and in b's cell of the summary table, beside its standing
     from cases.reporting.answers import _overall_cell
     from cases.reporting import scorecard
@@ -1028,6 +1040,11 @@ def test_a_growing_stiffness_error_bounds_the_limit_and_fems_nonlinearity_is_no_
     assert lim["five"] == pytest.approx((2e-10, 2e-10, "displacement"))
     assert lim["bcc"][2] == "stiffness; displacement not decided"
     assert "displacement not decided on bcc (its stiffness 0.04 +- 0.01 there)" in _no_limit(lim)
+    # said as a bound, its finest value without an extrapolation's +-, over how many lattices
+    from cases.reporting.answers import _limit_text, _worst_limit
+    assert _limit_text(_worst_limit(lim), 3) == (
+        "at least 0.7 (stiffness growing under refinement on six: no limit, its finest value; "
+        "3 lattices)")
 
 
 def test_a_studys_failed_runs_are_named_once_per_model_and_cause():

@@ -213,7 +213,7 @@ def _overall_cell(means, model, pops, finite, spread):
            for _, st, _ in p.standings() if st.model == model and st.failed]
     if not out:
         return said
-    return said + (f"; in failure-only rankings: {', '.join(out)}"
+    return said + (f"; where the numbers are left out: {', '.join(out)}"
                    if model in means else f"; failed outside the ranking: {', '.join(out)}")
 
 
@@ -465,11 +465,11 @@ def _limit_text(w, n=None):
     """'0.45 +- 3e-05 (stiffness, six; 3 lattices)': the largest limit with what
     it measures and where, and of how many lattices' limits (``n``) it is the largest; a
     stiffness error growing under refinement is no limit but a bound from below: 'at least
-    0.7 +- 0.02 (stiffness growing under refinement on six: no limit, its finest value)'."""
+    0.7 (stiffness growing under refinement on six: no limit, its finest value)'."""
     of = f"; {n} lattices" if n and n > 1 else ""
-    if w[2] == GROWING:
-        return (f"at least {_pm(w)} (stiffness growing under refinement on {w[3]}: no limit, "
-                f"its finest value{of})")
+    if w[2] == GROWING:     # a finest value, not an extrapolation: no +- to give
+        return (f"at least {rel(w[0], 2)} (stiffness growing under refinement on {w[3]}: no "
+                f"limit, its finest value{of})")
     return f"{_pm(w)} ({w[2]}, {w[3]}{of})"
 
 
@@ -492,12 +492,16 @@ def _cost_of_replacing(pops, models, quick):
             used = [p for p in pops if p.finite == finite and p.ranked]
             n, c = len(used), len({p.case for p in used})
             us = [p.u_model_form for p in used]
+            checked = [p.label for p in pops
+                       if p.finite == finite and scorecard.counts_failures(p)]
             said.append(f"{regime} (over {c} case{'s' if c > 1 else ''}, {n} case/bc "
                         f"population{'s' if n > 1 else ''}"
                         + (", so one case decides it" if c == 1 else "")
                         + (f"; their u_val {_span(us, ' to ')}, each score floored at "
                            "its own"
-                           if us else "") + "): " + ", ".join(
+                           if us else "")
+                        + (f"; for failures alone, {', '.join(checked)}" if checked else "")
+                        + "): " + ", ".join(
                 f"{m} " + (f"failed ({e[3]} of {e[4]} populations failed at the median"
                            + (f"; {fmt(e[1])} over the others" if e[1] is not None else "")
                            + ")" if e[3] else fmt(e[1]) if e[1] is not None else "n/a")
@@ -505,7 +509,8 @@ def _cost_of_replacing(pops, models, quick):
                    else "")
                 + (f" ({scorecard.failed_text(e)})" if scorecard.failed(e) else "")
                 + (f" (the same mean rank as {tie})" if tie else "")
-                for _, m, e, tie in ranked)
+                + _rank_against_mean(ranked, k)
+                for k, (_, m, e, tie) in enumerate(ranked))
                 # the order where it holds: every pair a unit left out reverses or levels
                 + _resolved_groups([m for _, m, _, _ in ranked],
                                    scorecard.unresolved_pairs(pops, models, finite)))
@@ -516,9 +521,21 @@ def _cost_of_replacing(pops, models, quick):
             "(each case weighing one, its boundary conditions averaged), beside it the geometric mean over the cases of the median over the "
             "meshes [its range when one mesh family is left out]; a failed run (no number; at "
             "the load, no converged solve) counts against its model once, as infinitely wrong "
-            "in its population's rank, or behind every model with fewer where the "
-            "population's numbers are left out (a failure-only ranking): "
+            "in its population's rank (also where a population's numbers are left out: a "
+            "failure-only ranking; the table below names where): "
             + "; ".join(said) + _left_out(pops) + " (the scorecard below).")
+
+
+def _rank_against_mean(ranked, k):
+    """' (mean rank 4.4, after 3.4)' where the k-th of ``ranked`` has a smaller geometric mean
+    than the one before it (the mean rank orders them, the failures in it): said, so that the
+    order is not read as a misprint; '' elsewhere."""
+    if k == 0:
+        return ""
+    (_, _, prev, _), (_, _, e, tie) = ranked[k - 1], ranked[k]
+    if tie or e[1] is None or prev[1] is None or e[1] >= prev[1]:
+        return ""
+    return f" (mean rank {e[0]:.2g}, after {prev[0]:.2g})"
 
 
 def _resolved_groups(order, loose):
@@ -549,7 +566,8 @@ def _resolved_groups(order, loose):
 def _left_out(pops):
     """'; left out of the ranking ...': the locking-prone populations, with how far their twin
     is from the continuum, and the finite-load populations the linear law meets within the
-    scorecard's NEARLY_LINEAR: shown in the scorecard, never pooled."""
+    scorecard's NEARLY_LINEAR: shown in the scorecard, never pooled (their failed runs: each
+    model's row of the summary table)."""
     from .scorecard import NEARLY_LINEAR
     out = []
     for p in pops:
@@ -558,21 +576,12 @@ def _left_out(pops):
             out.append(p.label + (f" (FEM P1 up to {rel(max(d))} from the continuum there)"
                                   if d else ""))
     near = [p.label for p in pops if p.nearly_linear and not p.patch_test and not p.locking]
-    # a failure in a population the ranking leaves out is still a failure: counted and said
-    # (where its regime has a ranking to count it in)
-    failed = [f"{st.model} {st.failed} of {st.runs} in {p.label}"
-              + ("" if any(q.ranked and q.finite == p.finite for q in pops) else
-                 " (no ranking in its regime to count it in)")
-              for p in pops if not p.ranked and not p.patch_test
-              for _, st, _ in p.standings() if st.failed]
     return (("; left out of the ranking, locking-prone (FEM P1, the twin, locks there: its "
              "model-form error ranks closeness to a locked mesh): " + ", ".join(out)
              if out else "")
             + (f"; left out at finite load, nearly linear ({P1_LINEAR} within "
-               f"{NEARLY_LINEAR:g} of neo-Hookean P1 there: no test of finite strain): " + ", ".join(near) if near else "")
-            + ("; failed runs in the populations left out (in the failure-only rankings "
-               "above): "
-               + ", ".join(failed) if failed else ""))
+               f"{NEARLY_LINEAR:g} of neo-Hookean P1 there: no test of finite strain): "
+               + ", ".join(near) if near else ""))
 
 
 # a model's internal forces balance where their net sum is round-off against their sizes

@@ -98,6 +98,7 @@ def conclusion(pops, models, quick):
         if not means:
             continue
         n = len([p for p in pops if p.finite == finite and p.ranked])
+        checked = [p.label for p in pops if p.finite == finite and scorecard.counts_failures(p)]
         loose = scorecard.unresolved(pops, models, finite)
         rng = scorecard.spread(pops, models, finite)
         if quick:
@@ -108,12 +109,14 @@ def conclusion(pops, models, quick):
         reach = {b: mesh for b, mesh in scorecard.not_resolved_from(
             pops, models, first, finite).items() if (first, b) not in loose} if first else {}
         out.append(f"Model-form ranking, {regime}, over its {n} populations other than patch "
-                   "tests, locking-prone problems and, at finite load, nearly linear loads "
+                   "tests, locking-prone problems and, at finite load, nearly linear loads"
+                   + (f" (and, for failures alone, {', '.join(checked)})" if checked else "")
+                   + " "
                    "(each model's "
                    "mean rank, a population ranking its models first by unpaired modes, then "
                    "by the median over the meshes with a failed run counted as infinitely "
-                   "wrong, and, where a population's numbers are left out but a run failed, "
-                   "by its failed runs alone (a failure-only ranking); the geometric mean of its "
+                   "wrong, and, where a population's numbers are left out, by whether a model "
+                   "fails its median there (a failure-only ranking); the geometric mean of its "
                    "scores beside it, each floored at the comparison's uncertainty; FEM P1 "
                    "itself is the identity check and not ranked; an order that reverses "
                    "when one mesh family or one case is left out is not resolved): " + "; ".join(
@@ -330,7 +333,10 @@ TERMS = {
     "wrong (so a failure never removes a population from anyone's comparison); models within "
     "u_val of the first of a group (tied), or within both medians' spread over the meshes "
     "beside it (not resolved), share its rank; a failed run counts once, in its "
-    "population's rank. Beside it the geometric mean over the cases of the population "
+    "population's rank. A population whose numbers are left out of the ranking (locking-prone, "
+    "or nearly linear at finite load; never a patch test) still enters it where a model fails "
+    "its median there or loses a mode (a failure-only ranking): the models that did not share "
+    "the first rank, the others follow. Beside it the geometric mean over the cases of the population "
     "medians, each floored at its population's u_val, with its range over the rankings that "
     "leave one mesh family out; 'failed' where a population failed at the median (no finite "
     "mean exists), with the mean over the others beside it.",

@@ -348,10 +348,12 @@ def spread(pops, models, finite=False):
 
 def counts_failures(p):
     """Whether population ``p``, which the ranking leaves out for its numbers, still counts in
-    it for its failed runs: not a patch test (the consistency limit's subject), and a ranked
-    model's run failed there (a failure is a result wherever it happened)."""
+    it for its failures: not a patch test (the consistency limit's subject), and a ranked
+    model failed there as a ranked population would read it, at the median (half its runs or
+    more without a number) or with an unpaired mode (a failure is a result wherever it
+    happened)."""
     return not p.ranked and not p.patch_test and any(
-        _failures(p, st) for _, st, _ in p.standings())
+        _failure_key(p, st) != (0, 0) for _, st, _ in p.standings())
 
 
 def _failures(p, standing):
@@ -359,25 +361,35 @@ def _failures(p, standing):
     return standing.failed + p.unpaired.get(standing.model, 0)
 
 
+def _failure_key(p, standing):
+    """What orders a model in a failure-only ranking, as a ranked population's standings
+    would: its unpaired modes first, then its failed runs where they fail its median (a
+    failed run counted as infinitely wrong); fewer failures leave a median its numbers would
+    decide, so they order nothing here."""
+    lost = p.unpaired.get(standing.model, 0)
+    return lost, standing.failed if math.isinf(standing.score) else 0
+
+
 def failure_rank(p, model):
-    """``model``'s rank in a population counted for its failed runs alone
-    (``counts_failures``): after every model with fewer failed runs there, so the models
-    without one share the first rank (its numbers order nothing)."""
-    failed = {st.model: _failures(p, st) for _, st, _ in p.standings()}
-    return 1 + sum(f < failed[model] for f in failed.values())
+    """``model``'s rank in a population counted for its failures alone (``counts_failures``):
+    after every model whose failures there weigh less (``_failure_key``), so the models that
+    did not fail at the median share the first rank (its numbers order nothing)."""
+    keys = {st.model: _failure_key(p, st) for _, st, _ in p.standings()}
+    return 1 + sum(k < keys[model] for k in keys.values())
 
 
 def overall(pops, models, finite=False):
     """{model: (mean rank, geometric mean of its finite population scores, failed runs,
-    failed populations, populations, failed runs where only its failures count)} over the
+    failed populations, populations, failed runs where the numbers are left out)} over the
     populations of one regime (``finite``): every population counts for every model, a failed
     run (no number, or at the load no converged solve) against its model; each case weighs one
     (its boundary conditions are averaged first: two bcs of one case are not two independent
     observations); each score floored at its population's model-form uncertainty; P1 itself
     left out (an identity check). The populations ``Population.ranked`` leaves out for their
     numbers (patch tests, locking-prone problems, nearly linear finite loads) give no score;
-    those where a run failed (``counts_failures``, not patch tests) still give each model a
-    rank by its failed runs (``failure_rank``), so a failure counts wherever it happened;
+    those where a model failed at the median (``counts_failures``, not patch tests) still
+    give each model a rank by its failures (``failure_rank``), so a failure counts wherever
+    it happened, as it would in a ranked population;
     a failed run counts once, as infinitely wrong in its population's rank (``_order``)."""
     used = [p for p in pops if p.finite == finite and p.ranked]
     checked = [p for p in pops if p.finite == finite and counts_failures(p)]
@@ -401,7 +413,10 @@ def overall(pops, models, finite=False):
         scores = [s for s in scores if s is not None]
         failed = sum(sum(v is None for v in p.parts[m]) for p in mine)
         lost = sum(not math.isfinite(s) for c in by_case.values() for s, _ in c)
-        failed_outside = sum(sum(v is None for v in p.parts[m]) for p in outside)
+        # every failed run where the numbers are left out, whether or not it moved the rank
+        failed_outside = sum(sum(v is None for v in p.parts[m]) for p in pops
+                             if p.finite == finite and not p.ranked and not p.patch_test
+                             and m in p.parts and m not in p.identity)
         out[m] = (E.mean_rank(ranks), E.geometric_mean(scores, [0.0] * len(scores)), failed,
                   lost, len(mine), failed_outside)
     return out
@@ -428,16 +443,15 @@ def failed(entry):
 
 
 def failed_text(entry):
-    """'3 failed runs (2 in failure-only rankings)' of an ``overall`` entry ('1 failed run',
-    '2 failed runs in failure-only rankings': populations ``counts_failures`` ranks); '' for
-    none."""
+    """'3 failed runs (2 where the numbers are left out)' of an ``overall`` entry ('1 failed
+    run', '2 failed runs where the numbers are left out'); '' for none."""
     n = entry[2] + entry[5]
     if not n:
         return ""
     text = f"{n} failed run{'s' if n != 1 else ''}"
     if entry[5] and entry[2]:
-        return text + f" ({entry[5]} in failure-only rankings)"
-    return text + (" in failure-only rankings" if entry[5] else "")
+        return text + f" ({entry[5]} where the numbers are left out)"
+    return text + (" where the numbers are left out" if entry[5] else "")
 
 
 def ranked(means):

@@ -448,16 +448,27 @@ def index_line(data, v, quick, words=None):
     if len(v["best"]) == 1:
         return (f"At real time on this machine {what}, the most accurate model is {p} "
                 f"({at(p)}): {_why_pick(v)}.")
-    force = (v.get("force") or {}).get(p)
-    stiff = ("" if not v.get("pick_stiff") or force is None else
-             f"its top force within {STIFF:g} of FEM P1's ({fmt(force, 2)}"
-             + (", P1's own law: 0 by construction" if p == P1 else "") + "), ")
+    force = v.get("force") or {}
+    passed = [m for m in v["best"] if force.get(m) is not None and abs(force[m]) <= STIFF]
+    # the force test decides only where some of the tied fail it; P1's own law passes it by
+    # construction
+    test = (f"the top force within {STIFF:g} of FEM P1's ("
+            + ", ".join(f"{m} {fmt(force[m], 2)}" for m in passed)
+            + (f"; {P1} by construction" if P1 in passed else "") + ") "
+            + ("decides nothing here, all passing it" if len(passed) == len(v["best"]) else
+               "leaves " + ", ".join(passed) + (" alone" if len(passed) == 1 else ""))
+            ) if v.get("pick_stiff") else ""
+    decides = "" if len(passed) == 1 and v.get("pick_stiff") else "; the cost does"
+    r = v["reach"][p]
     return (f"At real time on this machine {what}, the most accurate models are tied "
             f"({len(v['best'])}, within u_val {err(v['u_two_meshes'])} of two bounds on two "
-            "meshes: the reference's estimate on each; u_input not estimated): "
+            "meshes: the reference's estimate on each; u_input not estimated; static "
+            "equilibria, a timed run's lag not measured): "
             + "; ".join(f"{m} ({at(m)})" for m in v["best"])
-            + f". Accuracy does not decide among them, so the force and the cost do: pick {p}: "
-            f"{stiff}{_why_pick(v)}.")
+            + ". Accuracy does not decide among them"
+            + (f"; {test}" if test else "")
+            + f"{decides}: pick {p}, {_wall(r['cost'])} [{_wall(r['range'][0])}-"
+            f"{_wall(r['range'][1])}] s per simulated s at its reach: {_why_pick(v)}.")
 
 
 def _smaller_words(v):
