@@ -455,8 +455,8 @@ def test_a_left_out_problem_that_is_a_training_problem_again_is_not_counted_as_l
 def test_costs_are_the_benchs_in_round_ratios_at_a_size_it_ran():
     """A candidate's cost is the bench's own in-round step ratio over fem-linear's at the size
     the bench ran closest to 1e4 tetrahedra (the number bench.md prints), never a ratio of two
-    interpolated times; the size is the bench's."""
-    from cases.studies.extensions.study import cost_size, costs
+    interpolated times, with its range over the rounds; the size is the bench's."""
+    from cases.studies.extensions.study import cost_ranges, cost_size, costs
 
     def row(model, tets, ratio):
         return {"model": model, "tets": tets, "step_vs_fem-linear": ratio,
@@ -464,4 +464,6 @@ def test_costs_are_the_benchs_in_round_ratios_at_a_size_it_ran():
     bench = {"rows": [row("fem-linear", 1080, 1.0), row("fem-linear", 10985, 1.0),
                       row("a", 1080, 30.9), row("a", 10985, 25.7), row("a", 98415, 20.0)]}
     assert costs(bench, ["a", "fem-linear", "b"]) == {"a": 25.7, "fem-linear": 1.0, "b": None}
+    bench["rows"][3]["step_vs_fem-linear_range"] = [18.1, 31.6]
+    assert cost_ranges(bench, ["a", "fem-linear"]) == {"a": [18.1, 31.6], "fem-linear": None}
     assert cost_size(bench) == 10985 and cost_size({}) is None

@@ -214,7 +214,7 @@ def rankings(data, models):
             "alternation": alternations(data, models),
             "floors": floors(data, models),
             "tensors": tensors(data, models), "cost": data["cost_vs_fem_linear"],
-            "cost_tets": data.get("cost_tets")}
+            "cost_tets": data.get("cost_tets"), "cost_range": data.get("cost_range") or {}}
 
 
 def order(values):
@@ -421,6 +421,13 @@ def _lead(rank, cands):
     return out
 
 
+def _cost(rank, model):
+    """'3.16 [3-3.3]': a model's step over fem-linear's with its range over the bench's
+    rounds (the median alone where the record has no range)."""
+    rng = rank.get("cost_range", {}).get(model)
+    return fmt(rank["cost"][model]) + (f" [{fmt(rng[0], 2)}-{fmt(rng[1], 2)}]" if rng else "")
+
+
 def _cost_size(rank):
     """The size the costs were read at: the bench's own, or COST_TETS where a record predates
     it."""
@@ -437,11 +444,12 @@ def conclusion(data):
     lines.append(_lead(rank, cands))
     cost = {m: rank["cost"].get(m) for m in cands if rank["cost"].get(m) is not None}
     if cost and rank["cost"].get(BASE) is not None:
+        lo, hi = min(cost, key=cost.get), max(cost, key=cost.get)
         lines.append(f"Each adds cost: at {_cost_size(rank)} tetrahedra an RK4 step of the "
-                     f"candidates takes {fmt(min(cost.values()))} to {fmt(max(cost.values()))} "
-                     f"times fem-linear's, the paper model's {fmt(rank['cost'][BASE])} times "
-                     "(the bench's median ratios: their range over its rounds is in the bench "
-                     "report, so nearby costs are not ordered here).")
+                     f"candidates takes {_cost(rank, lo)} to {_cost(rank, hi)} "
+                     f"times fem-linear's, the paper model's {_cost(rank, BASE)} times "
+                     "(the bench's median in-round ratios [smallest-largest over its rounds]: "
+                     "costs whose ranges overlap are not ordered here).")
     if not fs:
         lines.append(f"{BASE} fails none of the criteria checked here (model-form error "
                      f"within {FEM_FACTOR:g}x FEM P1's discretisation error, C_eff within "
@@ -589,7 +597,8 @@ def build(out, study, s, doc):
     fl = rank["floors"]
     d.table(["model", "step / fem-linear", "alternation (5-layer view)", "floor + diverges",
              "floors (each with its +-)"] + [f"C_eff {lat}" for lat in lattices],
-            [[short(m), fmt(rank["cost"].get(m)), fmt(rank["alternation"].get(m)),
+            [[short(m), _cost(rank, m) if rank["cost"].get(m) is not None else "n/a",
+              fmt(rank["alternation"].get(m)),
               f"{fl[m]['floor'] + fl[m]['diverges']} of {fl[m]['fits']}",
               f"{fmt(fl[m]['range'][0])}-{fmt(fl[m]['range'][1])}" if fl[m].get("range")
               else "none"]

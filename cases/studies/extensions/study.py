@@ -103,6 +103,14 @@ def costs(bench, models):
     return {m: None if r is None else float(r[STEP_RATIO]) for m, r in rows.items()}
 
 
+def cost_ranges(bench, models):
+    """Each model's [smallest, largest] over the bench's rounds of the ratio ``costs`` reads,
+    or None where the bench lacks it."""
+    rows = {m: near(bench, m, STEP_RATIO) for m in models}
+    return {m: None if r is None or not r.get(f"{STEP_RATIO}_range") else
+            [float(x) for x in r[f"{STEP_RATIO}_range"]] for m, r in rows.items()}
+
+
 def cost_size(bench):
     """The size ``costs`` reads: the bench's size closest to COST_TETS, or None."""
     r = near(bench, YARDSTICK, STEP_RATIO)
@@ -147,4 +155,5 @@ def run(s, workers=None, log=True, bench=None, store=OFF):
                                "nu_xy", "G_xy_pa", "failed")} for e in conv["elasticity"]],
         "cost_vs_fem_linear": costs(bench, s.models),
         # the preset with the same terms as +normal_edge, timed by another bench run
-        "cost_same_terms": {TWIN: costs(bench, [TWIN])[TWIN]}, "cost_tets": cost_size(bench)})
+        "cost_same_terms": {TWIN: costs(bench, [TWIN])[TWIN]}, "cost_tets": cost_size(bench),
+        "cost_range": cost_ranges(bench, s.models)})
