@@ -109,7 +109,8 @@ def test_the_quick_engines_run_is_a_preview_that_holds_its_gold(tmp_path, capsys
 
 def test_the_answer_names_per_case_the_solver_that_matches_fem_p1_and_from_which_count():
     """A solver within 0.05 of FEM P1 in both regimes of a case from 40 iterations on (not at
-    10) is named there 'from 40 iterations'; a case where no solver matches reads 'none'."""
+    10) is named there 'from 40 iterations'; a case where no solver matches reads 'none', with
+    each solver's median model-form error there."""
     from cases.studies.engines.report import answer
     runs = []
     for regime in ("linear regime", "at the load"):
@@ -123,6 +124,9 @@ def test_the_answer_names_per_case_the_solver_that_matches_fem_p1_and_from_which
     text = answer(findings({"runs": runs}, ladder), ladder, quick=False, installed=True)
     assert "the cube (paper-cube): newton-vbd from 40 iterations" in text
     assert "the cantilever (cantilever): none" in text
+    # a miss is a number: each solver's median model-form error there at its defaults
+    assert "the cantilever (cantilever): none (at their defaults, linear regime: newton-vbd " \
+        "0.3)" in text
 
 
 def test_convergence_is_relative_to_the_solvers_own_answer_not_the_continuums():
