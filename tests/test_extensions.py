@@ -99,7 +99,7 @@ def test_headline_says_when_no_candidate_beats_the_paper_model():
     doc = {"parameters": {"models": models}, "rankings": R.rankings(data, models)}
     # one population: no range leaving one out, so no best is named
     assert R.conclusion(doc)[0].startswith(
-        "Over the 1 pooled populations of the library, among the normal-stress extensions "
+        "Over the 1 populations the library averages, among the normal-stress extensions "
         "not resolved between m1, m2 (their ranges leaving one population or one mesh "
         "family out overlap): ")
     assert "m1 2, m2 4; m1 farther from FEM P1 than the paper model whichever population" in \
@@ -139,7 +139,7 @@ def test_a_population_with_a_failed_run_stays_and_counts_against_its_model():
     _, data = _doc(twin, {}, {})
     lead = R.conclusion({"parameters": {"models": models},
                          "rankings": R.rankings(data, models)})[0]
-    assert "Identical on every pooled population (one observation, not several): m1 = m2" in lead
+    assert "Identical on every averaged population (one observation, not several): m1 = m2" in lead
 
 
 @pytest.fixture(scope="module")

@@ -500,7 +500,10 @@ def _cost_of_replacing(pops, models, quick):
                         + (f"; their u_val {_span(us, ' to ')}, each score floored at "
                            "its own"
                            if us else "")
-                        + (f"; for failures alone, {', '.join(checked)}" if checked else "")
+                        + (f"; and {len(checked)} more case/bc population"
+                           f"{'s' if len(checked) > 1 else ''} ranked for failures alone "
+                           f"(their cases weighing one each too): {', '.join(checked)}"
+                           if checked else "")
                         + "): " + ", ".join(
                 f"{m} " + (f"failed ({e[3]} of {e[4]} populations failed at the median"
                            + (f"; {fmt(e[1])} over the others" if e[1] is not None else "")
@@ -535,7 +538,7 @@ def _rank_against_mean(ranked, k):
     (_, _, prev, _), (_, _, e, tie) = ranked[k - 1], ranked[k]
     if tie or e[1] is None or prev[1] is None or e[1] >= prev[1]:
         return ""
-    return f" (mean rank {e[0]:.2g}, after {prev[0]:.2g})"
+    return f" (mean rank {e[0]:.3g}, after {prev[0]:.3g})"
 
 
 def _resolved_groups(order, loose):

@@ -335,8 +335,9 @@ TERMS = {
     "beside it (not resolved), share its rank; a failed run counts once, in its "
     "population's rank. A population whose numbers are left out of the ranking (locking-prone, "
     "or nearly linear at finite load; never a patch test) still enters it where a model fails "
-    "its median there or loses a mode (a failure-only ranking): the models that did not share "
-    "the first rank, the others follow. Beside it the geometric mean over the cases of the population "
+    "its median there or loses a mode (a failure-only ranking): the models that did not fail "
+    "share the first rank, the failing ones follow, and its case weighs one in the mean like "
+    "any other. Beside it the geometric mean over the cases of the population "
     "medians, each floored at its population's u_val, with its range over the rankings that "
     "leave one mesh family out; 'failed' where a population failed at the median (no finite "
     "mean exists), with the mean over the others beside it.",

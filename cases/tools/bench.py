@@ -448,7 +448,7 @@ def _targets_table(doc, data):
     met_all = ("no preset meets every target" if not clean
                else "every target met by " + ", ".join(clean))
     doc.p(f"Against the kernel targets on this machine ({m['cpu']}, {m['cores']} cores): "
-          f"{met_all}. "
+          f"{met_all}. Verdicts, one per preset and size: "
           + "; ".join(f"{q}: {c['met']} met, {c['missed']} missed, {c['not resolved']} not "
                       "resolved" for q, c in counts.items()) + ". The targets: serial ns per "
           "tetrahedron per force evaluation ("

@@ -393,7 +393,7 @@ def _lead(rank, cands):
                                                           if r else "")
     ok = [m for m in ranked if rank["overall"][m] is not None]
     if not ok:
-        return (f"Over the {n} pooled populations of the library no candidate has a result "
+        return (f"Over the {n} populations the library averages no candidate has a result "
                 "on every one: " + ", ".join(said(m) for m in ranked) + ".")
     b = ok[0]
     level = [m for m in ok[1:] if _overlap(rng.get(b), rng.get(m))]
@@ -407,16 +407,16 @@ def _lead(rank, cands):
             "leaving one population or one mesh family out overlap)" if level else f"the best is {short(b)}")
     same = [" = ".join(short(m) for m in g) for g in rank.get("identical", [])
             if set(g) <= set(cands)]
-    out = (f"Over the {n} pooled populations of the library, among the normal-stress "
+    out = (f"Over the {n} populations the library averages, among the normal-stress "
            f"extensions {lead}: the geometric mean of each one's model-form errors (against "
            f"FEM P1 on the same tetrahedra) over the paper model's ({BASE}) [its range leaving "
            f"one population or one mesh family out]: " + ", ".join(said(m) for m in ranked)
            + f"; {short(b)} {versus}.")
     if same:
-        out += (" Identical on every pooled population (one observation, not several): "
+        out += (" Identical on every averaged population (one observation, not several): "
                 + "; ".join(same) + ".")
     if rank.get("left_out"):
-        out += (" Not pooled: " + ", ".join(rank["left_out"]) + " (patch tests and "
+        out += (" Not averaged: " + ", ".join(rank["left_out"]) + " (patch tests and "
                 "locking-prone problems: in the table, not in the mean).")
     return out
 
@@ -533,7 +533,7 @@ def build(out, study, s, doc):
           "discretisation error on the same meshes (replacing FEM costs more than FEM's "
           "distance from the continuum there). The FEM P1 of a finite-load case is "
           "neo-Hookean, so fem-linear's error there is its linearisation.",
-          f"overall: geometric mean over the pooled populations (neither patch tests nor "
+          f"overall: geometric mean over the averaged populations (neither patch tests nor "
           f"locking-prone problems) of the model-form error over {BASE}'s (below 1: closer "
           "to FEM P1 than the paper's model), each population weighing one (the index's "
           "ranking weighs each case one, its boundary conditions averaged: a case with two "
