@@ -1059,7 +1059,7 @@ def test_a_studys_failed_runs_are_named_once_per_model_and_cause():
              {"model": "k", "mesh": "mesh1", "bc": "clamped", "failed": None}]
     line = failed_checks({}, {"study": ({"cells": runs, "names": {"m": "model m"}},
                                         ("cells",))})
-    assert ("model m on study, 16 runs (mesh0/clamped, mesh1/clamped, mesh2/clamped, "
+    assert ("model m on study, 16 runs in 8 places (mesh0/clamped, mesh1/clamped, mesh2/clamped, "
             "mesh3/clamped, mesh4/clamped, mesh5/clamped and 2 more) (build: the fit gave "
             "c = 0)") in line
     assert "model m on study/mesh0/sliding (inverted)" in line and "k on" not in line

@@ -191,7 +191,9 @@ def failed_checks(data, studies=None):
         out += (" Failed runs of the studies (no number; each named in its report): "
                 + ("; ".join(f"{model} on " + (
                     f"{name}/{wheres[0]}" if len(wheres) == 1 else
-                    f"{name}, {len(wheres)} runs ({_listed(wheres)})") + f" ({why})"
+                    f"{name}, {len(wheres)} runs" + (
+                        f" in {len(set(wheres))} places" if len(set(wheres)) < len(wheres)
+                        else "") + f" ({_listed(wheres)})") + f" ({why})"
                     for (name, model, why), wheres in grouped.items())
                    if runs else "none") + ".")
     return out
