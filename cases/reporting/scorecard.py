@@ -356,11 +356,6 @@ def counts_failures(p):
         _failure_key(p, st) != (0, 0) for _, st, _ in p.standings())
 
 
-def _failures(p, standing):
-    """A model's failed runs in ``p``: runs without a number and runs with an unpaired mode."""
-    return standing.failed + p.unpaired.get(standing.model, 0)
-
-
 def _failure_key(p, standing):
     """What orders a model in a failure-only ranking, as a ranked population's standings
     would: its unpaired modes first, then its failed runs where they fail its median (a

@@ -30,13 +30,10 @@ class Extensions(Study):
         # the costs are the checkout's bench, the numbers the bench report prints; the
         # recorded ones only where the checkout has no bench
         from ...reporting.costs import load
-        from .study import TWIN, cost_ranges, cost_size, costs
+        from .study import bench_costs
         bench = load()
         if bench:
-            data.update({"cost_vs_fem_linear": costs(bench, s.models),
-                         "cost_same_terms": {TWIN: costs(bench, [TWIN])[TWIN]},
-                         "cost_tets": cost_size(bench),
-                         "cost_range": cost_ranges(bench, s.models)})
+            data.update(bench_costs(bench, s.models))
         else:
             data.update({k: metrics.get(k) for k in ("cost_tets", "cost_range")})
         return data

@@ -111,6 +111,14 @@ def cost_ranges(bench, models):
             [float(x) for x in r[f"{STEP_RATIO}_range"]] for m, r in rows.items()}
 
 
+def bench_costs(bench, models):
+    """What the study takes from the bench document: each model's cost, the size it is read
+    at and its range, and the preset with +normal_edge's terms (timed by another bench run)."""
+    return {"cost_vs_fem_linear": costs(bench, models),
+            "cost_same_terms": {TWIN: costs(bench, [TWIN])[TWIN]},
+            "cost_tets": cost_size(bench), "cost_range": cost_ranges(bench, models)}
+
+
 def cost_size(bench):
     """The size ``costs`` reads: the bench's size closest to COST_TETS, or None."""
     r = near(bench, YARDSTICK, STEP_RATIO)
@@ -153,7 +161,4 @@ def run(s, workers=None, log=True, bench=None, store=OFF):
                      "elasticity": [
         {k: e.get(k) for k in ("model", "mesh", "moduli_rel_err", "anisotropy_AU", "E_x_pa",
                                "nu_xy", "G_xy_pa", "failed")} for e in conv["elasticity"]],
-        "cost_vs_fem_linear": costs(bench, s.models),
-        # the preset with the same terms as +normal_edge, timed by another bench run
-        "cost_same_terms": {TWIN: costs(bench, [TWIN])[TWIN]}, "cost_tets": cost_size(bench),
-        "cost_range": cost_ranges(bench, s.models)})
+        **bench_costs(bench, s.models)})
