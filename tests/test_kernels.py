@@ -24,9 +24,10 @@ TERMS = {
     "fem_corotated": ("fem_corotated", {}),
     "fem_linear": ("fem_linear", {}),
     "fem_neohookean": ("fem_neohookean", {}),
+    "springs": ("springs", {}),
 }
 # the terms whose kernel reports an edge of zero length rather than a flattened tetrahedron
-COLLAPSED_EDGE = {"normal_edge"}
+COLLAPSED_EDGE = {"normal_edge", "springs"}
 # lattice and unstructured meshes; sizes not a multiple of the block (a padded last block)
 MESHES = {"five": lambda: cube(6, 0.03, "five"), "six": lambda: cube(5, 0.02, "six"),
           "bcc": lambda: cube(4, 0.03, "bcc"),
@@ -107,6 +108,17 @@ def test_kernel_equals_its_reference(key, family):
         assert scale > 0
         got = forces(t.kernel(), x, start * scale) - start * scale
         assert np.abs(got - want).max() <= 1e-12 * scale
+
+
+@pytest.mark.parametrize("family", MESHES)
+def test_spring_kernel_gives_its_references_bits(family):
+    """The spring kernel (a run of edges with one first node summed in registers) adds the
+    reference kernel's forces bit for bit into a non-zero ``out``, on every mesh family."""
+    mesh = mesh_of(family)
+    t = make_term("springs", mesh, MAT)
+    x = perturbed(mesh, 0.02, seed=3)
+    start = np.random.default_rng(3).standard_normal(x.shape)
+    assert np.array_equal(forces(t.kernel(), x, start), forces(t.reference_kernel(), x, start))
 
 
 @pytest.mark.parametrize("key", TERMS)

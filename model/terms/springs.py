@@ -26,10 +26,10 @@ FAST = {"nnan", "ninf", "nsz", "afn"}
 
 
 @njit(inline="always", fastmath=FAST, error_model="numpy")
-def spring_force(x, edge, rest, k, s):
+def spring_force(x, first, second, rest, k, s):
     """Edge s's force f = k (l - l0) / l d on its first node (minus that on its second), and
     its length l (0: collapsed)."""
-    i, j = edge[s, 0], edge[s, 1]
+    i, j = first[s], second[s]
     d0, d1, d2 = x[j, 0] - x[i, 0], x[j, 1] - x[i, 1], x[j, 2] - x[i, 2]
     ln = np.sqrt(d0 * d0 + d1 * d1 + d2 * d2)
     f = k[s] * (ln - rest[s]) / ln  # tension pulls j towards i
@@ -37,44 +37,82 @@ def spring_force(x, edge, rest, k, s):
 
 
 @njit(cache=True, fastmath=FAST, error_model="numpy")
-def spring_forces(x, edge, rest, k, out):
-    """Linear springs f = k (l - l0) on every edge; returns the first collapsed edge, or -1."""
-    for s in range(edge.shape[0]):
-        ln, g = spring_force(x, edge, rest, k, s)
+def spring_forces(x, first, second, rest, k, out):
+    """Linear springs f = k (l - l0) on every edge (its nodes first[s], second[s]); returns
+    the first collapsed edge, or -1. The force on a run of edges with one first node (the
+    edges come sorted by it) is summed in registers, in the same order as one addition into
+    ``out`` per edge: no other edge of the run touches that node, so the bits are those of
+    :func:`spring_forces_reference`, without a store-to-load wait per edge."""
+    m = first.shape[0]
+    if m == 0:
+        return -1
+    i = first[0]
+    a0, a1, a2 = out[i, 0], out[i, 1], out[i, 2]
+    x0, x1, x2 = x[i, 0], x[i, 1], x[i, 2]
+    for s in range(m):
+        if first[s] != i:
+            out[i, 0], out[i, 1], out[i, 2] = a0, a1, a2
+            i = first[s]
+            a0, a1, a2 = out[i, 0], out[i, 1], out[i, 2]
+            x0, x1, x2 = x[i, 0], x[i, 1], x[i, 2]
+        j = second[s]
+        d0, d1, d2 = x[j, 0] - x0, x[j, 1] - x1, x[j, 2] - x2
+        ln = np.sqrt(d0 * d0 + d1 * d1 + d2 * d2)
         if ln <= 0.0:
+            out[i, 0], out[i, 1], out[i, 2] = a0, a1, a2
             return s
-        i, j = edge[s, 0], edge[s, 1]
-        out[i, 0] += g[0]
-        out[i, 1] += g[1]
-        out[i, 2] += g[2]
-        out[j, 0] -= g[0]
-        out[j, 1] -= g[1]
-        out[j, 2] -= g[2]
+        f = k[s] * (ln - rest[s]) / ln
+        a0 += f * d0
+        a1 += f * d1
+        a2 += f * d2
+        out[j, 0] -= f * d0
+        out[j, 1] -= f * d1
+        out[j, 2] -= f * d2
+    out[i, 0], out[i, 1], out[i, 2] = a0, a1, a2
     return -1
 
 
 @njit(cache=True, fastmath=FAST, error_model="numpy")
-def spring_range(x, edge, rest, k, first, stop, late, route, buf, out):
-    """spring_forces over the edges of blocks [first, stop) of B edges, the forces of routed
+def spring_forces_reference(x, edge, rest, k, out):
+    """spring_forces on the (m, 2) edges: the kernel's reference implementation."""
+    for s in range(edge.shape[0]):
+        i, j = edge[s, 0], edge[s, 1]
+        d0, d1, d2 = x[j, 0] - x[i, 0], x[j, 1] - x[i, 1], x[j, 2] - x[i, 2]
+        ln = np.sqrt(d0 * d0 + d1 * d1 + d2 * d2)
+        if ln <= 0.0:
+            return s
+        f = k[s] * (ln - rest[s]) / ln
+        out[i, 0] += f * d0
+        out[i, 1] += f * d1
+        out[i, 2] += f * d2
+        out[j, 0] -= f * d0
+        out[j, 1] -= f * d1
+        out[j, 2] -= f * d2
+    return -1
+
+
+@njit(cache=True, fastmath=FAST, error_model="numpy")
+def spring_range(x, first, second, rest, k, start, stop, late, route, buf, out):
+    """spring_forces over the edges of blocks [start, stop) of B edges, the forces of routed
     ends into buf (the threaded mode's twin: model.terms._threads.SplitBlocks; a second
     end's force is stored negated, which adds to the bits of the serial subtraction)."""
-    blk = first
+    blk = start
     while blk < stop:
         lo = blk * B
         if not late[blk]:       # a run of blocks without a routed end: the serial kernel
             while blk < stop and not late[blk]:
                 blk += 1
-            hi = min(blk * B, edge.shape[0])
-            bad = spring_forces(x, edge[lo:hi], rest[lo:hi], k[lo:hi], out)
+            hi = min(blk * B, first.shape[0])
+            bad = spring_forces(x, first[lo:hi], second[lo:hi], rest[lo:hi], k[lo:hi], out)
             if bad >= 0:
                 return lo + bad
             continue
-        hi = min(lo + B, edge.shape[0])
+        hi = min(lo + B, first.shape[0])
         for s in range(lo, hi):
-            ln, g = spring_force(x, edge, rest, k, s)
+            ln, g = spring_force(x, first, second, rest, k, s)
             if ln <= 0.0:
                 return s
-            i, j = edge[s, 0], edge[s, 1]
+            i, j = first[s], second[s]
             ri, rj = route[blk * 2 * B + s - lo], route[blk * 2 * B + B + s - lo]
             if ri < 0:
                 out[i, 0] += g[0]
@@ -116,9 +154,17 @@ class Springs(Term):
         super().__init__(mesh, material, scale, **params)
         self.edge, self.rest, k = van_gelder_stiffness(mesh)
         self.k = self.scale * material.E * k
+        if mesh.n_nodes >= 2**31:
+            raise ValueError("more than 2**31 nodes")
+        # each end in an int32 array of its own: at 1e6 tetrahedra the (m, 2) int64 edges'
+        # traffic cost the kernel a quarter of its time
+        self._ends = tuple(np.ascontiguousarray(self.edge[:, c], dtype=np.int32) for c in (0, 1))
 
     def kernel(self):
-        return spring_forces, (self.edge, self.rest, self.k)
+        return spring_forces, (*self._ends, self.rest, self.k)
+
+    def reference_kernel(self):
+        return spring_forces_reference, (self.edge, self.rest, self.k)
 
     def threaded_kernel(self):
         # the routes of the edges taken B at a time, as the blocked kernels' elements
