@@ -339,6 +339,21 @@ def _law_run(runs, law, tets):
     return next(r for r in runs if r["model"] == law and r["tets"] == tets)
 
 
+def _parts(data, v, m):
+    """(model-form error, FEM P1's distance) that model m's bound at its reach adds, or None
+    where either was not computed."""
+    bound = v["bounds"][m]
+    form = _law_run(data["runs"], m, v["reach"][m]["tets"]).get("disp_form_rel_l2")
+    return None if bound is None or form is None else (form, bound - form)
+
+
+def _split_words(data, v, m):
+    """The bound of model m split into its two parts (rule 9): ' = model-form a + FEM P1's
+    b', or nothing where either was not computed."""
+    q = _parts(data, v, m)
+    return "" if q is None else f" = model-form {err(q[0])} + FEM P1's {err(q[1])}"
+
+
 def answer_line(data, v, quick, words=None):
     """The index's one line: the most accurate model at real time on the bench's machine
     (``words``: how the loading is named, ``study.CubePush.words`` by default)."""
@@ -352,7 +367,7 @@ def answer_line(data, v, quick, words=None):
         reach_ = v["reach"][m]
         mode = _mode(m, reach_)
         said.append(f"{m} ({mode}, {_reach_words(reach_, v['spans'].get(m))}, "
-                    f"{_judged(v['bounds'][m], v)})")
+                    f"{_judged(v['bounds'][m], v)}{_split_words(data, v, m)})")
     y, p = v.get("yardstick"), v["pick"]
     if len(said) > 1:
         reaches = [v["reach"][m] for m in v["best"]]
@@ -374,6 +389,10 @@ def answer_line(data, v, quick, words=None):
     else:
         head = ("the smallest error bound (model-form error plus FEM P1's discretisation "
                 f"error at the model's reach) is {said[0]}")
+    parts = [_parts(data, v, m) for m in v["best"]]
+    if parts and all(q is not None and q[0] < q[1] for q in parts):
+        head += (" (in each, FEM P1's share is the larger: the mesh the budget allows "
+                 "weighs more than the law)")
     # the runners-up: tied with some of the first, resolved behind first ones only
     nearly = [k for k in v["ranks"] if k["rank"] > 1 and set(k["tied"]) & set(v["best"])
               and set(k["behind"]) <= set(v["best"])]
