@@ -777,9 +777,9 @@ def test_the_reading_is_decided_only_where_no_other_could_match_as_many():
     v = analysis.reading_verdict(table, 50.0)
     assert not v["decided"] and v["model"] is None and v["margin"] == 0
     plain = ("a, b miss the paper's cost (Figure 2's measure: the time of one step over "
-             "msm's, at the paper's size, with this implementation's kernels; per simulated "
-             "second, at each model's own stable step, the index's cost line gives other "
-             "ratios)")
+             "msm's, which is how the paper's text reads its figure, at the paper's size, with "
+             "this implementation's kernels; per simulated second, at each model's own stable "
+             "step, the index's cost line gives other ratios, not the paper's claim)")
     assert v["sure"] == "not decided" and v["text"].startswith(
         f"Plainly: {plain}. Not decided: ")
     assert v["plain"] == plain

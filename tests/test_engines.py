@@ -225,6 +225,97 @@ def test_the_scorecard_rows_band_each_solver_by_its_worst_mesh_and_count_failure
     assert scorecard({**doc, "parameters": {"quick": True, "meshes": ["five"]}}) == []
 
 
+def test_the_scorecard_marks_the_engines_shared_cells_as_the_studys_own():
+    """The engines rows share the cases' columns 'FEM P1 vs continuum' and 'u_val' but hold
+    signed values on the study's own quick meshes: each such cell says so (FEM P1 at 1.2 of
+    a continuum of 1 on two meshes: 0.2, signed), the metric says its values are signed, and
+    the label gives the meshes' sizes where the record holds them."""
+    from cases.studies.engines.report import scorecard
+    ladder = {"newton-xpbd": (2,), "newton-vbd": (10, 40)}
+    runs = [dict(r, u_num=0.003) for m in ("five", "six")
+            for r in (row("newton-vbd", 1.21, mesh=m, p1=1.2),
+                      row("newton-vbd(iterations=40)", 1.2, mesh=m, p1=1.2))]
+    doc = {"installed": True, "parameters": {"quick": False, "meshes": ["five", "six"]},
+           "findings": findings({"runs": runs}, ladder),
+           "mesh_tets": {"paper-cube": {"five": 320, "six": 384}}}
+    (label, metric, _, (p1, u)), = scorecard(doc)
+    assert label == ("paper-cube/clamped (engines study, the case's quick meshes five/six, "
+                     "320/384 tetrahedra, and references)")
+    assert metric == "model-form vs FEM P1 at the engine's defaults, signed"
+    assert p1 == "0.2 [0.2 to 0.2], 2 of 2 (engines study, 2 quick meshes, signed)"
+    assert u == "0.003 (engines study, 2 quick meshes)"
+
+
+def test_the_engines_meshes_are_the_cases_quick_meshes_of_known_size():
+    """The study's meshes are the cases' quick meshes, built by each case's own builder from
+    the recorded problem: the bar and the cube 4 lattice cells a side (64 cells: 5 and 6
+    tetrahedra a cell on the splits five and six, 320 and 384), the cantilever 16 by 4 by 4
+    cells (256: 1280 and 1536); the answer and the report say them where they say 'quick
+    meshes'."""
+    from cases.studies.engines.report import sizes_text
+    from cases.studies.engines.study import EngineSettings, mesh_sizes
+    tets = mesh_sizes(EngineSettings())
+    assert tets == {"self-weight": {"five": 320, "six": 384},
+                    "paper-cube": {"five": 320, "six": 384},
+                    "cantilever": {"five": 1280, "six": 1536}}
+    assert mesh_sizes(EngineSettings(quick=True))["cantilever"] == {"five": 1280}
+    assert sizes_text(tets, ["paper-cube", "cantilever"]) == \
+        "the cube's 320 and 384 tetrahedra, the cantilever's 1280 and 1536"
+    assert sizes_text({}, ["paper-cube"]) == ""
+
+
+def test_a_redrawn_engines_report_says_its_meshes_sizes(tmp_path, capsys):
+    """Drawn again from the committed record (nothing computed), the engines report records
+    the sizes of the meshes it ran on and says them where it says 'quick meshes'."""
+    import json
+    import shutil
+    from pathlib import Path
+    from cases.cli import main
+    reports = Path(__file__).resolve().parents[1] / "reports" / "engines"
+    out = tmp_path / "engines"
+    out.mkdir()
+    shutil.copy(reports / "metrics.json", out / "metrics.json")
+    assert main(["run", "engines", "--rewrite", "--out", str(out)]) == 0
+    doc = json.loads((out / "metrics.json").read_text())
+    assert doc["mesh_tets"]["cantilever"] == {"five": 1280, "six": 1536}
+    assert "the cases' quick meshes, split 'five' and 'six' (two splits of one lattice size, " \
+        "the quick run 'five' only; here the bar's 320 and 384 tetrahedra, the cube's 320 " \
+        "and 384, the cantilever's 1280 and 1536)" in (out / "report.md").read_text()
+
+
+def test_a_pick_not_converged_in_iterations_is_provisional_in_the_pick_itself():
+    """newton-vbd matches FEM P1 on the cube and the cantilever from 40 iterations, but on the
+    cantilever its answer at 40 (1.04) is not within 1 % of its answer at the ladder's top
+    (1.0 at 160): the pick itself says it is provisional, and why; where 40 is converged
+    (1.0 at 40 and 160) the pick is plain. The quick meshes' sizes are said beside FEM P1's
+    distance."""
+    from cases.studies.engines.report import answer
+    ladder = {"newton-xpbd": (2,), "newton-vbd": (10, 40, 160)}
+
+    def runs(at40):
+        out = []
+        for regime in ("linear regime", "at the load"):
+            out += [row("newton-vbd", 1.02, regime=regime),
+                    row("newton-vbd(iterations=40)", 1.01, regime=regime),
+                    row("newton-vbd(iterations=160)", 1.01, regime=regime),
+                    row("newton-vbd", 1.3, regime=regime, case="cantilever"),
+                    row("newton-vbd(iterations=40)", at40, regime=regime, case="cantilever"),
+                    row("newton-vbd(iterations=160)", 1.0, regime=regime, case="cantilever")]
+        return out
+    tets = {"paper-cube": {"five": 320}, "cantilever": {"five": 1280}}
+    text = answer(findings({"runs": runs(1.04)}, ladder), ladder, False, True, tets=tets)
+    assert text.startswith(
+        "pick newton-vbd(iterations=40), provisional (not converged in iterations at 40: not "
+        "within 1% of its answer at the ladder's top on the cantilever, linear regime; the "
+        "cantilever, at the load) (the setting within 0.05 of FEM P1")
+    assert "not shown converged" not in text
+    assert "on those 2 quick meshes (the cube's 320 tetrahedra, the cantilever's 1280; " \
+        "|Q_P1 - Q_c| / |Q_c|" in text
+    plain = answer(findings({"runs": runs(1.0)}, ladder), ladder, False, True)
+    assert plain.startswith("pick newton-vbd(iterations=40) (the setting within 0.05")
+    assert "provisional" not in plain
+
+
 def test_the_dynamic_push_counts_failures_and_says_where_float32_cannot_resolve_rest():
     """The dynamic push's line gives each solver's median reaction error over the meshes with
     a failed run reading 'failed'; the table's note states the rest speed and the smallest

@@ -295,7 +295,43 @@ def test_a_failure_where_the_ranking_leaves_the_numbers_out_still_ranks_its_mode
     assert scorecard.overall(three + [one], models)["a"][0] == \
         scorecard.overall(three, models)["a"][0]
     assert scorecard.failed_text(scorecard.overall(three + [one], models)["a"]) == \
-        "1 failed run where the numbers are left out"
+        "1 failed run where the numbers are left out: counted only"
+
+
+def test_a_failure_where_the_numbers_are_left_out_says_whether_it_ranked(tmp_path):
+    """Where the ranking leaves a population's numbers out, a model's failed runs rank it only
+    where they fail its median there (2 of 3 runs), and are counted only where they do not (1
+    of 3): the count, the summary table's cell and the list of failed runs each say which
+    ranked and which are counted only; a failed run in a ranked population is counted apart."""
+    from dataclasses import replace
+    from cases.reporting.answers import _overall_cell
+    from cases.reporting.index import conclusion
+    three, models = _three_models(tmp_path, {"five": (1.1, 1.3, 2.0), "six": (1.1, 1.3, 2.0),
+                                             "bcc": (1.1, 1.3, 2.0)})
+    q = replace(three[0], locking=True)
+    a = q.parts["a"]
+    two = replace(q, case="cantilever", parts={**q.parts, "a": [None, None, a[2]]})
+    one = replace(q, case="self-weight", parts={**q.parts, "a": [None, a[1], a[2]]})
+    assert scorecard.failure_ranks(two, "a") and not scorecard.failure_ranks(one, "a")
+    pops = three + [two, one]
+    means = scorecard.overall(pops, models)
+    assert means["a"][5:] == (3, 2)
+    assert scorecard.failed_text(means["a"]) == \
+        "3 failed runs where the numbers are left out: 2 ranked, 1 counted only"
+    assert _overall_cell(means, "a", pops, False, {}).endswith(
+        "; where the numbers are left out: 2 of 3 in cantilever/clamped (ranked), 1 of 3 in "
+        "self-weight/clamped (counted, below its median: no rank)")
+    failed = conclusion(pops, models, False)[-1]
+    assert "a in cantilever/clamped (2 of 3, where the numbers are left out: ranked), a in " \
+        "self-weight/clamped (1 of 3, where the numbers are left out: counted, below its " \
+        "median: no rank)" in failed
+    # every failure left out ranks: nothing to tell apart; one in a ranked population besides
+    assert scorecard.failed_text(scorecard.overall(three + [two], models)["a"]) == \
+        "2 failed runs where the numbers are left out"
+    assert scorecard.failed_text((1, 0.1, 1, 0, 1, 3, 2)) == \
+        "4 failed runs (3 where the numbers are left out: 2 ranked, 1 counted only)"
+    assert scorecard.failed_text((1, 0.1, 1, 0, 1, 2, 2)) == \
+        "3 failed runs (2 where the numbers are left out)"
 
 
 def test_a_discretisation_error_is_read_against_the_continuums_u_val(tmp_path):

@@ -207,9 +207,12 @@ def _overall_cell(means, model, pops, finite, spread):
     if any(model in p.identity and p.finite == finite for p in pops):
         return "identity check (P1's law in this regime)"
     said = scorecard.describe(means[model], spread.get(model)) if model in means else "n/a"
-    # a failure in a population the ranking leaves out is the model's all the same
-    out = [f"{st.failed} of {st.runs} in {p.label}" for p in pops
-           if p.finite == finite and not p.ranked and not p.patch_test
+    # a failure in a population the ranking leaves out is the model's all the same; it ranks
+    # the model only where it fails its median there, as in a ranked population
+    out = [f"{st.failed} of {st.runs} in {p.label}"
+           + ("" if model not in means else " (ranked)" if scorecard.failure_ranks(p, model)
+              else " (counted, below its median: no rank)")
+           for p in pops if p.finite == finite and not p.ranked and not p.patch_test
            for _, st, _ in p.standings() if st.model == model and st.failed]
     if not out:
         return said

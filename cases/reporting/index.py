@@ -149,8 +149,12 @@ def conclusion(pops, models, quick):
                        f"{m} in {p.label} ("
                        + ("failed at the median" if math.isinf(v) else rel(v)) + ")"
                        for m, (v, p) in worst.items()) + ".")
-    failed = [f"{s.model} in {p.label} ({s.failed} of {s.runs})" for p in pops
-              for _, s, _ in p.standings() if s.failed]
+    # where the numbers are left out, a failure ranks only where it fails the model's median
+    failed = [f"{s.model} in {p.label} ({s.failed} of {s.runs}"
+              + ("" if p.ranked or p.patch_test else ", where the numbers are left out: "
+                 + ("ranked" if scorecard.failure_ranks(p, s.model)
+                    else "counted, below its median: no rank")) + ")"
+              for p in pops for _, s, _ in p.standings() if s.failed]
     # against the continuum a run fails on its own too (a continuum mode left unpaired)
     total = [f"{s.model} in {p.label} ({s.failed} of {s.runs})" for p in pops
              for _, s, _ in p.standings("total") if s.failed]
@@ -339,7 +343,9 @@ TERMS = {
     "or nearly linear at finite load; never a patch test) still enters it where a model fails "
     "its median there or loses a mode (a failure-only ranking): the models that did not fail "
     "share the first rank, the failing ones follow, and its case weighs one in the mean like "
-    "any other. Beside it the geometric mean over the cases of the population "
+    "any other; a model's failed runs there that leave its median to its numbers (fewer than "
+    "half its runs) rank nothing and are counted against it only (marked 'counted only', or "
+    "'counted, below its median: no rank'; those that rank, 'ranked'). Beside it the geometric mean over the cases of the population "
     "medians, each floored at its population's u_val, with its range over the rankings that "
     "leave one mesh family out; 'failed' where a population failed at the median (no finite "
     "mean exists), with the mean over the others beside it.",

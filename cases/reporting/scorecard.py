@@ -375,7 +375,8 @@ def failure_rank(p, model):
 
 def overall(pops, models, finite=False):
     """{model: (mean rank, geometric mean of its finite population scores, failed runs,
-    failed populations, populations, failed runs where the numbers are left out)} over the
+    failed populations, populations, failed runs where the numbers are left out, those of
+    them that rank (``failure_ranks``))} over the
     populations of one regime (``finite``): every population counts for every model, a failed
     run (no number, or at the load no converged solve) against its model; each case weighs one
     (its boundary conditions are averaged first: two bcs of one case are not two independent
@@ -408,13 +409,24 @@ def overall(pops, models, finite=False):
         scores = [s for s in scores if s is not None]
         failed = sum(sum(v is None for v in p.parts[m]) for p in mine)
         lost = sum(not math.isfinite(s) for c in by_case.values() for s, _ in c)
-        # every failed run where the numbers are left out, whether or not it moved the rank
-        failed_outside = sum(sum(v is None for v in p.parts[m]) for p in pops
-                             if p.finite == finite and not p.ranked and not p.patch_test
-                             and m in p.parts and m not in p.identity)
+        # every failed run where the numbers are left out, whether or not it moved the rank,
+        # and those of them that ranked (where they fail the model's median: ``_failure_key``)
+        left = [p for p in pops if p.finite == finite and not p.ranked and not p.patch_test
+                and m in p.parts and m not in p.identity]
+        failed_outside = sum(sum(v is None for v in p.parts[m]) for p in left)
+        ranked_outside = sum(sum(v is None for v in p.parts[m]) for p in left
+                             if failure_ranks(p, m))
         out[m] = (E.mean_rank(ranks), E.geometric_mean(scores, [0.0] * len(scores)), failed,
-                  lost, len(mine), failed_outside)
+                  lost, len(mine), failed_outside, ranked_outside)
     return out
+
+
+def failure_ranks(p, model):
+    """Whether ``model``'s failed runs in population ``p``, which the ranking leaves out for
+    its numbers, rank it there: where they fail its median (half its runs or more without a
+    number), as in a ranked population; fewer are counted against it and rank nothing."""
+    return any(st.model == model and st.failed and math.isinf(st.score)
+               for _, st, _ in p.standings())
 
 
 def largest(pops, model, finite=False):
@@ -439,14 +451,22 @@ def failed(entry):
 
 def failed_text(entry):
     """'3 failed runs (2 where the numbers are left out)' of an ``overall`` entry ('1 failed
-    run', '2 failed runs where the numbers are left out'); '' for none."""
+    run', '2 failed runs where the numbers are left out'); '' for none. Where some of those
+    left out fail no median, and so rank nothing (``failure_ranks``), it says how many ranked
+    and how many are counted only: '3 failed runs where the numbers are left out: 2 ranked,
+    1 counted only'."""
     n = entry[2] + entry[5]
     if not n:
         return ""
     text = f"{n} failed run{'s' if n != 1 else ''}"
+    counted = entry[5] - entry[6]
+    split = ("" if not counted else f"{entry[6]} ranked, {counted} counted only" if entry[6]
+             else "counted only")
     if entry[5] and entry[2]:
-        return text + f" ({entry[5]} where the numbers are left out)"
-    return text + (" where the numbers are left out" if entry[5] else "")
+        return text + f" ({entry[5]} where the numbers are left out" + (
+            f": {split})" if split else ")")
+    return text + (" where the numbers are left out" + (f": {split}" if split else "")
+                   if entry[5] else "")
 
 
 def ranked(means):
@@ -466,7 +486,7 @@ def ranked(means):
 def describe(entry, rng=None):
     """'mean rank r, geometric mean g [range leaving one mesh family out]' with the failed
     runs and populations of ``overall``."""
-    r, g, _, lost, n, _ = entry
+    r, g, _, lost, n, *_ = entry
     text = f"mean rank {r:.3g}"
     if lost:    # a failed population scores infinitely wrong: no finite mean exists
         text += (f", geometric mean failed ({lost} of {n} populations failed at the median"

@@ -2750,10 +2750,11 @@ def reading_verdict(table, damping, spread=None, figure=None):
     literal = any(m.endswith("-literal") for m in cost_miss)
     plain = "; ".join(x for x in (
         f"{_names(cost_miss)} miss the paper's cost (Figure 2's measure: the time of one "
-        f"step over msm's, at the paper's size, with this implementation's kernels"
+        f"step over msm's, which is how the paper's text reads its figure, at the paper's "
+        f"size, with this implementation's kernels"
         + ("; a literal reading is timed as its calibrated one, the same kernel"
            if literal else "") + "; per simulated second, at each model's own stable step, "
-        "the index's cost line gives other ratios)" if cost_miss else "",
+        "the index's cost line gives other ratios, not the paper's claim)" if cost_miss else "",
         f"the cost is not decided for {_names(cost_open)}" if cost_open else "") if x)
     text = ((f"Plainly: {plain}. " if plain else "")
             + (f"Not decided: {why}. " if not decided else f"{why}. ")

@@ -10,7 +10,7 @@ from ...measuring.error_model import P1_LINEAR
 from ...reporting.document import Document, fmt
 from ...reporting.report import environment, write_study
 from ...running.runner import jsonable
-from .study import BCS, CASE_NAMES, CONVERGED, MATCH, MESHES, SOLVERS
+from .study import BCS, CASE_NAMES, CONVERGED, MATCH, MESHES, SOLVERS, mesh_sizes
 
 GATED = catalogue.gated("engine_error")
 REGIMES = ("linear regime", "at the load")
@@ -152,10 +152,13 @@ def pick(f, ladder, costs):
     return None if best is None else best[1:]
 
 
-def answer(f, ladder, quick, installed, shear=None, costs=None, where="", baseline=None):
+def answer(f, ladder, quick, installed, shear=None, costs=None, where="", baseline=None,
+           tets=None):
     """The index's line: per case, which engine replaces FEM P1 there (within MATCH on both
     regimes and every mesh) and from which setting; the pick with its cost on the bench's
-    machine (``where``) beside linear FEM P1's there (``baseline``, its bench row)."""
+    machine (``where``) beside linear FEM P1's there (``baseline``, its bench row), the sizes
+    of the quick meshes it was judged on (``tets``, ``mesh_sizes``), and, where its count is
+    below the one its answer converges from, said provisional in the pick itself."""
     if not installed:
         return "not measured: the engines extra is not installed"
     if quick:
@@ -189,7 +192,13 @@ def answer(f, ladder, quick, installed, shear=None, costs=None, where="", baseli
         p1 = [(CASE_NAMES[c], _median(_unsigned(got["discretisation"]))
                + f" (u_val {fmt(got['u_num'], 2)})")
               for c in cases if (got := f[solver]["cases"].get(f"{c}/{REGIMES[0]}"))]
-        said = (f"pick {model} (the setting within {MATCH:g} of FEM P1 on the most cases, then "
+        sizes = sizes_text(tets or {}, [c for c in cases if c in CASE_NAMES])
+        # a pick whose answer still moves with the count is provisional: said in the pick
+        said = (f"pick {model}"
+                + (f", provisional (not converged in iterations at {n}: not within "
+                   f"{CONVERGED:.0%} of its answer at the ladder's top on " + "; ".join(early)
+                   + ")" if early else "")
+                + f" (the setting within {MATCH:g} of FEM P1 on the most cases, then "
                 "the cheapest per simulated second): within it on "
                 + ", ".join(CASE_NAMES[c] for c in cases)
                 + (", every case" if len(cases) == len(CASE_NAMES) else
@@ -198,11 +207,9 @@ def answer(f, ladder, quick, installed, shear=None, costs=None, where="", baseli
                                         if BCS[c] == "sliding" else "")
                        for c in CASE_NAMES if c not in cases))
                 + f", so within {MATCH:g} of FEM P1's own distance from the continuum on "
-                f"those {len(MESHES)} quick meshes (|Q_P1 - Q_c| / |Q_c|, the median over the "
-                "meshes: "
+                f"those {len(MESHES)} quick meshes (" + (f"{sizes}; " if sizes else "")
+                + "|Q_P1 - Q_c| / |Q_c|, the median over the meshes: "
                 + ", ".join(f"{name} {v}" for name, v in p1) + ", linear regime)"
-                + (f"; not shown converged there within {CONVERGED:.0%} of its answer at the "
-                   "ladder's top on " + "; ".join(early) if early else "")
                 + (f"; {fmt(cost[0], 3)} [{fmt(cost[1], 3)}-{fmt(cost[2], 3)}] wall s per "
                    f"simulated s on the paper's cube ({where}, single precision on Warp's "
                    "CPU backend through pbcm's adapter): "
@@ -229,6 +236,16 @@ def answer(f, ladder, quick, installed, shear=None, costs=None, where="", baseli
                else ""))
 
 
+def sizes_text(tets, cases):
+    """"the cube's 320 and 384 tetrahedra, the cantilever's 1280 and 1536": the sizes of each
+    of ``cases``' meshes in ``tets`` ({case: {mesh: tetrahedra}}, ``mesh_sizes``), in the
+    study's mesh order; '' where none is known."""
+    got = [(CASE_NAMES[c], " and ".join(str(n) for n in tets[c].values()))
+           for c in cases if tets.get(c)]
+    return ", ".join(f"{name}'s {n}" + (" tetrahedra" if k == 0 else "")
+                     for k, (name, n) in enumerate(got))
+
+
 def scorecard(doc):
     """The index's scorecard rows: per case and regime, each solver at its default settings,
     its model-form error against FEM P1 (median over the study's meshes [range], n of N, a
@@ -236,6 +253,9 @@ def scorecard(doc):
     if not doc.get("installed") or doc["parameters"]["quick"]:
         return []
     f, meshes = doc["findings"], "/".join(doc["parameters"]["meshes"])
+    n_meshes, tets = len(doc["parameters"]["meshes"]), doc.get("mesh_tets") or {}
+    # the study's own meshes and signs, said in its shared cells: not the cases' quantities
+    marked = f" (engines study, {n_meshes} quick mesh{'es' if n_meshes != 1 else ''}"
     out = []
     for case, name in CASE_NAMES.items():
         for regime in REGIMES:
@@ -256,10 +276,13 @@ def scorecard(doc):
                 p1 = p1 or _spread(c["discretisation"])
                 u = u if u is not None else c.get("u_num")
             if cells:
+                size = "/".join(str(n) for n in tets.get(case, {}).values())
                 out.append((f"{case}/{BCS[case]}{'' if regime == 'linear regime' else ' at the load'}"
-                            f" (engines study, the case's quick meshes {meshes} and references)",
-                            "model-form vs FEM P1 at the engine's defaults", cells,
-                            (p1, "n/a" if u is None else fmt(u, 2))))
+                            f" (engines study, the case's quick meshes {meshes}"
+                            + (f", {size} tetrahedra," if size else "") + " and references)",
+                            "model-form vs FEM P1 at the engine's defaults, signed", cells,
+                            (p1 + marked + ", signed)",
+                             "n/a" if u is None else fmt(u, 2) + marked + ")")))
     return out
 
 
@@ -280,13 +303,15 @@ def shear_moduli(material):
 
 def write(out, study, s, data):
     found = findings(data, s.ladder) if data["installed"] else {}
+    # the meshes' sizes from the cases' builders under the recorded problem (nothing is run)
+    tets = mesh_sizes(s) if data["installed"] else {}
     doc = jsonable({"case": study.name, "study": True, "parameters": s.describe(),
                     "problem": s.problem(), "gated": GATED, "environment": environment(),
-                    **data, "findings": found,
+                    **data, "findings": found, "mesh_tets": tets,
                     "answer": answer(found, s.ladder, s.quick, data["installed"],
                                      shear_moduli(s.material) if data["installed"] else None,
                                      data.get("costs"), cost_where(data),
-                                     data.get("baseline_cost")),
+                                     data.get("baseline_cost"), tets),
                     "gate_runs": gate_rows(data)})
     return write_study(out, doc, lambda folder: build(folder, study, s, doc))
 
@@ -535,7 +560,9 @@ def build(out, study, s, doc):
         "value at the ladder's top from that count on, on every mesh; a solver matches FEM P1 "
         f"where |Q - Q_P1| / |Q_c| is at most {MATCH:g} on every mesh. The meshes are the "
         "cases' quick meshes, split 'five' and 'six' (two splits of one lattice size, the "
-        "quick run 'five' only), and their references the cases' quick references (each "
+        "quick run 'five' only" + (f"; here {sizes}" if (sizes := sizes_text(
+            doc.get("mesh_tets") or {}, CASE_NAMES)) else "")
+        + "), and their references the cases' quick references (each "
         "reference's own estimate in the table of every run). The bar is the block settling "
         "under its own weight on a sliding base (self-weight), the cube the paper's on a "
         "clamped base, the cantilever clamped. Only the iteration count was varied; the "

@@ -64,6 +64,15 @@ class EngineSettings(MaterialSettings):
         return {**self.problem(), "quick": self.quick, "models": list(self.models())}
 
 
+def mesh_sizes(s):
+    """{case: {mesh: tetrahedra}} of the meshes the study runs each case on (``s.meshes``, the
+    cases' quick meshes): each case's own mesh builder under the study's settings of it, so
+    known from the recorded problem without running anything."""
+    from ...registry import CASES
+    return {name: {m: CASES[name].mesh(m, cfg).n_tets for m in s.meshes}
+            for name, cfg in s.case_settings().items()}
+
+
 def solver_of(model):
     """(solver, iterations or None) of an engine model's name."""
     for solver in SOLVERS:
