@@ -680,7 +680,7 @@ def test_a_reading_stable_on_one_mesh_and_growing_on_another_is_not_stable():
     assert by["a"]["growth_apart"] == {"five-unmirrored": 73.5}
     assert by["a"]["stable_why"] == ("depends on the damping: flutters, damped out by the "
                                      "damping we assume (50 1/s) on five (0.27 1/s), six "
-                                     "(8 1/s), bcc (6 1/s); damped out on every mesh by "
+                                     "(8 1/s), bcc (6 1/s); damped out on each of these meshes by "
                                      "mass damping above 16 1/s (twice its largest rate)")
     mixed = analysis.mesh_stability([("five", 0.0), ("six", 8.0)], 50.0)
     assert mixed[0] is None and mixed[1].startswith("depends on the mesh: stable (rate 0)")
@@ -778,8 +778,8 @@ def test_the_reading_is_decided_only_where_no_other_could_match_as_many():
     assert not v["decided"] and v["model"] is None and v["margin"] == 0
     plain = ("a, b miss the paper's cost (Figure 2's measure: the time of one step over "
              "msm's, which is how the paper's text reads its figure, at the paper's size, with "
-             "this implementation's kernels; per simulated second, at each model's own stable "
-             "step, the index's cost line gives other ratios, not the paper's claim)")
+             "this implementation's kernels; per simulated second, each at its own stable "
+             "step, what a user pays but not the paper's claim, x msm: not measured)")
     assert v["sure"] == "not decided" and v["text"].startswith(
         f"Plainly: {plain}. Not decided: ")
     assert v["plain"] == plain
@@ -1518,3 +1518,25 @@ def test_a_node_level_parts_u_adds_the_leak_of_its_own_splits_profile():
     barrel = {"bc": "sliding", "bulge_profile_mm": list(r + bulge)}
     assert analysis.cell_node_u(barrel, fem, (0.0, 0.0)) == pytest.approx(base)
     assert analysis.cell_node_u(barrel, fem, (0.01, 0.0)) > base
+
+
+def test_the_cost_per_simulated_second_is_the_step_ratio_times_the_stable_steps_ratio():
+    """A reading's cost of a simulated second over msm's is its in-round step ratio times
+    msm's stable step over its own, with the rounds' range scaled alike, at every size the
+    bench measured both stable steps; a literal reading takes its calibrated one's; the words
+    give the paper's size and the largest, one entry per kernel."""
+    from cases.studies.artefact.study import per_simulated_second
+    rows = [{"model": "msm", "tets": 320, "stable_dt_us": 900.0},
+            {"model": "msm", "tets": 98415, "stable_dt_us": 300.0},
+            {"model": "msm", "tets": 10985, "stable_dt_us": None},
+            {"model": "pbcm-corner", "tets": 320, "stable_dt_us": 300.0, "step_vs_msm": 2.0,
+             "step_vs_msm_range": [1.5, 2.5]},
+            {"model": "pbcm-corner", "tets": 98415, "stable_dt_us": 100.0, "step_vs_msm": 4.0,
+             "step_vs_msm_range": [3.0, 5.0]},
+            {"model": "pbcm-corner", "tets": 10985, "stable_dt_us": 50.0, "step_vs_msm": 9.0}]
+    got = per_simulated_second({"rows": rows}, ["pbcm-corner", "pbcm-corner-literal", "x"])
+    assert got["pbcm-corner"] == {320: [6.0, 4.5, 7.5], 98415: [12.0, 9.0, 15.0]}
+    assert got["pbcm-corner-literal"] == got["pbcm-corner"] and got["x"] is None
+    said = analysis.per_second_words(got, ["pbcm-corner", "pbcm-corner-literal"])
+    assert said == "pbcm-corner 6 [4.5-7.5] at 320 and 12 [9-15] at 98415 tetrahedra"
+    assert analysis.per_second_words({}, ["pbcm-corner"]) == ""

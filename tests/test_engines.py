@@ -243,7 +243,7 @@ def test_the_scorecard_marks_the_engines_shared_cells_as_the_studys_own():
                      "320/384 tetrahedra, and references)")
     assert metric == "model-form vs FEM P1 at the engine's defaults, signed"
     assert p1 == "0.2 [0.2 to 0.2], 2 of 2 (engines study, 2 quick meshes, signed)"
-    assert u == "0.003 (engines study, 2 quick meshes)"
+    assert u == "0.003 (of FEM P1's distance; engines study, 2 quick meshes)"
 
 
 def test_the_engines_meshes_are_the_cases_quick_meshes_of_known_size():

@@ -145,6 +145,19 @@ def ratio_text(row, base):
     return fmt(r, 2) + (f" [{fmt(rng[0], 2)}-{fmt(rng[1], 2)}]" if rng else "")
 
 
+def ratio_parts(row, base):
+    """'its step s [lo-hi] x, its stable step d x': the two factors of ``sim_ratio`` (a model
+    cheap per simulated second by a larger stable step, not a cheaper step, says so); '' where
+    the bench has no in-round step ratio."""
+    key = f"step_vs_{base['model']}"
+    if key not in row:
+        return ""
+    rng = row.get(f"{key}_range")
+    return (f"its step {fmt(row[key], 2)}"
+            + (f" [{fmt(rng[0], 2)}-{fmt(rng[1], 2)}]" if rng else "")
+            + f" x, its stable step {fmt(row['stable_dt_us'] / base['stable_dt_us'], 2)} x")
+
+
 # a quick run's cell for a verdict the full run decides
 QUICK_CELL = "quick: not decided"
 
@@ -193,7 +206,8 @@ def table(root, models, pops=(), quick=False):
                      + (f", {flutter} {'grows' if flutter == 1 else 'grow'} beyond the "
                         "damping" if flutter else "")
                      if clamped else "n/a",
-                     (f"{fmt(b['cpu_s_per_simulated_s'])} ({ratio_text(b, fl)} x fem-linear)"
+                     (f"{fmt(b['cpu_s_per_simulated_s'])} ({ratio_text(b, fl)} x fem-linear: "
+                      f"{ratio_parts(b, fl)})"
                       if b and fl and b is not fl else
                       fmt(b["cpu_s_per_simulated_s"]) if b else "n/a"),
                      _bead(measured, m, truth_u)])
@@ -527,8 +541,8 @@ def _cost_of_replacing(pops, models, quick):
             "(each case weighing one, its boundary conditions averaged), beside it the geometric mean over the cases of the median over the "
             "meshes [its range when one mesh family is left out]; a failed run (no number; at "
             "the load, no converged solve) counts against its model once, as infinitely wrong "
-            "in its population's rank (also where a population's numbers are left out: a "
-            "failure-only ranking; the table below names where): "
+            "in its population's median (where the numbers are left out, it ranks only if "
+            "infinite: a failure-only ranking; the table below names where): "
             + "; ".join(said) + _left_out(pops) + " (the scorecard below).")
 
 

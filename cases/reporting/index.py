@@ -401,7 +401,9 @@ TERMS = {
     "RK4 step (undamped), from `pbcm bench` at about 1e4 tetrahedra; beside it the ratio to "
     "fem-linear's: the median over the bench's rounds of the step-time ratio taken within "
     "each round, times the ratio of the stable steps, with its range over the rounds (not the "
-    "ratio of the two median times, which the rounds' drift moves).",
+    "ratio of the two median times, which the rounds' drift moves), then those two factors "
+    "apart (a model cheap per simulated second by a larger stable step has not a cheaper "
+    "step); the seconds themselves are the bench's median, their spread not recorded.",
     "calibrated / literal": "a shear reading with c fitted so that its deviatoric moduli are "
     "closest to 2G (calibrated), or with the paper's c = 1 (literal).",
     "patch test": "a problem with a homogeneous exact answer that a consistent "

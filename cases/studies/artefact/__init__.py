@@ -60,7 +60,7 @@ class Artefact(Study):
             data.update(bench_costs(bench, list(s.models)))
         else:
             data.update({k: metrics.get(k) for k in ("step_vs_msm_range", "step_vs_msm_sizes",
-                                                       "bench_spread")})
+                                                       "sim_vs_msm_sizes", "bench_spread")})
         for c in data["cells"]:     # the glossary's flutter: a growth rate above 0
             if c.get("growth_rate_1_s") is not None:
                 c["flutter"] = c["growth_rate_1_s"] > 0.0

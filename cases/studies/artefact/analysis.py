@@ -36,8 +36,8 @@ from model.static import SHORTEST_STEP
 from ...reporting.document import fmt
 from ...library import paper_cube as P
 from ...measuring.metrics import ALTERNATION_CLEAR, nyquist_weights
-from .study import (DECISIVE, FIXED_NORMAL_C, HELD, LINEAR_SCALE, LITERAL_NORMAL, SPLITS,
-                    SPLITS_TRIED, YARDSTICK as YARDSTICK_MODEL, _free_layers, held, short)
+from .study import (DECISIVE, FIVE_TETS, FIXED_NORMAL_C, HELD, LINEAR_SCALE, LITERAL_NORMAL,
+                    SPLITS, SPLITS_TRIED, YARDSTICK as YARDSTICK_MODEL, _free_layers, held, short)
 
 PAPER_COST = 10.0      # the paper (its Figure 2): the time of one step over msm's, more than 10
 RUN_S = P.PUSH_MM / P.SPEED_MM_S   # the paper's run: the push, 1.7 mm at 1.7 mm/s
@@ -2523,7 +2523,7 @@ def mesh_stability(rates, damping):
         f"{m} ({fmt(r, 3)} 1/s)" for m, r, kk in kinds if kk == k) for k in order)
     top = max(r for _, r, _ in kinds)
     if top > GROWS:       # the damping each model needs: the paper states none
-        by += (f"; damped out on every mesh by mass damping above {fmt(2 * top, 3)} 1/s "
+        by += (f"; damped out on each of these meshes by mass damping above {fmt(2 * top, 3)} 1/s "
                "(twice its largest rate)")
     if len(order) > 1:
         return None, "depends on the mesh: " + by
@@ -2647,7 +2647,25 @@ def _span(r):
     return f"{fmt(r['step_vs_msm'], 3)} [{fmt(lo, 3)}-{fmt(hi, 3)}]"
 
 
-def reading_verdict(table, damping, spread=None, figure=None):
+def per_second_words(per_second, names):
+    """'pbcm-corner 6.6 [5.1-7.5] at 320 and 11 [10-12] at 98415 tetrahedra, ...': each
+    kernel's cost of a simulated second over msm's (``per_simulated_second``) at the paper's
+    size and the largest the bench measured it, a literal reading left to its calibrated one
+    (the same kernel); '' where none is known."""
+    said = []
+    for m in names:
+        got = (per_second or {}).get(m)
+        if m.endswith("-literal") or not got:
+            continue
+        sizes = sorted({min(got, key=lambda t: abs(int(t) - FIVE_TETS)), max(got, key=int)},
+                       key=int)
+        said.append(f"{m} " + " and ".join(
+            f"{fmt(got[t][0], 2)} [{fmt(got[t][1], 2)}-{fmt(got[t][2], 2)}] at {t}"
+            for t in sizes))
+    return "; ".join(said) + (" tetrahedra" if said else "")
+
+
+def reading_verdict(table, damping, spread=None, figure=None, per_second=None):
     """Which reading of the paper's equations its decidable observables point to: a reading
     is decided only where its matches (True) exceed every other reading's possible matches
     (True or not decided); else 'not decided', with why. Whether no reading reproduces all
@@ -2656,7 +2674,8 @@ def reading_verdict(table, damping, spread=None, figure=None):
     readings with a normal-stress term are said apart: their cost is not decided (this
     implementation's term). ``spread`` the bench's sizes and rounds the cost ranges cover;
     ``figure`` (``paper_figure``) the paper's Figure 1 on its 5 layers, said beside the
-    verdict, never scored."""
+    verdict, never scored; ``per_second`` the cost of a simulated second over msm's
+    (``per_second_words``), said beside the paper's measure, never scored."""
     readings = [r for r in table if r["in_paper"]]
     extra = [r for r in table if not r["in_paper"]]
     total = len(OBSERVABLES)
@@ -2679,8 +2698,8 @@ def reading_verdict(table, damping, spread=None, figure=None):
     why = (f"{best['name']} matches {best['score']} of {total} and no other reading can match "
            "as many" if decided else
            f"no reading matches more of the {total} decidable observables than every other "
-           "could (matched, of at most: " + ", ".join(
-               f"{r['name']} {r['score']} of {r['possible']}" for r in readings) + ")")
+           "could (matched / at most, were the undecided to go its way: " + ", ".join(
+               f"{r['name']} {r['score']}/{r['possible']}" for r in readings) + ")")
     meshes = list(dict.fromkeys(m for r in rated for m in r["growth_by_mesh"]))
     apart = list(dict.fromkeys(m for r in rated for m in r["growth_apart"]))
     stability = (
@@ -2753,8 +2772,10 @@ def reading_verdict(table, damping, spread=None, figure=None):
         f"step over msm's, which is how the paper's text reads its figure, at the paper's "
         f"size, with this implementation's kernels"
         + ("; a literal reading is timed as its calibrated one, the same kernel"
-           if literal else "") + "; per simulated second, at each model's own stable step, "
-        "the index's cost line gives other ratios, not the paper's claim)" if cost_miss else "",
+           if literal else "") + "; per simulated second, each at its own stable step, what "
+        "a user pays but not the paper's claim, x msm: "
+        + (per_second_words(per_second, cost_miss) or "not measured") + ")"
+        if cost_miss else "",
         f"the cost is not decided for {_names(cost_open)}" if cost_open else "") if x)
     text = ((f"Plainly: {plain}. " if plain else "")
             + (f"Not decided: {why}. " if not decided else f"{why}. ")

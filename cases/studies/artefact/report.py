@@ -51,7 +51,8 @@ def analyse(data, models, damping):
                           data.get("step_vs_msm_sizes"))
     found = {"answer": answer(data["cells"], models, _estimates(data)), "readings": table,
              "verdict": reading_verdict(table, damping, data.get("bench_spread"),
-                                        paper_figure(data["cells"], readings(models)))}
+                                        paper_figure(data["cells"], readings(models)),
+                                        data.get("sim_vs_msm_sizes"))}
     found["how_sure"] = how_sure(found["answer"], found["verdict"])
     found["thresholds"] = threshold_moves(data["cells"], models, _estimates(data))
     return found

@@ -347,6 +347,12 @@ def _parts(data, v, m):
     return None if bound is None or form is None else (form, bound - form)
 
 
+def _p1_larger(data, v):
+    """Whether FEM P1's distance is the larger part of every tied first's bound."""
+    parts = [_parts(data, v, m) for m in v["best"]]
+    return bool(parts) and all(q is not None and q[0] < q[1] for q in parts)
+
+
 def _split_words(data, v, m):
     """The bound of model m split into its two parts (rule 9): ' = model-form a + FEM P1's
     b', or nothing where either was not computed."""
@@ -389,8 +395,7 @@ def answer_line(data, v, quick, words=None):
     else:
         head = ("the smallest error bound (model-form error plus FEM P1's discretisation "
                 f"error at the model's reach) is {said[0]}")
-    parts = [_parts(data, v, m) for m in v["best"]]
-    if parts and all(q is not None and q[0] < q[1] for q in parts):
+    if _p1_larger(data, v):
         head += (" (in each, FEM P1's share is the larger: the mesh the budget allows "
                  "weighs more than the law)")
     # the runners-up: tied with some of the first, resolved behind first ones only
@@ -459,7 +464,7 @@ def index_line(data, v, quick, words=None):
     def at(m):
         r = v["reach"][m]
         return (f"{_mode(m, r)}, {r['tets']} tetrahedra, "
-                f"error bound {_judged(v['bounds'][m], v)}")
+                f"error bound {_judged(v['bounds'][m], v)}{_split_words(data, v, m)}")
     what = (f"({machine(data)}, wall clock, {w['loading']}; the error bound is the model-form "
             "error plus FEM P1's distance from the continuum at the model's reach"
             + (", which is round-off here: FEM P1 is exact for this problem's field"
@@ -481,9 +486,11 @@ def index_line(data, v, quick, words=None):
     r = v["reach"][p]
     return (f"At real time on this machine {what}, the most accurate models are tied "
             f"({len(v['best'])}, within u_val {err(v['u_two_meshes'])} of two bounds on two "
-            "meshes: the reference's estimate on each; u_input not estimated; static "
+            "meshes: the reference's estimate on each; u_input 0, a stated problem; static "
             "equilibria, a timed run's lag not measured): "
             + "; ".join(f"{m} ({at(m)})" for m in v["best"])
+            + (" (FEM P1's share the larger in each: the mesh the budget allows decides more "
+               "than the law)" if _p1_larger(data, v) else "")
             + ". Accuracy does not decide among them"
             + (f"; {test}" if test else "")
             + f"{decides}: pick {p}, {_wall(r['cost'])} [{_wall(r['range'][0])}-"
@@ -664,7 +671,7 @@ def build(out, study, s, doc):
             f"u_val = {err(v['u_two_meshes'])}: u_num the reference's estimate "
             f"{err(v['estimate'])} on each mesh's FEM P1 distance, added (the two meshes' "
             "errors come from one reference, so they are not independent: the triangle "
-            "inequality's bound); u_input not estimated (every model has the same E, nu and "
+            "inequality's bound); u_input 0, a stated problem (every model has the same E, nu and "
             f"{w['load'].removeprefix('the ')} on the same family of meshes, so the ranking "
             "holds at those inputs; how "
             f"they move each model is {w['inputs']}); u_D the static "
