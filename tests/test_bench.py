@@ -37,6 +37,9 @@ def test_bench_writes_table_figure_and_in_round_ratios(tmp_path):
         # the rounds' range of a ratio brackets its median
         lo, hi = r["step_vs_fem-linear_range"]
         assert lo <= r["step_vs_fem-linear"] <= hi
+        # the kernels it was timed on: this checkout's, so nothing is said stale
+        assert r["kernels"] == costs.checkout_sources(model)
+    assert costs.stale(data) == ([], False) and costs.stale_words(data) == ""
     assert rows[("pbcm-variational", 625)]["calibration_s"] > 0
     # the roofline: the peaks of this run, each row's counted operations (fem-linear's 189,
     # tests/test_roofline.py), compulsory bytes and its fraction of the attainable rate
@@ -395,3 +398,24 @@ def test_the_bench_report_opens_with_the_targets_and_tabulates_the_largest_size(
     assert md[1].startswith("Against the kernel targets on this machine")
     said = next(p for p in md if p.startswith(f"At {top} tetrahedra"))
     assert f"msm's own step costs {fmt(row['step_over_4_forces'])} times its four" in said
+
+
+def test_a_row_timed_on_other_kernels_is_said_stale():
+    """A bench row whose recorded kernel sources differ from the checkout's is named, a row
+    recording none makes the bench's provenance unknown, and the sentence says which; the
+    fingerprint is the same for two builds of one model and differs between models with other
+    term files."""
+    same = costs.checkout_sources("msm")
+    assert same is not None and same == costs.checkout_sources("msm")
+    assert same != costs.checkout_sources("fem-linear")
+    now = {"rows": [{"model": "msm", "kernels": same},
+                    {"model": "fem-linear", "kernels": costs.checkout_sources("fem-linear")}]}
+    assert costs.stale(now) == ([], False) and costs.stale_words(now) == ""
+    old = {"rows": [{"model": "msm", "kernels": "0" * 16}, *now["rows"][1:]],
+           "realtime_rows": [{"model": "fem-linear", "timed": False},
+                             {"model": "newton-vbd", "engine": "newton"}]}
+    assert costs.stale(old) == (["msm"], False)
+    assert costs.stale_words(old).startswith("Timed on other kernels than this checkout's: msm;")
+    unknown = {"rows": now["rows"], "realtime_rows": [{"model": "msm", "timed": True}]}
+    assert costs.stale(unknown) == ([], True)
+    assert "records no kernel sources" in costs.stale_words(unknown)

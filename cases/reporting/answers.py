@@ -10,7 +10,8 @@ from pathlib import Path
 
 import numpy as np
 
-from .costs import FILE as BENCH_FILE, FOLDER as BENCH_FOLDER, near
+from .costs import BASE, FILE as BENCH_FILE, FOLDER as BENCH_FOLDER, near
+from .costs import stale as costs_stale
 from .document import fmt, rel, rel_range
 from ..measuring.error_model import JUDGES, P1_LINEAR, ROUND_OFF, input_spread
 from ..measuring.metrics import PATCH_TOL
@@ -176,6 +177,7 @@ def table(root, models, pops=(), quick=False):
         else None
     linear, finite = scorecard.overall(pops, models), scorecard.overall(pops, models, True)
     spread = {f: scorecard.spread(pops, models, f) for f in (False, True)}
+    stale = set(costs_stale(bench)[0])
     header = ["model", "model-form error, linear regime", "model-form error, finite load",
               "consistency limit (largest, +- fit)", "worst isotropy error",
               "alternation on the mirrored five split, 5-layer view, linear regime (signed, the "
@@ -193,7 +195,7 @@ def table(root, models, pops=(), quick=False):
         flutter = sum(r.get("dyn_verdict") == "unstable (flutter)" for r in mine
                       if r["bc"] == "clamped")
         clamped = sum(r["bc"] == "clamped" for r in mine)
-        b, fl = _bench_row(bench, m), _bench_row(bench, "fem-linear")
+        b, fl = _bench_row(bench, m), _bench_row(bench, BASE)
         conv_quick = bool(conv and conv["parameters"]["quick"])
         rows.append([m, QUICK_CELL if quick else
                      _overall_cell(linear, m, pops, False, spread[False]),
@@ -208,6 +210,7 @@ def table(root, models, pops=(), quick=False):
                      if clamped else "n/a",
                      (f"{fmt(b['cpu_s_per_simulated_s'])} ({ratio_text(b, fl)} x fem-linear: "
                       f"{ratio_parts(b, fl)})"
+                      + (" (timed on earlier kernels)" if m in stale or BASE in stale else "")
                       if b and fl and b is not fl else
                       fmt(b["cpu_s_per_simulated_s"]) if b else "n/a"),
                      _bead(measured, m, truth_u)])

@@ -7,11 +7,16 @@ the bench sizes) times the model's step ratio to fem-linear at T, itself interpo
 ratios are medians of interleaved rounds (one process), steadier than either time alone.
 Outside the bench sizes the nearest size's values are used.
 """
+import hashlib
+import inspect
 import json
+from functools import lru_cache
 from pathlib import Path
 
 import numpy as np
 
+import model as _model
+from model.mesh import cube
 from model.presets import IMPLICIT_STEP
 
 from .document import Table, fmt
@@ -38,6 +43,54 @@ def load(root=None):
     checkout's, else None."""
     here = Path(root) / FOLDER / FILE if root is not None else None
     return read(here) if here is not None and here.is_file() else read(CHECKOUT)
+
+
+def kernel_sources(pm):
+    """A fingerprint of the source a built model's force evaluation and RK4 step run: its
+    terms' own files, the kernel files they share (``model/terms/_*.py``, the base class) and
+    the integrator. The bench records it with each row, so that a row timed on other kernels
+    than the checkout's is said to be so (``stale``)."""
+    root = Path(_model.__file__).resolve().parent
+    files = {root / "integrate.py", root / "terms" / "base.py", *root.glob("terms/_*.py")}
+    files |= {Path(inspect.getsourcefile(type(t))).resolve() for t in pm.terms}
+    h = hashlib.sha256()
+    for f in sorted(files):
+        h.update(str(f.relative_to(root)).encode() + b"\0" + f.read_bytes() + b"\0")
+    return h.hexdigest()[:16]
+
+
+@lru_cache(maxsize=None)
+def checkout_sources(name):
+    """``kernel_sources`` of the model ``name`` as this checkout builds it (on a two-cell
+    cube: only its terms' classes matter), or None where it does not build."""
+    try:
+        mesh = cube(2, 0.01, "five")
+        return kernel_sources(_model.build(name, mesh, _model.Material(E=1e4, nu=0.3)))
+    except Exception:       # a model of a file not loaded here: its sources are not known
+        return None
+
+
+def stale(bench):
+    """(models whose rows were timed on other kernels than this checkout's, sorted; whether
+    any row records no kernel sources): what a cost sentence must say before it is read."""
+    rows = [r for key in ("rows", "realtime_rows") for r in (bench or {}).get(key, [])
+            if r.get("timed", True) and "engine" not in r]      # pbcm's own kernels, timed
+    other = sorted({r["model"] for r in rows if r.get("kernels") is not None
+                    and checkout_sources(r["model"]) not in (None, r["kernels"])})
+    return other, any(r.get("kernels") is None for r in rows)
+
+
+def stale_words(bench):
+    """The sentence a report built on ``bench`` says about its kernels: '' where every row
+    was timed on the checkout's."""
+    other, unknown = stale(bench)
+    if other:
+        return (f"Timed on other kernels than this checkout's: {', '.join(other)}; their costs "
+                "are the earlier kernels' until `pbcm bench` is run again.")
+    if unknown:
+        return ("This bench records no kernel sources for some rows: whether they were timed "
+                "on this checkout's kernels is not known until `pbcm bench` is run again.")
+    return ""
 
 
 def near(bench, model, key, tets=COST_TETS):

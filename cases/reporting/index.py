@@ -8,7 +8,7 @@ from pathlib import Path
 
 import numpy as np
 
-from . import scorecard
+from . import costs, scorecard
 from .document import GLOSSARY, Cell, Document, Link, rel, rel_range
 from ..measuring.error_model import JUDGES
 from ..running.output import SWEEP_MARK
@@ -238,7 +238,9 @@ def index_documents(root, cases, studies=(), missing=()):
         doc.p(line)
     header, rows = answers.table(root, models, pops, quick)
     doc.table(header, rows)
-    doc.p(f"Definitions of every column and metric: [glossary]({GLOSSARY}).")
+    kernels = costs.stale_words(costs.load(root))
+    doc.p((f"The costs: {kernels[0].lower()}{kernels[1:]} " if kernels else "")
+          + f"Definitions of every column and metric: [glossary]({GLOSSARY}).")
     shown = [n for n in studies if (root / n / "metrics.json").is_file()]
     if shown:
         doc.h(2, "Studies")

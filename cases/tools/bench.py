@@ -24,7 +24,7 @@ from ..library.common import bench_mesh
 from ..reporting import figures
 from ..running import stop
 from .engines import ENGINES
-from ..reporting.costs import FILE, REAL_TIME, best
+from ..reporting.costs import FILE, REAL_TIME, best, kernel_sources, stale_words
 from . import flops, realtime_bench, roofline
 from .timers import DAMPING, SAMPLE_S, ImplicitTimed, Timed, own_stable_step
 from ..reporting.document import Document, fmt
@@ -189,6 +189,7 @@ def run(sizes=SIZES, models=None, rounds=7, progress=print, with_engines=True, d
                                                 if timed[name].kernels_2 is not None
                                                 else None),
                    "memory_mb": timed[name].memory / 1e6, "rounds": rounds,
+                   "kernels": kernel_sources(timed[name].pm),
                    "flops_per_tet": flop_counts.get(name),
                    "bytes_per_tet": roofline.bytes_per_tet(timed[name].pm)}
             row.update(zip(("gflop_s", "attainable_gflop_s", "roofline_fraction"),
@@ -295,7 +296,8 @@ def write(data, out):
           "the medians of per-round ratios (models timed round-robin), so machine drift "
           "cancels; [smallest-largest] over the rounds beside them. The two-thread speed-up (`build(..., threads=2)`, forces equal bit for bit "
           "to serial) is the median ratio of wall-clock times of the serial and the threaded "
-          "force evaluation run back to back; '-' where a model has no threaded term.")
+          "force evaluation run back to back; '-' where a model has no threaded term."
+          + (f" {said}" if (said := stale_words(data)) else ""))
     _largest_size(doc, data)
     doc.table(["model", "tets", "ns/tet (force)", "us/step", "step / 4 forces",
                "step vs msm", "step vs fem-linear", "calibration [s]", "memory [MB]",

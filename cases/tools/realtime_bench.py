@@ -26,7 +26,7 @@ from ..framework import DEFAULT_MATERIAL
 from ..library.common import bench_mesh, paper_push
 from model import build
 from model.compose import simulator
-from ..reporting.costs import REAL_TIME, best, family_models, sizes
+from ..reporting.costs import REAL_TIME, best, family_models, kernel_sources, sizes
 from ..running import stop
 from .timers import DAMPING, ImplicitTimed, Timed, own_stable_step
 
@@ -149,6 +149,8 @@ def _row(name, mesh, timer, got, rounds):
                    two_thread_range=[float(got[:, 1].min()), float(got[:, 1].max())])
     if getattr(timer, "sim", None) is not None:       # an engine: which one, which version
         row["engine"] = timer.sim.info.get("engine")
+    elif getattr(timer, "pm", None) is not None:      # pbcm's own kernels: which source
+        row["kernels"] = kernel_sources(timer.pm)
     if got.shape[1] > 2:
         row.update(newton_per_step=float(np.median(got[:, 2])),
                    cg_per_newton=float(np.median(got[:, 3])))
