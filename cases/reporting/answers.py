@@ -550,15 +550,15 @@ def _cost_of_replacing(pops, models, quick):
 
 
 def _rank_against_mean(ranked, k):
-    """' (mean rank 4.4, after 3.4)' where the k-th of ``ranked`` has a smaller geometric mean
-    than the one before it (the mean rank orders them, the failures in it): said, so that the
-    order is not read as a misprint; '' elsewhere."""
+    """' (mean rank 4.4, after b's 3.4)' where the k-th of ``ranked`` has a smaller geometric
+    mean than the one before it, b (the mean rank orders them, the failures in it): said, so
+    that the order is not read as a misprint; '' elsewhere."""
     if k == 0:
         return ""
-    (_, _, prev, _), (_, _, e, tie) = ranked[k - 1], ranked[k]
+    (_, before, prev, _), (_, _, e, tie) = ranked[k - 1], ranked[k]
     if tie or e[1] is None or prev[1] is None or e[1] >= prev[1]:
         return ""
-    return f" (mean rank {e[0]:.3g}, after {prev[0]:.3g})"
+    return f" (mean rank {e[0]:.3g}, after {before}'s {prev[0]:.3g})"
 
 
 def _resolved_groups(order, loose):

@@ -282,7 +282,7 @@ def scorecard(doc):
                             + (f", {size} tetrahedra," if size else "") + " and references)",
                             "model-form vs FEM P1 at the engine's defaults, signed", cells,
                             (p1 + marked + ", signed)",
-                             "n/a" if u is None else fmt(u, 2) + " (of FEM P1's distance;"
+                             "n/a" if u is None else fmt(u, 2) + " (of FEM P1's distance; "
                              + marked.removeprefix(" (") + ")")))
     return out
 
