@@ -402,7 +402,8 @@ def test_the_bench_report_opens_with_the_targets_and_tabulates_the_largest_size(
 
 def test_a_row_timed_on_other_kernels_is_said_stale():
     """A bench row whose recorded kernel sources differ from the checkout's is named, a row
-    recording none makes the bench's provenance unknown, and the sentence says which; the
+    recording none makes the bench's provenance unknown, and the sentence says which (for
+    some rows or for all); the
     fingerprint is the same for two builds of one model and differs between models with other
     term files."""
     same = costs.checkout_sources("msm")
@@ -417,5 +418,8 @@ def test_a_row_timed_on_other_kernels_is_said_stale():
     assert costs.stale(old) == (["msm"], False)
     assert costs.stale_words(old).startswith("Timed on other kernels than this checkout's: msm;")
     unknown = {"rows": now["rows"], "realtime_rows": [{"model": "msm", "timed": True}]}
-    assert costs.stale(unknown) == ([], True)
-    assert "records no kernel sources" in costs.stale_words(unknown)
+    assert costs.stale(unknown) == ([], "some")
+    assert "records no kernel sources for some of its rows" in costs.stale_words(unknown)
+    none = {"rows": [{"model": "msm"}]}
+    assert costs.stale(none) == ([], "all")
+    assert "records no kernel sources for any of its rows" in costs.stale_words(none)

@@ -529,9 +529,9 @@ def test_what_to_pick_is_computed_and_names_what_is_not_decided(tmp_path, monkey
     locked, _ = populations(tmp_path, ["torsion", "large-compression"])
     assert [p.ranked for p in locked if p.case == "large-compression"] == [False]
     said = _cost_of_replacing(locked, ["a", "b"], False)
-    assert "finite load" not in said.split("(the scorecard")[0].split("; left out")[0]
-    assert ("left out of the ranking, locking-prone (FEM P1, the twin, locks there: its "
-            "model-form error ranks closeness to a locked mesh): large-compression/clamped "
+    assert "finite load" not in said.split("(the scorecard")[0].split("; numbers left out")[0]
+    assert ("numbers left out, locking-prone (FEM P1, the twin, locks there: "
+            "its model-form error ranks closeness to a locked mesh): large-compression/clamped "
             "(FEM P1 up to 0.2 from the continuum there)") in said
     # and in b's cell of the summary table, beside its standing
     from cases.reporting.answers import _overall_cell

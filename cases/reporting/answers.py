@@ -599,10 +599,10 @@ def _left_out(pops):
             out.append(p.label + (f" (FEM P1 up to {rel(max(d))} from the continuum there)"
                                   if d else ""))
     near = [p.label for p in pops if p.nearly_linear and not p.patch_test and not p.locking]
-    return (("; left out of the ranking, locking-prone (FEM P1, the twin, locks there: its "
-             "model-form error ranks closeness to a locked mesh): " + ", ".join(out)
+    return (("; numbers left out, locking-prone (FEM P1, the twin, locks there: "
+             "its model-form error ranks closeness to a locked mesh): " + ", ".join(out)
              if out else "")
-            + (f"; left out at finite load, nearly linear ({P1_LINEAR} within "
+            + (f"; numbers left out at finite load, nearly linear ({P1_LINEAR} within "
                f"{NEARLY_LINEAR:g} of neo-Hookean P1 there: no test of finite strain): "
                + ", ".join(near) if near else ""))
 

@@ -71,13 +71,15 @@ def checkout_sources(name):
 
 
 def stale(bench):
-    """(models whose rows were timed on other kernels than this checkout's, sorted; whether
-    any row records no kernel sources): what a cost sentence must say before it is read."""
+    """(models whose rows were timed on other kernels than this checkout's, sorted; 'all' or
+    'some' where rows record no kernel sources, else False): what a cost sentence must say
+    before it is read."""
     rows = [r for key in ("rows", "realtime_rows") for r in (bench or {}).get(key, [])
             if r.get("timed", True) and "engine" not in r]      # pbcm's own kernels, timed
     other = sorted({r["model"] for r in rows if r.get("kernels") is not None
                     and checkout_sources(r["model"]) not in (None, r["kernels"])})
-    return other, any(r.get("kernels") is None for r in rows)
+    missing = sum(r.get("kernels") is None for r in rows)
+    return other, ("all" if missing == len(rows) else "some") if missing else False
 
 
 def stale_words(bench):
@@ -88,8 +90,9 @@ def stale_words(bench):
         return (f"Timed on other kernels than this checkout's: {', '.join(other)}; their costs "
                 "are the earlier kernels' until `pbcm bench` is run again.")
     if unknown:
-        return ("This bench records no kernel sources for some rows: whether they were timed "
-                "on this checkout's kernels is not known until `pbcm bench` is run again.")
+        return (f"This bench records no kernel sources for {'some' if unknown == 'some' else 'any'} "
+                "of its rows: whether they were timed on this checkout's kernels is not known "
+                "until `pbcm bench` is run again.")
     return ""
 
 

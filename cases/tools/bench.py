@@ -293,8 +293,9 @@ def write(data, out):
     _targets_table(doc, data)     # the answer first: the presets against their targets
     doc.p(f"Measured on {m['cpu']} ({m['cores']} cores), Python {m['python']}, serial kernels. "
           f"Times are medians over {rows[0]['rounds']} rounds of thread CPU time; ratios are "
-          "the medians of per-round ratios (models timed round-robin), so machine drift "
-          "cancels; [smallest-largest] over the rounds beside them. The two-thread speed-up (`build(..., threads=2)`, forces equal bit for bit "
+          "the medians of per-round ratios (models timed round-robin), so drift between "
+          "rounds cancels from each ratio; [smallest-largest] over the rounds beside them, "
+          "what remains. The two-thread speed-up (`build(..., threads=2)`, forces equal bit for bit "
           "to serial) is the median ratio of wall-clock times of the serial and the threaded "
           "force evaluation run back to back; '-' where a model has no threaded term."
           + (f" {said}" if (said := stale_words(data)) else ""))

@@ -2545,8 +2545,10 @@ def cost_call(point, span):
     if not span:
         return None, "one timing, no spread: not decided"
     call = bounded(span[0], span[1], PAPER_COST)
-    return call, {"above": f"above {PAPER_COST:g} over the bench's rounds on the paper's cube",
-                  "below": f"below {PAPER_COST:g} over the bench's rounds on the paper's cube",
+    return call, {"above": f"above {PAPER_COST * (1 + NEAR):g} ({PAPER_COST:g} beyond its "
+                           f"{NEAR:.0%} band) over the bench's rounds on the paper's cube",
+                  "below": f"below {PAPER_COST * (1 - NEAR):g} ({PAPER_COST:g} less its "
+                           f"{NEAR:.0%} band) over the bench's rounds on the paper's cube",
                   "at": f"the range reaches {PAPER_COST:g} (within {NEAR:.0%}): not decided"
                   }[call]
 
