@@ -628,7 +628,8 @@ def test_geometric_mean_range_leaves_one_mesh_family_out(tmp_path):
 def test_cost_ratio_is_the_in_round_step_ratio_times_the_stable_steps_with_its_range():
     """A simulated second's cost over fem-linear's is the in-round step ratio (2, rounds 1.5
     to 3) times fem-linear's stable step over the model's (10 / 5 us): 4 [3-6]."""
-    from cases.reporting.answers import ratio_text, sim_ratio
+    from cases.reporting.answers import ratio_text
+    from cases.reporting.costs import sim_ratio
     fl = {"model": "fem-linear", "stable_dt_us": 10.0, "cpu_s_per_simulated_s": 1.0}
     row = {"model": "a", "stable_dt_us": 5.0, "cpu_s_per_simulated_s": 3.9,
            "step_vs_fem-linear": 2.0, "step_vs_fem-linear_range": [1.5, 3.0]}

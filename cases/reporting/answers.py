@@ -10,7 +10,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .costs import BASE, FILE as BENCH_FILE, FOLDER as BENCH_FOLDER, near
+from .costs import BASE, FILE as BENCH_FILE, FOLDER as BENCH_FOLDER, near, sim_ratio
 from .costs import stale as costs_stale
 from .document import fmt, rel, rel_range
 from ..measuring.error_model import JUDGES, P1_LINEAR, ROUND_OFF, input_spread
@@ -126,18 +126,6 @@ def _bench_row(bench, model):
     """The bench row of ``model`` at the size closest to the costs' comparison size that has
     the cost per simulated second."""
     return near(bench, model, "cpu_s_per_simulated_s")
-
-
-def sim_ratio(row, base):
-    """(ratio, [smallest, largest] or None): the cost of one simulated second of ``row``'s
-    model over ``base``'s (a bench row each): the in-round step-time ratio times the ratio of
-    their stable steps, its range the rounds' (the bench's ``step_vs_fem-linear_range``)."""
-    dt = base["stable_dt_us"] / row["stable_dt_us"]
-    key = f"step_vs_{base['model']}"
-    if key not in row:            # the base itself, or a bench without in-round ratios
-        return row["cpu_s_per_simulated_s"] / base["cpu_s_per_simulated_s"], None
-    rng = row.get(f"{key}_range")
-    return row[key] * dt, ([rng[0] * dt, rng[1] * dt] if rng else None)
 
 
 def ratio_text(row, base):

@@ -96,6 +96,18 @@ def stale_words(bench):
     return ""
 
 
+def sim_ratio(row, base):
+    """(ratio, [smallest, largest] or None): the cost of one simulated second of ``row``'s
+    model over ``base``'s (a bench row each): the in-round step-time ratio times the ratio of
+    their stable steps, its range the rounds' (the bench's ``step_vs_fem-linear_range``)."""
+    dt = base["stable_dt_us"] / row["stable_dt_us"]
+    key = f"step_vs_{base['model']}"
+    if key not in row:            # the base itself, or a bench without in-round ratios
+        return row["cpu_s_per_simulated_s"] / base["cpu_s_per_simulated_s"], None
+    rng = row.get(f"{key}_range")
+    return row[key] * dt, ([rng[0] * dt, rng[1] * dt] if rng else None)
+
+
 def near(bench, model, key, tets=COST_TETS):
     """The bench row of ``model`` at the size it ran closest to ``tets`` (in log) among those
     with ``key``, or None: a size the bench ran, never an interpolation between two."""

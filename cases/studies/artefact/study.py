@@ -18,6 +18,7 @@ from ...framework import (MaterialSettings, FINDINGS, LOAD_SPLITS, STALL,
 from ...library import paper_cube as P
 from ...library.common import layers_mm
 from ...running.progress import Progress
+from ...reporting.costs import sim_ratio
 from ...running.runner import free_components, jsonable
 from ...running.store import OFF, key
 from ...running.workers import dearest_first
@@ -489,18 +490,17 @@ def per_simulated_second(bench, models):
     stable steps; a literal reading's is its calibrated reading's. Not the paper's measure
     (Figure 2 compares the time of one step)."""
     rows = (bench or {}).get("rows", [])
-    dt = {(r["model"], int(r["tets"])): r.get("stable_dt_us") for r in rows}
+    msm = {int(r["tets"]): r for r in rows if r["model"] == "msm" and r.get("stable_dt_us")}
     out = {}
     for m in models:
         got = {}
         for r in rows:
             t = int(r["tets"])
             if r["model"] != m.replace("-literal", "") or r.get("step_vs_msm") is None \
-                    or not dt.get((m.replace("-literal", ""), t)) or not dt.get(("msm", t)):
+                    or not r.get("stable_dt_us") or t not in msm:
                 continue
-            k = dt[("msm", t)] / dt[(r["model"], t)]
-            span = r.get("step_vs_msm_range") or [r["step_vs_msm"]] * 2
-            got[t] = [float(r["step_vs_msm"] * k), float(span[0] * k), float(span[1] * k)]
+            ratio, span = sim_ratio(r, msm[t])
+            got[t] = [float(ratio), *map(float, span or [ratio, ratio])]
         out[m] = dict(sorted(got.items())) or None
     return out
 
