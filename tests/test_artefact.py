@@ -1410,12 +1410,17 @@ def test_the_short_answer_says_each_hypothesis_with_the_numbers_that_decide_it(n
 def test_the_reading_line_names_each_observable_a_reading_fails():
     """The opening's reading sentence says 'Not decided' where no reading is decided, names
     the readings that miss the cost and those whose stability depends on the mesh or the
-    damping, and says plainly when no reading reproduces every observable."""
+    damping, each with its numbers (the measured cost over msm's, the largest growth rate),
+    and says plainly when no reading reproduces every observable."""
     from cases.studies.artefact.report import reading_line
     said = reading_line({"decided": False, "cost_miss": ["a"], "cost_open": ["b"],
                          "unstable": [], "stability_depends": ["a"],
+                         "cost_span": {"a": "2.78 [2.14-3.14]"}, "growth_max": {"a": 8.02},
                          "none_reproduces": True})
     assert said.startswith("Not decided: a miss the paper's cost")
+    assert "median [range over the rounds]: a 2.78 [2.14-3.14])" in said
+    assert "stability depends on the mesh or the damping for a (largest growth rate 8.02 1/s)" \
+        in said
     assert "the cost is not decided for b" in said and "stability depends" in said
     assert "No reading reproduces every observable the paper reports." in said
 

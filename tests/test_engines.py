@@ -388,6 +388,6 @@ def test_the_index_names_where_its_numbers_come_from(tmp_path):
     assert f"in serial CPU time on {machine['cpu']} (one of its {machine['cores']} cores" \
         in at_cost
     cost = (tmp_path / "index.md").read_text().split("- Cost at a stated accuracy")[1]
-    assert "s per simulated s on the bench's machine (serial CPU time at its own stable RK4 " \
+    assert "CPU s per simulated s on the bench's machine (serial CPU time at its own stable RK4 " \
         f"step on the bench's {bench_mesh(COST_TETS).n_tets}-tetrahedron cube" \
         in cost.split("\n")[0]

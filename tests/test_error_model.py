@@ -946,13 +946,16 @@ def test_a_studys_failed_run_is_named_in_the_index():
         "report): none.")
 
 
-def test_a_model_shares_the_rank_of_the_first_group_it_is_not_ordered_from():
-    """Ranks are shared pair by pair with each group's first: a model not ordered from the
-    first group's first shares rank 1 even when a model between them began a group of its
-    own; models that all failed their median are ordered by how many runs failed."""
-    rows = E.standings({"a": [0.10, 0.10, 0.10], "b": [0.20, 0.20, 0.20],
-                        "c": [0.0, 0.22, 0.6]}, u=0.0)
-    assert [(r, s.model) for r, s, _ in rows] == [(1, "a"), (2, "b"), (1, "c")]
+def test_no_model_ranks_above_one_with_a_smaller_median():
+    """A model not resolved from the first of an earlier group shares that group's rank only
+    if every model with a smaller median between them does: c is not resolved from a, but b,
+    between them, is ranked apart from a, so c ranks with b and is still named as not
+    resolved from a; models that all failed their median are ordered by how many runs
+    failed."""
+    rows = E.standings({"a": [0.10, 0.10, 0.30], "b": [0.17] * 3, "c": [0.05, 0.18, 0.40]},
+                       u=0.0)
+    assert [(r, s.model) for r, s, _ in rows] == [(1, "a"), (2, "b"), (2, "c")]
+    assert rows[2][2].unresolved == ("a", "b")
     failed = E.standings({"x": [0.1, None, None], "y": [None, None, None]}, u=0.0)
     assert [s.model for _, s, _ in failed] == ["x", "y"]
 

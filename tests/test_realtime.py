@@ -117,7 +117,7 @@ def test_the_ranking_holds_the_yardstick_and_ties_by_the_pair_s_uncertainty():
         "(FEM P1's share the larger in each: the mesh the budget allows decides more than the "
         "law). "
         "Accuracy does not decide among them; the cost does: pick pbcm-variational, 0.9 "
-        "[0.9-0.9] s per simulated s at its reach: real time in every timing round at its "
+        "[0.9-0.9] wall s per simulated s at its reach: real time in every timing round at its "
         "reach, cheaper than fem-neohookean on every mesh both were timed on.")
     close = {**data, "error_estimate": 0.002}        # 2 e = 0.004 > 0.0024
     v = R.verdict(close)
@@ -267,7 +267,7 @@ def test_the_pick_is_among_the_tied_whose_top_force_is_within_five_percent_of_fe
     # the index's line says the force test left the pick, and the pick's cost
     assert ("Accuracy does not decide among them; the top force within 0.05 of FEM P1's "
             "(pbcm-variational 0.01) leaves pbcm-variational alone: pick pbcm-variational, 0.9 "
-            "[0.9-0.9] s per simulated s") in R.index_line(data, v, False)
+            "[0.9-0.9] wall s per simulated s") in R.index_line(data, v, False)
     data["runs"][1] = run("pbcm-variational", 0.9, 0.2)
     v = R.verdict(data)
     assert v["pick"] == "msm+volume" and not v["pick_stiff"]

@@ -255,11 +255,11 @@ def standings(by_model, u, lost=None):
     number (unpaired modes)}, ranked on before the error. Returns [(rank, Standing,
     Unordered)], best first: a model whose score is within ``u`` (tied) or within ``u`` and
     the two medians' ``Standing.spread`` over the meshes in quadrature (not resolved) of the
-    first of a group (and that lost as many parts) shares the rank of the first such group; the
-    :class:`Unordered` names every other model it is not ordered from, and which of them it
-    is tied with (pair by pair, never chained, so two neighbours across a rank boundary are
-    still named); failed runs count against their model, and models that all failed their
-    median share the last rank."""
+    first of the last group (and that lost as many parts) shares that group's rank, so no
+    model ranks above one with a smaller median; the :class:`Unordered` names every other
+    model it is not ordered from, and which of them it is tied with (pair by pair, never
+    chained, so two neighbours across a rank boundary are still named); failed runs count
+    against their model, and models that all failed their median share the last rank."""
     lost = lost or {}
     u = max(u, ROUND_OFF)       # round-off never orders two models
     # models that all failed their median are ordered by how many runs failed
@@ -277,13 +277,15 @@ def standings(by_model, u, lost=None):
         return same(a, b) and (tied(a, b) or abs(a.score - b.score) < math.sqrt(
             u ** 2 + a.spread ** 2 + b.spread ** 2))
 
-    out, heads = [], []
+    out, head = [], None
     for k, s in enumerate(st):
-        # the rank of the first group whose first it is not ordered from, pair by pair
-        rank = next((r for r, h in heads if unordered(s, h)), None)
-        if rank is None:
+        # the last group's rank where it is not ordered from that group's first: a model never
+        # shares an earlier group's rank past one with a smaller median ranked apart
+        if head is not None and unordered(s, head[1]):
+            rank = head[0]
+        else:
             rank = k + 1
-            heads.append((rank, s))
+            head = (rank, s)
         others = [o for o in st if o is not s]
         out.append((rank, s, Unordered(tuple(o.model for o in others if unordered(s, o)),
                                        {o.model for o in others if tied(s, o)})))

@@ -170,7 +170,7 @@ def table(root, models, pops=(), quick=False):
               "consistency limit (largest, +- fit)", "worst isotropy error",
               "alternation on the mirrored five split, 5-layer view, linear regime (signed, the "
               "larger over the bases; decides nothing)", "RK4 run",
-              "s per simulated s", "Truth Cube bead RMS [mm]"]
+              "CPU s per simulated s", "Truth Cube bead RMS [mm]"]
     rows = []
     for m in models:
         el = [e["moduli_rel_err"] for e in (conv or {}).get("elasticity", [])
@@ -747,7 +747,7 @@ def recommendation(root, models, pops, quick, bench_rows):
                 + (" (FEM P1 itself, the yardstick of this accuracy: no approximation "
                    "comes within it of FEM P1 on every case, so none replaces it there)"
                    if cheap == p1_lin else f" (at most {fmt(worst_of[cheap])})")
-                + f", {fmt(bench_rows[cheap]['cpu_s_per_simulated_s'])} s per simulated s on "
+                + f", {fmt(bench_rows[cheap]['cpu_s_per_simulated_s'])} CPU s per simulated s on "
                 f"the bench's machine (serial CPU time at its own stable RK4 step on the "
                 f"bench's {bench_rows[cheap]['tets']}-tetrahedron cube, the cost line's; its "
                 "median round; a time moves with the machine, the ratios to fem-linear are "

@@ -365,9 +365,16 @@ TERMS = {
     "value below what its uncertainty resolves (a convergence fit whose finest error is below "
     f"{JUDGES} times its reference's estimate; an artefact part within its u of 0). A reference "
     "too coarse to judge a case's differences is said as such, not with this word.",
-    "failed run": "a run that gave no number (no equilibrium, a metric undefined, a run that "
-    "could not start): it counts against its model, as infinitely wrong, in every ranking, "
-    "case table and answer; the population stays in every other model's comparison.",
+    "failed run": "the one meaning of 'failed' in every ranking, case table and answer: a run "
+    "that gave no number (no equilibrium, at the load no converged solve, a metric undefined, "
+    "a run that could not start; in the engines study, whose solvers are read at rest, a run "
+    "that does not come to rest) or, for the modes, a run that leaves a mode unpaired (one "
+    "failed run however many of its modes are unpaired; the unpaired modes are counted apart "
+    "and ranked on first): it counts against its model, as infinitely wrong, in its "
+    "population's median; the population stays in every other model's comparison. Two other "
+    "states are not failed runs and are said in their own words: a case's dynamic run that "
+    "does not come to rest (the RK4 run's column, the cases' settling), and an RK4 run that "
+    "grows beyond the damping (the artefact study's stability).",
     "consistency limit": "the error a model keeps under mesh refinement on a problem whose "
     "answer every consistent discretisation reproduces exactly: the converged limit of the "
     "sliding cube (a homogeneous compression, a patch test) in the linear regime, per "
@@ -399,13 +406,19 @@ TERMS = {
     "under the damping (a positive growth below it, flutter in the paper cube's tables, is "
     "damped out); the mass damping is ours, stated in the paper cube's report (the paper "
     "states none).",
-    "s per simulated s": "CPU seconds one simulated second costs at the model's own stable "
+    "CPU s per simulated s": "CPU seconds one simulated second costs at the model's own stable "
     "RK4 step (undamped), from `pbcm bench` at about 1e4 tetrahedra; beside it the ratio to "
     "fem-linear's: the median over the bench's rounds of the step-time ratio taken within "
     "each round, times the ratio of the stable steps, with its range over the rounds (not the "
     "ratio of the two median times, which the rounds' drift moves), then those two factors "
     "apart (a model cheap per simulated second by a larger stable step has not a cheaper "
-    "step); the seconds themselves are the bench's median, their spread not recorded.",
+    "step); the seconds themselves are the bench's median, their spread not recorded. Not "
+    "the wall s per simulated s.",
+    "wall s per simulated s": "wall-clock seconds one simulated second takes in the real-time "
+    "study, under the paper's push on the named mesh, in the model's faster mode (serial or "
+    "two threads), median [smallest-largest] over the bench's timing rounds: what real time "
+    "(at most 1) is judged on; not the summary table's CPU s per simulated s, which is one "
+    "core's at the bench's 1e4 cube.",
     "calibrated / literal": "a shear reading with c fitted so that its deviatoric moduli are "
     "closest to 2G (calibrated), or with the paper's c = 1 (literal).",
     "patch test": "a problem with a homogeneous exact answer that a consistent "

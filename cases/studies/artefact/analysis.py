@@ -2808,6 +2808,8 @@ def reading_verdict(table, damping, spread=None, figure=None, per_second=None):
             "plain": plain,
             "none_reproduces": none_all, "none_reproduces_timed": none_timed,
             "cost_miss": cost_miss, "cost_open": cost_open, "untimed": untimed,
+            "cost_span": {r["name"]: _span(r) for r in ranged},
+            "growth_max": {r["name"]: r["growth_max_1_s"] for r in rated},
             "stable": stable, "unstable": unstable,
             "stability_depends": [r["name"] for r in depends],
             "stability_why": {r["name"]: r["stable_why"] for r in rated},

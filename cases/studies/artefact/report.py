@@ -103,16 +103,24 @@ def reading_line(v):
     """The reading verdict in one sentence: decided or not, and the observables that fail."""
     head = (f"{v['model']}, {v['sure']}" if v.get("decided") else "Not decided")
     bits = []
+    span = v.get("cost_span", {})
     if v.get("cost_miss"):
+        measured = [f"{m} {span[m]}" for m in v["cost_miss"] if m in span]
         bits.append(f"{', '.join(v['cost_miss'])} miss the paper's cost (a step over 10 times "
-                    "msm's)")
+                    "msm's" + ("; measured, a step over msm's on the five split of the "
+                               "paper's lattice, median [range over the rounds]: "
+                               f"{', '.join(measured)}" if measured else "")
+                    + ")")
     if v.get("cost_open"):
         bits.append(f"the cost is not decided for {', '.join(v['cost_open'])}")
     if v.get("unstable"):
         bits.append(f"{', '.join(v['unstable'])} grow beyond the damping we assume")
     if v.get("stability_depends"):
-        bits.append(f"stability depends on the mesh or the damping for "
-                    f"{', '.join(v['stability_depends'])}")
+        rate = v.get("growth_max", {})
+        bits.append("stability depends on the mesh or the damping for "
+                    + ", ".join(m + (f" (largest growth rate {fmt(rate[m], 3)} 1/s)"
+                                     if rate.get(m) is not None else "")
+                                for m in v["stability_depends"]))
     none = (" No reading reproduces every observable the paper reports." if
             v.get("none_reproduces") else "")
     return (head + (": " + "; ".join(bits) if bits else "") + "." + none

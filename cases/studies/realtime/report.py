@@ -431,7 +431,7 @@ def answer_line(data, v, quick, words=None):
     return (f"At real time on this machine ({machine(data)}, wall clock, {w['loading']}; "
             f"the errors are each model's static equilibrium under {w['load']}, how "
             f"far a timed run lags it not measured), {head}. {stiff}Pick {p}: {why} "
-            f"({fmt(v['reach'][p]['range'][1])} s per simulated s in its slowest round)"
+            f"({fmt(v['reach'][p]['range'][1])} wall s per simulated s in its slowest round)"
             f"{beside}{newton}.{_smaller_words(v)}{_exact_words(v)}")
 
 
@@ -494,7 +494,7 @@ def index_line(data, v, quick, words=None):
             + ". Accuracy does not decide among them"
             + (f"; {test}" if test else "")
             + f"{decides}: pick {p}, {_wall(r['cost'])} [{_wall(r['range'][0])}-"
-            f"{_wall(r['range'][1])}] s per simulated s at its reach: {_why_pick(v)}.")
+            f"{_wall(r['range'][1])}] wall s per simulated s at its reach: {_why_pick(v)}.")
 
 
 def _smaller_words(v):
