@@ -679,7 +679,8 @@ def test_a_reading_stable_on_one_mesh_and_growing_on_another_is_not_stable():
     assert by["a"]["growth_by_mesh"] == {"five": 0.27, "six": 8.0, "bcc": 6.0}
     assert by["a"]["growth_apart"] == {"five-unmirrored": 73.5}
     assert by["a"]["stable_why"] == ("depends on the damping: flutters, damped out by the "
-                                     "damping we assume (50 1/s) on five (0.27 1/s), six "
+                                     "damping we assume (50 1/s, which removes rates up to 25 "
+                                     "1/s) on five (0.27 1/s), six "
                                      "(8 1/s), bcc (6 1/s); damped out on each of these meshes by "
                                      "mass damping above 16 1/s (twice its largest rate)")
     mixed = analysis.mesh_stability([("five", 0.0), ("six", 8.0)], 50.0)
@@ -778,7 +779,7 @@ def test_the_reading_is_decided_only_where_no_other_could_match_as_many():
     assert not v["decided"] and v["model"] is None and v["margin"] == 0
     plain = ("a, b miss the paper's cost (Figure 2's measure: the time of one step over "
              "msm's, which is how the paper's text reads its figure, at the paper's size, with "
-             "this implementation's kernels; per simulated second, each at its own stable "
+             "this implementation's kernels; CPU time per simulated second, each at its own stable "
              "step, what a user pays but not the paper's claim, x msm: not measured)")
     assert v["sure"] == "not decided" and v["text"].startswith(
         f"Plainly: {plain}. Not decided: ")
@@ -1408,16 +1409,20 @@ def test_the_short_answer_says_each_hypothesis_with_the_numbers_that_decide_it(n
 
 
 def test_the_reading_line_names_each_observable_a_reading_fails():
-    """The opening's reading sentence says 'Not decided' where no reading is decided, names
-    the readings that miss the cost and those whose stability depends on the mesh or the
-    damping, each with its numbers (the measured cost over msm's, the largest growth rate),
-    and says plainly when no reading reproduces every observable."""
+    """The opening's reading sentence says 'Not decided' and why where no reading is decided,
+    then plainly names the readings that miss the cost, those stable on every mesh and those
+    whose stability depends on the mesh or the damping, each with its numbers (the measured
+    cost over msm's, the largest growth rate), and says when no reading reproduces every
+    observable."""
     from cases.studies.artefact.report import reading_line
     said = reading_line({"decided": False, "cost_miss": ["a"], "cost_open": ["b"],
                          "unstable": [], "stability_depends": ["a"],
                          "cost_span": {"a": "2.78 [2.14-3.14]"}, "growth_max": {"a": 8.02},
+                         "stable": ["c"], "why": "no reading matches more",
                          "none_reproduces": True})
-    assert said.startswith("Not decided: a miss the paper's cost")
+    assert said.startswith("Not decided (no reading matches more). Plainly: a miss the "
+                           "paper's cost")
+    assert "c stable (rate 0) on every mesh" in said
     assert "median [range over the rounds]: a 2.78 [2.14-3.14])" in said
     assert "stability depends on the mesh or the damping for a (largest growth rate 8.02 1/s)" \
         in said

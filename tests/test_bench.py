@@ -37,6 +37,11 @@ def test_bench_writes_table_figure_and_in_round_ratios(tmp_path):
         # the rounds' range of a ratio brackets its median
         lo, hi = r["step_vs_fem-linear_range"]
         assert lo <= r["step_vs_fem-linear"] <= hi
+        lo, hi = r["us_per_step_range"]
+        assert lo <= r["us_per_step"] <= hi
+        if r.get("cpu_s_per_simulated_s") is not None:
+            lo, hi = r["cpu_s_per_simulated_s_range"]
+            assert lo <= r["cpu_s_per_simulated_s"] <= hi
         # the kernels it was timed on: this checkout's, so nothing is said stale
         assert r["kernels"] == costs.checkout_sources(model)
     assert costs.stale(data) == ([], False) and costs.stale_words(data) == ""
@@ -103,16 +108,32 @@ def test_merge_adds_a_composed_model_and_keeps_every_other_row(tmp_path):
 def test_cost_rows_come_from_the_nearest_bench_size():
     """A case's cost table comes from the bench size nearest its own on a log scale (1080 tetrahedra
     for 500) and gives the step ratios to msm and fem-linear, the own stable step and the CPU
-    seconds per simulated second, also over msm's; with no bench it says to run `pbcm bench`."""
-    data = {"rows": [{"model": m, "tets": t, "rounds": 5, "step_vs_msm": r,
-                      "step_vs_fem-linear": r / 2, "cpu_s_per_simulated_s": 2 * r,
-                      "stable_dt_us": 100.0}
-                     for t, r in ((135, 3.0), (1080, 7.0), (10985, 9.0)) for m in ("a", "msm")]}
+    seconds per simulated second, also over msm's as every cost ratio is taken: the in-round
+    step ratio (with its range over the rounds) times the stable steps' ratio, never the
+    ratio of two medians; with no bench it says to run `pbcm bench`."""
+    def row(m, t, r):
+        own = r if m == "a" else 1.0
+        return {"model": m, "tets": t, "rounds": 5, "step_vs_msm": own,
+                "step_vs_msm_range": [own * 0.9, own * 1.1], "step_vs_fem-linear": own / 2,
+                "cpu_s_per_simulated_s": 2 * own, "stable_dt_us": 100.0 if m == "a" else 200.0}
+    data = {"rows": [row(m, t, r) for t, r in ((135, 3.0), (1080, 7.0), (10985, 9.0))
+                     for m in ("a", "msm")]}
     (table,) = costs.cost_items(data, ["a"], 500)
     assert "1080 tetrahedra" in table.title
-    # step ratios as the bench took them; per simulated second: a's 14 s over msm's 14 s
-    assert table.rows == [["a", "7", "3.5", "100", "14", "1"]]
+    # per simulated second over msm's: a's step 7 [6.3-7.7] x msm's, its stable step half of
+    # msm's, so 14 [12.6-15.4] (the medians' ratio, 14 s over 2 s, would say 7)
+    assert table.rows == [["a", "7 [6.3-7.7]", "3.5", "100", "14", "14 [12.6-15.4]"]]
     assert "run `pbcm bench`" in costs.cost_items(None, ["a"], 500)[0]
+
+
+def test_cpu_seconds_carry_the_rounds_range_where_recorded():
+    """A CPU time per simulated second is said as its median round with the rounds'
+    [smallest-largest] where the bench recorded them, the median alone where it did not, and
+    'n/a' where there is none."""
+    row = {"cpu_s_per_simulated_s": 1.59, "cpu_s_per_simulated_s_range": [1.52, 1.71]}
+    assert costs.cpu_seconds(row) == "1.59 [1.52-1.71]"
+    assert costs.cpu_seconds({"cpu_s_per_simulated_s": 1.59}) == "1.59"
+    assert costs.cpu_seconds({}) == "n/a"
 
 
 def test_bench_mesh_is_the_closest_five_cube():

@@ -920,7 +920,8 @@ def test_the_scorecard_names_failures_against_the_continuum_too():
 
 def test_a_failed_check_outside_the_rankings_is_named_in_the_index():
     """A case's own check that failed (a '<check>_failed' run key no population counts) is
-    named in the index with its model, case, mesh and bc; the ranked phases' failures are
+    named in the index with its model, case, mesh and bc, and the runs of the held modal
+    check that leave a mode unpaired per case and model; the ranked phases' failures are
     left to the rankings; with none failed the line says none."""
     from cases.reporting.index import failed_checks
     runs = [{"model": "msm", "mesh": "bcc", "bc": "clamped", "homogeneous_failed": "no root",
@@ -929,6 +930,11 @@ def test_a_failed_check_outside_the_rankings_is_named_in_the_index():
     line = failed_checks({"large-compression": {"runs": runs}})
     assert line.endswith("report): msm on large-compression/bcc/clamped (homogeneous).")
     assert failed_checks({"c": {"runs": runs[1:]}}).endswith(": none.")
+    held = [{"model": "a", "mesh": m, "bc": "clamped", "modes_unpaired_held": n}
+            for m, n in (("five", 0), ("six", 2), ("bcc", 0))] \
+        + [{"model": "a", "mesh": "five", "bc": "sliding", "modes_unpaired_held": None}]
+    assert failed_checks({"paper-cube": {"runs": held}}).endswith(
+        "report): a on paper-cube, 1 of 3 runs (modes with the top held: a mode unpaired).")
 
 
 def test_a_studys_failed_run_is_named_in_the_index():

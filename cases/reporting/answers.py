@@ -10,7 +10,8 @@ from pathlib import Path
 
 import numpy as np
 
-from .costs import BASE, FILE as BENCH_FILE, FOLDER as BENCH_FOLDER, near, sim_ratio
+from .costs import BASE, FILE as BENCH_FILE, FOLDER as BENCH_FOLDER, cpu_seconds, near, \
+    sim_ratio
 from .costs import stale as costs_stale
 from .document import fmt, rel, rel_range
 from ..measuring.error_model import JUDGES, P1_LINEAR, ROUND_OFF, input_spread
@@ -196,11 +197,11 @@ def table(root, models, pops=(), quick=False):
                      + (f", {flutter} {'grows' if flutter == 1 else 'grow'} beyond the "
                         "damping" if flutter else "")
                      if clamped else "n/a",
-                     (f"{fmt(b['cpu_s_per_simulated_s'])} ({ratio_text(b, fl)} x fem-linear: "
+                     (f"{cpu_seconds(b)} ({ratio_text(b, fl)} x fem-linear: "
                       f"{ratio_parts(b, fl)})"
                       + (" (timed on earlier kernels)" if m in stale or BASE in stale else "")
                       if b and fl and b is not fl else
-                      fmt(b["cpu_s_per_simulated_s"]) if b else "n/a"),
+                      cpu_seconds(b) if b else "n/a"),
                      _bead(measured, m, truth_u)])
     return header, rows
 
@@ -672,7 +673,7 @@ def recommendation(root, models, pops, quick, bench_rows):
     def cost(m):
         r, fl = bench_rows.get(m), bench_rows.get(p1_lin)
         return (f", {ratio_text(r, fl)} times "
-                f"{p1_lin}'s cost per simulated second") if r and fl else ""
+                f"{p1_lin}'s CPU cost per simulated second") if r and fl else ""
     if lin and p1_lin:
         same = sorted({m for p in pops if not p.finite for m in p.identity if m in p.parts}
                       - {p1_lin})
@@ -747,16 +748,15 @@ def recommendation(root, models, pops, quick, bench_rows):
                 + (" (FEM P1 itself, the yardstick of this accuracy: no approximation "
                    "comes within it of FEM P1 on every case, so none replaces it there)"
                    if cheap == p1_lin else f" (at most {fmt(worst_of[cheap])})")
-                + f", {fmt(bench_rows[cheap]['cpu_s_per_simulated_s'])} CPU s per simulated s on "
+                + f", {cpu_seconds(bench_rows[cheap])} CPU s per simulated s on "
                 f"the bench's machine (serial CPU time at its own stable RK4 step on the "
                 f"bench's {bench_rows[cheap]['tets']}-tetrahedron cube, the cost line's; its "
-                "median round; a time moves with the machine, the ratios to fem-linear are "
-                "the comparison)")
+                "median round [the rounds' range where recorded]; a time moves with the "
+                "machine, the ratios to fem-linear are the comparison)")
         if cheapest and bench_rows[cheapest]["cpu_s_per_simulated_s"] < \
                 bench_rows[cheap]["cpu_s_per_simulated_s"]:
             line += (f"; {cheapest} is cheaper ("
-                     f"{fmt(bench_rows[cheapest]['cpu_s_per_simulated_s'])} s per simulated "
-                     "s, "
+                     f"{cpu_seconds(bench_rows[cheapest])} CPU s per simulated s, "
                      f"{ratio_text(bench_rows[cheapest], bench_rows[p1_lin])} x {p1_lin}'s) "
                      + (f"at model-form error up to {fmt(worst_of[cheapest])} on a case"
                         if math.isfinite(worst_of[cheapest]) else

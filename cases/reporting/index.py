@@ -178,6 +178,17 @@ def failed_checks(data, studies=None):
     bad = [f"{r['model']} on {case}/{r['mesh']}/{r['bc']} ({k[:-len('_failed')]})"
            for case, d in data.items() for r in d["runs"] for k in sorted(r)
            if k.endswith("_failed") and k not in RANKED_FAILURES and r[k]]
+    # a run with a mode unpaired where the top is held (the paper cube's second modal
+    # problem, against the continuum only): a failed run of that check, per case and model
+    held = {}
+    for case, d in data.items():
+        for r in d["runs"]:
+            if r.get("modes_unpaired_held") is not None:
+                got = held.setdefault((case, r["model"]), [0, 0])
+                got[0] += bool(r["modes_unpaired_held"])
+                got[1] += 1
+    bad += [f"{model} on {case}, {n} of {t} runs (modes with the top held: a mode unpaired)"
+            for (case, model), (n, t) in held.items() if n]
     out = ("Failed checks outside the rankings (each a case's own check, named in its "
            "report): " + (", ".join(bad) if bad else "none") + ".")
     if studies:
@@ -261,9 +272,9 @@ def index_documents(root, cases, studies=(), missing=()):
           "over the meshes in quadrature, or the estimate alone where each mesh poses its "
           "own continuum problem). Each cell is the median over the meshes "
           "[smallest-largest], n of N runs; a failed run counts against its model; models "
-          "within u_val of the first of a group (tied), or beyond it but within both medians' "
-          "spread over the meshes (not resolved), share its rank, and a cell names every "
-          "model within either of it. Colours in "
+          "within u_val of the first of the last group (tied), or beyond it but within both "
+          "medians' spread over the meshes (not resolved), share its rank, and a cell names "
+          "every model within either of any model, whatever its rank. Colours in "
           "the HTML: "
           + ", ".join(f"{label}" for _, _, label in BANDS) + ", red also for a failed run. "
           "Quick-mode cases are marked. The last rows are measured against reality (the "
@@ -338,9 +349,10 @@ TERMS = {
     "each case weighs one), each population ranking its models first by the parts they "
     "lost (unpaired "
     "modes), then by the median over the meshes with a failed run counted as infinitely "
-    "wrong (so a failure never removes a population from anyone's comparison); models within "
-    "u_val of the first of a group (tied), or within both medians' spread over the meshes "
-    "beside it (not resolved), share its rank; a failed run counts once, in its "
+    "wrong (so a failure never removes a population from anyone's comparison); a model within "
+    "u_val of the first of the last group (tied), or within both medians' spread over the "
+    "meshes beside it (not resolved), shares its rank (so no model ranks above one with a "
+    "smaller median); a failed run counts once, in its "
     "population's rank. A population whose numbers are left out of the ranking (locking-prone, "
     "or nearly linear at finite load; never a patch test) still enters it where a model fails "
     "its median there or loses a mode (a failure-only ranking): the models that did not fail "
@@ -349,8 +361,9 @@ TERMS = {
     "half its runs) rank nothing and are counted against it only (marked 'counted only', or "
     "'counted, below its median: no rank'; those that rank, 'ranked'). Beside it the geometric mean over the cases of the population "
     "medians, each floored at its population's u_val, with its range over the rankings that "
-    "leave one mesh family out; 'failed' where a population failed at the median (no finite "
-    "mean exists), with the mean over the others beside it.",
+    "leave one mesh family out; 'failed' where a population whose numbers rank failed at the "
+    "median (no finite mean exists), with the mean over the others beside it (a population "
+    "ranked for its failures alone adds no score to it).",
     "tied": "two errors whose difference is below the uncertainty of that difference, u_val "
     "(V&V 20); a difference beyond u_val but within both medians' spread over the meshes "
     "(half the range of the medians with one mesh left out, in quadrature with u_val) is "
@@ -364,7 +377,13 @@ TERMS = {
     "population errors' ratio) keep that order whatever is left out; or a "
     "value below what its uncertainty resolves (a convergence fit whose finest error is below "
     f"{JUDGES} times its reference's estimate; an artefact part within its u of 0). A reference "
-    "too coarse to judge a case's differences is said as such, not with this word.",
+    "too coarse to judge a case's differences is said as such, not with this word. The index "
+    "judges its pooled order over the cases together, so a pair it resolves there may be "
+    "not resolved in one case's population, as that case's report says. A rank column groups "
+    "the sorted medians (a model shares the rank of the last group's first where it is not "
+    "ordered from it, so no model ranks above one with a smaller median), while its notes "
+    "name, pair by pair, every model it is not ordered from, which may sit in another rank: "
+    "the rank is the order of the medians, the notes what the data leaves unordered.",
     "failed run": "the one meaning of 'failed' in every ranking, case table and answer: a run "
     "that gave no number (no equilibrium, at the load no converged solve, a metric undefined, "
     "a run that could not start; in the engines study, whose solvers are read at rest, a run "
@@ -372,9 +391,12 @@ TERMS = {
     "failed run however many of its modes are unpaired; the unpaired modes are counted apart "
     "and ranked on first): it counts against its model, as infinitely wrong, in its "
     "population's median; the population stays in every other model's comparison. Two other "
-    "states are not failed runs and are said in their own words: a case's dynamic run that "
-    "does not come to rest (the RK4 run's column, the cases' settling), and an RK4 run that "
-    "grows beyond the damping (the artefact study's stability).",
+    "states are said in their own words: a linearised growth rate above half the damping (the "
+    "artefact study's stability call, made without a run) grows beyond the damping, which no "
+    "run failed; a case's RK4 run that blows up gave no number, so it is a failed run of the "
+    "dynamics (the RK4 run column says 'grows beyond the damping' where its growth rate "
+    "explains it), counted outside the rankings. A model that 'fails' a patch test has a "
+    "consistency error: a check's verdict on runs that gave numbers, not failed runs.",
     "consistency limit": "the error a model keeps under mesh refinement on a problem whose "
     "answer every consistent discretisation reproduces exactly: the converged limit of the "
     "sliding cube (a homogeneous compression, a patch test) in the linear regime, per "
@@ -403,16 +425,18 @@ TERMS = {
     "and 17 layers).",
     "RK4 run": "grows beyond the damping when the linearised growth rate of the clamped "
     "paper cube exceeds half the mass damping (so that the damped RK4 run grows), else stable "
-    "under the damping (a positive growth below it, flutter in the paper cube's tables, is "
-    "damped out); the mass damping is ours, stated in the paper cube's report (the paper "
+    "under the damping (a positive growth below it, a flutter, is damped out; the paper cube's "
+    "metrics.json records a growth above it as its dyn_verdict 'unstable (flutter)'); the mass damping is ours, stated in the paper cube's report (the paper "
     "states none).",
     "CPU s per simulated s": "CPU seconds one simulated second costs at the model's own stable "
-    "RK4 step (undamped), from `pbcm bench` at about 1e4 tetrahedra; beside it the ratio to "
+    "RK4 step (undamped), from `pbcm bench`: in the index at about 1e4 tetrahedra, in a case's "
+    "cost table at the bench size nearest the case's meshes; beside it the ratio to "
     "fem-linear's: the median over the bench's rounds of the step-time ratio taken within "
     "each round, times the ratio of the stable steps, with its range over the rounds (not the "
     "ratio of the two median times, which the rounds' drift moves), then those two factors "
     "apart (a model cheap per simulated second by a larger stable step has not a cheaper "
-    "step); the seconds themselves are the bench's median, their spread not recorded. Not "
+    "step); the seconds themselves are the bench's median round, with the rounds' range where "
+    "the bench recorded it. Not "
     "the wall s per simulated s.",
     "wall s per simulated s": "wall-clock seconds one simulated second takes in the real-time "
     "study, under the paper's push on the named mesh, in the model's faster mode (serial or "

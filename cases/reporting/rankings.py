@@ -144,8 +144,9 @@ def ranking(runs, metric, label, estimate_key="p2_error_estimate", lost_key=None
     models by median ``metric`` over every run they had (a run without a value, or one that
     lost a part, counts against its model, as infinitely wrong), best first, with the range
     and 'n of N runs'; a model within the reference's u_num (``uncertainty``) and the two
-    medians' spread of the first of a group shares its order, and every model names those
-    within it (the comparison cannot order them); ``per_mesh``: the boundary conditions where
+    medians' spread of the first of the last group shares its order, and every model names
+    those within it, whatever their order (the comparison cannot order them); ``per_mesh``:
+    the boundary conditions where
     each mesh poses its own continuum problem."""
     rows = []
     for bc, rs in populations(runs).items():

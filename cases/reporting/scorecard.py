@@ -640,8 +640,14 @@ def case_findings(name, quantities, runs, patch_tests=(), estimate_key="p2_error
                             + (", its estimate widened to the reference's spread over the "
                                "meshes, which exceeds it" if p.spread_defect else "")
                             + (", the reference's estimate alone: each mesh poses its own "
-                               "continuum problem" if p.per_mesh else "") + "):",
-                            ["bc", "rank", "model", "model-form", "total"]
+                               "continuum problem" if p.per_mesh else "") + "; the rank "
+                            "orders the medians, a model sharing its group's rank where "
+                            "not ordered from its first, its cell naming every model it is "
+                            "not ordered from, whatever that one's rank):",
+                            ["bc", "rank" if p.ranked else
+                             "order (the overall ranking counts its failures alone)"
+                             if counts_failures(p) else "order (not in the overall ranking)",
+                             "model", "model-form", "total"]
                             + (["unpaired P1 modes (failed, ranked first)"] if p.lost else []),
                             rows))
     return lines, tables

@@ -24,7 +24,7 @@ from ..library.common import bench_mesh
 from ..reporting import figures
 from ..running import stop
 from .engines import ENGINES
-from ..reporting.costs import FILE, REAL_TIME, best, kernel_sources, stale_words
+from ..reporting.costs import FILE, REAL_TIME, best, cpu_seconds, kernel_sources, stale_words
 from . import flops, realtime_bench, roofline
 from .timers import DAMPING, SAMPLE_S, ImplicitTimed, Timed, own_stable_step
 from ..reporting.document import Document, fmt
@@ -179,6 +179,8 @@ def run(sizes=SIZES, models=None, rounds=7, progress=print, with_engines=True, d
                    "ns_per_tet_range": [float(own[:, 0].min() / mesh.n_tets * 1e9),
                                         float(own[:, 0].max() / mesh.n_tets * 1e9)],
                    "us_per_step": float(np.median(own[:, 1]) * 1e6),
+                   "us_per_step_range": [float(own[:, 1].min() * 1e6),
+                                         float(own[:, 1].max() * 1e6)],
                    "step_over_4_forces": float(np.median(own[:, 1] / (4 * own[:, 0]))),
                    "step_over_4_forces_range": [float(np.min(own[:, 1] / (4 * own[:, 0]))),
                                                 float(np.max(own[:, 1] / (4 * own[:, 0])))],
@@ -198,7 +200,9 @@ def run(sizes=SIZES, models=None, rounds=7, progress=print, with_engines=True, d
             if mesh.n_tets <= STABLE_STEP_TETS:
                 dt = own_stable_step(timed[name].pm)
                 row.update(stable_dt_us=dt * 1e6,
-                           cpu_s_per_simulated_s=row["us_per_step"] * 1e-6 / dt)
+                           cpu_s_per_simulated_s=row["us_per_step"] * 1e-6 / dt,
+                           cpu_s_per_simulated_s_range=[u * 1e-6 / dt
+                                                        for u in row["us_per_step_range"]])
             for base in BASELINES:
                 ref = np.array(samples[base])
                 row[f"force_vs_{base}"] = float(np.median(own[:, 0] / ref[:, 0]))
@@ -538,7 +542,7 @@ def per_simulated_second(data):
         if r.get("cpu_s_per_simulated_s") is not None:
             c = r["cpu_s_per_simulated_s"]
             out.append([r["model"], r["tets"], fmt(r["stable_dt_us"]), fmt(r["us_per_step"]),
-                        fmt(c), "yes" if c <= REAL_TIME else "no", "-", "-"])
+                        cpu_seconds(r), "yes" if c <= REAL_TIME else "no", "-", "-"])
     for r in data.get("implicit_rows", []):
         c = r["cpu_s_per_simulated_s"]
         out.append([r["model"], r["tets"], fmt(r["dt_us"]), fmt(r["us_per_step"]), fmt(c),

@@ -2518,8 +2518,12 @@ def mesh_stability(rates, damping):
         return None, "no growth rate"
     kinds = [(mesh, rate, _stable_class(rate, damping)) for mesh, rate in rates]
     order = list(dict.fromkeys(k for _, _, k in kinds))
-    by = "; ".join(f"{STABLE_WORDS[k]}" + (f" ({damping:g} 1/s)" if k in ("damping", False)
-                                            else "") + " on " + ", ".join(
+    # the rate a damping removes is half of it: said, so that a rate below the damping's own
+    # value that grows beyond it reads as it is
+    by = "; ".join(f"{STABLE_WORDS[k]}" + (f" ({damping:g} 1/s, which removes rates up to "
+                                            f"{damping / 2:g} 1/s)"
+                                            if k in ("damping", False) else "")
+                   + " on " + ", ".join(
         f"{m} ({fmt(r, 3)} 1/s)" for m, r, kk in kinds if kk == k) for k in order)
     top = max(r for _, r, _ in kinds)
     if top > GROWS:       # the damping each model needs: the paper states none
@@ -2774,8 +2778,8 @@ def reading_verdict(table, damping, spread=None, figure=None, per_second=None):
         f"step over msm's, which is how the paper's text reads its figure, at the paper's "
         f"size, with this implementation's kernels"
         + ("; a literal reading is timed as its calibrated one, the same kernel"
-           if literal else "") + "; per simulated second, each at its own stable step, what "
-        "a user pays but not the paper's claim, x msm: "
+           if literal else "") + "; CPU time per simulated second, each at its own stable "
+        "step, what a user pays but not the paper's claim, x msm: "
         + (per_second_words(per_second, cost_miss) or "not measured") + ")"
         if cost_miss else "",
         f"the cost is not decided for {_names(cost_open)}" if cost_open else "") if x)

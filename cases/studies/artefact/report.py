@@ -100,8 +100,10 @@ def _moved(moves):
 
 
 def reading_line(v):
-    """The reading verdict in one sentence: decided or not, and the observables that fail."""
-    head = (f"{v['model']}, {v['sure']}" if v.get("decided") else "Not decided")
+    """The reading verdict in two sentences: decided or not and why, then plainly what each
+    reading's observables measured."""
+    head = (f"{v['model']}, {v['sure']}" if v.get("decided") else "Not decided") + (
+        f" ({v['why']})" if v.get("why") else "")
     bits = []
     span = v.get("cost_span", {})
     if v.get("cost_miss"):
@@ -115,6 +117,8 @@ def reading_line(v):
         bits.append(f"the cost is not decided for {', '.join(v['cost_open'])}")
     if v.get("unstable"):
         bits.append(f"{', '.join(v['unstable'])} grow beyond the damping we assume")
+    if v.get("stable"):
+        bits.append(f"{', '.join(v['stable'])} stable (rate 0) on every mesh")
     if v.get("stability_depends"):
         rate = v.get("growth_max", {})
         bits.append("stability depends on the mesh or the damping for "
@@ -123,7 +127,7 @@ def reading_line(v):
                                 for m in v["stability_depends"]))
     none = (" No reading reproduces every observable the paper reports." if
             v.get("none_reproduces") else "")
-    return (head + (": " + "; ".join(bits) if bits else "") + "." + none
+    return (head + "." + (" Plainly: " + "; ".join(bits) + "." if bits else "") + none
             + " The full verdict is in 'Which reading the paper used'.")
 
 

@@ -157,8 +157,9 @@ def answer(f, ladder, quick, installed, shear=None, costs=None, where="", baseli
     """The index's line: per case, which engine replaces FEM P1 there (within MATCH on both
     regimes and every mesh) and from which setting; the pick with its cost on the bench's
     machine (``where``) beside linear FEM P1's there (``baseline``, its bench row), the sizes
-    of the quick meshes it was judged on (``tets``, ``mesh_sizes``), and, where its count is
-    below the one its answer converges from, said provisional in the pick itself."""
+    of the quick meshes it was judged on (``tets``, ``mesh_sizes``), said provisional in the
+    pick itself: judged on the quick meshes alone, and, where its count is below the one its
+    answer converges from, not converged in iterations."""
     if not installed:
         return "not measured: the engines extra is not installed"
     if quick:
@@ -193,11 +194,13 @@ def answer(f, ladder, quick, installed, shear=None, costs=None, where="", baseli
                + f" (u_val {fmt(got['u_num'], 2)})")
               for c in cases if (got := f[solver]["cases"].get(f"{c}/{REGIMES[0]}"))]
         sizes = sizes_text(tets or {}, [c for c in cases if c in CASE_NAMES])
-        # a pick whose answer still moves with the count is provisional: said in the pick
-        said = (f"pick {model}"
-                + (f", provisional (not converged in iterations at {n}: not within "
+        # a pick judged on the cases' quick meshes alone, or whose answer still moves with
+        # the count, is provisional: said in the pick
+        said = (f"pick {model}, provisional (judged on the cases' quick meshes and quick "
+                "references only: no run on their full meshes decides it"
+                + (f"; not converged in iterations at {n}: not within "
                    f"{CONVERGED:.0%} of its answer at the ladder's top on " + "; ".join(early)
-                   + ")" if early else "")
+                   if early else "") + ")"
                 + f" (the setting within {MATCH:g} of FEM P1 on the most cases, then "
                 "the cheapest per simulated second): within it on "
                 + ", ".join(CASE_NAMES[c] for c in cases)
