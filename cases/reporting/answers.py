@@ -858,8 +858,8 @@ def _discretisation(pops, finite):
     if len(meds) == 1:
         return (f", whose discretisation error there is {rel(lo)} {lo_range} (median over "
                 f"the meshes, {a})")
-    return (f", whose discretisation error, the median over the meshes of each case, runs "
-            f"from {rel(lo)} {lo_range} ({a}) to {rel(hi)} {hi_range} ({b}): what every "
+    return (f", whose discretisation error, the median over the meshes of each ranked case, "
+            f"runs from {rel(lo)} {lo_range} ({a}) to {rel(hi)} {hi_range} ({b}): what every "
             "model on those meshes pays as well")
 
 def u_vals(truth, strain, floor):

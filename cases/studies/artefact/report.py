@@ -121,7 +121,8 @@ def reading_line(v):
         bits.append(f"{', '.join(v['stable'])} stable (rate 0) on every mesh")
     if v.get("stability_depends"):
         rate = v.get("growth_max", {})
-        bits.append("stability depends on the mesh or the damping for "
+        bits.append("stability (the clamped base, on the conforming splits of the paper's "
+                    "lattice) depends on the mesh or the damping for "
                     + ", ".join(m + (f" (largest growth rate {fmt(rate[m], 3)} 1/s)"
                                      if rate.get(m) is not None else "")
                                 for m in v["stability_depends"]))
@@ -818,7 +819,7 @@ def profiles_figure(path, panels, title, decides=None, clear=None):
                             color=cmap(i % 10))
         n_free = len(rows[0]["bulge_profile_mm"]) - (2 if bc == "clamped" else 0) if rows else 0
         ax.set_title(f"{bc} base" + ("" if decides.get(bc) else
-                                     "\n(the configuration's check fails: decides nothing)")
+                                     "\n(the configuration's check not passed: decides nothing)")
                      + ("\n(3 free layers: no period-2 component, n/a)" if n_free == 3
                         else ""), fontsize=9)
         ax.set_xlabel("mean outward lateral displacement [mm]", fontsize=8)

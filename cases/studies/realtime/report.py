@@ -683,7 +683,7 @@ def build(out, study, s, doc):
             "are not resolved. "
             "The reach's range: from the largest size real time in every round to the "
             "largest real time in some round; the bound over it is the smallest to the "
-            "largest bound at the sizes of that range (failed where none is real time in "
+            "largest bound at the sizes of that range (none where no size is real time in "
             "every round), and two models are tied where the sizes their reaches take over "
             "the rounds give bounds within the uncertainty of those two meshes, or disagree "
             "on which is ahead: that depends on the timing round. "
