@@ -1086,11 +1086,11 @@ def test_a_growing_stiffness_error_bounds_the_limit_and_fems_nonlinearity_is_no_
     assert lim["five"] == pytest.approx((2e-10, 2e-10, "displacement"))
     assert lim["bcc"][2] == "stiffness; displacement not decided"
     assert "displacement not decided on bcc (its stiffness 0.04 +- 0.01 there)" in _no_limit(lim)
-    # said as a bound, its finest value without an extrapolation's +-, over how many lattices
+    # said as a bound, its finest value +- 1.25 x its last change, over how many lattices
     from cases.reporting.answers import _limit_text, _worst_limit
     assert _limit_text(_worst_limit(lim), 3) == (
-        "at least 0.7 (stiffness growing under refinement on six: no limit, its finest value; "
-        "3 lattices)")
+        "at least 0.7 +- 0.02 (stiffness growing under refinement on six: no limit, its finest "
+        "value +- 1.25 x its last change; 3 lattices)")
 
 
 def test_a_studys_failed_runs_are_named_once_per_model_and_cause():

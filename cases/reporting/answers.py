@@ -474,11 +474,12 @@ def _limit_text(w, n=None):
     """'0.45 +- 3e-05 (stiffness, six; 3 lattices)': the largest limit with what
     it measures and where, and of how many lattices' limits (``n``) it is the largest; a
     stiffness error growing under refinement is no limit but a bound from below: 'at least
-    0.7 (stiffness growing under refinement on six: no limit, its finest value)'."""
+    0.7 +- 0.02 (stiffness growing under refinement on six: no limit, its finest value +-
+    1.25 x its last change)'."""
     of = f"; {n} lattices" if n and n > 1 else ""
-    if w[2] == GROWING:     # a finest value, not an extrapolation: no +- to give
-        return (f"at least {rel(w[0], 2)} (stiffness growing under refinement on {w[3]}: no "
-                f"limit, its finest value{of})")
+    if w[2] == GROWING:     # a finest value, +- 1.25 times its last change (the glossary's)
+        return (f"at least {_pm(w)} (stiffness growing under refinement on {w[3]}: no "
+                f"limit, its finest value +- 1.25 x its last change{of})")
     return f"{_pm(w)} ({w[2]}, {w[3]}{of})"
 
 
