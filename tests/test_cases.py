@@ -489,6 +489,22 @@ def test_a_line_says_failed_at_the_median_with_the_runs_that_gave_a_number():
     assert "b (3 of 4)" in line
 
 
+def test_the_modal_table_counts_the_clamped_runs_it_reports():
+    """The paper cube's modal column is the clamped base's: its failed runs (a mode unpaired)
+    are counted over the clamped runs alone, never with the sliding base's, whose modal
+    problem is not scored."""
+    from types import SimpleNamespace
+    from cases.library.narratives.paper_cube import _dynamics
+    runs = [{"model": "a", "mesh": m, "bc": bc, "dyn_verdict": "at rest", "dyn_failed": None,
+             "dyn_failed_dt4": None, "rigid_modes_free": 6, "growth_rate_1_s": 0.0,
+             "reaction_time_rel_l2": 0.1, "modal_rel_err": 0.2,
+             "modes_unpaired_held": lost if bc == "clamped" else None}
+            for m, lost in (("five", 0), ("six", 2)) for bc in ("clamped", "sliding")]
+    cfg = SimpleNamespace(damping=50.0, models=["a"], transient_element="P2")
+    (table,) = [t for t in _dynamics(runs, cfg) if not isinstance(t, str)]
+    assert table.rows == [["a", "0.1 to 0.1", "0.2; 1 of 2 runs failed (unpaired modes)"]]
+
+
 def test_the_sliding_bases_blow_ups_are_said_apart_from_the_scored_clamped_ones():
     """The paper cube's blow-ups are counted on the clamped base, the one scored; the sliding
     base's (an ill-posed modal problem) are reported apart and never pooled with them."""

@@ -16,6 +16,13 @@ def rel_range(lo, hi):
     return rel(hi) if rel(hi).startswith("<") else f"{rel(lo)}-{rel(hi)}"
 
 
+def fmt_span(v, span, digits=3):
+    """'v [lo-hi]' with ``digits`` significant figures, or 'v' alone where ``span`` is None
+    (a range not recorded)."""
+    return fmt(v, digits) + (f" [{fmt(span[0], digits)}-{fmt(span[1], digits)}]" if span
+                             else "")
+
+
 def fmt(v, digits=3):
     """A number for a report cell: 'n/a' for None, yes/no for a bool, ``digits`` significant
     figures for a float."""

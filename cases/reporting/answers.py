@@ -13,7 +13,7 @@ import numpy as np
 from .costs import BASE, FILE as BENCH_FILE, FOLDER as BENCH_FOLDER, cpu_seconds, near, \
     sim_ratio
 from .costs import stale as costs_stale
-from .document import fmt, rel, rel_range
+from .document import fmt, fmt_span, rel, rel_range
 from ..measuring.error_model import JUDGES, P1_LINEAR, ROUND_OFF, input_spread
 from ..measuring.metrics import PATCH_TOL
 
@@ -132,7 +132,7 @@ def _bench_row(bench, model):
 def ratio_text(row, base):
     """'r [lo-hi]' of ``sim_ratio``."""
     r, rng = sim_ratio(row, base)
-    return fmt(r, 2) + (f" [{fmt(rng[0], 2)}-{fmt(rng[1], 2)}]" if rng else "")
+    return fmt_span(r, rng, 2)
 
 
 def ratio_parts(row, base):

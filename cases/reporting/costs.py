@@ -19,7 +19,7 @@ import model as _model
 from model.mesh import cube
 from model.presets import IMPLICIT_STEP
 
-from .document import Table, fmt
+from .document import Table, fmt, fmt_span
 
 FILE = "bench.json"
 FOLDER = "bench"                 # beside the case folders: reports/bench/bench.json
@@ -151,7 +151,7 @@ def cpu_seconds(row):
     own, span = row.get("cpu_s_per_simulated_s"), row.get("cpu_s_per_simulated_s_range")
     if own is None:
         return "n/a"
-    return fmt(own) + (f" [{fmt(span[0])}-{fmt(span[1])}]" if span else "")
+    return fmt_span(own, span)
 
 
 def cost_items(data, models, tets):
@@ -172,14 +172,12 @@ def cost_items(data, models, tets):
         if not (r.get("cpu_s_per_simulated_s") and msm):
             return cpu_seconds(r), "n/a"
         ratio, span = sim_ratio(r, msm)     # in-round, as every cost over another model's
-        return cpu_seconds(r), fmt(ratio) + (f" [{fmt(span[0])}-{fmt(span[1])}]" if span
-                                             else "")
+        return cpu_seconds(r), fmt_span(ratio, span)
 
     def step(r, base):
         key = f"step_vs_{base}"
         span = r.get(f"{key}_range")
-        return fmt(r[key]) + (f" [{fmt(span[0])}-{fmt(span[1])}]" if span and r[key] != 1.0
-                              else "")
+        return fmt_span(r[key], span if r[key] != 1.0 else None)
     return [Table(
         f"From `pbcm bench` at {sizes[0]} tetrahedra (median of {near[0]['rounds']} "
         "interleaved rounds [smallest-largest over them]; a ratio is taken within each round; "

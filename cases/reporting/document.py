@@ -4,7 +4,7 @@ import html
 import re
 from pathlib import Path
 
-from ..measuring.numbers import fmt, rel, rel_range  # noqa: F401 (a report's numbers)
+from ..measuring.numbers import fmt, fmt_span, rel, rel_range  # noqa: F401 (a report's numbers)
 
 
 MAX_COLUMNS = 10            # a table wider than this is split (a report reads in a minute)

@@ -432,7 +432,8 @@ TERMS = {
     "RK4 run": "grows beyond the damping when the linearised growth rate of the clamped "
     "paper cube exceeds half the mass damping (so that the damped RK4 run grows), else stable "
     "under the damping (a positive growth below it, a flutter, is damped out; the paper cube's "
-    "metrics.json records a growth above it as its dyn_verdict 'unstable (flutter)'); the mass damping is ours, stated in the paper cube's report (the paper "
+    "metrics.json records a growth above it as its dyn_verdict 'unstable (flutter)'); the "
+    "mass damping is ours, stated in the paper cube's report (the paper "
     "states none).",
     "CPU s per simulated s": "CPU seconds one simulated second costs at the model's own stable "
     "RK4 step (undamped), from `pbcm bench`: in the index at about 1e4 tetrahedra, in a case's "
